@@ -1,0 +1,25 @@
+"""footzoo: foot-mounted IMU motion estimation, a zoo of published building blocks.
+
+Conventions: NED navigation frame, FRD body frame, scalar-first body -> NED
+quaternions, SI units (see :mod:`footzoo.conventions`).
+"""
+
+__version__ = "0.1.0"
+
+from .data import Recording, Result, Truth  # noqa: E402
+from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
+from .io import load  # noqa: E402
+from .pipeline import Pipeline  # noqa: E402
+
+__all__ = [
+    "ConfigError",
+    "FootzooError",
+    "FormatError",
+    "Pipeline",
+    "Recording",
+    "RecordingError",
+    "Result",
+    "Truth",
+    "load",
+    "__version__",
+]

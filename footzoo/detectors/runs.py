@@ -1,0 +1,52 @@
+"""Run-length logic shared by detectors that switch state after a minimum run."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def dated_and_online_states(
+    candidate: np.ndarray, min_samples: int, initial: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
+    """Two-state machine that switches after ``min_samples`` consecutive samples.
+
+    The state follows ``candidate`` (True = stance) only when ``candidate`` has
+    stayed on the other side for ``min_samples`` consecutive samples; shorter
+    runs are ignored (momentary dips and spikes).
+
+    Parameters
+    ----------
+    candidate : (N,) bool ndarray
+        Per-sample vote (True = looks like stance).
+    min_samples : int
+        Γ_th: consecutive samples needed to switch.
+    initial : bool
+        State before the first long run (True = stance).
+
+    Returns
+    -------
+    dated : (N,) bool ndarray
+        State with each switch dated back to where its run began (what Yun's
+        FIFOs achieve); available ``min_samples - 1`` samples late.
+    online : (N,) bool ndarray
+        State as a live machine knows it at each sample (switch when the run
+        reaches ``min_samples``).
+    """
+    c = np.asarray(candidate, dtype=bool)
+    n = c.shape[0]
+    g = max(int(min_samples), 1)
+    change = np.flatnonzero(c[1:] != c[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    lengths = np.diff(np.concatenate([starts, [n]]))
+    long_starts = starts[lengths >= g]
+    idx = np.arange(n)
+
+    def fill(switch_at: np.ndarray, value_at: np.ndarray) -> np.ndarray:
+        src = np.full(n, -1)
+        src[switch_at] = idx[value_at]
+        src = np.maximum.accumulate(src)
+        return np.where(src >= 0, c[np.maximum(src, 0)], initial)
+
+    dated = fill(long_starts, long_starts)
+    online = fill(long_starts + g - 1, long_starts)
+    return dated, online

@@ -1,0 +1,107 @@
+"""Readers: every supported format converted once to a :class:`~footzoo.data.Recording` (FRD, SI).
+
+``load(path, format=None, **options)`` picks the reader from ``format`` or, when
+``format`` is None, from the file's extension and header.
+
+Formats and their axis maps (sensor axes -> FRD):
+
+============== ============================== ============================================
+format         units in the file              axis map
+============== ============================== ============================================
+canonical      SI (t s, acc m/s², gyr rad/s)  already FRD
+xio            g, deg/s                       NGIMU z up: (x, −y, −z), 180° about x
+pyshoe         m/s², rad/s                    already x fwd, y right, z down; VICON ``gt``
+                                              is mirrored: truth = gt · [1, 1, −1]
+gaitmap        m/s², deg/s                    foot frame x toe, y left, z up: (x, −y, −z);
+                                              the right foot is mirrored (see gaitmap.py)
+sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down: identity
+============== ============================== ============================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..data import Recording
+from ..errors import FormatError
+from ..registry import did_you_mean
+from . import canonical, gaitmap, pyshoe, sensorconnect, xio
+
+READERS: dict[str, Callable[..., Recording]] = {
+    "canonical": canonical.read,
+    "xio": xio.read,
+    "pyshoe": pyshoe.read,
+    "gaitmap": gaitmap.read,
+    "sensorconnect": sensorconnect.read,
+}
+
+
+def detect_format(path: str | Path) -> str:
+    """Guess a file's format from its extension and first line."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".mat":
+        return "pyshoe"
+    if suffix in (".parquet", ".pq"):
+        return "canonical"
+    if suffix in (".csv", ".txt"):
+        with open(p, encoding="utf-8", errors="replace") as fh:
+            head = fh.readline()
+        if not head.strip():
+            raise FormatError(f"{p}: the file is empty (no header line)")
+        if xio.matches(head):
+            return "xio"
+        if gaitmap.matches(head):
+            return "gaitmap"
+        if sensorconnect.matches(head):
+            return "sensorconnect"
+        if canonical.matches(head):
+            return "canonical"
+        raise FormatError(
+            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}; "
+            f"pass format= one of {sorted(READERS)}"
+        )
+    raise FormatError(f"{p}: unknown extension {suffix!r}; pass format= one of {sorted(READERS)}")
+
+
+def load(path: str | Path, format: str | None = None, **options: Any) -> Recording:
+    """Read a recording and convert it to footzoo's conventions.
+
+    Parameters
+    ----------
+    path : str or Path
+        File to read.
+    format : str, optional
+        One of ``canonical``, ``xio``, ``pyshoe``, ``gaitmap``, ``sensorconnect``;
+        detected from the file when omitted.
+    **options
+        Reader options, e.g. ``foot="left"`` for gaitmap, ``acc_unit="g"`` for
+        canonical files, ``duplicates="drop"``.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise FormatError(f"{p}: no such file")
+    if p.stat().st_size == 0:
+        raise FormatError(f"{p}: the file is empty")
+    fmt = format or detect_format(p)
+    if fmt not in READERS:
+        raise FormatError(f"unknown format {fmt!r}{did_you_mean(fmt, list(READERS))}; valid: {sorted(READERS)}")
+    return READERS[fmt](p, **options)
+
+
+__all__ = ["READERS", "builtin_sample", "detect_format", "load"]
+
+
+def builtin_sample() -> Recording:
+    """The built-in sample recording: x-io's ``short_walk.csv`` (MIT), a closed walk."""
+    import warnings
+    from importlib.resources import as_file, files
+
+    with as_file(files("footzoo.samples") / "xio_short_walk.csv.gz") as p, warnings.catch_warnings():
+        # the file's 205 exact duplicate rows are dropped on purpose; the count is in meta
+        warnings.simplefilter("ignore", UserWarning)
+        rec = xio.read(Path(p))
+    rec.meta.update(name="xio_short_walk", source="footzoo built-in sample (x-io Technologies, MIT)")
+    return rec

@@ -1,0 +1,117 @@
+"""Trajectory metrics: path length, loop closure, ARMSE after yaw alignment, PyShoe's error.
+
+All positions are (N, 3) arrays in NED (m). Horizontal means north-east.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def path_length(pos: np.ndarray, horizontal: bool = True) -> float:
+    """Length (m) of the travelled path: sum of distances between samples.
+
+    ``horizontal`` uses north and east only (the walked distance on a floor).
+    """
+    p = np.asarray(pos, dtype=float)[:, : 2 if horizontal else 3]
+    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
+
+
+def loop_closure(pos: np.ndarray) -> dict[str, float]:
+    """End-to-start distance of a walk that should end where it started.
+
+    Returns
+    -------
+    dict
+        ``loop_closure_3d_m``, ``loop_closure_xy_m`` (m), ``path_length_m``
+        (horizontal, m) and ``loop_closure_xy_pct`` / ``loop_closure_3d_pct`` (%
+        of the horizontal path length).
+    """
+    p = np.asarray(pos, dtype=float)
+    d = p[-1] - p[0]
+    length = path_length(p)
+    e3, exy = float(np.linalg.norm(d)), float(np.linalg.norm(d[:2]))
+    def pct(e):
+        return (100.0 * e / length if length > 0 else float("nan"))
+    return {
+        "loop_closure_3d_m": e3,
+        "loop_closure_xy_m": exy,
+        "path_length_m": length,
+        "loop_closure_3d_pct": pct(e3),
+        "loop_closure_xy_pct": pct(exy),
+    }
+
+
+def yaw_alignment(est: np.ndarray, ref: np.ndarray) -> float:
+    """Rotation ψ (rad) about the vertical that best maps ``est`` onto ``ref``.
+
+    Both start at the origin; ψ minimises ``Σ |R_z(ψ) e_i − r_i|²`` over the
+    horizontal components, whose closed form is
+    ``ψ = atan2(Σ (e_n r_e − e_e r_n), Σ (e_n r_n + e_e r_e))``.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    num = np.sum(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0])
+    den = np.sum(e[:, 0] * r[:, 0] + e[:, 1] * r[:, 1])
+    return float(np.arctan2(num, den))
+
+
+def rotate_about_vertical(pos: np.ndarray, psi: float) -> np.ndarray:
+    """Rotate positions (N, 3) by ψ (rad) about the NED z axis (north toward east)."""
+    c, s = np.cos(psi), np.sin(psi)
+    p = np.asarray(pos, dtype=float).copy()
+    n, e = p[:, 0].copy(), p[:, 1].copy()
+    p[:, 0] = c * n - s * e
+    p[:, 1] = s * n + c * e
+    return p
+
+
+def armse(est: np.ndarray, ref: np.ndarray) -> float:
+    """3-D RMS position error (m) after both start at the origin and a least-squares yaw alignment.
+
+    ``sqrt(mean_i |R_z(ψ*) (e_i − e_0) − (r_i − r_0)|²)`` with ψ* from
+    :func:`yaw_alignment`. Vertical axes are not rotated.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    _check_same_length(e, r)
+    e = rotate_about_vertical(e, yaw_alignment(e, r))
+    return float(np.sqrt(np.mean(np.sum((e - r) ** 2, axis=1))))
+
+
+def pyshoe_error(est: np.ndarray, ref: np.ndarray, align_distance: float = 0.8) -> float:
+    """PyShoe's 2-D trial error (m), as defined by Wagstaff et al.'s evaluation code.
+
+    Both trajectories start at the origin. The estimate is rotated about the
+    vertical once, so that its position at the first sample whose horizontal
+    straight-line distance from the start reaches ``align_distance`` (0.8 m)
+    points in the same direction as the reference at that sample (sample 300
+    when it never gets that far, as PyShoe does). The error is the mean over
+    samples of ``sqrt((dn² + de²) / 2)``.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    _check_same_length(e, r)
+    dist = np.linalg.norm(e[:, :2], axis=1)
+    far = np.flatnonzero(dist >= align_distance)
+    k = int(far[0]) if far.size else min(300, len(e) - 1)
+    psi = np.arctan2(r[k, 1], r[k, 0]) - np.arctan2(e[k, 1], e[k, 0])
+    e = rotate_about_vertical(e, psi)
+    d = e[:, :2] - r[:, :2]
+    return float(np.mean(np.sqrt(np.mean(d**2, axis=1))))
+
+
+def _check_same_length(e: np.ndarray, r: np.ndarray) -> None:
+    if e.shape != r.shape:
+        raise ValueError(f"estimate {e.shape} and reference {r.shape} must have the same shape")
+
+
+def trajectory_metrics(pos: np.ndarray, truth_pos: np.ndarray | None, closed_loop: bool) -> dict[str, float]:
+    """The metrics a run can compute: loop closure (closed walks) and ARMSE/PyShoe error (with a reference)."""
+    out: dict[str, float] = {"path_length_m": path_length(pos)}
+    if closed_loop:
+        out.update(loop_closure(pos))
+    if truth_pos is not None:
+        out["armse_3d_m"] = armse(pos, truth_pos)
+        out["pyshoe_error_m"] = pyshoe_error(pos, truth_pos)
+    return out

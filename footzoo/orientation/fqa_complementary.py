@@ -1,0 +1,141 @@
+"""Adaptive-gain quaternion complementary filter (Yun et al. 2012, Sec. II-A)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..registry import Plugin, check_positive, register
+from .fqa import fqa, fqa_tilt
+
+
+def complementary_kernel(
+    q0: np.ndarray, gyr: np.ndarray, dt: np.ndarray, q_static: np.ndarray, gain: np.ndarray, keep_yaw: bool
+) -> np.ndarray:
+    """Per-sample core of the complementary filter (plain arrays, no objects).
+
+    ``q̂_k = normalise( q̂_{k-1} ⊗ exp(ω_k dt_k / 2) + k_k dt_k (±q_s,k − q̂_{k-1}) )``
+
+    The gyro branch ``q̇_d = ½ q̂ ⊗ ω`` (eq. 2) is integrated exactly for a rate
+    that is constant over the sample interval; the feedback ``k e(t)`` with
+    ``e = ±q_s − q̂`` (the sign of ``q_s`` chosen to match ``q̂``) is added with
+    the same step. With ``keep_yaw`` (no magnetometer) ``q_s`` is the tilt-only
+    FQA quaternion given the current estimate's heading, so the static branch
+    corrects roll and pitch only.
+    """
+    n = gyr.shape[0]
+    out = np.empty((n, 4))
+    w, x, y, z = q0[0], q0[1], q0[2], q0[3]
+    for k in range(n):
+        h = dt[k]
+        gx, gy, gz = gyr[k, 0] * h, gyr[k, 1] * h, gyr[k, 2] * h
+        ang = math.sqrt(gx * gx + gy * gy + gz * gz)
+        if ang > 1e-12:
+            s = math.sin(0.5 * ang) / ang
+            dw, dx, dy, dz = math.cos(0.5 * ang), gx * s, gy * s, gz * s
+        else:
+            dw, dx, dy, dz = 1.0, 0.5 * gx, 0.5 * gy, 0.5 * gz
+        # dynamic branch, eq. 2: q̂ ⊗ Δq
+        pw = w * dw - x * dx - y * dy - z * dz
+        px = w * dx + x * dw + y * dz - z * dy
+        py = w * dy - x * dz + y * dw + z * dx
+        pz = w * dz + x * dy - y * dx + z * dw
+        kk = gain[k] * h
+        if kk != 0.0:
+            sw, sx, sy, sz = q_static[k, 0], q_static[k, 1], q_static[k, 2], q_static[k, 3]
+            if keep_yaw:
+                # heading of the current estimate, as a yaw quaternion q_ψ ⊗ q_tilt
+                psi = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+                cw, cz = math.cos(0.5 * psi), math.sin(0.5 * psi)
+                sw, sx, sy, sz = cw * sw - cz * sz, cw * sx - cz * sy, cw * sy + cz * sx, cw * sz + cz * sw
+            if sw * w + sx * x + sy * y + sz * z < 0.0:  # ±q_s: same sign as q̂
+                sw, sx, sy, sz = -sw, -sx, -sy, -sz
+            # feedback k e(t), e = ±q_s − q̂ (Fig. 2)
+            pw += kk * (sw - w)
+            px += kk * (sx - x)
+            py += kk * (sy - y)
+            pz += kk * (sz - z)
+        nrm = math.sqrt(pw * pw + px * px + py * py + pz * pz)
+        w, x, y, z = pw / nrm, px / nrm, py / nrm, pz / nrm
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = w, x, y, z
+    return out
+
+
+@register
+class FQAComplementary(Plugin):
+    """Adaptive-gain quaternion complementary filter with an FQA static branch.
+
+    Yun, Calusdian, Bachmann & McGhee, IEEE TIM 61(7), 2012, Sec. II-A, eqs. 2–4
+    and Fig. 2. The gyro branch integrates ``q̇ = ½ q̂ ⊗ ω`` (eq. 2); the static
+    branch is the FQA quaternion ``q_s`` from accelerometer and magnetometer;
+    the error ``e = ±q_s − q̂`` times the gain ``k`` is added to the rate and the
+    result normalised. The gain is ``static_gain`` (k_s) in stance and
+    ``dynamic_gain`` (k_d) in swing, switched by the detector's causal gait phase.
+    The transfer functions are ``k/(s+k)`` for the static and ``s/(s+k)`` for the
+    dynamic branch (eqs. 3–4): k is the corner frequency in rad/s.
+
+    Without a magnetometer the static branch corrects roll and pitch only.
+
+    Parameters
+    ----------
+    static_gain : float
+        k_s (1/s), gain in stance; paper: 1.05 (Table II).
+    dynamic_gain : float
+        k_d (1/s), gain in swing; paper: 0.0 (Table II).
+    use_magnetometer : bool
+        Use the magnetometer for heading when the recording has one.
+
+    Attributes
+    ----------
+    quat_ : (N, 4) ndarray
+        Estimated attitude, body -> NED.
+    gain_ : (N,) ndarray
+        Gain used at each sample (1/s).
+    """
+
+    kind = "orientation"
+    name = "fqa_complementary"
+    paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
+    units = {"static_gain": "1/s", "dynamic_gain": "1/s"}
+    needs_stance = True
+
+    def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True):
+        self.static_gain = check_positive("static_gain", static_gain, allow_zero=True)
+        self.dynamic_gain = check_positive("dynamic_gain", dynamic_gain, allow_zero=True)
+        self.use_magnetometer = bool(use_magnetometer)
+
+    def estimate(
+        self,
+        t: np.ndarray,
+        acc: np.ndarray,
+        gyr: np.ndarray,
+        mag: np.ndarray | None,
+        stance: np.ndarray,
+        q0: np.ndarray,
+    ) -> FQAComplementary:
+        """Run the filter over a recording.
+
+        Parameters
+        ----------
+        t : (N,) ndarray
+            Time (s).
+        acc, gyr : (N, 3) ndarray
+            Specific force (m/s²) and angular rate (rad/s) in FRD.
+        mag : (N, 3) ndarray or None
+            Magnetic field in FRD (any unit).
+        stance : (N,) bool ndarray
+            Gait phase known to the filter at each sample (causal).
+        q0 : (4,) ndarray
+            Initial attitude.
+        """
+        dt = np.empty_like(t)
+        dt[1:] = np.diff(t)
+        dt[0] = 0.0
+        use_mag = self.use_magnetometer and mag is not None
+        q_static = fqa(acc, mag) if use_mag else fqa_tilt(acc)
+        self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
+        self.quat_ = complementary_kernel(
+            np.asarray(q0, dtype=float), gyr, dt, q_static, self.gain_, keep_yaw=not use_mag
+        )
+        return self

@@ -1,0 +1,17 @@
+"""Shared fixtures: the real recordings in ../shared/data (skipped when absent)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def data_file(*parts: str) -> Path:
+    """Path of a file under ../shared/data, skipping the test when it is absent."""
+    p = DATA.joinpath(*parts)
+    if not p.exists():
+        pytest.skip(f"shared data not available: {p}")
+    return p

@@ -1,0 +1,107 @@
+"""Every bad-input case gets an error that names the problem and the fix."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from footzoo import Recording, RecordingError
+from footzoo.data import Truth
+
+
+def frame(n=400, rate=100.0, acc_scale=1.0, gyr_scale=1.0):
+    rng = np.random.default_rng(0)
+    t = np.arange(n) / rate
+    acc = np.tile([0.0, 0.0, -9.81], (n, 1)) + rng.normal(scale=0.02, size=(n, 3))
+    gyr = rng.normal(scale=0.01, size=(n, 3))
+    gyr[200:260, 1] = 5.0  # a swing
+    df = pd.DataFrame({"t": t})
+    for i, a in enumerate("xyz"):
+        df[f"acc_{a}"] = acc[:, i] * acc_scale
+        df[f"gyr_{a}"] = gyr[:, i] * gyr_scale
+    return df
+
+
+def test_a_good_frame_builds_a_recording():
+    rec = Recording.from_dataframe(frame())
+    assert rec.n == 400 and rec.rate == pytest.approx(100.0)
+    assert rec.mag is None and rec.truth is None
+
+
+def test_missing_columns_are_named():
+    with pytest.raises(RecordingError, match=r"missing column\(s\) \['gyr_z'\]"):
+        Recording.from_dataframe(frame().drop(columns="gyr_z"))
+
+
+def test_empty_frame():
+    with pytest.raises(RecordingError, match="empty"):
+        Recording.from_dataframe(frame().iloc[:0])
+
+
+def test_non_finite_values_name_the_column_and_row():
+    df = frame()
+    df.loc[17, "acc_y"] = np.nan
+    with pytest.raises(RecordingError, match=r"'acc_y' has 1 non-finite value\(s\), first at row 17.*nan_policy"):
+        Recording.from_dataframe(df)
+    rec = Recording.from_dataframe(df, nan_policy="interpolate")
+    assert np.isfinite(rec.acc).all()
+
+
+def test_time_going_backwards():
+    df = frame()
+    df.loc[50, "t"] = df.loc[48, "t"]
+    with pytest.raises(RecordingError, match=r"time stamps go backwards at sample 50 \(t = 0.490000 s -> 0.480000 s\)"):
+        Recording.from_dataframe(df)
+
+
+def test_duplicate_time_stamps_are_an_error_unless_dropped_with_a_count():
+    df = frame()
+    df = pd.concat([df.iloc[:30], df.iloc[[29, 29]], df.iloc[30:]]).reset_index(drop=True)
+    with pytest.raises(RecordingError, match=r"2 duplicate time stamp\(s\).*duplicates='drop'"):
+        Recording.from_dataframe(df)
+    with pytest.warns(UserWarning, match=r"dropped 2 row\(s\)"):
+        rec = Recording.from_dataframe(df, duplicates="drop")
+    assert rec.n == 400
+
+
+def test_gaps_are_reported_with_their_length_and_place():
+    df = frame().drop(index=range(100, 120)).reset_index(drop=True)
+    with pytest.raises(RecordingError, match=r"gap\(s\) longer than 50.0 ms, the first 210.0 ms at t = 0.990 s"):
+        Recording.from_dataframe(df)
+    assert Recording.from_dataframe(df, max_gap=0.3).n == 380
+
+
+def test_too_short_to_align():
+    with pytest.raises(RecordingError, match="too short to align"):
+        Recording.from_dataframe(frame().iloc[:50])
+
+
+def test_acc_in_g_is_recognised():
+    with pytest.raises(RecordingError, match="looks like g.*acc_unit: g"):
+        Recording.from_dataframe(frame(acc_scale=1 / 9.81))
+    rec = Recording.from_dataframe(frame(acc_scale=1 / 9.81), acc_unit="g")
+    assert np.linalg.norm(rec.acc[0]) == pytest.approx(9.81, rel=0.01)
+
+
+def test_gyro_in_deg_per_s_is_recognised():
+    with pytest.raises(RecordingError, match="looks like deg/s; declare gyr_unit: deg/s"):
+        Recording.from_dataframe(frame(gyr_scale=180 / np.pi))
+    rec = Recording.from_dataframe(frame(gyr_scale=180 / np.pi), gyr_unit="deg/s")
+    assert rec.gyr.max() == pytest.approx(5.0, rel=0.01)
+
+
+def test_unknown_unit_is_rejected_with_the_choices():
+    with pytest.raises(RecordingError, match=r"acc_unit='ft/s\^2' is not supported; use one of"):
+        Recording.from_dataframe(frame(), acc_unit="ft/s^2")
+
+
+def test_shape_mismatch_in_direct_construction():
+    with pytest.raises(RecordingError, match=r"gyr must have shape \(400, 3\)"):
+        Recording(t=np.arange(400) / 100.0, acc=np.zeros((400, 3)), gyr=np.zeros((399, 3)))
+
+
+def test_round_trip_through_a_dataframe_keeps_truth():
+    rec = Recording.from_dataframe(frame())
+    rec.truth = Truth(pos=np.zeros((400, 3)), stance=np.ones(400, bool))
+    back = Recording.from_dataframe(rec.to_dataframe())
+    np.testing.assert_allclose(back.acc, rec.acc)
+    assert back.truth is not None and back.truth.stance.all()

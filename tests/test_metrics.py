@@ -1,0 +1,60 @@
+"""Trajectory metrics on hand-made trajectories."""
+
+import numpy as np
+import pytest
+
+from footzoo.metrics import armse, loop_closure, path_length, pyshoe_error, rotate_about_vertical, yaw_alignment
+
+
+def square(n=400, side=10.0):
+    s = np.linspace(0, 4, n, endpoint=False)
+    pts = []
+    for u in s:
+        leg, f = int(u), u - int(u)
+        corners = [(0, 0), (side, 0), (side, side), (0, side), (0, 0)]
+        a, b = np.array(corners[leg]), np.array(corners[leg + 1])
+        pts.append([*(a + f * (b - a)), 0.0])
+    pts.append([0.0, 0.0, 0.0])
+    return np.array(pts)
+
+
+def test_path_length_and_loop_closure_of_a_square():
+    p = square()
+    assert path_length(p) == pytest.approx(40.0)
+    p_open = p.copy()
+    p_open[-1] = [0.3, 0.4, -1.2]
+    lc = loop_closure(p_open)
+    assert lc["loop_closure_xy_m"] == pytest.approx(0.5)
+    assert lc["loop_closure_3d_m"] == pytest.approx(1.3)
+    assert lc["loop_closure_xy_pct"] == pytest.approx(100 * 0.5 / lc["path_length_m"])
+
+
+def test_yaw_alignment_recovers_a_known_rotation_and_offset():
+    ref = square() + [2.0, 3.0, 0.5]
+    est = rotate_about_vertical(square(), -0.7)
+    assert yaw_alignment(est, ref) == pytest.approx(0.7)
+    assert armse(est, ref) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_armse_of_a_constant_offset_after_alignment():
+    ref = square()
+    est = ref.copy()
+    est[1:, 2] += 0.2  # vertical error after the start is not rotated away
+    assert armse(est, ref) == pytest.approx(0.2 * np.sqrt((len(ref) - 1) / len(ref)))
+
+
+def test_pyshoe_error_aligns_on_the_first_point_0p8m_away():
+    ref = square()
+    est = rotate_about_vertical(ref, 1.0)
+    assert pyshoe_error(est, ref) == pytest.approx(0.0, abs=1e-12)
+    # hand-derived: a straight walk north, estimated 10 % long and turned by 0.3 rad;
+    # after alignment the error at distance x is 0.1 x in north only: sqrt((0.1 x)² / 2)
+    x = np.linspace(0.0, 20.0, 201)
+    line = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
+    est2 = rotate_about_vertical(1.1 * line, 0.3)
+    assert pyshoe_error(est2, line) == pytest.approx(np.mean(0.1 * x / np.sqrt(2)), rel=1e-12)
+
+
+def test_shape_mismatch_is_an_error():
+    with pytest.raises(ValueError, match="same shape"):
+        armse(np.zeros((5, 3)), np.zeros((4, 3)))
