@@ -120,7 +120,7 @@ class Pipeline:
         orientation = _clone(self.orientation)
         use_mag = mag is not None and getattr(orientation, "use_magnetometer", False)
         q0 = initial_attitude(t, acc, gyr, mag if use_mag else None, **self.init)
-        orientation.estimate(t, acc, gyr, mag, detector.stance_online_, q0)
+        orientation.estimate(t, acc, gyr, mag, detector.stance_, q0)
         quat = orientation.quat_
         acc_nav = motion_acceleration(quat, acc, self.gravity)
         stance = detector.stance_

@@ -25,8 +25,8 @@ def test_builtin_walk_closes_the_loop_horizontally(walk_result):
     for col in res.samples.columns:
         assert np.isfinite(res.samples[col].to_numpy(dtype=float)).all(), col
     lc = loop_closure(res.pos)
-    # measured 0.20 m horizontal over 23.2 m; the vertical drifts (see README)
-    assert lc["loop_closure_xy_m"] < 0.3
+    # measured 0.10 m horizontal over 23.2 m; the vertical drifts (see README)
+    assert lc["loop_closure_xy_m"] < 0.15
     assert 20.0 < lc["path_length_m"] < 27.0  # about 25 m walked
     assert 14 <= len(res.steps) <= 20
     # velocity is zero in stance and position held there
@@ -46,8 +46,23 @@ def test_pyshoe_trial_matches_the_published_best():
     rec = load(data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat"))
     res = Pipeline.from_yaml(CONFIG).run(rec)
     err = pyshoe_error(res.pos, rec.truth.pos)
-    # PyShoe's best detector at its per-trial optimal threshold: 0.032 m; footzoo measured 0.032 m
-    assert err < 0.05
+    # PyShoe's best detector at its per-trial optimal threshold: 0.032 m; footzoo measured 0.038 m
+    assert err < 0.045
+
+
+def test_pyshoe_walking_trials_median():
+    import pandas as pd
+
+    root = data_file("pyshoe_vicon", "trials.csv").parent
+    trials = pd.read_csv(root / "trials.csv")
+    walking = trials[(trials.bipedal_tag_koroglu == 1) & trials.trial.str.startswith("2017-11-22")]
+    pipeline = Pipeline.from_yaml(CONFIG)
+    errors = []
+    for name in walking.trial:
+        rec = load(root / f"{name}.mat")
+        errors.append(pyshoe_error(pipeline.run(rec).pos, rec.truth.pos))
+    # measured median 0.053 m over the 18 walking trials (PyShoe's per-trial best: 0.034 m)
+    assert np.median(errors) < 0.06
 
 
 def test_recording_without_rest_is_rejected_and_a_late_rest_is_carried_back():
@@ -78,7 +93,7 @@ def test_cli_run_writes_outputs(tmp_path, capsys):
         assert (tmp_path / name).stat().st_size > 0
     payload = json.loads((tmp_path / "metrics.json").read_text())
     assert payload["config"]["detector"]["type"] == "angular_rate_fsm"
-    assert payload["metrics"]["loop_closure_xy_m"] < 0.3
+    assert payload["metrics"]["loop_closure_xy_m"] < 0.15
 
 
 def test_cli_run_on_pyshoe_prints_armse(capsys):

@@ -36,7 +36,8 @@ class AngularRateFSM(Plugin):
     stance_ : (N,) bool ndarray
         Gait phase with switches dated back (True = stance).
     stance_online_ : (N,) bool ndarray
-        Gait phase as the live machine knows it (used for adaptive gains).
+        Gait phase as the live machine knows it at each sample, before the
+        FIFO delay dates the switches back.
     min_samples_ : int
         Γ_th in samples.
     """
