@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | list | validate``."""
+"""Command line: ``footzoo run | simulate | list | validate``."""
 
 from __future__ import annotations
 
@@ -84,6 +84,32 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """Simulate a recording with ground truth and write it as canonical CSV/Parquet."""
+    import numpy as np
+
+    from .io.canonical import write
+    from .sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_pendulum
+
+    biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
+    noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
+    if args.scenario == "pendulum":
+        rec = simulate_pendulum(rate=args.rate, noise=noise, sampling=args.sampling)
+    else:
+        rec = simulate(
+            path=args.scenario, n_strides=args.strides, stride_length=args.stride_length, rate=args.rate,
+            profile=args.profile, sampling=args.sampling, noise=noise, seed=args.seed,
+            fpa=np.radians(args.fpa), mount_yaw=np.radians(args.mount_yaw), foot=args.foot,
+            distance_sensors=DistanceSensors() if args.distance_sensors else False,
+            disturbance=MagneticDisturbance() if args.disturbance else None,
+        )
+    out = write(rec, args.out)
+    closed = "closed loop" if rec.truth.closed_loop else "open path"
+    print(f"wrote {out} ({rec.n} samples at {rec.rate:.0f} Hz, {rec.t[-1]:.1f} s, {closed}, "
+          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} steps)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``footzoo`` command."""
     parser = argparse.ArgumentParser(
@@ -99,6 +125,24 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
     run.add_argument("--plot", action="store_true", help="also write trajectory.png (needs --out)")
     run.set_defaults(func=cmd_run)
+
+    sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
+    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum"])
+    sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
+    sim.add_argument("--strides", type=int, default=100, help="strides of a straight walk (default 100)")
+    sim.add_argument("--stride-length", type=float, default=1.2, help="stride length in m (default 1.2)")
+    sim.add_argument("--rate", type=float, default=50.0, help="sampling rate in Hz (default 50)")
+    sim.add_argument("--profile", choices=["paper", "physical"], default="paper", help="stance kinematics")
+    sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
+    sim.add_argument("--noise-scale", type=float, default=1.0, help="factor on Table II noise σ (default 1)")
+    sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
+    sim.add_argument("--seed", type=int, default=0)
+    sim.add_argument("--fpa", type=float, default=0.0, help="foot progression angle in deg (toe-out +)")
+    sim.add_argument("--mount-yaw", type=float, default=0.0, help="sensor yaw on the foot in deg")
+    sim.add_argument("--foot", choices=["right", "left"], default="right")
+    sim.add_argument("--distance-sensors", action="store_true", help="add two VL6180-like range sensors")
+    sim.add_argument("--disturbance", action="store_true", help="add a magnetic disturbance (first 10 m north)")
+    sim.set_defaults(func=cmd_simulate)
 
     lst = sub.add_parser("list", help="list plug-ins with their parameters, defaults, units and papers")
     lst.add_argument("--kind", choices=["orientation", "detector", "correction"], help="only this kind")

@@ -53,6 +53,8 @@ class Truth:
         foot progression angle in rad), where known.
     closed_loop : bool
         The walk ends where it started (loop-closure metrics apply).
+    dist : (N, k) ndarray or None
+        True range of each distance sensor (m), NaN where it has no sample.
     """
 
     pos: np.ndarray | None = None
@@ -61,6 +63,7 @@ class Truth:
     stance: np.ndarray | None = None
     steps: pd.DataFrame | None = None
     closed_loop: bool = False
+    dist: np.ndarray | None = None
 
 
 @dataclass
@@ -254,6 +257,8 @@ class Recording:
                 cols.update(zip(TRUTH_QUAT_COLS, tr.quat.T, strict=True))
             if tr.stance is not None:
                 cols["true_stance"] = tr.stance.astype(int)
+            if tr.dist is not None:
+                cols.update({f"true_dist_{chr(97 + i)}": d for i, d in enumerate(tr.dist.T)})
         return pd.DataFrame(cols)
 
 
@@ -263,9 +268,11 @@ def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
     stance = df["true_stance"].to_numpy().astype(bool) if "true_stance" in df.columns else None
+    dist_cols = sorted(c for c in df.columns if c.startswith("true_dist_"))
+    dist = df[dist_cols].to_numpy(dtype=float) if dist_cols else None
     if pos is None and vel is None and quat is None and stance is None:
         return None
-    return Truth(pos=pos, vel=vel, quat=quat, stance=stance)
+    return Truth(pos=pos, vel=vel, quat=quat, stance=stance, dist=dist)
 
 
 def _check_choice(name: str, value: str, allowed) -> None:

@@ -2,8 +2,8 @@
 
 SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``).
 A file written by ``footzoo simulate`` also carries its ground truth in
-``true_*`` columns and, for closed paths, a ``closed_loop`` marker in the
-sidecar ``<file>.meta.yaml``.
+``true_*`` columns, a sidecar ``<file>.meta.yaml`` (metadata and the
+``closed_loop`` marker) and the true steps in ``<file>.steps.csv``.
 """
 
 from __future__ import annotations
@@ -40,6 +40,9 @@ def read(path: Path, **options: Any) -> Recording:
     rec = Recording.from_dataframe(df, meta=meta, **options)
     if rec.truth is not None and isinstance(extra, dict):
         rec.truth.closed_loop = bool(extra.get("closed_loop", False))
+        steps = path.with_name(path.name + ".steps.csv")
+        if steps.exists():
+            rec.truth.steps = pd.read_csv(steps)
     return rec
 
 
@@ -54,4 +57,6 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
     side = {"meta": meta, "closed_loop": bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))}
     p.with_name(p.name + ".meta.yaml").write_text(yaml.safe_dump(side))
+    if rec.truth is not None and rec.truth.steps is not None:
+        rec.truth.steps.to_csv(p.with_name(p.name + ".steps.csv"), index=False, float_format="%.9g")
     return p

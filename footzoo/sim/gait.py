@@ -1,0 +1,286 @@
+"""Foot motion model: a timeline of gait phases with exact position, velocity and attitude.
+
+Yun et al. 2012, Sec. III-B and Table I: a gait cycle is stance (initial
+contact, foot flat, pre-swing) and swing (acceleration, deceleration). The
+foot pitches about its y axis: −θ_ic during initial contact (Table I:
+−6.5 rad/s × 0.1 s), nothing during foot flat, −θ_ps during pre-swing
+(−7.5 rad/s × 0.1 s) and +(θ_ic + θ_ps) during swing (+3.5 rad/s × 0.4 s),
+so the attitude returns to where it started. Phase durations scale with the
+cycle time and the stance fraction (Table I: 1 s, 60 %).
+
+Two profiles:
+
+* ``"paper"`` — Table I as printed: constant angular rates, and the sensor does
+  not move while the foot rolls over heel and toe (linear acceleration zero in
+  stance). The truth's stance is the whole 60 %.
+* ``"physical"`` — the foot rotates about its heel (initial contact) and toe
+  (pre-swing) contact points, so the instep sensor moves; rates follow a
+  raised cosine with the same angles, so velocities have no jumps. Only foot
+  flat (and standing) is stance.
+
+In both, the swing carries the sensor along the straight horizontal line
+between its positions at toe-off and heel strike with the corrected Gaussian
+velocity profile (eq. 14) and lifts it by the clearance with the corrected
+Gaussian of eq. 15 (see :mod:`footzoo.sim.profiles`); the foot's yaw turns
+from one stance's yaw to the next with the same progress profile.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..conventions import quat_from_euler, quat_mul
+from .profiles import GaussianSwing, rotation_progress
+
+#: Table I angles (rad): initial contact −6.5 rad/s × 0.1 s, pre-swing −7.5 rad/s × 0.1 s.
+IC_ANGLE = 0.65
+PS_ANGLE = 0.75
+
+
+@dataclass
+class StrideSpec:
+    """Timing and height of one gait cycle.
+
+    Parameters
+    ----------
+    cycle : float
+        Gait cycle duration (s); Table I: 1.0.
+    stance_fraction : float
+        Stance share of the cycle; Table I: 0.6 (running: about 0.4).
+    clearance : float
+        Peak height of the swing above the straight toe-off-to-heel-strike line (m);
+        Table II: 0.25.
+    """
+
+    cycle: float = 1.0
+    stance_fraction: float = 0.6
+    clearance: float = 0.25
+
+    def phases(self) -> dict[str, float]:
+        """Durations (s) of initial contact, foot flat, pre-swing and swing."""
+        stance = self.cycle * self.stance_fraction
+        return {"ic": stance / 6, "ff": 4 * stance / 6, "ps": stance / 6, "swing": self.cycle - stance}
+
+
+@dataclass
+class Footstep:
+    """Where and how the foot is flat on the floor: sensor position (NED, m), walking heading and FPA (rad)."""
+
+    pos: np.ndarray
+    heading: float
+    fpa: float = 0.0
+
+
+@dataclass
+class FootGeometry:
+    """Sensor mounting and contact points, in the foot frame (FRD, origin at the sensor, m / rad).
+
+    ``heel`` and ``toe`` are the vectors from the sensor to the heel and toe
+    contact points with the foot flat; ``mount_yaw`` and ``mount_pitch`` rotate
+    the sensor on the foot; ``side`` is +1 for a right foot (toe-out = yaw to
+    the right) and −1 for a left foot.
+    """
+
+    heel: np.ndarray = field(default_factory=lambda: np.array([-0.10, 0.0, 0.06]))
+    toe: np.ndarray = field(default_factory=lambda: np.array([0.12, 0.0, 0.06]))
+    mount_yaw: float = 0.0
+    mount_pitch: float = 0.0
+    side: int = 1
+
+    def mount_quat(self) -> np.ndarray:
+        """Sensor attitude in the foot frame (scalar first)."""
+        return quat_from_euler(0.0, self.mount_pitch, self.mount_yaw)
+
+
+def _rz(psi: np.ndarray) -> np.ndarray:
+    c, s = np.cos(psi), np.sin(psi)
+    z, o = np.zeros_like(psi), np.ones_like(psi)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+def _ry(theta: np.ndarray, order: int = 0) -> np.ndarray:
+    """Ry(θ) or its first/second derivative with respect to θ."""
+    c, s = np.cos(theta), np.sin(theta)
+    z = np.zeros_like(theta)
+    if order == 0:
+        rows = [[c, z, s], [z, z + 1, z], [-s, z, c]]
+    elif order == 1:
+        rows = [[-s, z, c], [z, z, z], [-c, z, -s]]
+    else:
+        rows = [[-c, z, -s], [z, z, z], [s, z, -c]]
+    return np.stack([np.stack(r, -1) for r in rows], -2)
+
+
+@dataclass
+class Segment:
+    """One phase of the timeline, evaluated in closed form."""
+
+    t0: float
+    t1: float
+    kind: str  # "still", "ic", "ps", "swing"
+    still: bool
+    psi: tuple[float, float]
+    theta: tuple[float, float]
+    contact: np.ndarray | None = None  # world contact point (ic/ps, physical)
+    r_contact: np.ndarray | None = None  # foot-frame vector sensor -> contact
+    a: np.ndarray | None = None  # swing start / still position
+    b: np.ndarray | None = None  # swing end
+    clearance: float = 0.0
+    smooth: bool = False
+    swing: GaussianSwing | None = None
+
+    def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Position, velocity, acceleration (NED), yaw ψ, pitch θ and their rates at absolute times ``t``."""
+        tl = np.asarray(t, dtype=float) - self.t0
+        n = tl.shape[0]
+        T = self.t1 - self.t0
+        out = {k: np.zeros((n, 3)) for k in ("p", "v", "a")}
+        if self.kind == "swing":
+            s, s1, s2 = self.swing.progress(tl)
+            u, u1, u2 = rotation_progress(tl, T, self.smooth)
+            d = self.b - self.a
+            bb, b1, b2 = self.swing.bump(tl)
+            up = np.array([0.0, 0.0, -self.clearance])
+            out["p"] = self.a + s[:, None] * d + bb[:, None] * up
+            out["v"] = s1[:, None] * d + b1[:, None] * up
+            out["a"] = s2[:, None] * d + b2[:, None] * up
+            dpsi, dth = self.psi[1] - self.psi[0], self.theta[1] - self.theta[0]
+            out["psi"], out["psi_dot"] = self.psi[0] + dpsi * s, dpsi * s1
+            out["theta"], out["theta_dot"] = self.theta[0] + dth * u, dth * u1
+            return out
+        if self.kind == "still":
+            out["p"] = np.tile(self.a, (n, 1))
+            out["psi"], out["psi_dot"] = np.full(n, self.psi[0]), np.zeros(n)
+            out["theta"], out["theta_dot"] = np.full(n, self.theta[0]), np.zeros(n)
+            return out
+        # rotation about a contact point (ic, ps)
+        u, u1, u2 = rotation_progress(tl, T, self.smooth)
+        dth = self.theta[1] - self.theta[0]
+        th, thd, thdd = self.theta[0] + dth * u, dth * u1, dth * u2
+        out["psi"], out["psi_dot"] = np.full(n, self.psi[0]), np.zeros(n)
+        out["theta"], out["theta_dot"] = th, thd
+        if self.contact is None:  # paper profile: the sensor only rotates
+            out["p"] = np.tile(self.a, (n, 1))
+            return out
+        rz = _rz(np.array(self.psi[0]))
+        r = self.r_contact
+        out["p"] = self.contact - np.einsum("ij,njk,k->ni", rz, _ry(th), r)
+        out["v"] = -np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thd[:, None]
+        out["a"] = -(np.einsum("ij,njk,k->ni", rz, _ry(th, 2), r) * thd[:, None] ** 2
+                     + np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thdd[:, None])
+        return out
+
+
+class GaitTimeline:
+    """The whole walk: standing, strides between footsteps, standing.
+
+    Parameters
+    ----------
+    footsteps : list of Footstep
+        Where the foot is flat, in order (N + 1 footsteps make N strides).
+    strides : list of StrideSpec
+        One per stride.
+    geometry : FootGeometry
+        Contact points and sensor mounting.
+    profile : {"paper", "physical"}
+        See the module docstring.
+    stand_start, stand_end : float
+        Standing still before the first and after the last stride (s).
+    """
+
+    def __init__(
+        self,
+        footsteps: list[Footstep],
+        strides: list[StrideSpec],
+        geometry: FootGeometry,
+        profile: str = "paper",
+        stand_start: float = 2.0,
+        stand_end: float = 1.0,
+    ):
+        if profile not in ("paper", "physical"):
+            raise ValueError(f"profile must be 'paper' or 'physical', got {profile!r}")
+        if len(strides) != len(footsteps) - 1:
+            raise ValueError(f"{len(footsteps)} footsteps need {len(footsteps) - 1} stride specs, got {len(strides)}")
+        self.footsteps, self.strides, self.geometry, self.profile = footsteps, strides, geometry, profile
+        self.segments: list[Segment] = []
+        self.steps: list[dict[str, float]] = []
+        self._build(stand_start, stand_end)
+        self.t_end = self.segments[-1].t1
+        self._starts = np.array([s.t0 for s in self.segments])
+
+    def foot_yaw(self, step: Footstep) -> float:
+        """Yaw of the foot (rad) while flat at ``step``: heading + side · FPA."""
+        return float(step.heading + self.geometry.side * step.fpa)
+
+    def _build(self, stand_start: float, stand_end: float) -> None:
+        geo, physical = self.geometry, self.profile == "physical"
+        t = 0.0
+        fs = self.footsteps
+        # unwrapped, so that a turn through ±π is not made the long way round
+        yaws = np.unwrap([self.foot_yaw(f) for f in fs])
+        psi0 = float(yaws[0])
+        seg = self.segments
+        seg.append(Segment(t, t + stand_start, "still", True, (psi0, psi0), (0.0, 0.0), a=np.asarray(fs[0].pos, float)))
+        t += stand_start
+        for i, spec in enumerate(self.strides):
+            ph = spec.phases()
+            a_step, b_step = fs[i], fs[i + 1]
+            psi_a, psi_b = float(yaws[i]), float(yaws[i + 1])
+            pa, pb = np.asarray(a_step.pos, float), np.asarray(b_step.pos, float)
+            rz_a, rz_b = _rz(np.array(psi_a)), _rz(np.array(psi_b))
+            toe_a = pa + rz_a @ geo.toe
+            heel_b = pb + rz_b @ geo.heel
+            start = t
+            # pre-swing: rotate about the toe, 0 -> -θ_ps
+            ps = Segment(t, t + ph["ps"], "ps", not physical, (psi_a, psi_a), (0.0, -PS_ANGLE),
+                         contact=toe_a if physical else None, r_contact=geo.toe, a=pa, smooth=physical)
+            t += ph["ps"]
+            # initial contact of the next stance: rotate about the heel, θ_ic -> 0
+            ic_t0 = t + ph["swing"]
+            ic = Segment(ic_t0, ic_t0 + ph["ic"], "ic", not physical, (psi_b, psi_b), (IC_ANGLE, 0.0),
+                         contact=heel_b if physical else None, r_contact=geo.heel, a=pb, smooth=physical)
+            a_sw = ps.evaluate(np.array([ps.t1]))["p"][0]
+            b_sw = ic.evaluate(np.array([ic.t0]))["p"][0]
+            sw = Segment(t, t + ph["swing"], "swing", False, (psi_a, psi_b), (-PS_ANGLE, IC_ANGLE), a=a_sw, b=b_sw,
+                         clearance=spec.clearance, smooth=physical, swing=GaussianSwing(ph["swing"]))
+            t = ic.t1
+            ff = Segment(t, t + ph["ff"], "still", True, (psi_b, psi_b), (0.0, 0.0), a=pb)
+            t += ph["ff"]
+            seg.extend([ps, sw, ic, ff])
+            d = pb - pa
+            self.steps.append({
+                "start": start, "end": ff.t0, "stride_length": float(np.hypot(d[0], d[1])),
+                "heading": float(np.arctan2(d[1], d[0])), "fpa": float(b_step.fpa), "foot_yaw": psi_b,
+                "swing_start": sw.t0, "swing_end": sw.t1,
+            })
+        psi_n = float(yaws[-1])
+        end = np.asarray(fs[-1].pos, float)
+        seg.append(Segment(t, t + stand_end, "still", True, (psi_n, psi_n), (0.0, 0.0), a=end))
+
+    def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Exact state at times ``t`` (s): ``p, v, a`` (NED), ``q`` (body->NED), ``w`` (body rate, rad/s), ``still``."""
+        t = np.asarray(t, dtype=float)
+        idx = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self.segments) - 1)
+        n = t.shape[0]
+        out = {"p": np.zeros((n, 3)), "v": np.zeros((n, 3)), "a": np.zeros((n, 3)),
+               "psi": np.zeros(n), "psi_dot": np.zeros(n), "theta": np.zeros(n), "theta_dot": np.zeros(n),
+               "still": np.zeros(n, bool)}
+        for j in np.unique(idx):
+            m = idx == j
+            res = self.segments[j].evaluate(t[m])
+            for k, v in res.items():
+                out[k][m] = v
+            out["still"][m] = self.segments[j].still
+        q_foot = quat_mul(quat_from_euler(np.zeros(n), np.zeros(n), out["psi"]),
+                          quat_from_euler(np.zeros(n), out["theta"], np.zeros(n)))
+        q_mount = self.geometry.mount_quat()
+        out["q"] = quat_mul(q_foot, np.broadcast_to(q_mount, q_foot.shape))
+        # body rate: ω_foot = Ry(θ)^T [0, 0, ψ̇] + [0, θ̇, 0]; ω_body = R_mount^T ω_foot
+        w_foot = np.einsum("nji,j->ni", _ry(out["theta"]), np.array([0.0, 0.0, 1.0])) * out["psi_dot"][:, None]
+        w_foot[:, 1] += out["theta_dot"]
+        from ..conventions import quat_to_matrix
+
+        out["w"] = w_foot @ quat_to_matrix(q_mount)
+        return out

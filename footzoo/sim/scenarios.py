@@ -1,0 +1,166 @@
+"""Composable simulated recordings with ground truth.
+
+``simulate(path=..., ...)`` builds a :class:`~footzoo.data.Recording` whose
+:class:`~footzoo.data.Truth` holds, for every sample, the sensor's position,
+velocity, attitude and stance flag (stance = the sensor's velocity is zero
+over the whole sample interval), and per step the start and end, stride
+length, heading and foot progression angle; with distance sensors, the true
+range of every distance sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+
+import numpy as np
+import pandas as pd
+
+from ..conventions import GRAVITY, quat_conj, quat_rotate
+from ..data import Recording, Truth
+from . import paths
+from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
+from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu
+
+#: Walking speeds Nguyen & La tested (m/s) and a run, as (stride length m, cycle s, stance fraction).
+SPEEDS = {
+    "slow": (1.0, 1.18, 0.62),  # 0.85 m/s
+    "normal": (1.38, 1.0, 0.60),  # 1.38 m/s
+    "fast": (1.6, 0.833, 0.58),  # 1.92 m/s
+    "run": (2.4, 0.75, 0.40),  # 3.2 m/s
+}
+
+PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed")
+
+
+def _footsteps(path: str, n_strides: int, stride_length: float, **kw) -> tuple[list[Footstep], bool]:
+    if path == "straight":
+        return paths.straight(n_strides, stride_length, kw.get("heading", 0.0)), False
+    if path == "rectangle":
+        return paths.rectangle(kw.get("length", 40.0), kw.get("width", 20.0), stride_length), True
+    if path == "track":
+        return paths.track(stride_length=stride_length), True
+    if path == "figure_eight":
+        return paths.figure_eight(kw.get("radius", 5.0), stride_length), True
+    raise ValueError(f"unknown path {path!r}; known: {list(PATHS)}")
+
+
+def simulate(
+    path: str = "straight",
+    n_strides: int = 100,
+    stride_length: float = 1.2,
+    cycle: float = 1.0,
+    stance_fraction: float = 0.6,
+    clearance: float = 0.25,
+    rate: float = 50.0,
+    profile: str = "paper",
+    sampling: str = "interval",
+    noise: NoiseModel | dict | None = None,
+    magnetometer: bool = True,
+    location: str | tuple[float, float] = "monterey",
+    disturbance: MagneticDisturbance | None = None,
+    distance_sensors: DistanceSensors | bool = False,
+    fpa: float | list[float] = 0.0,
+    mount_yaw: float = 0.0,
+    mount_pitch: float = 0.0,
+    foot: str = "right",
+    speeds: list[tuple[str, int]] | None = None,
+    stand_start: float = 2.0,
+    stand_end: float = 1.0,
+    gravity: float = GRAVITY,
+    seed: int = 0,
+    **path_options,
+) -> Recording:
+    """Simulate one foot-mounted IMU walk.
+
+    Parameters
+    ----------
+    path : {"straight", "rectangle", "track", "figure_eight", "mixed_speed"}
+        Footstep layout; ``mixed_speed`` walks straight through ``speeds``.
+    n_strides : int
+        Strides of a straight walk (closed paths take as many as they need).
+    stride_length : float
+        Stride length (m); Table II: 1.2.
+    cycle, stance_fraction, clearance : float
+        Gait cycle (s), stance share, swing clearance (m); Table I/II: 1.0, 0.6, 0.25.
+    rate : float
+        Sampling rate (Hz); Table II: 50.
+    profile : {"paper", "physical"}
+        Stance kinematics (see :mod:`footzoo.sim.gait`).
+    sampling : {"interval", "instantaneous"}
+        See :mod:`footzoo.sim.sensors`.
+    noise : NoiseModel or dict, optional
+        Sensor errors (eq. 18); default: none.
+    magnetometer : bool
+        Include a magnetometer (eq. 13 generalised: the field rotated into the body).
+    location : str or (intensity G, inclination deg)
+        Earth field (default Monterey, where Yun et al. worked).
+    disturbance : MagneticDisturbance, optional
+        Extra field in a region.
+    distance_sensors : DistanceSensors or bool
+        Two VL6180-like sensors seeing a flat floor (Duong & Suh Table 1) when True.
+    fpa : float or list of float
+        Foot progression angle per footstep (rad, toe-out positive).
+    mount_yaw, mount_pitch : float
+        Sensor mounting on the foot (rad).
+    foot : {"right", "left"}
+        Which foot (sets the sign of toe-out).
+    speeds : list of (name, n_strides)
+        For ``mixed_speed``: e.g. ``[("slow", 8), ("normal", 8), ("fast", 8), ("run", 8)]``
+        with names from :data:`SPEEDS`.
+    stand_start, stand_end : float
+        Standing still before and after (s).
+    seed : int
+        Seed of the noise (reproducible).
+    """
+    if foot not in ("right", "left"):
+        raise ValueError(f"foot must be 'right' or 'left', got {foot!r}")
+    if path == "mixed_speed":
+        speeds = speeds or [("slow", 9), ("normal", 9), ("fast", 9), ("run", 9)]
+        specs, lengths = [], []
+        for name, n in speeds:
+            if name not in SPEEDS:
+                raise ValueError(f"unknown speed {name!r}; known: {sorted(SPEEDS)}")
+            L, c, sf = SPEEDS[name]
+            specs += [StrideSpec(c, sf, clearance if name != "run" else clearance * 1.2)] * n
+            lengths += [L] * n
+        steps, closed = paths.straight(len(lengths), lengths), False
+    else:
+        steps, closed = _footsteps(path, n_strides, stride_length, **path_options)
+        specs = [StrideSpec(cycle, stance_fraction, clearance)] * (len(steps) - 1)
+    fpas = np.broadcast_to(np.asarray(fpa, float), (len(steps),))
+    for s, a in zip(steps, fpas, strict=True):
+        s.fpa = float(a)
+    geometry = FootGeometry(mount_yaw=mount_yaw, mount_pitch=mount_pitch, side=1 if foot == "right" else -1)
+    timeline = GaitTimeline(steps, specs, geometry, profile=profile, stand_start=stand_start, stand_end=stand_end)
+
+    t = np.arange(0.0, timeline.t_end, 1.0 / rate)
+    state = timeline.evaluate(t)
+    acc, gyr = sample_imu(state, t, gravity, sampling)
+    mag = None
+    if magnetometer:
+        field = np.tile(magnetic_field_ned(location), (t.size, 1))
+        if disturbance is not None:
+            field = field + disturbance.at(state["p"])
+        mag = quat_rotate(quat_conj(state["q"]), field)
+    if noise is not None:
+        noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
+        acc, gyr, mag = noise.apply(acc, gyr, mag)
+    dist = true_dist = None
+    if distance_sensors:
+        ds = distance_sensors if isinstance(distance_sensors, DistanceSensors) else DistanceSensors()
+        ds.floor_z = float(geometry.heel[2])
+        dist, true_dist = ds.sample(t, state["p"], state["q"], seed=seed)
+
+    mid = timeline.evaluate(np.concatenate([[t[0]], t[:-1] + 0.5 / rate]))["still"]
+    stance = state["still"] & mid & np.concatenate([[True], state["still"][:-1]])
+    step_table = pd.DataFrame(timeline.steps)
+    truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=stance, steps=step_table,
+                  closed_loop=closed, dist=true_dist)
+    meta = {
+        "name": f"sim_{path}", "source": "footzoo.sim", "format": "simulated", "profile": profile,
+        "sampling": sampling, "foot": foot, "seed": seed,
+        "noise": asdict(noise) if isinstance(noise, NoiseModel) else "none",
+    }
+    if dist is not None:
+        meta["dist_columns"] = [f"dist_{chr(97 + j)}" for j in range(dist.shape[1])]
+    return Recording(t=t, acc=acc, gyr=gyr, mag=mag, dist=dist, meta=meta, truth=truth)
