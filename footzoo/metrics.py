@@ -115,3 +115,66 @@ def trajectory_metrics(pos: np.ndarray, truth_pos: np.ndarray | None, closed_loo
         out["armse_3d_m"] = armse(pos, truth_pos)
         out["pyshoe_error_m"] = pyshoe_error(pos, truth_pos)
     return out
+
+
+# --------------------------------------------------------------------------- stance detection
+
+
+def intervals(mask: np.ndarray) -> np.ndarray:
+    """``(start, stop)`` index pairs (stop exclusive) of the True runs of a boolean mask, (K, 2)."""
+    m = np.asarray(mask, dtype=bool).astype(np.int8)
+    d = np.diff(np.concatenate([[0], m, [0]]))
+    return np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)])
+
+
+def stance_scores(stance: np.ndarray, truth: np.ndarray) -> dict[str, float]:
+    """Per-sample precision, recall and F1 of a stance mask (stance = positive class)."""
+    s, r = np.asarray(stance, bool), np.asarray(truth, bool)
+    tp = float(np.sum(s & r))
+    precision = tp / max(float(s.sum()), 1.0)
+    recall = tp / max(float(r.sum()), 1.0)
+    f1 = 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
+    return {"precision": precision, "recall": recall, "f1": f1, "accuracy": float(np.mean(s == r))}
+
+
+def step_detection(stance: np.ndarray, truth: np.ndarray, t: np.ndarray) -> dict[str, float]:
+    """Step-level comparison of detected and true stance phases (the gait-phase error rate).
+
+    Matching rule: a true stance phase is detected correctly when exactly one
+    detected stance phase overlaps it and that detected phase overlaps no other
+    true stance phase. Every other true phase is an error (missed: no overlap;
+    split: two or more overlap; merged: its detected phase spans two true
+    phases), and so is every detected phase that overlaps no true phase
+    (false step). ``error_rate = (wrong true phases + false steps) / true phases``,
+    the measure of Nguyen & La's "1 wrong in 36 steps". Timing errors are over
+    the correct matches (detected − true, s): onset at the phase's first sample,
+    offset at its last.
+    """
+    det, ref = intervals(stance), intervals(truth)
+    overlap = (det[:, None, 0] < ref[None, :, 1]) & (ref[None, :, 0] < det[:, None, 1])
+    per_ref = overlap.sum(axis=0)
+    per_det = overlap.sum(axis=1)
+    correct, onset, offset = 0, [], []
+    for j in range(len(ref)):
+        if per_ref[j] == 1:
+            i = int(np.flatnonzero(overlap[:, j])[0])
+            if per_det[i] == 1:
+                correct += 1
+                onset.append(t[det[i, 0]] - t[ref[j, 0]])
+                offset.append(t[det[i, 1] - 1] - t[ref[j, 1] - 1])
+    false_steps = int(np.sum(per_det == 0))
+    n = len(ref)
+    return {
+        "true_steps": n,
+        "detected_steps": len(det),
+        "correct": correct,
+        "missed": int(np.sum(per_ref == 0)),
+        "split": int(np.sum(per_ref > 1)),
+        "false_steps": false_steps,
+        "step_count_error": len(det) - n,
+        "error_rate": (n - correct + false_steps) / n if n else float("nan"),
+        "onset_error_mean_s": float(np.mean(onset)) if onset else float("nan"),
+        "offset_error_mean_s": float(np.mean(offset)) if offset else float("nan"),
+        "onset_error_abs_max_s": float(np.max(np.abs(onset))) if onset else float("nan"),
+        "offset_error_abs_max_s": float(np.max(np.abs(offset))) if offset else float("nan"),
+    }

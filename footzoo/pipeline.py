@@ -61,12 +61,7 @@ class Pipeline:
         self.name = name
         self.gravity = check_positive("gravity", gravity)
         self.init = {**INIT_KEYS, **(init or {})}
-        if len(self.corrections) > 1:
-            names = [c.name for c in self.corrections]
-            raise ConfigError(
-                f"corrections {names}: only one velocity/position correction can be applied at a time "
-                "in this version"
-            )
+        check_compatibility(orientation, detector, self.corrections)
 
     # ----------------------------------------------------------------- build
     @classmethod
@@ -116,22 +111,39 @@ class Pipeline:
         if not isinstance(rec, Recording):
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
         t, acc, gyr, mag = rec.t, rec.acc, rec.gyr, rec.mag
-        detector = _clone(self.detector).detect(t, acc, gyr)
+        detector = _clone(self.detector)
+        if getattr(detector, "needs_truth", False):
+            detector.detect(t, acc, gyr, rec.truth)
+        else:
+            detector.detect(t, acc, gyr)
+        stance = detector.stance_
         orientation = _clone(self.orientation)
+        corrections = [_clone(c) for c in self.corrections]
         use_mag = mag is not None and getattr(orientation, "use_magnetometer", False)
         q0 = initial_attitude(t, acc, gyr, mag if use_mag else None, **self.init)
-        orientation.estimate(t, acc, gyr, mag, detector.stance_, q0)
-        quat = orientation.quat_
-        acc_nav = motion_acceleration(quat, acc, self.gravity)
-        stance = detector.stance_
-        dt = sample_intervals(t)
         diagnostics: dict[str, Any] = {"detector_statistic": detector.statistic_}
-        if self.corrections:
-            corr = _clone(self.corrections[0]).apply(t, acc_nav, stance)
-            vel, pos = corr.vel_, corr.pos_
+        kalman = [c for c in corrections if c.role == "kalman"]
+        heading = [c for c in corrections if c.role == "heading"]
+        velocity = [c for c in corrections if c.role == "velocity"]
+        dt = sample_intervals(t)
+        if kalman:
+            quat_ext = None
+            if orientation.name != "ins":
+                quat_ext = orientation.estimate(t, acc, gyr, mag, stance, q0).quat_
+            nav = _run_kalman(t, acc, gyr, stance, q0, orientation, kalman + heading, quat_ext, self.gravity)
+            quat, vel, pos, acc_nav = nav["quat"], nav["vel"], nav["pos"], nav["acc_nav"]
+            diagnostics.update(gyro_bias=nav["gyro_bias"], acc_bias=nav["acc_bias"], P_diag=nav["P_diag"])
         else:
-            vel = integrate_velocity(acc_nav, dt)
-            pos = integrate_position(vel, dt)
+            quat = orientation.estimate(t, acc, gyr, mag, stance, q0).quat_
+            acc_nav = motion_acceleration(quat, acc, self.gravity)
+            for h in heading:
+                acc_nav = h.apply_acceleration(quat, acc_nav, stance)
+            if velocity:
+                corr = velocity[0].apply(t, acc_nav, stance)
+                vel, pos = corr.vel_, corr.pos_
+            else:
+                vel = integrate_velocity(acc_nav, dt)
+                pos = integrate_position(vel, dt)
         euler = quat_to_euler(quat)
         samples = pd.DataFrame(
             {
@@ -152,6 +164,61 @@ class Pipeline:
             recording=dict(rec.meta),
             diagnostics=diagnostics,
         )
+
+
+def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gravity) -> dict[str, Any]:
+    """Assemble the error-state layout from the plug-ins and run the filter loop."""
+    from .filters.eskf import ErrorStateFilter, Layout
+    from .filters.navigation import run_error_state_filter
+    from .orientation.ins import INS
+
+    ins = orientation if orientation.name == "ins" else INS()
+    extra = {name: (size, p0, q) for m in measurements for name, size, p0, q in m.blocks()}
+    blocks: list[tuple[str, int, float, float]] = []
+    if quat_ext is None:
+        blocks.append(("att", 3, ins.initial_attitude_std**2, ins.attitude_noise))
+    if "gyro_bias" in extra:
+        blocks.append(("gyro_bias", *extra.pop("gyro_bias")))
+    blocks.append(("pos", 3, 0.0, ins.position_noise))
+    blocks.append(("vel", 3, 0.0, ins.velocity_noise))
+    if "acc_bias" in extra:
+        blocks.append(("acc_bias", *extra.pop("acc_bias")))
+    blocks += [(name, *spec) for name, spec in extra.items()]
+    layout = Layout([(b[0], b[1]) for b in blocks])
+    p0 = np.concatenate([np.full(b[1], b[2]) for b in blocks])
+    q = np.concatenate([np.full(b[1], b[3]) for b in blocks])
+    kf = ErrorStateFilter(layout, p0, q)
+    return run_error_state_filter(t, acc, gyr, stance, q0, layout, kf, measurements, quat_ext, gravity)
+
+
+def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:
+    """Reject plug-in combinations that cannot work together, with the reason and the fix."""
+    roles: dict[str, list[str]] = {}
+    for c in corrections:
+        roles.setdefault(c.role, []).append(c.name)
+    names = [c.name for c in corrections]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        raise ConfigError(f"corrections: {dupes} listed more than once; keep one of each")
+    if len(roles.get("velocity", [])) > 1:
+        raise ConfigError(f"corrections {roles['velocity']}: only one velocity correction can be applied")
+    if roles.get("kalman") and roles.get("velocity"):
+        raise ConfigError(
+            f"corrections: {roles['velocity']} and the Kalman filter {roles['kalman']} both correct the velocity; "
+            "choose one"
+        )
+    ins = orientation.name == "ins"
+    if roles.get("kalman") and roles.get("heading") and not ins:
+        raise ConfigError(
+            f"corrections: {roles['heading']} inside the Kalman filter {roles['kalman']} observes the attitude "
+            f"error, which only orientation: ins carries (got {orientation.name!r}); use orientation: {{type: ins}}"
+        )
+    for c in corrections:
+        if c.name == "ekf_zupt" and not ins and (c.gyro_bias or c.zero_rate):
+            raise ConfigError(
+                f"ekf_zupt: gyro_bias and zero_rate need the attitude in the Kalman filter (orientation: ins); "
+                f"with orientation {orientation.name!r} set gyro_bias: false and zero_rate: false"
+            )
 
 
 def versions() -> dict[str, str]:

@@ -26,6 +26,7 @@ class Plugin:
     name: ClassVar[str] = ""
     paper: ClassVar[str] = ""
     units: ClassVar[dict[str, str]] = {}
+    role: ClassVar[str] = ""  # corrections: "velocity", "heading" or "kalman"
 
     @classmethod
     def param_names(cls) -> list[str]:

@@ -58,3 +58,41 @@ def test_pyshoe_error_aligns_on_the_first_point_0p8m_away():
 def test_shape_mismatch_is_an_error():
     with pytest.raises(ValueError, match="same shape"):
         armse(np.zeros((5, 3)), np.zeros((4, 3)))
+
+
+def test_stance_metrics_on_a_hand_made_case():
+    from footzoo.metrics import intervals, stance_scores, step_detection
+
+    t = np.arange(40) * 0.01
+    truth = np.zeros(40, bool)
+    truth[2:8] = truth[12:18] = truth[22:28] = truth[32:38] = True
+    det = np.zeros(40, bool)
+    det[3:8] = True  # correct, onset 10 ms late
+    det[12:14] = det[15:18] = True  # split
+    det[19:20] = True  # false step
+    # third true phase missed; the fourth merged with nothing else: correct, offset 10 ms early
+    det[32:37] = True
+    np.testing.assert_array_equal(intervals(det), [[3, 8], [12, 14], [15, 18], [19, 20], [32, 37]])
+    r = step_detection(det, truth, t)
+    assert (r["true_steps"], r["detected_steps"], r["correct"], r["missed"], r["split"], r["false_steps"]) == (
+        4, 5, 2, 1, 1, 1)
+    assert r["error_rate"] == pytest.approx((4 - 2 + 1) / 4)
+    assert r["onset_error_mean_s"] == pytest.approx(0.005)
+    assert r["offset_error_mean_s"] == pytest.approx(-0.005)
+    s = stance_scores(det, truth)
+    tp = 5 + 5 + 5
+    assert s["precision"] == pytest.approx(tp / det.sum())
+    assert s["recall"] == pytest.approx(tp / truth.sum())
+    assert s["f1"] == pytest.approx(2 * s["precision"] * s["recall"] / (s["precision"] + s["recall"]))
+
+
+def test_a_merged_detection_counts_both_true_phases_wrong():
+    from footzoo.metrics import step_detection
+
+    t = np.arange(20) * 0.01
+    truth = np.zeros(20, bool)
+    truth[2:6] = truth[9:13] = True
+    det = np.zeros(20, bool)
+    det[2:13] = True
+    r = step_detection(det, truth, t)
+    assert r["correct"] == 0 and r["error_rate"] == 1.0

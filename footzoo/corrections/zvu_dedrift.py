@@ -74,7 +74,9 @@ class ZVUDedrift(Plugin):
     Yun et al. 2012, IEEE TIM 61(7), Sec. II-B, eqs. 5–10: the motion
     acceleration is integrated over each swing, the drift ``ε = v(T)/T`` removed
     linearly, the velocity set to zero in stance and the corrected velocity
-    integrated to position (held during stance). No parameters.
+    integrated to position (held during stance). No parameters. This is also
+    the ZVU of Nguyen & La 2016, eqs. 16–22 (the bias ``a_mbe = v_m(T_i)/δT_i``
+    subtracted from the swing's acceleration), used by their INS/ZVU systems.
 
     Attributes
     ----------
@@ -88,6 +90,7 @@ class ZVUDedrift(Plugin):
 
     kind = "correction"
     name = "zvu_dedrift"
+    role = "velocity"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-B, eqs. 5-10"
     units: dict[str, str] = {}
 

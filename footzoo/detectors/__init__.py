@@ -1,6 +1,8 @@
 """Stance/swing detectors."""
 
 from .angular_rate_fsm import AngularRateFSM
+from .dgp import DGP
+from .oracle import Oracle
 from .runs import dated_and_online_states
 
-__all__ = ["AngularRateFSM", "dated_and_online_states"]
+__all__ = ["DGP", "AngularRateFSM", "Oracle", "dated_and_online_states"]

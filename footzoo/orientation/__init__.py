@@ -2,5 +2,6 @@
 
 from .fqa import fqa
 from .fqa_complementary import FQAComplementary
+from .ins import INS
 
-__all__ = ["FQAComplementary", "fqa"]
+__all__ = ["INS", "FQAComplementary", "fqa"]

@@ -15,8 +15,9 @@ Two profiles:
   stance). The truth's stance is the whole 60 %.
 * ``"physical"`` — the foot rotates about its heel (initial contact) and toe
   (pre-swing) contact points, so the instep sensor moves; rates follow a
-  raised cosine with the same angles, so velocities have no jumps. Only foot
-  flat (and standing) is stance.
+  raised cosine with the same angles, so velocities have no jumps; the swing's
+  pitch rate is a half sine, so it passes through zero at toe-off and heel
+  strike without dwelling there. Only foot flat (and standing) is stance.
 
 In both, the swing carries the sensor along the straight horizontal line
 between its positions at toe-off and heel strike with the corrected Gaussian
@@ -52,16 +53,21 @@ class StrideSpec:
     clearance : float
         Peak height of the swing above the straight toe-off-to-heel-strike line (m);
         Table II: 0.25.
+    flat_fraction : float
+        Foot-flat share of the stance; Table I: 0.4 s of 0.6 s = 2/3. Running has
+        almost no flat foot (about 0.2).
     """
 
     cycle: float = 1.0
     stance_fraction: float = 0.6
     clearance: float = 0.25
+    flat_fraction: float = 2.0 / 3.0
 
     def phases(self) -> dict[str, float]:
         """Durations (s) of initial contact, foot flat, pre-swing and swing."""
         stance = self.cycle * self.stance_fraction
-        return {"ic": stance / 6, "ff": 4 * stance / 6, "ps": stance / 6, "swing": self.cycle - stance}
+        roll = stance * (1.0 - self.flat_fraction) / 2.0
+        return {"ic": roll, "ff": stance * self.flat_fraction, "ps": roll, "swing": self.cycle - stance}
 
 
 @dataclass
@@ -128,7 +134,7 @@ class Segment:
     a: np.ndarray | None = None  # swing start / still position
     b: np.ndarray | None = None  # swing end
     clearance: float = 0.0
-    smooth: bool = False
+    smooth: bool | str = False
     swing: GaussianSwing | None = None
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
@@ -244,7 +250,8 @@ class GaitTimeline:
             a_sw = ps.evaluate(np.array([ps.t1]))["p"][0]
             b_sw = ic.evaluate(np.array([ic.t0]))["p"][0]
             sw = Segment(t, t + ph["swing"], "swing", False, (psi_a, psi_b), (-PS_ANGLE, IC_ANGLE), a=a_sw, b=b_sw,
-                         clearance=spec.clearance, smooth=physical, swing=GaussianSwing(ph["swing"]))
+                         clearance=spec.clearance, smooth="sine" if physical else False,
+                         swing=GaussianSwing(ph["swing"]))
             t = ic.t1
             ff = Segment(t, t + ph["ff"], "still", True, (psi_b, psi_b), (0.0, 0.0), a=pb)
             t += ph["ff"]

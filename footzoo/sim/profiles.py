@@ -67,15 +67,25 @@ class GaussianSwing:
         return b / self.peak, b1 / self.peak, b2 / self.peak
 
 
-def rotation_progress(t: np.ndarray, duration: float, smooth: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rotation_progress(
+    t: np.ndarray, duration: float, smooth: bool | str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fraction ``u`` of a rotation done at time ``t`` of a phase, with ``du/dt``, ``d²u/dt²``.
 
     ``smooth=False``: constant rate (Yun's Table I), ``u = t/T``.
     ``smooth=True``: raised-cosine rate, ``u = τ − sin(2πτ)/(2π)``, zero rate and
-    zero angular acceleration at both ends (no velocity jumps at phase changes).
+    zero angular acceleration at both ends (no velocity jumps at phase changes;
+    used for rotations about a contact point, which move the sensor).
+    ``smooth="sine"``: half-sine rate, ``u = (1 − cos πτ)/2``: zero rate at the ends
+    but leaving zero quickly (used for the swing, whose rotation does not move
+    the sensor in this model: the pitch rate passes through zero at toe-off and
+    heel strike without dwelling near it, as a real foot's does).
     """
     T = float(duration)
     tau = np.asarray(t, dtype=float) / T
+    if smooth == "sine":
+        u = (1 - np.cos(np.pi * tau)) / 2
+        return u, np.pi * np.sin(np.pi * tau) / (2 * T), np.pi**2 * np.cos(np.pi * tau) / (2 * T**2)
     if not smooth:
         return tau, np.full_like(tau, 1.0 / T), np.zeros_like(tau)
     u = tau - np.sin(2 * np.pi * tau) / (2 * np.pi)

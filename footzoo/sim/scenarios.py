@@ -21,12 +21,13 @@ from . import paths
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu
 
-#: Walking speeds Nguyen & La tested (m/s) and a run, as (stride length m, cycle s, stance fraction).
+#: Walking speeds Nguyen & La tested (m/s) and a run, as
+#: (stride length m, cycle s, stance fraction, foot-flat share of stance).
 SPEEDS = {
-    "slow": (1.0, 1.18, 0.62),  # 0.85 m/s
-    "normal": (1.38, 1.0, 0.60),  # 1.38 m/s
-    "fast": (1.6, 0.833, 0.58),  # 1.92 m/s
-    "run": (2.4, 0.75, 0.40),  # 3.2 m/s
+    "slow": (1.0, 1.18, 0.62, 2 / 3),  # 0.85 m/s
+    "normal": (1.38, 1.0, 0.60, 2 / 3),  # 1.38 m/s
+    "fast": (1.6, 0.833, 0.58, 0.6),  # 1.92 m/s
+    "run": (2.4, 0.75, 0.40, 1 / 3),  # 3.2 m/s: 0.3 s contact, 0.1 s still (PyShoe fast trials: 0.10-0.15 s)
 }
 
 PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed")
@@ -120,8 +121,8 @@ def simulate(
         for name, n in speeds:
             if name not in SPEEDS:
                 raise ValueError(f"unknown speed {name!r}; known: {sorted(SPEEDS)}")
-            L, c, sf = SPEEDS[name]
-            specs += [StrideSpec(c, sf, clearance if name != "run" else clearance * 1.2)] * n
+            L, c, sf, flat = SPEEDS[name]
+            specs += [StrideSpec(c, sf, clearance, flat)] * n
             lengths += [L] * n
         steps, closed = paths.straight(len(lengths), lengths), False
     else:

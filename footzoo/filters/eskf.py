@@ -1,0 +1,116 @@
+"""The one error-state Kalman filter of footzoo, on filterpy's ``KalmanFilter``.
+
+Error state (the enabled blocks, in this order; Nguyen & La 2016, eq. 31):
+``att`` δφ (rad, NED), ``gyro_bias`` δω (rad/s, body), ``pos`` δp (m), ``vel``
+δv (m/s), ``acc_bias`` δa (m/s², body), then any extra states a correction adds
+(e.g. distance-sensor calibration, Duong & Suh 2015).
+
+Conventions: ``δφ, δp, δv`` are estimate − truth; the attitude error is in NED,
+``C_est = (I + [δφ×]) C_true``; ``δω, δa`` are the corrections to add to the bias
+estimates. The first-order error dynamics are then (Nguyen & La eq. 33, read
+with these signs)::
+
+    δφ' = C δω,   δp' = δv,   δv' = −[f^n×] δφ + C δa,   biases constant
+
+with ``f^n = C (f − b̂_a)`` the bias-corrected specific force in NED (eqs. 34–35).
+After every measurement update the error is fed back (eqs. 49–52:
+``q ← exp(−δφ) ⊗ q``, ``p ← p − δp``, ``v ← v − δv``, ``b̂ ← b̂ + δb``) and the error
+state reset to zero — the closed-loop form. (The paper's Algorithm 2 keeps
+propagating δX after the feedback, which would apply each correction again at
+every later sample; footzoo resets it, as indirect-feedback filters do.)
+The covariance update is filterpy's Joseph form (eq. 45).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
+
+
+@dataclass
+class Layout:
+    """Error-state blocks and their slices."""
+
+    blocks: list[tuple[str, int]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.slices: dict[str, slice] = {}
+        i = 0
+        for name, size in self.blocks:
+            if name in self.slices:
+                raise ValueError(f"error-state block {name!r} declared twice")
+            self.slices[name] = slice(i, i + size)
+            i += size
+        self.n = i
+
+    def has(self, name: str) -> bool:
+        """Whether the block is part of the state."""
+        return name in self.slices
+
+    def __getitem__(self, name: str) -> slice:
+        return self.slices[name]
+
+    def names(self) -> list[str]:
+        """Block names in order."""
+        return [b[0] for b in self.blocks]
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    """``[v×]``."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def transition(layout: Layout, c: np.ndarray, f_n: np.ndarray, dt: float) -> np.ndarray:
+    """Φ = I + A dt for the enabled blocks (Nguyen & La eq. 33)."""
+    F = np.eye(layout.n)
+    i3 = np.eye(3)
+    has = layout.has
+    if has("att") and has("gyro_bias"):
+        F[layout["att"], layout["gyro_bias"]] = dt * c
+    F[layout["pos"], layout["vel"]] = dt * i3
+    if has("att"):
+        F[layout["vel"], layout["att"]] = -dt * skew(f_n)
+    if has("acc_bias"):
+        F[layout["vel"], layout["acc_bias"]] = dt * c
+    return F
+
+
+class ErrorStateFilter:
+    """filterpy ``KalmanFilter`` holding the error state, with predict/update/take-and-reset.
+
+    Parameters
+    ----------
+    layout : Layout
+        State blocks.
+    p0 : (n,) array
+        Initial variances.
+    q : (n,) array
+        Process-noise variance growth per second of each state (Q = diag(q) dt).
+    """
+
+    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray):
+        self.layout = layout
+        self.kf = KalmanFilter(dim_x=layout.n, dim_z=1)
+        self.kf.P = np.diag(np.asarray(p0, dtype=float))
+        self.q = np.asarray(q, dtype=float)
+
+    def predict(self, F: np.ndarray, dt: float) -> None:
+        """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates."""
+        self.kf.predict(F=F, Q=np.diag(self.q * dt))
+
+    def update(self, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:
+        """Measurement update (eqs. 40, 43, 45) and return of the error, which is then reset."""
+        self.kf.dim_z = len(z)
+        self.kf.update(np.asarray(z, dtype=float).reshape(-1, 1), R=R, H=H)
+        dx = self.kf.x[:, 0].copy()
+        self.kf.x[:] = 0.0
+        return dx
+
+    @property
+    def P(self) -> np.ndarray:
+        """Current covariance."""
+        return self.kf.P
