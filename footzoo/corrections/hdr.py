@@ -76,7 +76,7 @@ class HDR(Plugin):
         ends: list[float] = []
         biases = []
         st = intervals(stance)
-        for j, (a, b) in enumerate(st):
+        for j, (_start, b) in enumerate(st):
             d = heading_bias(float(yaw[b - 1]), ends, self.threshold)
             ends.append(float(yaw[b - 1]))
             biases.append(np.nan if d is None else d)
