@@ -130,9 +130,16 @@ class Pipeline:
             quat_ext = None
             if orientation.name != "ins":
                 quat_ext = orientation.estimate(t, acc, gyr, mag, stance, q0).quat_
+            init_window = t <= t[0] + self.init["duration"]
+            for m in kalman:
+                if getattr(m, "needs_recording", False):
+                    m.bind(rec.dist, t, init_window)
             nav = _run_kalman(t, acc, gyr, stance, q0, orientation, kalman + heading, quat_ext, self.gravity)
             quat, vel, pos, acc_nav = nav["quat"], nav["vel"], nav["pos"], nav["acc_nav"]
             diagnostics.update(gyro_bias=nav["gyro_bias"], acc_bias=nav["acc_bias"], P_diag=nav["P_diag"])
+            for m in kalman:
+                if hasattr(m, "calibration_result"):
+                    diagnostics["distance_calibration"] = m.calibration_result()
         else:
             quat = orientation.estimate(t, acc, gyr, mag, stance, q0).quat_
             acc_nav = motion_acceleration(quat, acc, self.gravity)

@@ -1,7 +1,18 @@
 """Corrections applied to the navigation solution."""
 
-from .ekf_zupt import EKFZUPT
+from .ekf_zupt import EKFZUPT, ZUPT
 from .hdr import HDR
+from .height import HeightDistance, HeightFlatFloor, load_calibration, save_calibration
 from .zvu_dedrift import ZVUDedrift, zvu_dedrift
 
-__all__ = ["EKFZUPT", "HDR", "ZVUDedrift", "zvu_dedrift"]
+__all__ = [
+    "EKFZUPT",
+    "HDR",
+    "ZUPT",
+    "HeightDistance",
+    "HeightFlatFloor",
+    "ZVUDedrift",
+    "load_calibration",
+    "save_calibration",
+    "zvu_dedrift",
+]

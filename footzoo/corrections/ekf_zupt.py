@@ -104,3 +104,28 @@ class EKFZUPT(Plugin):
 
     def after(self, nav: NavState) -> None:
         """Nothing to remember."""
+
+
+@register
+class ZUPT(EKFZUPT):
+    """Zero-velocity update of the error-state Kalman filter (Duong & Suh 2015, eq. 23).
+
+    Duong & Suh 2015, Sensors 15, Sec. 4.2: in zero-velocity intervals the
+    measurement ``z_v = 0 − v̂`` with ``H_v`` picking the velocity error and noise
+    ``E{v_zero v_zero'} = 0.0001 I`` (Table 1, σ = 0.01 m/s). The same model as
+    ``ekf_zupt`` without bias states or the zero-rate measurement: with the
+    attitude, position and velocity errors of the INS it is the paper's
+    9-state filter.
+
+    Parameters
+    ----------
+    velocity_std : float
+        Standard deviation of v_zero (m/s).
+    """
+
+    name = "zupt"
+    paper = "Duong & Suh 2015, Sensors 15, eq. 23, Table 1"
+    units = {"velocity_std": "m/s"}
+
+    def __init__(self, velocity_std: float = 0.01):
+        super().__init__(gyro_bias=False, accel_bias=False, zero_rate=False, velocity_std=velocity_std)

@@ -27,7 +27,7 @@ class NavState:
     f: np.ndarray  # bias-corrected specific force (m/s²)
     stance: bool
     layout: Layout
-    extra: dict[str, np.ndarray] = field(default_factory=dict)  # values of extra (non-core) states
+    extra: dict[str, np.ndarray] = field(default_factory=dict)  # free for the measurement models
 
     def yaw(self) -> float:
         """Z-Y-X heading of the attitude (rad)."""
@@ -56,7 +56,6 @@ def run_error_state_filter(
     measurements: list[Any],
     quat_external: np.ndarray | None = None,
     gravity: float = GRAVITY,
-    extra_feedback: Any = None,
 ) -> dict[str, np.ndarray]:
     """Strapdown mechanisation with error-state Kalman corrections in stance.
 
@@ -88,8 +87,7 @@ def run_error_state_filter(
     for m in measurements:
         m.begin(n, layout)
     extra: dict[str, np.ndarray] = {}
-    if extra_feedback is not None:
-        extra = extra_feedback.initial_values()
+    absorbing = [m for m in measurements if hasattr(m, "feedback")]
     for k in range(1, n):
         dt = t[k] - t[k - 1]
         w = gyr[k] - bg
@@ -124,8 +122,8 @@ def run_error_state_filter(
                 bg = bg + dx[layout["gyro_bias"]]
             if layout.has("acc_bias"):
                 ba = ba + dx[layout["acc_bias"]]
-            if extra_feedback is not None:
-                extra = extra_feedback.feedback(extra, dx, layout)
+            for m in absorbing:
+                m.feedback(dx, layout)
             nav = NavState(k, t[k], q, p, v, bg, ba, gyr[k] - bg, acc[k] - ba, bool(stance[k]), layout, extra)
         for m in measurements:
             m.after(nav)
@@ -136,7 +134,6 @@ def run_error_state_filter(
         out["gyro_bias"][k] = bg
         out["acc_bias"][k] = ba
         out["P_diag"][k] = np.diag(kf.P)
-    out["extra"] = extra
     return out
 
 

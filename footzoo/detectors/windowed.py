@@ -1,0 +1,81 @@
+"""Windowed gyro/accelerometer zero-velocity test (Duong & Suh 2015, eq. 21)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+
+from ..registry import Plugin, check_positive, register
+
+
+def centred_max(x: np.ndarray, half: int) -> np.ndarray:
+    """Maximum of ``x`` over ``[k − half, k + half]`` (clipped at the ends)."""
+    return maximum_filter1d(x, size=2 * half + 1, mode="nearest")
+
+
+@register
+class Windowed(Plugin):
+    """Stationary when the gyro and the accelerometer's changes stay small around the sample.
+
+    Duong & Suh 2015, Sensors 15, eq. 21: sample k is in a zero-velocity
+    interval when ``‖y_g,i‖ ≤ B_g`` for all i in ``[k − N_g/2, k + N_g/2]`` and
+    ``‖y_a,i − y_a,i−1‖ ≤ B_a`` for all i in ``[k − N_a/2, k + N_a/2]`` (N even).
+    The paper gives no values; footzoo's defaults: B_g = 0.6 rad/s, windows of
+    0.1 s (N = 10 at the paper's 100 Hz), B_a = 0.5 m/s² between consecutive
+    samples (at 100 Hz; the bound is per sample, so a faster IMU sees smaller
+    differences for the same motion). The window is centred: a live system
+    knows the result N/2 samples late.
+
+    Parameters
+    ----------
+    gyro_threshold : float
+        B_g (rad/s).
+    acc_diff_threshold : float
+        B_a (m/s², between consecutive samples).
+    gyro_window, acc_window : float
+        N_g and N_a as durations (s); the sample counts are the nearest even numbers.
+
+    Attributes
+    ----------
+    gyro_statistic_ : (N,) ndarray
+        Windowed max of ‖y_g‖ (rad/s).
+    acc_statistic_ : (N,) ndarray
+        Windowed max of ‖Δy_a‖ (m/s²).
+    statistic_ : (N,) ndarray
+        ``max(gyro_statistic_/B_g, acc_statistic_/B_a)``: stance where ≤ 1, so a
+        threshold sweep scales both bounds together.
+    stance_, stance_online_ : (N,) bool ndarray
+        Zero-velocity flag.
+    """
+
+    kind = "detector"
+    name = "windowed"
+    paper = "Duong & Suh 2015, Sensors 15, eq. 21"
+    units = {"gyro_threshold": "rad/s", "acc_diff_threshold": "m/s^2", "gyro_window": "s", "acc_window": "s"}
+
+    def __init__(
+        self,
+        gyro_threshold: float = 0.6,
+        acc_diff_threshold: float = 0.5,
+        gyro_window: float = 0.1,
+        acc_window: float = 0.1,
+    ):
+        self.gyro_threshold = check_positive("gyro_threshold", gyro_threshold)
+        self.acc_diff_threshold = check_positive("acc_diff_threshold", acc_diff_threshold)
+        self.gyro_window = check_positive("gyro_window", gyro_window, allow_zero=True)
+        self.acc_window = check_positive("acc_window", acc_window, allow_zero=True)
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Windowed:
+        """Evaluate eq. 21 over the whole recording (vectorised)."""
+        rate = 1.0 / float(np.median(np.diff(t)))
+        half_g = int(round(self.gyro_window * rate / 2))
+        half_a = int(round(self.acc_window * rate / 2))
+        dacc = np.zeros(t.shape[0])
+        dacc[1:] = np.linalg.norm(np.diff(acc, axis=0), axis=1)
+        self.gyro_statistic_ = centred_max(np.linalg.norm(gyr, axis=1), half_g)
+        self.acc_statistic_ = centred_max(dacc, half_a)
+        self.statistic_ = np.maximum(self.gyro_statistic_ / self.gyro_threshold,
+                                     self.acc_statistic_ / self.acc_diff_threshold)
+        self.stance_ = self.statistic_ <= 1.0
+        self.stance_online_ = self.stance_.copy()
+        return self
