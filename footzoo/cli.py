@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | simulate | list | validate``."""
+"""Command line: ``footzoo run | simulate | calibrate | list | validate``."""
 
 from __future__ import annotations
 
@@ -89,12 +89,14 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .io.canonical import write
-    from .sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_pendulum
+    from .sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_calibration, simulate_pendulum
 
     biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
     noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
     if args.scenario == "pendulum":
         rec = simulate_pendulum(rate=args.rate, noise=noise, sampling=args.sampling)
+    elif args.scenario == "calibration":
+        rec = simulate_calibration(mount_yaw=np.radians(args.mount_yaw), foot=args.foot, rate=args.rate, noise=noise)
     else:
         rec = simulate(
             path=args.scenario, n_strides=args.strides, stride_length=args.stride_length, rate=args.rate,
@@ -107,6 +109,24 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     closed = "closed loop" if rec.truth.closed_loop else "open path"
     print(f"wrote {out} ({rec.n} samples at {rec.rate:.0f} Hz, {rec.t[-1]:.1f} s, {closed}, "
           f"{0 if rec.truth.steps is None else len(rec.truth.steps)} steps)")
+    return 0
+
+
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    """Foot vector from a calibration recording (Huang et al. 2016, eq. 11), saved as YAML."""
+    import numpy as np
+
+    from .analysis.foot_vector import calibrate_foot_vector
+
+    rec = _load_recording(args)
+    fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
+                               flex=tuple(args.flex) if args.flex else None)
+    fv.save(args.out)
+    yaw = np.degrees(np.arctan2(-fv.vector[1], fv.vector[0]))
+    print(f"foot vector (sensor frame, FRD): {np.round(fv.vector, 4).tolist()}  "
+          f"(sensor yawed {yaw:.2f}° on the foot)")
+    print(f"still {fv.still[0]:.2f}-{fv.still[1]:.2f} s, flexions {fv.flex[0]:.2f}-{fv.flex[1]:.2f} s")
+    print(f"wrote {args.out}; use it with analysis: [{{type: huang_fpa, calibration: {args.out}}}]")
     return 0
 
 
@@ -127,7 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.set_defaults(func=cmd_run)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
-    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum"])
+    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
+                                          "calibration"])
     sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
     sim.add_argument("--strides", type=int, default=100, help="strides of a straight walk (default 100)")
     sim.add_argument("--stride-length", type=float, default=1.2, help="stride length in m (default 1.2)")
@@ -144,8 +165,17 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--disturbance", action="store_true", help="add a magnetic disturbance (first 10 m north)")
     sim.set_defaults(func=cmd_simulate)
 
+    cal = sub.add_parser("calibrate", help="foot vector from a still period and slow dorsi-/plantar-flexions")
+    cal.add_argument("--data", required=True, help="calibration recording")
+    cal.add_argument("--format", help="reader format (default: detect)")
+    cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
+    cal.add_argument("--still", nargs=2, type=float, metavar=("T0", "T1"), help="still period (s); default: found")
+    cal.add_argument("--flex", nargs=2, type=float, metavar=("T0", "T1"), help="flexion period (s); default: found")
+    cal.add_argument("--out", required=True, help="YAML file to write")
+    cal.set_defaults(func=cmd_calibrate)
+
     lst = sub.add_parser("list", help="list plug-ins with their parameters, defaults, units and papers")
-    lst.add_argument("--kind", choices=["orientation", "detector", "correction"], help="only this kind")
+    lst.add_argument("--kind", choices=["orientation", "detector", "correction", "analysis"], help="only this kind")
     lst.set_defaults(func=cmd_list)
 
     val = sub.add_parser("validate", help="check a pipeline config without running it")

@@ -29,6 +29,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "orientation": "orientation plug-in {type: ..., params}",
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
+    "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")
@@ -68,6 +69,6 @@ def check_top_level(d: dict[str, Any]) -> None:
     for key in init:
         if key not in INIT_KEYS:
             raise ConfigError(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; valid: {list(INIT_KEYS)}")
-    corr = d.get("corrections", []) or []
-    if not isinstance(corr, list):
-        raise ConfigError("corrections must be a list, e.g. [{type: zvu_dedrift}]")
+    for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]")):
+        if not isinstance(d.get(key, []) or [], list):
+            raise ConfigError(f"{key} must be a list, e.g. {example}")

@@ -178,3 +178,28 @@ def step_detection(stance: np.ndarray, truth: np.ndarray, t: np.ndarray) -> dict
         "onset_error_abs_max_s": float(np.max(np.abs(onset))) if onset else float("nan"),
         "offset_error_abs_max_s": float(np.max(np.abs(offset))) if offset else float("nan"),
     }
+
+
+# --------------------------------------------------------------------------- strides
+
+
+def match_strides(estimated, reference, tolerance: float = 0.5, min_fraction: float = 0.3):
+    """Pair estimated and reference strides by their end times.
+
+    Estimated strides shorter than ``min_fraction`` of the median stride length
+    (split stances, shuffles) are left out; each reference stride takes the
+    estimated stride whose ``end`` is nearest to its own, within ``tolerance``
+    seconds. Returns a DataFrame with the reference columns and ``est_*`` columns.
+    """
+    import pandas as pd
+
+    est = estimated[estimated["stride_length"] >= min_fraction * estimated["stride_length"].median()]
+    rows = []
+    ends = est["end"].to_numpy()
+    for _, r in reference.iterrows():
+        if ends.size == 0:
+            break
+        j = int(np.argmin(np.abs(ends - r["end"])))
+        if abs(ends[j] - r["end"]) <= tolerance:
+            rows.append({**r.to_dict(), **{f"est_{k}": v for k, v in est.iloc[j].to_dict().items()}})
+    return pd.DataFrame(rows)

@@ -54,10 +54,12 @@ class Pipeline:
         name: str = "pipeline",
         gravity: float = GRAVITY,
         init: dict[str, float] | None = None,
+        analysis: list[Plugin] | None = None,
     ):
         self.orientation = orientation
         self.detector = detector
         self.corrections = list(corrections or [])
+        self.analysis = list(analysis or [])
         self.name = name
         self.gravity = check_positive("gravity", gravity)
         self.init = {**INIT_KEYS, **(init or {})}
@@ -73,6 +75,7 @@ class Pipeline:
         corrections = [
             build("correction", c, f"corrections[{i}]") for i, c in enumerate(d.get("corrections") or [])
         ]
+        analysis = [build("analysis", a, f"analysis[{i}]") for i, a in enumerate(d.get("analysis") or [])]
         return cls(
             orientation,
             detector,
@@ -80,6 +83,7 @@ class Pipeline:
             name=str(d.get("name", "pipeline")),
             gravity=d.get("gravity", GRAVITY),
             init=d.get("init") or {},
+            analysis=analysis,
         )
 
     @classmethod
@@ -103,6 +107,7 @@ class Pipeline:
             "orientation": spec(self.orientation),
             "detector": spec(self.detector),
             "corrections": [spec(c) for c in self.corrections],
+            "analysis": [spec(a) for a in self.analysis],
         }
 
     # ------------------------------------------------------------------- run
@@ -163,9 +168,13 @@ class Pipeline:
                 "stance": stance,
             }
         )
+        steps = segment_steps(t, stance, pos)
+        for a in self.analysis:
+            a = _clone(a).analyze(t, quat, pos, stance, rec.meta)
+            steps = a.annotate(steps, t)
         return Result(
             samples=samples,
-            steps=segment_steps(t, stance, pos),
+            steps=steps,
             config=self.to_dict(),
             versions=versions(),
             recording=dict(rec.meta),

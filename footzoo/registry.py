@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 
 from .errors import ConfigError
 
-KINDS: tuple[str, ...] = ("orientation", "detector", "correction")
+KINDS: tuple[str, ...] = ("orientation", "detector", "correction", "analysis")
 
 _REGISTRY: dict[str, dict[str, type[Plugin]]] = {k: {} for k in KINDS}
 
@@ -128,7 +128,7 @@ def describe(kind: str | None = None) -> str:
 
 def _load_builtin() -> None:
     # importing the packages registers their plug-ins
-    from . import corrections, detectors, orientation  # noqa: F401
+    from . import analysis, corrections, detectors, orientation  # noqa: F401
 
 
 def check_positive(name: str, value: float, allow_zero: bool = False) -> float:

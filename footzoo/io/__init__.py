@@ -12,8 +12,8 @@ canonical      SI (t s, acc m/s², gyr rad/s)  already FRD
 xio            g, deg/s                       NGIMU z up: (x, −y, −z), 180° about x
 pyshoe         m/s², rad/s                    already x fwd, y right, z down; VICON ``gt``
                                               is mirrored: truth = gt · [1, 1, −1]
-gaitmap        m/s², deg/s                    foot frame x toe, y left, z up: (x, −y, −z);
-                                              the right foot is mirrored (see gaitmap.py)
+gaitmap        m/s², deg/s                    foot frame x toe, y left, z up: (x, −y, −z)
+                                              for both feet (see gaitmap.py)
 sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down: identity
 ============== ============================== ============================================
 """

@@ -4,14 +4,16 @@ Two header rows (sensor, axis); ``left_sensor`` and ``right_sensor`` with
 ``acc_x..z`` (m/s²) and ``gyr_x..z`` (**deg/s**); no time column: samples are at
 204.8 Hz. The data are in gaitmap's foot frame, x toward the toe, y left, z up.
 
-* Left foot: a right-handed frame; to FRD by 180° about x: ``(x, −y, −z)`` for
-  both accelerometer and gyroscope.
-* Right foot: mirrored about the sagittal plane (y points right), with the gyro
-  transformed as an axial vector (``ω' = −M ω``, ``M = diag(1, −1, 1)``). Undoing
-  the mirror and then turning to FRD gives acc ``(x, y, −z)`` and gyro
-  ``(−x, −y, z)``. Checked on the file: gyro integration over each stride then
-  predicts the next stance's gravity direction to about 1.5° (a polar-vector
-  reading of the gyro gives 16°), and both feet turn the same way in the turns.
+* Both feet: to FRD by 180° about x, ``(x, −y, −z)`` for accelerometer and
+  gyroscope alike.
+
+The data README calls the right foot's frame mirrored. Checked on the file,
+the right foot's data nevertheless behave as a right-handed frame: (1) gyro
+integration over each stride predicts the next stance's gravity direction to
+1.5° with this map (a mirror applied to the gyro as a polar vector gives 16°),
+and (2) with this map the estimated trajectory of the right foot turns the same
+way as the left foot's and as the motion-capture markers (an un-mirroring map
+makes the right foot turn the other way). So both feet use the same map.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ AXES = ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]
 #: Sign applied to each column (acc_x..z, gyr_x..z) to reach FRD.
 TO_FRD = {
     "left": np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0]),
-    "right": np.array([1.0, 1.0, -1.0, -1.0, -1.0, 1.0]),
+    "right": np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0]),  # see the module docstring
 }
 
 

@@ -3,5 +3,6 @@
 from .fqa import fqa
 from .fqa_complementary import FQAComplementary
 from .ins import INS
+from .madgwick import Madgwick
 
-__all__ = ["INS", "FQAComplementary", "fqa"]
+__all__ = ["INS", "FQAComplementary", "Madgwick", "fqa"]

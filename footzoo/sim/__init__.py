@@ -9,7 +9,7 @@
 
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
 from .pendulum import simulate_pendulum
-from .scenarios import SPEEDS, simulate
+from .scenarios import SPEEDS, simulate, simulate_calibration
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned
 
 __all__ = [
@@ -23,5 +23,6 @@ __all__ = [
     "StrideSpec",
     "magnetic_field_ned",
     "simulate",
+    "simulate_calibration",
     "simulate_pendulum",
 ]

@@ -136,6 +136,7 @@ class Segment:
     clearance: float = 0.0
     smooth: bool | str = False
     swing: GaussianSwing | None = None
+    cycles: int = 0  # flex: number of dorsi-/plantar-flexion cycles (theta[0] is the amplitude)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Position, velocity, acceleration (NED), yaw ψ, pitch θ and their rates at absolute times ``t``."""
@@ -161,10 +162,13 @@ class Segment:
             out["psi"], out["psi_dot"] = np.full(n, self.psi[0]), np.zeros(n)
             out["theta"], out["theta_dot"] = np.full(n, self.theta[0]), np.zeros(n)
             return out
-        # rotation about a contact point (ic, ps)
-        u, u1, u2 = rotation_progress(tl, T, self.smooth)
-        dth = self.theta[1] - self.theta[0]
-        th, thd, thdd = self.theta[0] + dth * u, dth * u1, dth * u2
+        # rotation about a contact point (ic, ps) or the ankle (flex)
+        if self.kind == "flex":
+            th, thd, thdd = flexion_angle(tl, T, self.theta[0], self.cycles)
+        else:
+            u, u1, u2 = rotation_progress(tl, T, self.smooth)
+            dth = self.theta[1] - self.theta[0]
+            th, thd, thdd = self.theta[0] + dth * u, dth * u1, dth * u2
         out["psi"], out["psi_dot"] = np.full(n, self.psi[0]), np.zeros(n)
         out["theta"], out["theta_dot"] = th, thd
         if self.contact is None:  # paper profile: the sensor only rotates
@@ -177,6 +181,49 @@ class Segment:
         out["a"] = -(np.einsum("ij,njk,k->ni", rz, _ry(th, 2), r) * thd[:, None] ** 2
                      + np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thdd[:, None])
         return out
+
+
+def flexion_angle(t: np.ndarray, duration: float, amplitude: float, cycles: int):
+    """Slow dorsi-/plantar-flexions: ``θ = A sin³(2π n t/T)`` with rate and acceleration, zero at both ends."""
+    phi = 2 * np.pi * cycles * np.asarray(t, dtype=float) / duration
+    w = 2 * np.pi * cycles / duration
+    s, c = np.sin(phi), np.cos(phi)
+    return amplitude * s**3, amplitude * 3 * s**2 * c * w, amplitude * (6 * s * c**2 - 3 * s**3) * w**2
+
+
+def calibration_timeline(
+    geometry: FootGeometry,
+    heading: float = 0.0,
+    stand: float = 3.0,
+    cycles: int = 3,
+    period: float = 2.0,
+    amplitude: float = float(np.radians(20.0)),
+    ankle: np.ndarray | None = None,
+) -> GaitTimeline:
+    """Huang et al.'s calibration trial: standing still, then slow flexions about the ankle, standing again.
+
+    The foot pitches about its own y axis through the ankle (``ankle``: vector
+    from the sensor to the ankle in the foot frame, m).
+    """
+    ankle = np.array([-0.08, 0.0, -0.02]) if ankle is None else np.asarray(ankle, float)
+    tl = GaitTimeline.__new__(GaitTimeline)
+    tl.footsteps, tl.strides, tl.geometry, tl.profile = [], [], geometry, "physical"
+    psi = float(heading)
+    origin = np.zeros(3)
+    pivot = origin + _rz(np.array(psi)) @ ankle
+    flex_t0 = stand
+    flex_t1 = stand + cycles * period
+    tl.segments = [
+        Segment(0.0, stand, "still", True, (psi, psi), (0.0, 0.0), a=origin),
+        Segment(flex_t0, flex_t1, "flex", False, (psi, psi), (amplitude, 0.0), contact=pivot, r_contact=ankle,
+                a=origin, cycles=cycles),
+        Segment(flex_t1, flex_t1 + stand, "still", True, (psi, psi), (0.0, 0.0), a=origin),
+    ]
+    tl.steps = []
+    tl.t_end = tl.segments[-1].t1
+    tl._starts = np.array([seg.t0 for seg in tl.segments])
+    tl.phases = {"still": (0.0, stand), "flex": (flex_t0, flex_t1)}
+    return tl
 
 
 class GaitTimeline:

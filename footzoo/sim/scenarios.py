@@ -165,3 +165,36 @@ def simulate(
     if dist is not None:
         meta["dist_columns"] = [f"dist_{chr(97 + j)}" for j in range(dist.shape[1])]
     return Recording(t=t, acc=acc, gyr=gyr, mag=mag, dist=dist, meta=meta, truth=truth)
+
+
+def simulate_calibration(
+    mount_yaw: float = 0.0,
+    mount_pitch: float = 0.0,
+    foot: str = "right",
+    rate: float = 100.0,
+    noise: NoiseModel | dict | None = None,
+    magnetometer: bool = True,
+    location: str | tuple[float, float] = "monterey",
+    gravity: float = GRAVITY,
+    **options,
+) -> Recording:
+    """The calibration trial of Huang et al. 2016 (Sec. III): stand still, three slow flexions, stand.
+
+    ``meta["calibration_still"]`` and ``meta["calibration_flex"]`` hold the two
+    periods (s); the truth's quaternion gives the mounting to recover.
+    """
+    from .gait import calibration_timeline
+
+    geometry = FootGeometry(mount_yaw=mount_yaw, mount_pitch=mount_pitch, side=1 if foot == "right" else -1)
+    timeline = calibration_timeline(geometry, **options)
+    t = np.arange(0.0, timeline.t_end, 1.0 / rate)
+    state = timeline.evaluate(t)
+    acc, gyr = sample_imu(state, t, gravity, "interval")
+    mag = quat_rotate(quat_conj(state["q"]), magnetic_field_ned(location)) if magnetometer else None
+    if noise is not None:
+        noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
+        acc, gyr, mag = noise.apply(acc, gyr, mag)
+    truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=state["still"])
+    meta = {"name": "sim_calibration", "source": "footzoo.sim", "format": "simulated", "foot": foot,
+            "calibration_still": list(timeline.phases["still"]), "calibration_flex": list(timeline.phases["flex"])}
+    return Recording(t=t, acc=acc, gyr=gyr, mag=mag, meta=meta, truth=truth)

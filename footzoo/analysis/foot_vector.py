@@ -1,0 +1,123 @@
+"""Foot vector calibration (Huang et al. 2016, Sec. II-C, eqs. 11–12)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from ..data import Recording
+from ..errors import ConfigError, RecordingError
+from ..metrics import intervals
+
+
+@dataclass
+class FootVector:
+    """A foot vector in the sensor frame and how it was found.
+
+    Attributes
+    ----------
+    vector : (3,) ndarray
+        Unit foot vector ``f`` in the sensor (body, FRD) frame, toward the toe.
+    gravity_axis : (3,) ndarray
+        Unit gravity direction ``g`` in the sensor frame, foot flat (down).
+    rotation_axis : (3,) ndarray
+        Unit common rotation axis ``k`` of the flexions (pointing to the sensor's right).
+    still, flex : tuple of float
+        The periods used (s).
+    """
+
+    vector: np.ndarray
+    gravity_axis: np.ndarray
+    rotation_axis: np.ndarray
+    still: tuple[float, float] = (float("nan"), float("nan"))
+    flex: tuple[float, float] = (float("nan"), float("nan"))
+
+    def save(self, path: str | Path) -> Path:
+        """Write as YAML (loaded by ``huang_fpa``'s ``calibration``)."""
+        p = Path(path)
+        p.write_text(yaml.safe_dump({
+            "foot_vector": [float(v) for v in self.vector],
+            "gravity_axis": [float(v) for v in self.gravity_axis],
+            "rotation_axis": [float(v) for v in self.rotation_axis],
+            "still_s": [float(v) for v in self.still], "flex_s": [float(v) for v in self.flex],
+            "frame": "sensor body frame (FRD)", "method": "Huang et al. 2016 eq. 11: f = k x g",
+        }, sort_keys=False))
+        return p
+
+    @classmethod
+    def load(cls, path: str | Path) -> FootVector:
+        """Read a file written by :meth:`save`."""
+        p = Path(path)
+        if not p.exists():
+            raise ConfigError(f"foot-vector calibration {str(p)!r} does not exist; create it with footzoo calibrate")
+        data = yaml.safe_load(p.read_text()) or {}
+        if "foot_vector" not in data:
+            raise ConfigError(f"{p}: no 'foot_vector' entry; was it written by footzoo calibrate?")
+        v = np.asarray(data["foot_vector"], float)
+        return cls(v / np.linalg.norm(v), np.asarray(data.get("gravity_axis", [0, 0, 1]), float),
+                   np.asarray(data.get("rotation_axis", [0, 1, 0]), float),
+                   tuple(data.get("still_s", (np.nan, np.nan))), tuple(data.get("flex_s", (np.nan, np.nan))))
+
+
+def calibrate_foot_vector(
+    rec: Recording,
+    still: tuple[float, float] | None = None,
+    flex: tuple[float, float] | None = None,
+    still_duration: float = 1.0,
+    max_gyr: float = 0.1,
+) -> FootVector:
+    """Foot vector ``f = k × g`` from a still period and slow dorsi-/plantar-flexions (eq. 11).
+
+    Parameters
+    ----------
+    rec : Recording
+        The calibration recording.
+    still : (t0, t1), optional
+        Foot flat and still (s). Default: the first run of at least
+        ``still_duration`` s with |ω| ≤ ``max_gyr``.
+    flex : (t0, t1), optional
+        The flexions (s). Default: from the end of that still period to the
+        start of the next such still run (or the end of the recording).
+
+    The gravity axis ``g`` is the mean specific force's opposite (down, in the
+    sensor frame); the common rotation axis ``k`` is the principal direction of
+    the angular rate during the flexions (eigenvector of ``Σ ω ωᵀ`` with the
+    largest eigenvalue), its sign chosen to point to the sensor's right (+y),
+    which assumes the sensor's y axis within 90° of the foot's right side.
+    """
+    t = rec.t
+    if still is None or flex is None:
+        runs = intervals(np.linalg.norm(rec.gyr, axis=1) <= max_gyr)
+        long = [(int(a), int(b)) for a, b in runs if t[b - 1] - t[a] >= still_duration]
+        if not long:
+            raise RecordingError(
+                f"no still period of {still_duration} s (|ω| ≤ {max_gyr} rad/s) in the calibration recording; "
+                "give the periods with --still T0 T1 --flex T0 T1"
+            )
+        if still is None:
+            still = (float(t[long[0][0]]), float(t[long[0][1] - 1]))
+        if flex is None:
+            after = [a for a, _ in long if t[a] > still[1]]
+            flex = (still[1], float(t[after[0]]) if after else float(t[-1]))
+    ws = (t >= still[0]) & (t <= still[1])
+    wf = (t >= flex[0]) & (t <= flex[1])
+    if ws.sum() < 2 or wf.sum() < 10:
+        raise RecordingError(
+            f"foot-vector calibration needs a still period and a flexion period with samples; got still {still} s "
+            f"({int(ws.sum())} samples) and flex {flex} s ({int(wf.sum())} samples): give them with --still/--flex"
+        )
+    g = -rec.acc[ws].mean(axis=0)
+    g = g / np.linalg.norm(g)
+    w = rec.gyr[wf]
+    if np.sqrt(np.mean(np.sum(w**2, axis=1))) < 0.05:
+        raise RecordingError(f"no rotation in the flexion period {flex} s (rms rate below 0.05 rad/s)")
+    eigval, eigvec = np.linalg.eigh(w.T @ w)
+    k = eigvec[:, -1]
+    if k[1] < 0:
+        k = -k
+    f = np.cross(k, g)
+    f = f / np.linalg.norm(f)
+    return FootVector(f, g, k, tuple(still), tuple(flex))

@@ -1,0 +1,137 @@
+"""Heading vector and foot progression angle (Huang et al. 2016, Sec. II-D/E, eqs. 12–16)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..conventions import quat_rotate, wrap_angle
+from ..errors import ConfigError
+from ..metrics import intervals
+from ..registry import Plugin, check_positive, register
+from .foot_vector import FootVector
+
+
+@register
+class HuangFPA(Plugin):
+    """Foot progression angle per step from a foot vector and a filtered heading vector.
+
+    Huang et al. 2016, IEEE TBME, Sec. II-C–E: the foot vector ``f`` fixed in
+    the sensor frame is turned into the earth frame with the attitude (eq. 12);
+    at each heel strike i the heading vector is ``h_i = α r_i + (1 − α) h_{i−1}``
+    with ``r_i = p_i − p_{i−1}`` the displacement since the previous heel strike
+    (eqs. 13–14, α = 0.35); the angle between ``f`` and ``h_i`` in the horizontal
+    plane (eq. 15) is averaged over 20–80 % of the stance (eq. 16), the stance
+    being 60 % of the stride time after the heel strike.
+
+    Sign: positive is toe-out. For a right foot that is ``f`` turned clockwise
+    seen from above (toward the walker's right) from ``h``; for a left foot,
+    counter-clockwise: ``FPA = s · wrap(ψ_f − ψ_h)`` with ``s = +1`` (right) or
+    ``−1`` (left). With ``foot: auto`` the side comes from the recording's
+    metadata (``meta["foot"]``).
+
+    Parameters
+    ----------
+    alpha : float
+        α of eq. 14; paper: 0.35.
+    window : [float, float]
+        Averaging window as fractions of the stance; paper: [0.2, 0.8].
+    stance_fraction : float
+        Stance as a fraction of the stride time; paper: 0.6.
+    foot_vector : [x, y, z]
+        Foot vector in the sensor frame (FRD); default the sensor's x axis.
+    calibration : str, optional
+        YAML file from ``footzoo calibrate`` (replaces ``foot_vector``).
+    foot : {"auto", "right", "left"}
+        Which foot the sensor is on.
+
+    Attributes
+    ----------
+    fpa_ : (M,) ndarray
+        FPA per stance after the first two heel strikes (rad; NaN before).
+    heel_strikes_ : (M,) ndarray
+        Sample index of each heel strike (stance onset).
+    """
+
+    kind = "analysis"
+    name = "huang_fpa"
+    paper = "Huang et al. 2016, IEEE TBME, Sec. II-C to II-E, eqs. 11-16"
+    units = {"alpha": "1", "window": "fraction of stance", "stance_fraction": "fraction of stride",
+             "foot_vector": "unit vector (sensor frame)"}
+
+    def __init__(
+        self,
+        alpha: float = 0.35,
+        window: list[float] | tuple[float, float] = (0.2, 0.8),
+        stance_fraction: float = 0.6,
+        foot_vector: list[float] | tuple[float, float, float] = (1.0, 0.0, 0.0),
+        calibration: str | None = None,
+        foot: str = "auto",
+    ):
+        self.alpha = check_positive("alpha", alpha)
+        if not self.alpha <= 1.0:
+            raise ConfigError(f"alpha must be in (0, 1], got {alpha}")
+        if len(window) != 2 or not 0.0 <= float(window[0]) < float(window[1]) <= 1.0:
+            raise ConfigError(f"window must be [start, end] fractions of the stance with 0 <= start < end <= 1, "
+                              f"got {window}")
+        self.window = [float(window[0]), float(window[1])]
+        self.stance_fraction = check_positive("stance_fraction", stance_fraction)
+        self.foot_vector = [float(v) for v in foot_vector]
+        if len(self.foot_vector) != 3 or np.linalg.norm(self.foot_vector) == 0:
+            raise ConfigError(f"foot_vector must be a non-zero [x, y, z], got {foot_vector}")
+        self.calibration = calibration
+        if calibration is not None:
+            FootVector.load(calibration)  # fail early on a bad file
+        if foot not in ("auto", "right", "left"):
+            raise ConfigError(f"foot must be 'auto', 'right' or 'left', got {foot!r}")
+        self.foot = foot
+
+    def _side(self, meta: dict) -> int:
+        foot = self.foot if self.foot != "auto" else meta.get("foot")
+        if foot not in ("right", "left"):
+            raise ConfigError(
+                "huang_fpa: the recording does not say which foot the sensor is on (meta['foot']); "
+                "set foot: right or foot: left in the analysis config"
+            )
+        return 1 if foot == "right" else -1
+
+    def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
+                meta: dict) -> HuangFPA:
+        """FPA per stance (eqs. 12–16)."""
+        side = self._side(meta)
+        f_s = FootVector.load(self.calibration).vector if self.calibration else np.asarray(self.foot_vector, float)
+        f_s = f_s / np.linalg.norm(f_s)
+        f_e = quat_rotate(quat, f_s)  # eq. 12
+        psi_f = np.arctan2(f_e[:, 1], f_e[:, 0])
+        st = intervals(stance)
+        hs = st[:, 0]
+        self.heel_strikes_ = hs
+        fpa = np.full(len(hs), np.nan)
+        h = None
+        for i in range(1, len(hs)):
+            r = pos[hs[i], :2] - pos[hs[i - 1], :2]  # eq. 13
+            h = r if h is None else self.alpha * r + (1 - self.alpha) * h  # eq. 14
+            if np.linalg.norm(h) == 0:
+                continue
+            stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < len(hs) else t[hs[i]] - t[hs[i - 1]]
+            stance_time = self.stance_fraction * stride
+            a = t[hs[i]] + self.window[0] * stance_time
+            b = t[hs[i]] + self.window[1] * stance_time
+            sel = (t >= a) & (t <= b)
+            if not sel.any():
+                continue
+            theta = side * wrap_angle(psi_f[sel] - np.arctan2(h[1], h[0]))  # eq. 15
+            fpa[i] = float(np.mean(theta))  # eq. 16
+        self.fpa_ = fpa
+        return self
+
+    def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
+        """Add ``fpa`` (rad) to the step table: the FPA of the stance that ends each stride."""
+        out = steps.copy()
+        onset_times = t[self.heel_strikes_]
+        values = []
+        for end in out["end"].to_numpy():
+            j = np.flatnonzero(np.isclose(onset_times, end))
+            values.append(self.fpa_[j[0]] if j.size else np.nan)
+        out["fpa"] = values
+        return out
