@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | simulate | calibrate | list | validate``."""
+"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``."""
 
 from __future__ import annotations
 
@@ -130,6 +130,34 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_ablate(args: argparse.Namespace) -> int:
+    """Run a study: every config × recording cell, in parallel, cached, with tables and plots."""
+    from .ablation import run_study
+    from .ablation.report import summarise, to_markdown
+
+    out = args.out or f"ablation_{Path(args.study).stem}"
+    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
+    runs = table.attrs["runs"]
+    failed = sum(1 for r in runs if r["error"])
+    print(f"{len(runs)} runs ({table.attrs['computed']} computed, {table.attrs['cached']} from the cache, "
+          f"{failed} failed); results in {out}/")
+    factors = [c for c in table.columns if c not in ("run", "base", "recording", "metric", "value", "error")]
+    for f in factors[:3]:
+        s = summarise(table, f)
+        keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
+        print(f"\n{f}:")
+        print(to_markdown(keep), end="")
+    return 0
+
+
+def cmd_list_compat(args: argparse.Namespace) -> int:
+    """Print which orientation × correction combinations validate, with the reasons for the others."""
+    from .compat import compatibility_matrix
+
+    print(compatibility_matrix(), end="")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``footzoo`` command."""
     parser = argparse.ArgumentParser(
@@ -174,9 +202,20 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--out", required=True, help="YAML file to write")
     cal.set_defaults(func=cmd_calibrate)
 
+    abl = sub.add_parser("ablate", help="run an ablation study (configs x recordings) and write tables and plots")
+    abl.add_argument("study", help="study YAML, e.g. configs/study_quick.yaml")
+    abl.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib); -1 = all cores")
+    abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
+    abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
+    abl.add_argument("--quiet", action="store_true", help="no progress bar")
+    abl.set_defaults(func=cmd_ablate)
+
     lst = sub.add_parser("list", help="list plug-ins with their parameters, defaults, units and papers")
     lst.add_argument("--kind", choices=["orientation", "detector", "correction", "analysis"], help="only this kind")
-    lst.set_defaults(func=cmd_list)
+    lst.add_argument("--compatibility", action="store_true",
+                     help="print which orientation x correction combinations validate, and why not")
+    lst.set_defaults(func=lambda a: cmd_list_compat(a) if a.compatibility else cmd_list(a))
 
     val = sub.add_parser("validate", help="check a pipeline config without running it")
     val.add_argument("config", help="pipeline YAML")

@@ -223,6 +223,9 @@ def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list
             f"corrections: {roles['velocity']} and the Kalman filter {roles['kalman']} both correct the velocity; "
             "choose one"
         )
+    zero_velocity = [n for n in names if n in ("ekf_zupt", "zupt")]
+    if len(zero_velocity) > 1:
+        raise ConfigError(f"corrections {zero_velocity}: two zero-velocity updates of the same filter; keep one")
     ins = orientation.name == "ins"
     if roles.get("kalman") and roles.get("heading") and not ins:
         raise ConfigError(

@@ -1,0 +1,200 @@
+"""Study files: base configs × factors (dotted-path overrides, grids) × recordings × metrics."""
+
+from __future__ import annotations
+
+import copy
+import glob
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ..config import load_yaml
+from ..errors import ConfigError
+from ..registry import did_you_mean
+
+STUDY_KEYS = {
+    "name": "study name",
+    "description": "free text",
+    "base": "a config path, an inline config, or a list of them",
+    "factors": "mapping of dotted paths to lists of values (all combinations are run)",
+    "recordings": "list of {path: glob, format: ...} or {simulate: {...}, seeds: [...]}",
+    "metrics": "list of metric names to keep (default: all)",
+    "sweep": "threshold sweep of the detectors: {points: 25}",
+}
+
+
+@dataclass
+class RecordingSpec:
+    """One recording of a study: a file or a simulator scenario with a seed."""
+
+    label: str
+    path: str | None = None
+    format: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+    simulate: dict[str, Any] | None = None
+    seed: int | None = None
+
+    def identity(self) -> str:
+        """What the cache key depends on: the file's content hash, or the simulator spec and seed."""
+        if self.path is not None:
+            digest = hashlib.sha256(Path(self.path).read_bytes()).hexdigest()
+            return json.dumps({"file": digest, "format": self.format, "options": self.options}, sort_keys=True)
+        from .. import __version__
+
+        return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": __version__}, sort_keys=True,
+                          default=str)
+
+    def load(self):
+        """The recording."""
+        if self.path is not None:
+            from ..io import load
+
+            return load(self.path, format=self.format, **self.options)
+        from ..sim import NoiseModel, simulate
+
+        spec = copy.deepcopy(self.simulate)
+        noise = spec.pop("noise", None)
+        if isinstance(noise, dict):
+            noise = NoiseModel(**{**noise, "seed": self.seed or 0})
+        return simulate(**spec, noise=noise, seed=self.seed or 0)
+
+
+@dataclass
+class Cell:
+    """One run: a resolved config on one recording."""
+
+    config: dict[str, Any]
+    recording: RecordingSpec
+    levels: dict[str, Any]
+    base: str
+
+    def key(self) -> str:
+        """Cache key: hash of the resolved config and the data's identity."""
+        payload = json.dumps({"config": self.config, "data": self.recording.identity()}, sort_keys=True, default=str)
+        return hashlib.sha256(payload.encode()).hexdigest()[:24]
+
+
+@dataclass
+class Study:
+    """A parsed study file."""
+
+    name: str
+    bases: list[tuple[str, dict[str, Any]]]
+    factors: dict[str, list[Any]]
+    recordings: list[RecordingSpec]
+    metrics: list[str] | None = None
+    sweep_points: int = 0
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> Study:
+        """Read and check a study file; paths in it are relative to the file."""
+        p = Path(path)
+        if not p.exists():
+            raise ConfigError(f"study file {str(p)!r} does not exist")
+        data = yaml.safe_load(p.read_text())
+        if not isinstance(data, dict):
+            raise ConfigError(f"{p}: a study must be a mapping with base, factors, recordings")
+        return cls.from_dict(data, root=p.parent)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
+        """Build from a mapping (see :data:`STUDY_KEYS`)."""
+        root = Path(root)
+        for key in d:
+            if key not in STUDY_KEYS:
+                raise ConfigError(f"unknown study key {key!r}{did_you_mean(key, list(STUDY_KEYS))}; "
+                                  f"valid keys: {list(STUDY_KEYS)}")
+        if "base" not in d or "recordings" not in d:
+            raise ConfigError("a study needs 'base' (config path(s)) and 'recordings'")
+        bases = []
+        for b in d["base"] if isinstance(d["base"], list) else [d["base"]]:
+            if isinstance(b, str):
+                path = _resolve(root, b)
+                bases.append((Path(path).stem, load_yaml(path)))
+            elif isinstance(b, dict):
+                bases.append((str(b.get("name", f"base{len(bases)}")), copy.deepcopy(b)))
+            else:
+                raise ConfigError(f"base entries must be config paths or mappings, got {b!r}")
+        factors = d.get("factors") or {}
+        if not isinstance(factors, dict):
+            raise ConfigError("factors must map dotted paths to lists of values, e.g. {detector.type: [dgp, shoe]}")
+        factors = {k: (v if isinstance(v, list) else [v]) for k, v in factors.items()}
+        recordings = []
+        for i, r in enumerate(d["recordings"] or []):
+            recordings += _expand_recording(r, root, i)
+        if not recordings:
+            raise ConfigError("the study has no recordings (check the globs)")
+        metrics = d.get("metrics")
+        sweep = d.get("sweep") or {}
+        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics,
+                   int(sweep.get("points", 0)) if isinstance(sweep, dict) else 0)
+
+    def cells(self) -> list[Cell]:
+        """Every base × factor combination × recording."""
+        # type changes first: they reset the plug-in's parameters, which other factors may then set
+        names = sorted(self.factors, key=lambda n: not n.endswith(".type"))
+        out = []
+        for base_name, base in self.bases:
+            for values in itertools.product(*(self.factors[n] for n in names)):
+                cfg = copy.deepcopy(base)
+                for n, v in zip(names, values, strict=True):
+                    set_dotted(cfg, n, v)
+                levels = {"base": base_name, **dict(zip(names, values, strict=True))}
+                for rec in self.recordings:
+                    out.append(Cell(cfg, rec, levels, base_name))
+        return out
+
+
+def _resolve(root: Path, path: str) -> str:
+    p = Path(path)
+    return str(p if p.is_absolute() or p.exists() else root / p)
+
+
+def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
+    if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
+        raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
+    if "path" in r:
+        pattern = r["path"]
+        matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
+        if not matches:
+            raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
+        opts = {k: v for k, v in r.items() if k not in ("path", "format")}
+        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts) for m in matches]
+    sim = dict(r["simulate"])
+    seeds = r.get("seeds", [0])
+    repeats = int(r.get("repeats", 1))
+    seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
+    label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
+    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s)) for s in seeds]
+
+
+def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``a.b.0.c`` in nested dicts/lists; setting ``X.type`` drops X's other parameters.
+
+    Changing a plug-in's type keeps only the new type (its parameters take their
+    defaults) unless other factors set them.
+    """
+    parts = path.split(".")
+    node: Any = d
+    for j, part in enumerate(parts[:-1]):
+        key: Any = int(part) if isinstance(node, list) else part
+        if isinstance(node, list):
+            if key >= len(node):
+                raise ConfigError(f"factor {path!r}: index {key} is out of range ({len(node)} entries)")
+        elif key not in node or node[key] is None:
+            node[key] = {}
+        node = node[key]
+        del j
+    last = parts[-1]
+    if isinstance(node, list):
+        node[int(last)] = value
+    elif last == "type" and isinstance(node, dict) and node.get("type") != value:
+        node.clear()
+        node["type"] = value
+    else:
+        node[last] = value
