@@ -111,8 +111,21 @@ class Pipeline:
         }
 
     # ------------------------------------------------------------------- run
-    def run(self, rec: Recording) -> Result:
-        """Estimate attitude, velocity, position and steps for one recording."""
+    def run(self, rec: Recording, engine: str = "auto") -> Result:
+        """Estimate attitude, velocity, position and steps for one recording.
+
+        Parameters
+        ----------
+        rec : Recording
+            The input.
+        engine : {"auto", "fast", "reference"}
+            For Kalman-filter pipelines: the compiled loop
+            (:mod:`footzoo.filters.eskf_fast`) or the reference loop on filterpy's
+            ``KalmanFilter``; ``auto`` takes the compiled one whenever every
+            correction is one footzoo ships. Both give the same numbers.
+        """
+        if engine not in ("auto", "fast", "reference"):
+            raise ValueError(f"engine must be 'auto', 'fast' or 'reference', got {engine!r}")
         if not isinstance(rec, Recording):
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
         t, acc, gyr, mag = rec.t, rec.acc, rec.gyr, rec.mag
@@ -139,12 +152,12 @@ class Pipeline:
             for m in kalman:
                 if getattr(m, "needs_recording", False):
                     m.bind(rec.dist, t, init_window)
-            nav = _run_kalman(t, acc, gyr, stance, q0, orientation, kalman + heading, quat_ext, self.gravity)
+            nav = _run_kalman(t, acc, gyr, stance, q0, orientation, kalman + heading, quat_ext, self.gravity,
+                              engine, rec.dist, init_window)
             quat, vel, pos, acc_nav = nav["quat"], nav["vel"], nav["pos"], nav["acc_nav"]
             diagnostics.update(gyro_bias=nav["gyro_bias"], acc_bias=nav["acc_bias"], P_diag=nav["P_diag"])
-            for m in kalman:
-                if hasattr(m, "calibration_result"):
-                    diagnostics["distance_calibration"] = m.calibration_result()
+            if "distance_calibration" in nav:
+                diagnostics["distance_calibration"] = nav["distance_calibration"]
         else:
             quat = orientation.estimate(t, acc, gyr, mag, stance, q0).quat_
             acc_nav = motion_acceleration(quat, acc, self.gravity)
@@ -182,8 +195,9 @@ class Pipeline:
         )
 
 
-def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gravity) -> dict[str, Any]:
-    """Assemble the error-state layout from the plug-ins and run the filter loop."""
+def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gravity, engine="auto",
+                dist=None, init_window=None) -> dict[str, Any]:
+    """Assemble the error-state layout from the plug-ins and run the filter loop (compiled or reference)."""
     from .filters.eskf import ErrorStateFilter, Layout
     from .filters.navigation import run_error_state_filter
     from .orientation.ins import INS
@@ -203,8 +217,78 @@ def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gr
     layout = Layout([(b[0], b[1]) for b in blocks])
     p0 = np.concatenate([np.full(b[1], b[2]) for b in blocks])
     q = np.concatenate([np.full(b[1], b[3]) for b in blocks])
+    fast = engine != "reference" and all(type(m).__module__.startswith("footzoo.corrections") for m in measurements)
+    if engine == "fast" and not fast:
+        raise ConfigError("engine='fast' supports footzoo's own corrections only; use engine='reference'")
+    if fast:
+        return _run_kalman_fast(t, acc, gyr, stance, q0, layout, p0, q, measurements, quat_ext, gravity, dist,
+                                init_window)
     kf = ErrorStateFilter(layout, p0, q)
-    return run_error_state_filter(t, acc, gyr, stance, q0, layout, kf, measurements, quat_ext, gravity)
+    out = run_error_state_filter(t, acc, gyr, stance, q0, layout, kf, measurements, quat_ext, gravity)
+    for m in measurements:
+        if hasattr(m, "calibration_result"):
+            out["distance_calibration"] = m.calibration_result()
+    return out
+
+
+def _run_kalman_fast(t, acc, gyr, stance, q0, layout, p0, q, measurements, quat_ext, gravity, dist,
+                     init_window) -> dict[str, Any]:
+    """Encode the corrections for :func:`footzoo.filters.eskf_fast.eskf_kernel` and run it."""
+    from .filters import eskf_fast as ef
+
+    order: list[int] = []
+    par = {"vel_std": 1.0, "rate_std": 1.0, "floor_std": 1.0, "hdr_threshold": 0.0, "hdr_std": 1.0}
+    k = 0
+    dist_m = None
+    for m in measurements:
+        if m.name in ("ekf_zupt", "zupt"):
+            order.append(ef.ZERO_VELOCITY)
+            par["vel_std"] = m.velocity_std
+            if m.zero_rate:
+                order.append(ef.ZERO_RATE)
+                par["rate_std"] = m.rate_std
+        elif m.name == "height_flat_floor":
+            order.append(ef.FLAT_FLOOR)
+            par["floor_std"] = m.height_std
+        elif m.name == "height_distance":
+            order.append(ef.DISTANCE)
+            dist_m = m
+            k = m.k
+        elif m.name == "hdr":
+            order.append(ef.HEADING)
+            par["hdr_threshold"], par["hdr_std"] = m.threshold, m.yaw_std
+    n = layout.n
+    idx = np.array([layout[b].start if layout.has(b) else -1 for b in ("att", "gyro_bias", "pos", "vel", "acc_bias")])
+    if dist_m is not None:
+        d, valid = dist_m._dist, dist_m._valid
+        r_d, n_d = dist_m._r.copy(), dist_m._n.copy()
+        calibrate = dist_m.calibrate
+        cal_r = np.array([layout[f"cal_r{j}"].start if calibrate else 0 for j in range(k)])
+        cal_n = np.array([layout[f"cal_n{j}"].start if calibrate else 0 for j in range(k)])
+        dist_par = (dist_m.range_std, calibrate, cal_r, cal_n, dist_m.constraint_std, dist_m.baseline,
+                    dist_m.baseline_std)
+    else:
+        d, valid = np.zeros((len(t), 0)), np.zeros((len(t), 0), dtype=bool)
+        r_d, n_d = np.zeros((0, 3)), np.zeros((0, 3))
+        dist_par = (1.0, False, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 1.0, 1.0, 1.0)
+    window = init_window if init_window is not None else np.zeros(len(t), dtype=bool)
+    use_ext = quat_ext is not None
+    ext = quat_ext if use_ext else np.zeros((1, 4))
+    res = ef.eskf_kernel(
+        np.ascontiguousarray(t), acc, gyr, np.asarray(stance, dtype=np.bool_), np.asarray(q0, float), ext, use_ext,
+        idx.astype(np.int64), n, np.diag(p0), q, float(gravity), np.array(order, dtype=np.int64),
+        par["vel_std"], par["rate_std"], par["floor_std"], par["hdr_threshold"], par["hdr_std"],
+        np.ascontiguousarray(d, dtype=float), np.ascontiguousarray(valid, dtype=np.bool_),
+        np.asarray(window, dtype=np.bool_), r_d, n_d, float(dist_par[0]), bool(dist_par[1]),
+        dist_par[2].astype(np.int64), dist_par[3].astype(np.int64), float(dist_par[4]), float(dist_par[5]),
+        float(dist_par[6]),
+    )
+    quat, vel, pos, acc_nav, gb, ab, pdiag, r_fin, n_fin = res
+    out = {"quat": quat, "vel": vel, "pos": pos, "acc_nav": acc_nav, "gyro_bias": gb, "acc_bias": ab,
+           "P_diag": pdiag}
+    if dist_m is not None:
+        out["distance_calibration"] = {"positions": r_fin.tolist(), "directions": n_fin.tolist()}
+    return out
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

@@ -115,12 +115,11 @@ class HuangFPA(Plugin):
                 continue
             stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < len(hs) else t[hs[i]] - t[hs[i - 1]]
             stance_time = self.stance_fraction * stride
-            a = t[hs[i]] + self.window[0] * stance_time
-            b = t[hs[i]] + self.window[1] * stance_time
-            sel = (t >= a) & (t <= b)
-            if not sel.any():
+            lo = np.searchsorted(t, t[hs[i]] + self.window[0] * stance_time, side="left")
+            hi = np.searchsorted(t, t[hs[i]] + self.window[1] * stance_time, side="right")
+            if hi <= lo:
                 continue
-            theta = side * wrap_angle(psi_f[sel] - np.arctan2(h[1], h[0]))  # eq. 15
+            theta = side * wrap_angle(psi_f[lo:hi] - np.arctan2(h[1], h[0]))  # eq. 15
             fpa[i] = float(np.mean(theta))  # eq. 16
         self.fpa_ = fpa
         return self
@@ -128,10 +127,6 @@ class HuangFPA(Plugin):
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
         """Add ``fpa`` (rad) to the step table: the FPA of the stance that ends each stride."""
         out = steps.copy()
-        onset_times = t[self.heel_strikes_]
-        values = []
-        for end in out["end"].to_numpy():
-            j = np.flatnonzero(np.isclose(onset_times, end))
-            values.append(self.fpa_[j[0]] if j.size else np.nan)
-        out["fpa"] = values
+        by_onset = dict(zip(t[self.heel_strikes_].tolist(), self.fpa_.tolist(), strict=True))
+        out["fpa"] = [by_onset.get(end, np.nan) for end in out["end"].tolist()]
         return out

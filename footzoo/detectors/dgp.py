@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from .._jit import njit
 from ..conventions import GRAVITY, quat_from_rotvec, quat_rotate
 from ..registry import Plugin, check_positive, register
 
@@ -54,6 +55,7 @@ def dgp_statistic(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: int, rate_
     return d_g * rate_scale
 
 
+@njit
 def dgp_kernel(
     s_c: np.ndarray, s_d0: float, th0: float, min_swing: int = 0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

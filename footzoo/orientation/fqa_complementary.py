@@ -6,11 +6,13 @@ import math
 
 import numpy as np
 
+from .._jit import njit
 from ..conventions import quat_from_rotvec, quat_mul, quat_yaw
 from ..registry import Plugin, check_positive, register
 from .fqa import fqa, fqa_tilt
 
 
+@njit
 def complementary_kernel(
     q0: np.ndarray,
     gyr: np.ndarray,

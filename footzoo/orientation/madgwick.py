@@ -6,9 +6,11 @@ import math
 
 import numpy as np
 
+from .._jit import njit
 from ..registry import Plugin, check_positive, register
 
 
+@njit
 def madgwick_kernel(
     q0: np.ndarray, gyr: np.ndarray, acc: np.ndarray, mag: np.ndarray | None, dt: np.ndarray, beta: float
 ) -> np.ndarray:
@@ -63,6 +65,7 @@ def madgwick_kernel(
     return out
 
 
+@njit
 def _rotate(w, x, y, z, vx, vy, vz):
     """q ⊗ v ⊗ q* (body -> nav)."""
     return (
@@ -72,6 +75,7 @@ def _rotate(w, x, y, z, vx, vy, vz):
     )
 
 
+@njit
 def _grad(w, x, y, z, dx, dy, dz, sx, sy, sz):
     """Jᵀ f for ``f = Rᵀ(q) d − s`` (eqs. 6–7), 4 components."""
     f1 = (1 - 2 * (y * y + z * z)) * dx + 2 * (x * y + w * z) * dy + 2 * (x * z - w * y) * dz - sx

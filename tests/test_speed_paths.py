@@ -1,0 +1,67 @@
+"""The compiled paths give the same numbers as the reference paths (speed itself: benchmarks/)."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from footzoo import Pipeline
+from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+ROOT = Path(__file__).resolve().parents[1]
+KALMAN = ["nguyen2016", "duong2015", "duong2015_zupt", "duong2015_zupt_height"]
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return simulate(n_strides=30, profile="physical", rate=100.0, noise=NoiseModel(seed=1), distance_sensors=True,
+                    clearance=0.1, disturbance=MagneticDisturbance(north=(5.0, 15.0)))
+
+
+@pytest.mark.parametrize("name", KALMAN)
+def test_compiled_kalman_loop_equals_the_filterpy_reference(walk, name):
+    p = Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
+    ref = p.run(walk, engine="reference")
+    fast = p.run(walk, engine="fast")
+    for col in ("pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "qw", "qx", "qy", "qz"):
+        a, b = ref.samples[col].to_numpy(), fast.samples[col].to_numpy()
+        assert np.max(np.abs(a - b)) <= 1e-9 * max(np.max(np.abs(a)), 1.0), col
+    np.testing.assert_allclose(fast.diagnostics["P_diag"], ref.diagnostics["P_diag"], rtol=1e-9, atol=1e-15)
+    if "distance_calibration" in ref.diagnostics:
+        np.testing.assert_allclose(fast.diagnostics["distance_calibration"]["positions"],
+                                   ref.diagnostics["distance_calibration"]["positions"], rtol=1e-9)
+
+
+def test_a_kalman_config_with_an_external_attitude_matches_too(walk):
+    cfg = {"orientation": {"type": "madgwick"}, "detector": {"type": "windowed"},
+           "corrections": [{"type": "zupt"}, {"type": "height_flat_floor"}]}
+    p = Pipeline.from_dict(cfg)
+    a, b = p.run(walk, engine="reference"), p.run(walk, engine="fast")
+    np.testing.assert_allclose(b.pos, a.pos, rtol=1e-9, atol=1e-12)
+
+
+def test_without_a_compiler_the_same_code_gives_the_same_numbers(tmp_path):
+    """FOOTZOO_DISABLE_JIT=1 runs the kernels as plain Python (an install without numba)."""
+    script = (
+        "import json, sys, numpy as np, footzoo;"
+        "from footzoo.sim import simulate, NoiseModel;"
+        "rec = simulate(n_strides=4, profile='physical', rate=100.0, noise=NoiseModel(seed=2));"
+        "out = {c: footzoo.Pipeline.from_yaml(f'configs/{c}.yaml').run(rec).pos[-1].tolist()"
+        " for c in ('yun2012', 'huang2016', 'nguyen2016', 'duong2015_zupt')};"
+        "out['jit'] = footzoo._jit.HAVE_NUMBA; print(json.dumps(out))"
+    )
+    results = []
+    for disable in ("0", "1"):
+        env = {**os.environ, "FOOTZOO_DISABLE_JIT": disable}
+        proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True, text=True,
+                              env=env, cwd=ROOT, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        results.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+    assert results[1]["jit"] is False
+    for name in ("yun2012", "huang2016", "nguyen2016", "duong2015_zupt"):
+        np.testing.assert_allclose(results[0][name], results[1][name], rtol=1e-9, atol=1e-12)
