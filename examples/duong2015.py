@@ -93,9 +93,9 @@ def main() -> None:
     args = parser.parse_args()
     pd.set_option("display.width", 200)
     print("== Table 2 (walking, simulated, 40 strides, two VL6180 sensors), RMS position error (m) ==")
-    print(table2(args.seeds).round(4))
+    print(table2(args.seeds).round(4).to_string())
     print("\n== Table 3: calibration from mounting perturbed by 3-4 mm and 3 deg (m; last row mm) ==")
-    print(table3(args.seeds).round(4))
+    print(table3(args.seeds).round(4).to_string())
     root = Path(args.pyshoe)
     if (root / "trials.csv").exists():
         ps = pyshoe(root)
