@@ -69,8 +69,8 @@ def main() -> None:
     det = detection_table(args.seeds)
     print("== gait-phase detection, mixed speeds (0.85, 1.38, 1.92 m/s walking, 3.2 m/s running) ==")
     print("paper: DGP 1 wrong in 36 steps (2.78 %)")
-    print(det.groupby(["rate_hz", "detector"])[["true_steps", "detected_steps", "correct", "error_rate",
-                                                 "onset_error_mean_s", "offset_error_mean_s"]].mean().round(4).to_string())
+    cols = ["true_steps", "detected_steps", "correct", "error_rate", "onset_error_mean_s", "offset_error_mean_s"]
+    print(det.groupby(["rate_hz", "detector"])[cols].mean().round(4).to_string())
     hall = hallway_table(args.seeds)
     print("\n== 120 m hallway loop, Table II biases, 0.1 G disturbance on 20 m of the first leg ==")
     print("paper: INS/EKF+ZVU+HDR 0.45 m over 120 m = 0.375 %, the best of the three")

@@ -193,7 +193,7 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
         f0, f1, f2 = acc[k, 0] - ba[0], acc[k, 1] - ba[1], acc[k, 2] - ba[2]
         pw, px, py, pz = q[0], q[1], q[2], q[3]
         if use_ext:
-            q = quat_ext[k].copy()
+            q[:] = quat_ext[k]
         else:
             # q ⊗ exp(w dt), the exact form of eq. 37
             rx, ry, rz = w[0] * dt, w[1] * dt, w[2] * dt
@@ -201,12 +201,10 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
             half = 0.5 * angle
             kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
             dw, dx_, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
-            q = np.array([
-                pw * dw - px * dx_ - py * dy - pz * dz,
-                pw * dx_ + px * dw + py * dz - pz * dy,
-                pw * dy - px * dz + py * dw + pz * dx_,
-                pw * dz + px * dy - py * dx_ + pz * dw,
-            ])
+            q[0] = pw * dw - px * dx_ - py * dy - pz * dz
+            q[1] = pw * dx_ + px * dw + py * dz - pz * dy
+            q[2] = pw * dy - px * dz + py * dw + pz * dx_
+            q[3] = pw * dz + px * dy - py * dx_ + pz * dw
         dot = pw * q[0] + px * q[1] + py * q[2] + pz * q[3]
         sg = 1.0 if dot >= 0 else -1.0
         mw, mx, my, mz = q[0] + sg * pw, q[1] + sg * px, q[2] + sg * py, q[3] + sg * pz

@@ -1,4 +1,4 @@
-"""Factored quaternion algorithm (FQA), vectorised.
+"""Factored quaternion algorithm (FQA), one sample at a time, compiled when numba is present.
 
 Yun, Bachmann & McGhee, "A simplified quaternion-based algorithm for orientation
 estimation from earth gravity and magnetic field measurements", IEEE TIM 57(3),
@@ -19,33 +19,62 @@ In footzoo's conventions (FRD body, NED navigation) a level sensor at rest reads
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..conventions import quat_mul, quat_rotate
+from .._jit import njit
 
 
-def _half_angle(c: np.ndarray, s_sign: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """cos(x/2), sin(x/2) from cos x and the sign of sin x (sign 0 counts as +)."""
-    c = np.clip(c, -1.0, 1.0)
-    sign = np.where(s_sign < 0, -1.0, 1.0)
-    return np.sqrt((1.0 + c) / 2.0), sign * np.sqrt((1.0 - c) / 2.0)
+@njit
+def _half(c, s):
+    """cos(x/2), sin(x/2) from cos x and the sign of sin x (0 counts as +)."""
+    c = min(max(c, -1.0), 1.0)
+    sign = -1.0 if s < 0 else 1.0
+    return math.sqrt((1.0 + c) / 2.0), sign * math.sqrt((1.0 - c) / 2.0)
 
 
-def fqa_tilt(acc: np.ndarray) -> np.ndarray:
-    """Elevation-and-roll quaternion ``q_e ⊗ q_r`` (N, 4) from specific force (N, 3)."""
-    a = np.atleast_2d(np.asarray(acc, dtype=float))
-    a = a / np.linalg.norm(a, axis=1, keepdims=True)
-    s_theta = np.clip(a[:, 0], -1.0, 1.0)
-    c_theta = np.sqrt(1.0 - s_theta**2)
-    ce, se = _half_angle(c_theta, s_theta)
-    safe = np.where(c_theta > 1e-12, c_theta, 1.0)
-    s_phi = np.where(c_theta > 1e-12, -a[:, 1] / safe, 0.0)
-    c_phi = np.where(c_theta > 1e-12, -a[:, 2] / safe, 1.0)
-    cr, sr = _half_angle(c_phi, s_phi)
-    zeros = np.zeros_like(ce)
-    q_e = np.stack([ce, zeros, se, zeros], axis=1)
-    q_r = np.stack([cr, sr, zeros, zeros], axis=1)
-    return quat_mul(q_e, q_r)
+@njit
+def fqa_sample(ax, ay, az, mx, my, mz, use_mag):
+    """FQA quaternion (w, x, y, z) of one sample (eqs. 20–41 of the FQA paper, footzoo's frames)."""
+    an = math.sqrt(ax * ax + ay * ay + az * az)
+    ax, ay, az = ax / an, ay / an, az / an
+    s_t = min(max(ax, -1.0), 1.0)
+    c_t = math.sqrt(1.0 - s_t * s_t)
+    ce, se = _half(c_t, s_t)
+    if c_t > 1e-12:
+        s_p, c_p = -ay / c_t, -az / c_t
+    else:
+        s_p, c_p = 0.0, 1.0
+    cr, sr = _half(c_p, s_p)
+    # q_e ⊗ q_r = [ce, 0, se, 0] ⊗ [cr, sr, 0, 0]
+    w, x, y, z = ce * cr, ce * sr, se * cr, -se * sr
+    if not use_mag:
+        return w, x, y, z
+    # level the field: q_er ⊗ m ⊗ q_er*
+    hx = (1 - 2 * (y * y + z * z)) * mx + 2 * (x * y - w * z) * my + 2 * (x * z + w * y) * mz
+    hy = 2 * (x * y + w * z) * mx + (1 - 2 * (x * x + z * z)) * my + 2 * (y * z - w * x) * mz
+    h = math.sqrt(hx * hx + hy * hy)
+    if h > 0.0:
+        hx, hy = hx / h, hy / h
+    else:
+        hx, hy = 1.0, 0.0
+    ca, sa = _half(hx, -hy)
+    # q_a ⊗ q_er with q_a = [ca, 0, 0, sa]
+    return ca * w - sa * z, ca * x - sa * y, ca * y + sa * x, ca * z + sa * w
+
+
+@njit
+def _fqa_many(acc, mag, use_mag):
+    n = acc.shape[0]
+    out = np.empty((n, 4))
+    for k in range(n):
+        if use_mag:
+            r = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2], True)
+        else:
+            r = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0, False)
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = r
+    return out
 
 
 def fqa(acc: np.ndarray, mag: np.ndarray | None = None) -> np.ndarray:
@@ -63,15 +92,13 @@ def fqa(acc: np.ndarray, mag: np.ndarray | None = None) -> np.ndarray:
     (N, 4) ndarray
         ``q_a ⊗ q_e ⊗ q_r`` (FQA eq. 41 in footzoo's frames).
     """
-    q_er = fqa_tilt(acc)
+    a = np.ascontiguousarray(np.atleast_2d(np.asarray(acc, dtype=float)))
     if mag is None:
-        return q_er
-    m = np.atleast_2d(np.asarray(mag, dtype=float))
-    m_level = quat_rotate(q_er, m)
-    h = np.linalg.norm(m_level[:, :2], axis=1)
-    h = np.where(h > 0, h, 1.0)
-    mx, my = m_level[:, 0] / h, m_level[:, 1] / h
-    ca, sa = _half_angle(mx, -my)
-    zeros = np.zeros_like(ca)
-    q_a = np.stack([ca, zeros, zeros, sa], axis=1)
-    return quat_mul(q_a, q_er)
+        return _fqa_many(a, np.zeros((1, 3)), False)
+    m = np.ascontiguousarray(np.atleast_2d(np.asarray(mag, dtype=float)))
+    return _fqa_many(a, m, True)
+
+
+def fqa_tilt(acc: np.ndarray) -> np.ndarray:
+    """Elevation-and-roll quaternion ``q_e ⊗ q_r`` (N, 4) from specific force (N, 3)."""
+    return fqa(acc, None)

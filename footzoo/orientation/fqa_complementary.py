@@ -7,9 +7,8 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..conventions import quat_from_rotvec, quat_mul, quat_yaw
 from ..registry import Plugin, check_positive, register
-from .fqa import fqa, fqa_tilt
+from .fqa import fqa_sample
 
 
 @njit
@@ -73,17 +72,50 @@ def complementary_kernel(
     return out
 
 
-def static_quaternion(acc: np.ndarray, gyr: np.ndarray, dt: np.ndarray, mag: np.ndarray | None) -> np.ndarray:
-    """FQA quaternion of each sample, carried to the sample's time stamp.
+@njit
+def _static_kernel(acc, gyr, dt, mag, use_mag):
+    n = acc.shape[0]
+    q_s = np.empty((n, 4))
+    yaw = np.empty(n)
+    for k in range(n):
+        if use_mag:
+            w, x, y, z = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2], True)
+        else:
+            w, x, y, z = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0, False)
+        # ⊗ exp(ω dt / 4): rotation by half the interval
+        rx, ry, rz = gyr[k, 0] * 0.5 * dt[k], gyr[k, 1] * 0.5 * dt[k], gyr[k, 2] * 0.5 * dt[k]
+        angle = math.sqrt(rx * rx + ry * ry + rz * rz)
+        half = 0.5 * angle
+        kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
+        dw, dx, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
+        qw = w * dw - x * dx - y * dy - z * dz
+        qx = w * dx + x * dw + y * dz - z * dy
+        qy = w * dy - x * dz + y * dw + z * dx
+        qz = w * dz + x * dy - y * dx + z * dw
+        q_s[k, 0], q_s[k, 1], q_s[k, 2], q_s[k, 3] = qw, qx, qy, qz
+        yaw[k] = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    return q_s, yaw
+
+
+def static_quaternion(acc: np.ndarray, gyr: np.ndarray, dt: np.ndarray, mag: np.ndarray | None):
+    """FQA quaternion of each sample, carried to the sample's time stamp, and its heading.
 
     An interval-average sample describes the middle of its interval
     ``(t[k-1], t[k]]``, so the FQA attitude is rotated on by half the
     interval's gyro rotation, ``q_s ⊗ exp(ω_k dt_k / 4)``, before it is
     compared with the estimate at ``t[k]``. Without this, a foot rotating at
     7.5 rad/s sampled at 50 Hz would see a 4° lag in ``q_s``.
+
+    Returns
+    -------
+    q_s : (N, 4) ndarray
+    yaw : (N,) ndarray
+        Z-Y-X heading of ``q_s`` (rad).
     """
-    q_s = fqa(acc, mag) if mag is not None else fqa_tilt(acc)
-    return quat_mul(q_s, quat_from_rotvec(gyr * (0.5 * dt)[:, None]))
+    use_mag = mag is not None
+    m = np.ascontiguousarray(mag, dtype=float) if use_mag else np.zeros((1, 3))
+    return _static_kernel(np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(gyr, dtype=float),
+                          np.ascontiguousarray(dt, dtype=float), m, use_mag)
 
 
 @register
@@ -162,8 +194,7 @@ class FQAComplementary(Plugin):
         dt[1:] = np.diff(t)
         dt[0] = 0.0
         use_mag = self.use_magnetometer and mag is not None
-        q_static = static_quaternion(acc, gyr, dt, mag if use_mag else None)
-        static_yaw = quat_yaw(q_static)
+        q_static, static_yaw = static_quaternion(acc, gyr, dt, mag if use_mag else None)
         self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
         self.quat_ = complementary_kernel(
             np.asarray(q0, dtype=float), gyr, dt, q_static, self.gain_, not use_mag, static_yaw
