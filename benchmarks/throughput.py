@@ -125,6 +125,20 @@ def peak_memory(rec: footzoo.Recording, name: str) -> float:
     return peak / rec.n
 
 
+def stream_latency(rec: footzoo.Recording, n: int = 20_000) -> tuple[float, float]:
+    """Mean and 99th-percentile time (s) of one ``Stream.push`` with the nguyen2016 config."""
+    from footzoo.stream import Stream
+
+    stream = Stream(footzoo.Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml"))
+    times = []
+    for k in range(min(n, rec.n)):
+        t0 = time.perf_counter()
+        stream.push(rec.t[k], rec.acc[k], rec.gyr[k], rec.mag[k])
+        times.append(time.perf_counter() - t0)
+    lat = np.array(times[200:])  # after the still start has been collected
+    return float(lat.mean()), float(np.percentile(lat, 99))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=float, default=1e6)
@@ -141,6 +155,8 @@ def main() -> None:
     print("\n== plug-ins alone ==")
     for r in plugin_rates(rec):
         print(f"{r['plugin']:32s} {r['samples_per_s'] / 1e6:8.2f} M/s")
+    mean, p99 = stream_latency(rec)
+    print(f"\n== streaming (nguyen2016, push one sample) == mean {mean * 1e6:.0f} us, p99 {p99 * 1e6:.0f} us")
     print(f"\n== cold start (new process: import + 4 configs on 8 k samples, cache warm) == {cold_start():.2f} s")
     print("\n== peak memory beyond the input (bytes per sample) ==")
     for name in ("yun2012", "nguyen2016", "duong2015"):

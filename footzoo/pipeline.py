@@ -195,17 +195,15 @@ class Pipeline:
         )
 
 
-def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gravity, engine="auto",
-                dist=None, init_window=None) -> dict[str, Any]:
-    """Assemble the error-state layout from the plug-ins and run the filter loop (compiled or reference)."""
-    from .filters.eskf import ErrorStateFilter, Layout
-    from .filters.navigation import run_error_state_filter
+def _kalman_layout(orientation, measurements, external: bool):
+    """Error-state blocks from the plug-ins: (layout, initial variances, variance growth per second)."""
+    from .filters.eskf import Layout
     from .orientation.ins import INS
 
     ins = orientation if orientation.name == "ins" else INS()
     extra = {name: (size, p0, q) for m in measurements for name, size, p0, q in m.blocks()}
     blocks: list[tuple[str, int, float, float]] = []
-    if quat_ext is None:
+    if not external:
         blocks.append(("att", 3, ins.initial_attitude_std**2, ins.attitude_noise))
     if "gyro_bias" in extra:
         blocks.append(("gyro_bias", *extra.pop("gyro_bias")))
@@ -217,12 +215,40 @@ def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gr
     layout = Layout([(b[0], b[1]) for b in blocks])
     p0 = np.concatenate([np.full(b[1], b[2]) for b in blocks])
     q = np.concatenate([np.full(b[1], b[3]) for b in blocks])
+    return layout, p0, q
+
+
+def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gravity, engine="auto",
+                dist=None, init_window=None) -> dict[str, Any]:
+    """Run the error-state filter loop over a recording (compiled or reference)."""
+    from .filters.eskf import ErrorStateFilter
+    from .filters.navigation import run_error_state_filter
+
     fast = engine != "reference" and all(type(m).__module__.startswith("footzoo.corrections") for m in measurements)
     if engine == "fast" and not fast:
         raise ConfigError("engine='fast' supports footzoo's own corrections only; use engine='reference'")
     if fast:
-        return _run_kalman_fast(t, acc, gyr, stance, q0, layout, p0, q, measurements, quat_ext, gravity, dist,
-                                init_window)
+        from .filters import eskf_fast as ef
+
+        window = np.asarray(init_window if init_window is not None else np.zeros(len(t), bool), dtype=np.bool_)
+        dist_m = next((m for m in measurements if m.name == "height_distance"), None)
+        init_dist = dist_m._dist[window] if dist_m is not None else np.zeros((int(window.sum()), 0))
+        s = _run_kalman_setup(orientation, measurements, init_dist, gravity, q0, quat_ext)
+        d = dist_m._dist if dist_m is not None else np.zeros((len(t), 0))
+        valid = np.isfinite(d) & (d <= s["max_range"])
+        res = ef.eskf_kernel(
+            np.ascontiguousarray(t), acc, gyr, np.asarray(stance, dtype=np.bool_), s["ext"], s["use_ext"],
+            s["idx"], s["n"], s["q"], s["gravity"], s["order"], *s["par"],
+            np.ascontiguousarray(d, dtype=float), np.ascontiguousarray(valid), window, s["init_dist"],
+            s["init_valid"], s["r_d"], s["n_d"], *s["dist_par"], s["nav"], s["P"], s["scal"], 0,
+        )
+        quat, vel, pos, acc_nav, gb, ab, pdiag = res
+        out = {"quat": quat, "vel": vel, "pos": pos, "acc_nav": acc_nav, "gyro_bias": gb, "acc_bias": ab,
+               "P_diag": pdiag}
+        if dist_m is not None:
+            out["distance_calibration"] = {"positions": s["r_d"].tolist(), "directions": s["n_d"].tolist()}
+        return out
+    layout, p0, q = _kalman_layout(orientation, measurements, quat_ext is not None)
     kf = ErrorStateFilter(layout, p0, q)
     out = run_error_state_filter(t, acc, gyr, stance, q0, layout, kf, measurements, quat_ext, gravity)
     for m in measurements:
@@ -231,14 +257,13 @@ def _run_kalman(t, acc, gyr, stance, q0, orientation, measurements, quat_ext, gr
     return out
 
 
-def _run_kalman_fast(t, acc, gyr, stance, q0, layout, p0, q, measurements, quat_ext, gravity, dist,
-                     init_window) -> dict[str, Any]:
-    """Encode the corrections for :func:`footzoo.filters.eskf_fast.eskf_kernel` and run it."""
+def _run_kalman_setup(orientation, measurements, init_dist, gravity, q0, quat_ext=None) -> dict[str, Any]:
+    """Encode the plug-ins for :func:`footzoo.filters.eskf_fast.eskf_kernel`, with its initial state."""
     from .filters import eskf_fast as ef
 
+    layout, p0, q = _kalman_layout(orientation, measurements, quat_ext is not None)
     order: list[int] = []
     par = {"vel_std": 1.0, "rate_std": 1.0, "floor_std": 1.0, "hdr_threshold": 0.0, "hdr_std": 1.0}
-    k = 0
     dist_m = None
     for m in measurements:
         if m.name in ("ekf_zupt", "zupt"):
@@ -253,42 +278,33 @@ def _run_kalman_fast(t, acc, gyr, stance, q0, layout, p0, q, measurements, quat_
         elif m.name == "height_distance":
             order.append(ef.DISTANCE)
             dist_m = m
-            k = m.k
         elif m.name == "hdr":
             order.append(ef.HEADING)
             par["hdr_threshold"], par["hdr_std"] = m.threshold, m.yaw_std
-    n = layout.n
-    idx = np.array([layout[b].start if layout.has(b) else -1 for b in ("att", "gyro_bias", "pos", "vel", "acc_bias")])
+    idx = np.array([layout[b].start if layout.has(b) else -1 for b in ("att", "gyro_bias", "pos", "vel", "acc_bias")],
+                   dtype=np.int64)
+    k = 0 if dist_m is None else dist_m.k
     if dist_m is not None:
-        d, valid = dist_m._dist, dist_m._valid
-        r_d, n_d = dist_m._r.copy(), dist_m._n.copy()
         calibrate = dist_m.calibrate
-        cal_r = np.array([layout[f"cal_r{j}"].start if calibrate else 0 for j in range(k)])
-        cal_n = np.array([layout[f"cal_n{j}"].start if calibrate else 0 for j in range(k)])
-        dist_par = (dist_m.range_std, calibrate, cal_r, cal_n, dist_m.constraint_std, dist_m.baseline,
-                    dist_m.baseline_std)
+        cal_r = np.array([layout[f"cal_r{j}"].start if calibrate else 0 for j in range(k)], dtype=np.int64)
+        cal_n = np.array([layout[f"cal_n{j}"].start if calibrate else 0 for j in range(k)], dtype=np.int64)
+        dist_par = (float(dist_m.range_std), bool(calibrate), cal_r, cal_n, float(dist_m.constraint_std),
+                    float(dist_m.baseline), float(dist_m.baseline_std))
+        r_d, n_d, max_range = dist_m._r.copy(), dist_m._n.copy(), float(dist_m.max_range)
     else:
-        d, valid = np.zeros((len(t), 0)), np.zeros((len(t), 0), dtype=bool)
-        r_d, n_d = np.zeros((0, 3)), np.zeros((0, 3))
         dist_par = (1.0, False, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 1.0, 1.0, 1.0)
-    window = init_window if init_window is not None else np.zeros(len(t), dtype=bool)
+        r_d, n_d, max_range = np.zeros((0, 3)), np.zeros((0, 3)), np.inf
+    init_dist = np.ascontiguousarray(np.asarray(init_dist, dtype=float).reshape(-1, k) if k else
+                                     np.zeros((len(init_dist), 0)))
+    init_valid = np.isfinite(init_dist) & (init_dist <= max_range)
     use_ext = quat_ext is not None
-    ext = quat_ext if use_ext else np.zeros((1, 4))
-    res = ef.eskf_kernel(
-        np.ascontiguousarray(t), acc, gyr, np.asarray(stance, dtype=np.bool_), np.asarray(q0, float), ext, use_ext,
-        idx.astype(np.int64), n, np.diag(p0), q, float(gravity), np.array(order, dtype=np.int64),
-        par["vel_std"], par["rate_std"], par["floor_std"], par["hdr_threshold"], par["hdr_std"],
-        np.ascontiguousarray(d, dtype=float), np.ascontiguousarray(valid, dtype=np.bool_),
-        np.asarray(window, dtype=np.bool_), r_d, n_d, float(dist_par[0]), bool(dist_par[1]),
-        dist_par[2].astype(np.int64), dist_par[3].astype(np.int64), float(dist_par[4]), float(dist_par[5]),
-        float(dist_par[6]),
-    )
-    quat, vel, pos, acc_nav, gb, ab, pdiag, r_fin, n_fin = res
-    out = {"quat": quat, "vel": vel, "pos": pos, "acc_nav": acc_nav, "gyro_bias": gb, "acc_bias": ab,
-           "P_diag": pdiag}
-    if dist_m is not None:
-        out["distance_calibration"] = {"positions": r_fin.tolist(), "directions": n_fin.tolist()}
-    return out
+    ext = np.ascontiguousarray(quat_ext) if use_ext else np.zeros((1, 4))
+    nav, P, scal = ef.initial_state(ext[0] if use_ext else np.asarray(q0, float), np.diag(p0))
+    return {"ext": ext, "use_ext": use_ext, "idx": idx, "n": layout.n, "q": q, "gravity": float(gravity),
+            "order": np.array(order, dtype=np.int64),
+            "par": (par["vel_std"], par["rate_std"], par["floor_std"], par["hdr_threshold"], par["hdr_std"]),
+            "init_dist": init_dist, "init_valid": np.ascontiguousarray(init_valid), "r_d": r_d, "n_d": n_d,
+            "dist_par": dist_par, "nav": nav, "P": P, "scal": scal, "k_sensors": k, "max_range": max_range}
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

@@ -71,13 +71,20 @@ def _motion_acc_change(t, acc, gyr):
     return out
 
 
+def dgp_initial_state(s_d0: float, th0: float) -> np.ndarray:
+    """Recursion state of :func:`dgp_kernel`: s_d^t, s_d^{t−1}, th, Mc, Md, in swing, swing length."""
+    return np.array([s_d0, s_d0, th0, -math.inf, -math.inf, 0.0, 0.0])
+
+
 @njit
 def dgp_kernel(
-    s_c: np.ndarray, s_d0: float, th0: float, min_swing: int = 0
+    s_c: np.ndarray, state: np.ndarray, min_swing: int = 0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Delayed condition, max changing speed, dynamic threshold and stance (eqs. 10–15).
 
-    The threshold is re-learned (eq. 14) only after a swing of at least
+    ``state`` (from :func:`dgp_initial_state`) is carried in place, so a live
+    stream can feed one sample at a time and get what a batch run gets. The
+    threshold is re-learned (eq. 14) only after a swing of at least
     ``min_swing`` samples (0: after every swing, as in the paper).
     """
     n = s_c.shape[0]
@@ -85,13 +92,9 @@ def dgp_kernel(
     max_cd = np.empty(n)
     th = np.empty(n)
     stance = np.empty(n, dtype=np.bool_)
-    threshold = th0
-    mc = -math.inf
-    md = -math.inf
-    in_swing = False
-    swing_len = 0
-    prev1 = s_d0  # s_d^{t}
-    prev2 = s_d0  # s_d^{t-1}
+    prev1, prev2, threshold, mc, md = state[0], state[1], state[2], state[3], state[4]
+    in_swing = state[5] != 0.0
+    swing_len = int(state[6])
     for k in range(n):
         sd = 0.5 * (prev2 + s_c[k])  # eq. 10
         prev2, prev1 = prev1, sd
@@ -113,6 +116,9 @@ def dgp_kernel(
                 threshold = mc - md  # eq. 14, for the next step
         th[k] = threshold
         stance[k] = is_stance
+    state[0], state[1], state[2], state[3], state[4] = prev1, prev2, threshold, mc, md
+    state[5] = 1.0 if in_swing else 0.0
+    state[6] = swing_len
     return s_d, max_cd, th, stance
 
 
@@ -198,8 +204,9 @@ class DGP(Plugin):
         n_c = max(int(round(self.condition_window * rate)), 1)
         self.d_g_ = dgp_statistic(t, acc, gyr, f, rate / self.reference_rate)
         self.s_c_ = _causal_mean(self.d_g_, n_c)  # eq. 9
+        state = dgp_initial_state(self.initial_delay, self.initial_threshold)
         self.s_d_, self.statistic_, self.threshold_, stance = dgp_kernel(
-            self.s_c_, self.initial_delay, self.initial_threshold, int(round(self.min_swing * rate))
+            self.s_c_, state, int(round(self.min_swing * rate))
         )
         self.stance_ = stance
         self.stance_online_ = stance.copy()

@@ -132,17 +132,32 @@ def _add_identity_cols(out, src, r0, c0, s):
             out[i, r0 + j] += s * src[i, c0 + j]
 
 
+def initial_state(q0: np.ndarray, p0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fresh loop state: ``nav`` (q, p, v, b_g, b_a), covariance, and the bookkeeping scalars.
+
+    ``scal`` = (was stance, last yaw, floor, have floor, stance ends, latest end yaw, previous end yaw).
+    """
+    nav = np.zeros(16)
+    nav[:4] = q0
+    return nav, np.array(p0, dtype=float, copy=True), np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
 @njit
-def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, gravity, order,
+def eskf_kernel(t, acc, gyr, stance, quat_ext, use_ext, idx, n, qn, gravity, order,
                 vel_std, rate_std, floor_std, hdr_threshold, hdr_std,
-                dist, valid, init_window, r_dist, n_dist, range_std, calibrate, cal_r, cal_n,
-                constraint_std, baseline, baseline_std):
-    """The sample loop (see the module docstring); ``idx`` = (att, gyro_bias, pos, vel, acc_bias), −1 if absent."""
+                dist, valid, in_init, init_dist, init_valid, r_d, n_d, range_std, calibrate, cal_r, cal_n,
+                constraint_std, baseline, baseline_std, nav, P, scal, k0):
+    """Run samples 1… of the given arrays from the state (``nav``, ``P``, ``scal``, ``r_d``, ``n_d``,
+    updated in place); sample 0 is the one the state belongs to.
+
+    ``k0`` is the index of sample 0 in the whole recording. ``idx`` = (att, gyro_bias, pos, vel,
+    acc_bias) offsets, −1 if absent. Row 0 of the outputs
+    is the incoming state. A batch run passes the whole recording from the initial state; a
+    live stream passes its last two samples, and gets the same numbers.
+    """
     N = t.shape[0]
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
-    k_sensors = r_dist.shape[0]
-    r_d = r_dist.copy()
-    n_d = n_dist.copy()
+    k_sensors = r_d.shape[0]
     quat = np.zeros((N, 4))
     vel = np.zeros((N, 3))
     pos = np.zeros((N, 3))
@@ -150,13 +165,16 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
     gb_out = np.zeros((N, 3))
     ab_out = np.zeros((N, 3))
     pdiag = np.zeros((N, n))
-    P = p0.copy()
-    q = quat_ext[0].copy() if use_ext else q0.copy()
-    p = np.zeros(3)
-    v = np.zeros(3)
-    bg = np.zeros(3)
-    ba = np.zeros(3)
+    q = nav[0:4].copy()
+    p = nav[4:7].copy()
+    v = nav[7:10].copy()
+    bg = nav[10:13].copy()
+    ba = nav[13:16].copy()
     quat[0] = q
+    pos[0] = p
+    vel[0] = v
+    gb_out[0] = bg
+    ab_out[0] = ba
     for i in range(n):
         pdiag[0, i] = P[i, i]
     m_max = 8 + 2 * k_sensors
@@ -174,12 +192,13 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
     nnz = np.zeros(m_max, dtype=np.int64)
     K = np.empty((n, m_max))
     dx = np.empty(n)
-    ends = np.zeros(N)
-    n_ends = 0
-    was_stance = True
-    last_yaw = 0.0
-    floor = 0.0
-    have_floor = False
+    was_stance = scal[0] != 0.0
+    last_yaw = scal[1]
+    floor = scal[2]
+    have_floor = scal[3] != 0.0
+    n_ends = int(scal[4])
+    end1 = scal[5]
+    end2 = scal[6]
     c = np.empty((3, 3))
     cdt = np.empty((3, 3))
     sdt = np.empty((3, 3))
@@ -278,15 +297,15 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
                 m += 1
             elif code == DISTANCE:
                 if not have_floor:
-                    if init_window[k]:
+                    if in_init[k]:
                         continue
                     cq = _matrix(q)
                     total = 0.0
                     count = 0
                     for j in range(k_sensors):
-                        for s in range(N):
-                            if init_window[s] and valid[s, j]:
-                                u = cq @ (r_d[j] + n_d[j] * dist[s, j])
+                        for s in range(init_dist.shape[0]):
+                            if init_valid[s, j]:
+                                u = cq @ (r_d[j] + n_d[j] * init_dist[s, j])
                                 total += u[2]
                                 count += 1
                     floor = total / count
@@ -331,8 +350,8 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
                     rdiag[m] = baseline_std * baseline_std
                     m += 1
             elif code == HEADING and st and n_ends >= 2:
-                a = ends[n_ends - 1]
-                b = ends[n_ends - 2]
+                a = end1
+                b = end2
                 mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
                 dpsi = _wrap(_yaw(q) - mean)
                 if abs(dpsi) <= hdr_threshold:
@@ -412,8 +431,9 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
                     r_d[j] = r_d[j] + dx[cal_r[j]:cal_r[j] + 3]
                     n_d[j] = n_d[j] + dx[cal_n[j]:cal_n[j] + 3]
         # HDR bookkeeping (after the update, as the reference's after())
-        if was_stance and not st and k > 1:
-            ends[n_ends] = last_yaw
+        if was_stance and not st and k0 + k > 1:
+            end2 = end1
+            end1 = last_yaw
             n_ends += 1
         was_stance = st
         last_yaw = _yaw(q)
@@ -425,4 +445,16 @@ def eskf_kernel(t, acc, gyr, stance, q0, quat_ext, use_ext, idx, n, p0, qn, grav
         ab_out[k] = ba
         for i in range(n):
             pdiag[k, i] = P[i, i]
-    return quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, r_d, n_d
+    nav[0:4] = q
+    nav[4:7] = p
+    nav[7:10] = v
+    nav[10:13] = bg
+    nav[13:16] = ba
+    scal[0] = 1.0 if was_stance else 0.0
+    scal[1] = last_yaw
+    scal[2] = floor
+    scal[3] = 1.0 if have_floor else 0.0
+    scal[4] = n_ends
+    scal[5] = end1
+    scal[6] = end2
+    return quat, vel, pos, acc_nav, gb_out, ab_out, pdiag

@@ -1,0 +1,62 @@
+"""Live streaming gives what the batch run gives, for causal pipelines."""
+
+import numpy as np
+import pytest
+
+from footzoo import ConfigError, Pipeline, RecordingError
+from footzoo.sim import NoiseModel, simulate
+from footzoo.stream import Stream
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return simulate(n_strides=12, profile="physical", rate=100.0, noise=NoiseModel(seed=3), distance_sensors=True,
+                    clearance=0.1)
+
+
+@pytest.mark.parametrize("config", [
+    "configs/nguyen2016.yaml",
+    {"orientation": {"type": "ins"}, "detector": {"type": "dgp"},
+     "corrections": [{"type": "zupt"}, {"type": "height_distance"}]},
+])
+def test_streamed_results_equal_the_batch_results(walk, config):
+    p = Pipeline.from_yaml(config) if isinstance(config, str) else Pipeline.from_dict(config)
+    batch = p.run(walk)
+    live = Stream(p).run(walk)
+    assert len(live["t"]) == walk.n
+    np.testing.assert_array_equal(live["stance"], batch.stance)
+    np.testing.assert_allclose(live["pos"], batch.pos, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(live["quat"], batch.quat, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(live["vel"], batch.vel, rtol=0, atol=1e-12)
+
+
+def test_push_returns_none_until_the_still_start_is_seen(walk):
+    s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
+    assert s.push(walk.t[0], walk.acc[0], walk.gyr[0], walk.mag[0]) is None
+    outs = [s.push(walk.t[k], walk.acc[k], walk.gyr[k], walk.mag[k]) for k in range(1, 80)]
+    est = outs[-1]
+    assert est is not None and set(est) == {"t", "quat", "pos", "vel", "stance"}
+    assert est["t"] == walk.t[79]
+
+
+def test_non_causal_pipelines_are_rejected_with_the_reason():
+    with pytest.raises(ConfigError, match=r"detector 'angular_rate_fsm' looks ahead or dates switches back"):
+        Stream(Pipeline.from_yaml("configs/yun2012.yaml"))
+    with pytest.raises(ConfigError, match=r"detector 'windowed'"):
+        Stream(Pipeline.from_yaml("configs/duong2015_zupt.yaml"))
+
+
+def test_bad_live_input_is_reported(walk):
+    s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
+    s.push(walk.t[0], walk.acc[0], walk.gyr[0])
+    with pytest.raises(RecordingError, match="samples must arrive in order"):
+        s.push(walk.t[0], walk.acc[0], walk.gyr[0])
+    with pytest.raises(RecordingError, match="non-finite sample"):
+        s.push(walk.t[1], [np.nan, 0, 0], walk.gyr[1])
+    moving = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
+    k0 = int(np.searchsorted(walk.t, 3.0))  # mid-walk
+    with pytest.raises(RecordingError, match="did not start still"):
+        for k in range(k0, k0 + 80):
+            moving.push(walk.t[k], walk.acc[k], walk.gyr[k])
