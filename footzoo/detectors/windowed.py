@@ -3,14 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d
 
 from ..registry import Plugin, check_positive, register
-
-
-def centred_max(x: np.ndarray, half: int) -> np.ndarray:
-    """Maximum of ``x`` over ``[k − half, k + half]`` (clipped at the ends)."""
-    return maximum_filter1d(x, size=2 * half + 1, mode="nearest")
+from .windows import row_norms, window_max
 
 
 @register
@@ -70,10 +65,11 @@ class Windowed(Plugin):
         rate = 1.0 / float(np.median(np.diff(t)))
         half_g = int(round(self.gyro_window * rate / 2))
         half_a = int(round(self.acc_window * rate / 2))
+        acc = np.ascontiguousarray(acc, dtype=float)
         dacc = np.zeros(t.shape[0])
-        dacc[1:] = np.linalg.norm(np.diff(acc, axis=0), axis=1)
-        self.gyro_statistic_ = centred_max(np.linalg.norm(gyr, axis=1), half_g)
-        self.acc_statistic_ = centred_max(dacc, half_a)
+        dacc[1:] = row_norms(np.ascontiguousarray(acc[1:] - acc[:-1]))
+        self.gyro_statistic_ = window_max(row_norms(np.ascontiguousarray(gyr, dtype=float)), half_g)
+        self.acc_statistic_ = window_max(dacc, half_a)
         self.statistic_ = np.maximum(self.gyro_statistic_ / self.gyro_threshold,
                                      self.acc_statistic_ / self.acc_diff_threshold)
         self.stance_ = self.statistic_ <= 1.0
