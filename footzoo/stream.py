@@ -7,7 +7,8 @@ detector, i.e. Nguyen & La's real-time system — :class:`Stream` gives exactly
 what :meth:`Pipeline.run` gives on the whole recording. It holds the filter's
 state between samples and feeds the same compiled loop two samples at a time.
 
-The stream needs the foot still for ``init.duration`` seconds at the start
+DGP and the filter run their compiled loops from carried state, one sample at
+a time. The stream needs the foot still for ``init.duration`` seconds at the start
 (the batch run can also look later and carry the attitude back; a live
 system cannot), and takes the sampling rate for DGP's windows from that
 still period (the batch run from the whole recording: the same for a
@@ -16,71 +17,12 @@ regular clock).
 
 from __future__ import annotations
 
-from collections import deque
 from typing import Any
 
 import numpy as np
 
-from .conventions import GRAVITY
 from .errors import ConfigError, RecordingError
 from .orientation.fqa import fqa
-
-
-class _CausalMean:
-    """Running mean of the last ``n`` values, with the batch's cumulative-sum arithmetic."""
-
-    def __init__(self, n: int, shape: tuple[int, ...] = ()):
-        self.n = n
-        self.c = np.zeros(shape)
-        self.hist: deque[np.ndarray] = deque([self.c.copy()], maxlen=n + 1)
-        self.count = 0
-
-    def push(self, x: np.ndarray) -> np.ndarray:
-        self.c = self.c + x
-        self.hist.append(self.c.copy())
-        self.count += 1
-        k = min(self.count, self.n)
-        return (self.hist[-1] - self.hist[-1 - k]) / k
-
-
-class _StreamingDGP:
-    """DGP (Nguyen & La eqs. 3–15) one sample at a time, equal to :meth:`DGP.detect`."""
-
-    def __init__(self, det, rate: float):
-        from .detectors.dgp import dgp_initial_state
-
-        self.det = det
-        f = max(int(round((det.window * rate - 1) / 2)), 1)
-        w = 2 * f + 1
-        self.ave = _CausalMean(w, (3,))
-        self.mean_ave = _CausalMean(w, (3,))
-        self.mean_sq = _CausalMean(w)
-        self.s_c = _CausalMean(max(int(round(det.condition_window * rate)), 1))
-        self.scale = rate / det.reference_rate
-        self.min_swing = int(round(det.min_swing * rate))
-        self.state = dgp_initial_state(det.initial_delay, det.initial_threshold)
-        self.prev: tuple[float, np.ndarray, np.ndarray, float, float] | None = None
-
-    def push(self, t: float, acc: np.ndarray, gyr: np.ndarray) -> bool:
-        from .detectors.dgp import _motion_acc_change, dgp_kernel
-
-        a = acc[None, :]
-        ave = self.ave.push(acc)[None, :]
-        mean_ave = self.mean_ave.push(ave[0])[None, :]
-        mean_sq = self.mean_sq.push(np.sum(ave**2, axis=1)[0])
-        local_sq = np.sum(a**2, axis=1) - 2 * np.sum(a * mean_ave, axis=1) + mean_sq
-        a_local = np.sqrt(np.maximum(local_sq, 0.0))[0]
-        w_m = np.linalg.norm(gyr[None, :], axis=1)[0]
-        if self.prev is None:
-            d_g = 0.0
-        else:
-            t0, acc0, gyr0, a_local0, w_m0 = self.prev
-            d_am = _motion_acc_change(np.array([t0, t]), np.vstack([acc0, acc]), np.vstack([gyr0, gyr]))[1]
-            d_g = d_am / GRAVITY + (np.abs(a_local - a_local0) / GRAVITY + np.abs(w_m - w_m0))
-        self.prev = (t, acc, gyr, a_local, w_m)
-        s_c = self.s_c.push(np.asarray(d_g * self.scale))
-        _, _, _, stance = dgp_kernel(np.array([float(s_c)]), self.state, self.min_swing)
-        return bool(stance[0])
 
 
 class Stream:
@@ -166,7 +108,10 @@ class Stream:
         mag = np.array([s[3] for s in b[: self._n_init]]) if use_mag else None
         q0 = fqa(acc.mean(axis=0)[None, :], None if mag is None else mag.mean(axis=0)[None, :])[0]
         rate = 1.0 / float(np.median(np.diff(t[: self._n_init])))
-        self._dgp = _StreamingDGP(self.pipeline.detector, rate)
+        from .pipeline import _clone as clone
+
+        self._dgp = clone(self.pipeline.detector)
+        self._dgp.begin(rate)
         dist = np.array([s[4] if s[4] is not None else np.zeros(0) for s in b[: self._n_init]], dtype=float)
         corrections = [_clone(c) for c in self.pipeline.corrections]
         # the batch order: Kalman corrections, then the heading reduction
@@ -185,7 +130,7 @@ class Stream:
         from .filters.eskf_fast import eskf_kernel
 
         self.k += 1
-        stance = self._dgp.push(t, acc, gyr)
+        stance = bool(self._dgp.step(np.array([t]), acc[None, :], gyr[None, :])[-1][0])
         s = self._setup
         in_init = self.k < self._n_init
         row = np.full((1, s["k_sensors"]), np.nan) if dist is None else dist[None, : s["k_sensors"]]

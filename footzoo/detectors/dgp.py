@@ -11,17 +11,44 @@ from ..conventions import GRAVITY
 from ..registry import Plugin, check_positive, register
 
 
-def _causal_mean(x: np.ndarray, n: int) -> np.ndarray:
-    """Mean of the last ``n`` rows (fewer at the start), along axis 0."""
-    c = np.cumsum(np.concatenate([np.zeros((1,) + x.shape[1:]), x]), axis=0)
-    idx = np.arange(1, x.shape[0] + 1)
-    lo = np.maximum(idx - n, 0)
-    count = (idx - lo).reshape((-1,) + (1,) * (x.ndim - 1))
-    return (c[idx] - c[lo]) / count
+def dgp_statistic_state(f: int, n_c: int) -> tuple[np.ndarray, ...]:
+    """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and the previous sample."""
+    w = 2 * f + 1
+    return (np.zeros((w + 1, 3)), np.zeros((w + 1, 3)), np.zeros(w + 1), np.zeros(n_c + 1),
+            np.zeros(1, dtype=np.int64), np.zeros(9))
 
 
-def dgp_statistic(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: int, rate_scale: float) -> np.ndarray:
-    """``d_g`` of eq. 3 per sample (scaled to the reference rate).
+@njit
+def _ring_mean(ring, count, window, value):
+    """Push ``value`` into the running sum kept in ``ring`` (row ``count`` mod len); mean of the last ``window``.
+
+    The sums are ``c_k = c_{k−1} + x_k`` and the mean ``(c_k − c_lo)/(k − lo)``, the
+    arithmetic of a cumulative sum over the whole recording.
+    """
+    size = ring.shape[0]
+    cur = (count + 1) % size
+    ring[cur] = ring[count % size] + value
+    k = min(count + 1, window)
+    return (ring[cur] - ring[(count + 1 - k) % size]) / k
+
+
+@njit
+def _ring_mean3(ring, count, window, x0, x1, x2):
+    """:func:`_ring_mean` for a 3-vector, component by component, without allocating."""
+    size = ring.shape[0]
+    cur = (count + 1) % size
+    old = count % size
+    ring[cur, 0] = ring[old, 0] + x0
+    ring[cur, 1] = ring[old, 1] + x1
+    ring[cur, 2] = ring[old, 2] + x2
+    k = min(count + 1, window)
+    lo = (count + 1 - k) % size
+    return (ring[cur, 0] - ring[lo, 0]) / k, (ring[cur, 1] - ring[lo, 1]) / k, (ring[cur, 2] - ring[lo, 2]) / k
+
+
+@njit
+def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ring_sq, ring_dg, count, prev):
+    """``s_c`` (eq. 9) of ``d_g`` (eq. 3) per sample, resumable: the state arrays carry on between calls.
 
     * ``|a_m^{t+1} − a_m^t|``: change of the NED motion acceleration (eqs. 4–6).
       Since ``a_m = C f + g``, the change is ``C_t (ΔC f_{t+1} − f_t)`` and its norm
@@ -34,41 +61,50 @@ def dgp_statistic(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: int, rate_
     * ``|w_m^{t+1} − w_m^t|``: change of the angular-rate magnitude.
 
     The accelerations are taken in g and the rate in rad/s, the units the paper's
-    MicroStrain 3DM-GX3-25 reports, for which its thresholds (0.8) were found.
+    MicroStrain 3DM-GX3-25 reports, for which its thresholds (0.8) were found;
+    ``d_g`` is scaled by ``scale`` (rate / reference rate).
     """
-    d_am = _motion_acc_change(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
-                              np.ascontiguousarray(gyr, dtype=float))
-    w = 2 * f + 1
-    ave = _causal_mean(acc, w)  # eq. 8
-    mean_ave = _causal_mean(ave, w)
-    mean_sq = _causal_mean(np.sum(ave**2, axis=1), w)
-    local_sq = np.sum(acc**2, axis=1) - 2 * np.sum(acc * mean_ave, axis=1) + mean_sq  # eq. 7
-    a_local = np.sqrt(np.maximum(local_sq, 0.0))
-    w_m = np.linalg.norm(gyr, axis=1)
-    d_g = d_am / GRAVITY
-    d_g[1:] += np.abs(np.diff(a_local)) / GRAVITY + np.abs(np.diff(w_m))
-    return d_g * rate_scale
+    n = t.shape[0]
+    s_c = np.empty(n)
+    d_g_out = np.empty(n)
+    for k in range(n):
+        c = count[0]
+        a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
+        v0, v1, v2 = _ring_mean3(ring_acc, c, window, a0, a1, a2)  # eq. 8
+        m0, m1, m2 = _ring_mean3(ring_ave, c, window, v0, v1, v2)
+        mean_sq = _ring_mean(ring_sq, c, window, (v0 * v0 + v1 * v1) + v2 * v2)
+        local_sq = ((a0 * a0 + a1 * a1) + a2 * a2) - 2 * ((a0 * m0 + a1 * m1) + a2 * m2) + mean_sq  # eq. 7
+        a_local = math.sqrt(max(local_sq, 0.0))
+        w_m = math.sqrt((gyr[k, 0] * gyr[k, 0] + gyr[k, 1] * gyr[k, 1]) + gyr[k, 2] * gyr[k, 2])
+        if prev[8] == 0.0:
+            d_g = 0.0
+        else:
+            d_am = _rotation_change(t[k] - prev[0], gyr[k, 0], gyr[k, 1], gyr[k, 2], a0, a1, a2,
+                                    prev[3], prev[4], prev[5])
+            d_g = d_am / GRAVITY + (abs(a_local - prev[1]) / GRAVITY + abs(w_m - prev[2]))  # eq. 3
+        d_g *= scale
+        d_g_out[k] = d_g
+        s_c[k] = _ring_mean(ring_dg, c, n_c, d_g)  # eq. 9
+        prev[0], prev[1], prev[2] = t[k], a_local, w_m
+        prev[3], prev[4], prev[5] = a0, a1, a2
+        prev[8] = 1.0
+        count[0] = c + 1
+    return s_c, d_g_out
 
 
 @njit
-def _motion_acc_change(t, acc, gyr):
-    """``|ΔC f_k − f_{k−1}|`` with ``ΔC = exp(ω_k dt_k)`` (Rodrigues), the norm of eq. 3's first term."""
-    n = t.shape[0]
-    out = np.zeros(n)
-    for k in range(1, n):
-        dt = t[k] - t[k - 1]
-        rx, ry, rz = gyr[k, 0] * dt, gyr[k, 1] * dt, gyr[k, 2] * dt
-        angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-        half = 0.5 * angle
-        kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-        w, x, y, z = math.cos(half), kk * rx, kk * ry, kk * rz
-        fx, fy, fz = acc[k, 0], acc[k, 1], acc[k, 2]
-        gx = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
-        gy = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
-        gz = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz
-        dx, dy, dz = gx - acc[k - 1, 0], gy - acc[k - 1, 1], gz - acc[k - 1, 2]
-        out[k] = math.sqrt(dx * dx + dy * dy + dz * dz)
-    return out
+def _rotation_change(dt, g0, g1, g2, fx, fy, fz, px, py, pz):
+    """``|exp(ω dt) f − f_prev|`` (Rodrigues)."""
+    rx, ry, rz = g0 * dt, g1 * dt, g2 * dt
+    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
+    half = 0.5 * angle
+    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
+    w, x, y, z = math.cos(half), kk * rx, kk * ry, kk * rz
+    gx = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
+    gy = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
+    gz = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz
+    dx, dy, dz = gx - px, gy - py, gz - pz
+    return math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 def dgp_initial_state(s_d0: float, th0: float) -> np.ndarray:
@@ -197,17 +233,29 @@ class DGP(Plugin):
         self.reference_rate = check_positive("reference_rate", reference_rate)
         self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
 
+    def begin(self, rate: float) -> None:
+        """Fresh state for a recording sampled at ``rate`` (Hz)."""
+        f = max(int(round((self.window * rate - 1) / 2)), 1)
+        self._n_c = max(int(round(self.condition_window * rate)), 1)
+        self._w = 2 * f + 1
+        self._scale = rate / self.reference_rate
+        self._min_swing = int(round(self.min_swing * rate))
+        self._stat_state = dgp_statistic_state(f, self._n_c)
+        self._state = dgp_initial_state(self.initial_delay, self.initial_threshold)
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
+        """Process the next samples (a whole recording, or one live sample) from the carried state."""
+        s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
+        s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing)
+        return s_c, d_g, s_d, max_cd, th, stance
+
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> DGP:
         """Detect stance over a recording (eqs. 3–15)."""
         rate = 1.0 / float(np.median(np.diff(t)))
-        f = max(int(round((self.window * rate - 1) / 2)), 1)
-        n_c = max(int(round(self.condition_window * rate)), 1)
-        self.d_g_ = dgp_statistic(t, acc, gyr, f, rate / self.reference_rate)
-        self.s_c_ = _causal_mean(self.d_g_, n_c)  # eq. 9
-        state = dgp_initial_state(self.initial_delay, self.initial_threshold)
-        self.s_d_, self.statistic_, self.threshold_, stance = dgp_kernel(
-            self.s_c_, state, int(round(self.min_swing * rate))
-        )
+        self.begin(rate)
+        self.s_c_, self.d_g_, self.s_d_, self.statistic_, self.threshold_, stance = self.step(
+            np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
+            np.ascontiguousarray(gyr, dtype=float))
         self.stance_ = stance
         self.stance_online_ = stance.copy()
         return self
