@@ -45,15 +45,6 @@ def gravity_ned(g: float = GRAVITY) -> np.ndarray:
     return np.array([0.0, 0.0, float(g)])
 
 
-def quat_identity(n: int | None = None) -> np.ndarray:
-    """Identity quaternion ``[1, 0, 0, 0]`` (or an (n, 4) stack of them)."""
-    if n is None:
-        return np.array([1.0, 0.0, 0.0, 0.0])
-    q = np.zeros((n, 4))
-    q[:, 0] = 1.0
-    return q
-
-
 def quat_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Hamilton product ``p ⊗ q`` of scalar-first quaternions (..., 4)."""
     p = np.asarray(p, dtype=float)
@@ -206,13 +197,3 @@ def tilt_from_specific_force(f_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     roll = np.arctan2(-f[..., 1], -f[..., 2])
     return roll, pitch
 
-
-def heading_from_magnetometer(m_b: np.ndarray, roll: np.ndarray, pitch: np.ndarray) -> np.ndarray:
-    """Magnetic heading ψ (rad) of the body from a magnetometer reading in FRD.
-
-    The reading is levelled with roll and pitch; ψ = atan2(-m_y, m_x) of the
-    levelled field (north = 0, east = +π/2). Declination is not applied.
-    """
-    q_tilt = quat_from_euler(roll, pitch, np.zeros_like(np.asarray(roll, dtype=float)))
-    m_level = quat_rotate(q_tilt, m_b)
-    return np.arctan2(-m_level[..., 1], m_level[..., 0])

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from .data import Recording, Result
 from .metrics import rotate_about_vertical, yaw_alignment
 
@@ -51,7 +49,3 @@ def plot_trajectory(result: Result, path: str | Path, recording: Recording | Non
     plt.close(fig)
     return out
 
-
-def finite(x: np.ndarray) -> bool:
-    """True when every value is finite."""
-    return bool(np.all(np.isfinite(x)))
