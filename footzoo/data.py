@@ -129,13 +129,6 @@ class Recording:
         """The recording's name (file stem or given)."""
         return str(self.meta.get("name", "recording"))
 
-    def dt(self) -> np.ndarray:
-        """Sample intervals (s), (N,): ``dt[k] = t[k] - t[k-1]``, ``dt[0]`` = median."""
-        d = np.empty_like(self.t)
-        d[1:] = np.diff(self.t)
-        d[0] = np.median(d[1:])
-        return d
-
     @classmethod
     def from_dataframe(
         cls,

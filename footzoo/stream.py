@@ -108,9 +108,7 @@ class Stream:
         mag = np.array([s[3] for s in b[: self._n_init]]) if use_mag else None
         q0 = fqa(acc.mean(axis=0)[None, :], None if mag is None else mag.mean(axis=0)[None, :])[0]
         rate = 1.0 / float(np.median(np.diff(t[: self._n_init])))
-        from .pipeline import _clone as clone
-
-        self._dgp = clone(self.pipeline.detector)
+        self._dgp = _clone(self.pipeline.detector)
         self._dgp.begin(rate)
         dist = np.array([s[4] if s[4] is not None else np.zeros(0) for s in b[: self._n_init]], dtype=float)
         corrections = [_clone(c) for c in self.pipeline.corrections]

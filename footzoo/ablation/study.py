@@ -181,7 +181,7 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
     """
     parts = path.split(".")
     node: Any = d
-    for j, part in enumerate(parts[:-1]):
+    for part in parts[:-1]:
         key: Any = int(part) if isinstance(node, list) else part
         if isinstance(node, list):
             if key >= len(node):
@@ -189,7 +189,6 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
         elif key not in node or node[key] is None:
             node[key] = {}
         node = node[key]
-        del j
     last = parts[-1]
     if isinstance(node, list):
         node[int(last)] = value

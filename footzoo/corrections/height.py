@@ -202,7 +202,7 @@ class HeightDistance(Plugin):
         return rows
 
     def _estimate_floor(self, nav: NavState) -> float:
-        """Floor height from the initial still period: mean of p_z + [Ĉ(r̂ + n̂ z)]_z."""
+        """Floor height from the initial still period: mean of [Ĉ(r̂ + n̂ z)]_z (the sensor starts at height 0)."""
         from ..conventions import quat_to_matrix
 
         c = quat_to_matrix(nav.q)
@@ -210,7 +210,7 @@ class HeightDistance(Plugin):
         w = self._init_window
         for j in range(self.k):
             z = self._dist[w & self._valid[:, j], j]
-            heights += list(nav.p[2] * 0 + (c @ (self._r[j][:, None] + np.outer(self._n[j], z)))[2])
+            heights += list((c @ (self._r[j][:, None] + np.outer(self._n[j], z)))[2])
         return float(np.mean(heights))
 
     def _constraints(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
