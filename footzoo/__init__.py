@@ -10,6 +10,7 @@ from .data import Recording, Result, Truth  # noqa: E402
 from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
 from .io import load  # noqa: E402
 from .pipeline import Pipeline  # noqa: E402
+from .registry import register  # noqa: E402
 
 __all__ = [
     "ConfigError",
@@ -21,5 +22,6 @@ __all__ = [
     "Result",
     "Truth",
     "load",
+    "register",
     "__version__",
 ]

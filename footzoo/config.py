@@ -30,6 +30,9 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
+    "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
+                  "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
+                  "initial_position_std: m}",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")

@@ -15,3 +15,7 @@ class ConfigError(FootzooError, ValueError):
 
 class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
+
+
+class FootzooWarning(UserWarning):
+    """Something footzoo handled but you should know: a bridged gap, a fallback engine, a clipped sensor, …"""

@@ -8,12 +8,13 @@ import pandas as pd
 from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
 from ..metrics import intervals
-from ..registry import Plugin, check_positive, register
+from ..plugin import Analysis
+from ..registry import check_positive, register
 from .foot_vector import FootVector
 
 
 @register
-class HuangFPA(Plugin):
+class HuangFPA(Analysis):
     """Foot progression angle per step from a foot vector and a filtered heading vector.
 
     Huang et al. 2016, IEEE TBME, Sec. II-C–E: the foot vector ``f`` fixed in
@@ -53,7 +54,6 @@ class HuangFPA(Plugin):
         Sample index of each heel strike (stance onset).
     """
 
-    kind = "analysis"
     name = "huang_fpa"
     paper = "Huang et al. 2016, IEEE TBME, Sec. II-C to II-E, eqs. 11-16"
     units = {"alpha": "1", "window": "fraction of stance", "stance_fraction": "fraction of stride",
