@@ -4,8 +4,7 @@ Conventions: NED navigation frame, FRD body frame, scalar-first body -> NED
 quaternions, SI units (see :mod:`footzoo.conventions`).
 """
 
-__version__ = "0.1.0"
-
+from ._version import __version__  # noqa: E402
 from .data import Recording, Result, Truth  # noqa: E402
 from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
 from .io import load  # noqa: E402

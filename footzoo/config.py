@@ -18,8 +18,7 @@ from typing import Any
 
 import yaml
 
-from .errors import ConfigError
-from .registry import did_you_mean
+from .errors import ConfigError, did_you_mean
 
 TOP_LEVEL_KEYS: dict[str, str] = {
     "name": "pipeline name (text)",

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from . import __version__
+from ._version import __version__
 from .alignment import initial_attitude
 from .analysis.strides import segment_steps
 from .config import INIT_KEYS, check_top_level, load_yaml

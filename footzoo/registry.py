@@ -12,12 +12,11 @@ time a listing or a lookup needs them, then the installed packages' entry points
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import inspect
 from typing import Any
 
-from .errors import ConfigError
+from .errors import ConfigError, did_you_mean
 from .plugin import BASES, Plugin
 
 KINDS: tuple[str, ...] = tuple(BASES)
@@ -53,12 +52,6 @@ def register(cls: type[Plugin]) -> type[Plugin]:
                              f"({old.__module__}.{old.__qualname__}); choose another name")
     _REGISTRY[cls.kind][cls.name] = cls
     return cls
-
-
-def did_you_mean(word: str, options: list[str]) -> str:
-    """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
-    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def available(kind: str) -> dict[str, type[Plugin]]:

@@ -91,3 +91,16 @@ def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
 
     with pytest.raises(ValueError, match="already registered"):
         footzoo.register(Shoe2)
+
+
+def test_the_engine_pipeline_and_stream_name_no_plugin():
+    """The engine knows no plug-in by name: adding one touches none of these files."""
+    from pathlib import Path
+
+    root = Path(footzoo.__file__).parent
+    files = [*sorted((root / "filters").glob("*.py")), root / "pipeline.py", root / "stream.py"]
+    names = {name for kind in KINDS for name in available(kind) if not name.startswith("test_")}
+    for f in files:
+        text = f.read_text()
+        for name in names:
+            assert f'"{name}"' not in text and f"'{name}'" not in text, f"{f.name} names the plug-in {name!r}"

@@ -25,8 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..data import Recording
-from ..errors import FormatError
-from ..registry import did_you_mean
+from ..errors import FormatError, did_you_mean
 from . import canonical, gaitmap, pyshoe, sensorconnect, xio
 
 READERS: dict[str, Callable[..., Recording]] = {
