@@ -29,6 +29,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
+    "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
     "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
                   "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
                   "initial_position_std: m}",

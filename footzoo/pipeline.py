@@ -58,7 +58,13 @@ class Pipeline:
         Run on the finished trajectory.
     navigation : NavigationNoise or dict, optional
         Process noise and initial uncertainty of the INS core of the Kalman filter.
+    smoother : {"none", "rts"}
+        ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
+        (:mod:`footzoo.filters.smoother`; offline only). The forward trajectory stays in
+        ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
     """
+
+    SMOOTHERS = ("none", "rts")
 
     def __init__(
         self,
@@ -70,6 +76,7 @@ class Pipeline:
         init: dict[str, float] | None = None,
         analysis: list[Analysis] | None = None,
         navigation: NavigationNoise | dict[str, Any] | None = None,
+        smoother: str = "none",
     ):
         self.orientation = orientation
         self.detector = detector
@@ -81,6 +88,12 @@ class Pipeline:
         self.navigation = (navigation if isinstance(navigation, NavigationNoise)
                            else NavigationNoise.from_dict(navigation))
         check_compatibility(orientation, detector, self.corrections)
+        if smoother not in self.SMOOTHERS:
+            raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
+        if smoother != "none" and not self.filter_corrections:
+            raise ConfigError(f"smoother: {smoother} smooths the Kalman filter, and this pipeline has none; "
+                              "add a Kalman correction (e.g. zupt) or remove smoother")
+        self.smoother = smoother
 
     # ----------------------------------------------------------------- build
     @classmethod
@@ -102,6 +115,7 @@ class Pipeline:
             init=d.get("init") or {},
             analysis=analysis,
             navigation=d.get("navigation"),
+            smoother=d.get("smoother", "none"),
         )
 
     @classmethod
@@ -120,6 +134,7 @@ class Pipeline:
             "gravity": self.gravity,
             "init": dict(self.init),
             "navigation": self.navigation.to_dict(),
+            "smoother": self.smoother,
             "orientation": self.orientation.spec(),
             "detector": self.detector.spec(),
             "corrections": [c.spec() for c in self.corrections],
@@ -199,8 +214,9 @@ class Pipeline:
         if kalman:
             samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
             eng = self.kalman_engine(kalman, samples, engine)
-            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat)
+            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, smoother=self.smoother == "rts")
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"], P_diag=out["P_diag"])
+            out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
             out["engine"] = eng.engine
             return out
         acc_nav = motion_acceleration(quat, rec.acc, self.gravity)

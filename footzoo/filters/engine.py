@@ -192,13 +192,28 @@ class KalmanEngine:
         return "fast"
 
     # ------------------------------------------------------------------ runs
-    def run(self, t, acc, gyr, stance, q0, quat_ext=None, covariance: bool = True) -> dict[str, Any]:
-        """Filter a whole recording; returns the trajectories and each model's diagnostics."""
+    def run(self, t, acc, gyr, stance, q0, quat_ext=None, covariance: bool = True,
+            smoother: bool = False) -> dict[str, Any]:
+        """Filter a whole recording; returns the trajectories and each model's diagnostics.
+
+        With ``smoother`` the trajectories are the RTS-smoothed ones (:mod:`footzoo.filters.smoother`)
+        and the forward pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
+        """
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
-        out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance)
+        out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
+                           smoother)
         out["diagnostics"] = self.diagnostics(state)
+        if smoother:
+            from .smoother import rts_backward
+
+            for key in ("quat", "vel", "pos"):
+                out[f"{key}_forward"] = out[key].copy()
+            core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
+            rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
+                         out["pos"], out["gyro_bias"], out["acc_bias"])
+        del out["gains"], out["dxs"]
         return out
 
     def start(self, nav0: np.ndarray) -> Any:
@@ -210,17 +225,19 @@ class KalmanEngine:
         return self.pack(nav0)
 
     def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
-                covariance: bool = True) -> dict[str, np.ndarray]:
+                covariance: bool = True, smoother: bool = False) -> dict[str, np.ndarray]:
         """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state."""
         n = len(t)
         if self.engine == "reference":
             from .kalman_reference import run_reference
 
             return run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
-                                 state["nav"], self.gravity, data, k0)
+                                 state["nav"], self.gravity, data, k0, smoother)
+        nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.empty((n, 3)), "acc_bias": np.empty((n, 3)),
-               "P_diag": np.empty((n if covariance else 0, self.layout.n))}
+               "P_diag": np.empty((n if covariance else 0, nx)),
+               "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         return out
 
@@ -280,6 +297,7 @@ class KalmanEngine:
             packed.core,
             (packed.nav, packed.P, packed.mems),
             (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off),
-            (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"], out["P_diag"]),
+            (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"], out["P_diag"],
+             out["gains"], out["dxs"]),
             k0,
         )

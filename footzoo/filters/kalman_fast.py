@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from .smoother import smoother_gain, spd_inverse
 
 
 @njit
@@ -43,32 +44,6 @@ def _add_block_cols(out, src, r0, c0, b):
             for m in range(3):
                 s += src[i, c0 + m] * b[j, m]
             out[i, r0 + j] += s
-
-
-@njit
-def _spd_inverse(S, m, L, out):
-    """Inverse of the symmetric positive definite ``S[:m, :m]`` by Cholesky, into ``out``."""
-    for i in range(m):
-        for j in range(i + 1):
-            acc_ = S[i, j]
-            for k in range(j):
-                acc_ -= L[i, k] * L[j, k]
-            if i == j:
-                L[i, i] = math.sqrt(acc_)
-            else:
-                L[i, j] = acc_ / L[j, j]
-    # solve L Lᵀ X = I column by column
-    for col in range(m):
-        for i in range(m):  # forward: L y = e_col
-            acc_ = 1.0 if i == col else 0.0
-            for k in range(i):
-                acc_ -= L[i, k] * out[k, col]
-            out[i, col] = acc_ / L[i, i]
-        for i in range(m - 1, -1, -1):  # backward: Lᵀ x = y
-            acc_ = out[i, col]
-            for k in range(i + 1, m):
-                acc_ -= L[k, i] * out[k, col]
-            out[i, col] = acc_ / L[i, i]
 
 
 @njit
@@ -108,8 +83,10 @@ def eskf_loop(signals, core, state, models, out, k0):
         ``(measures, feedbacks, afters, idx (L, w) int, par, par_off (L+1,), mem_off (L+1,),
         data (N, d), data_off (L+1,))``: the corrections' functions and their arrays, in stacking order.
     out : tuple
-        ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n))``; row 0
-        receives the incoming state. ``P_diag`` with 0 rows is not written.
+        ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n),
+        gains (N or 0, n, n), dxs (N or 0, n))``; row 0 receives the incoming state. ``P_diag``,
+        and the smoother's gains ``A_k`` and fed-back errors (:mod:`footzoo.filters.smoother`),
+        with 0 rows are not written.
     k0 : int
         Index of sample 0 in the whole recording (a stream passes its running count).
     """
@@ -117,9 +94,14 @@ def eskf_loop(signals, core, state, models, out, k0):
     idx, qn, gravity, use_ext, m_max = core
     nav, P, mems = state
     measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off = models
-    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag = out
+    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs = out
     N = t.shape[0]
     n = P.shape[0]
+    smooth = gains.shape[0] == N
+    sub = np.empty((n, n))
+    Ls = np.empty((n, n))
+    inv = np.empty((n, n))
+    keep = np.empty(n, dtype=np.int64)
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
     keep_p = pdiag.shape[0] == N
     z = np.zeros(m_max)
@@ -221,6 +203,10 @@ def eskf_loop(signals, core, state, models, out, k0):
             _add_block_cols(P, M, vel_i, ab_i, cdt)
         for i in range(n):
             P[i, i] += qn[i] * dt
+        if smooth:  # M = Φ P⁺_{k−1}, P = P⁻_k
+            smoother_gain(M, P, gains[k - 1], sub, Ls, inv, keep)
+            for i in range(n):
+                dxs[k, i] = 0.0
         # the corrections' measurement rows, stacked in order
         st = stance[k]
         m = 0
@@ -253,7 +239,7 @@ def eskf_loop(signals, core, state, models, out, k0):
                         acc_ += H[a, i] * PHT[i, b2]
                     S[a, b2] = acc_
                 S[a, a] += rdiag[a]
-            _spd_inverse(S, m, L, SI)
+            spd_inverse(S, m, L, SI)
             for i in range(n):
                 for a in range(m):
                     acc_ = 0.0
@@ -310,6 +296,9 @@ def eskf_loop(signals, core, state, models, out, k0):
                     nav[13 + i] += dx[ab_i + i]
             for j in range(len(feedbacks)):
                 feedbacks[j](dx, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
+            if smooth:
+                for i in range(n):
+                    dxs[k, i] = dx[i]
         for j in range(len(afters)):
             afters[j](k0 + k, nav, st, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
         for i in range(4):

@@ -12,6 +12,7 @@ import numpy as np
 from ..conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
 from .measurement import MeasurementModel
+from .smoother import smoother_gain
 
 
 def run_reference(
@@ -28,6 +29,7 @@ def run_reference(
     gravity: float,
     data: list[np.ndarray] | None = None,
     k0: int = 0,
+    smooth: bool = False,
 ) -> dict[str, np.ndarray]:
     """Strapdown mechanisation with error-state Kalman corrections (Nguyen & La 2016, eqs. 37–52).
 
@@ -57,6 +59,8 @@ def run_reference(
         Each model's per-sample inputs for these samples (default: the models' ``data``).
     k0 : int
         Index of sample 0 in the whole recording (a stream's running count).
+    smooth : bool
+        Also return ``gains`` (N, n, n) and ``dxs`` (N, n) for :mod:`footzoo.filters.smoother`.
 
     Returns
     -------
@@ -74,6 +78,10 @@ def run_reference(
     out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
     out["quat"] = np.zeros((n, 4))
     out["P_diag"] = np.zeros((n, layout.n))
+    out["gains"] = np.zeros((n if smooth else 0, layout.n, layout.n))
+    out["dxs"] = np.zeros((n if smooth else 0, layout.n))
+    work = (np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)),
+            np.empty(layout.n, dtype=np.int64))
     _store(out, 0, nav, np.zeros(3), kf.P)
     for k in range(1, n):
         dt = t[k] - t[k - 1]
@@ -89,7 +97,11 @@ def run_reference(
         v_prev = nav[7:10].copy()
         nav[7:10] = v_prev + a_n * dt
         nav[4:7] = nav[4:7] + 0.5 * (v_prev + nav[7:10]) * dt
-        kf.predict(transition(layout, c, f_n, dt), dt)
+        F = transition(layout, c, f_n, dt)
+        p_post = kf.P.copy()
+        kf.predict(F, dt)
+        if smooth:
+            smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
         z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
         m = 0
         st = bool(stance[k])
@@ -109,6 +121,8 @@ def run_reference(
                 nav[13:16] += dx[layout["acc_bias"]]
             for model, ix in zip(models, idx, strict=True):
                 model.feedback(dx, ix, model.par, model.mem)
+            if smooth:
+                out["dxs"][k] = dx
         for model, ix in zip(models, idx, strict=True):
             model.after(k0 + k, nav, st, ix, model.par, model.mem)
         _store(out, k, nav, a_n, kf.P)
