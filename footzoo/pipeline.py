@@ -181,7 +181,7 @@ class Pipeline:
                 "stance": stance,
             }
         )
-        steps = segment_steps(t, stance, pos)
+        steps = segment_steps(t, stance, pos, gyr)
         for a in self.analysis:
             a = _clone(a).analyze(t, quat, pos, stance, rec.meta)
             steps = a.annotate(steps, t)
@@ -192,6 +192,7 @@ class Pipeline:
             versions=versions(),
             recording=dict(rec.meta),
             diagnostics=diagnostics,
+            reference=rec.truth,
         )
 
 

@@ -125,8 +125,14 @@ class HuangFPA(Plugin):
         return self
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
-        """Add ``fpa`` (rad) to the step table: the FPA of the stance that ends each stride."""
+        """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
+
+        That stance is the first one whose onset is at or after the stride's
+        initial contact ``end_s`` (the detector's onset follows the contact).
+        """
         out = steps.copy()
-        by_onset = dict(zip(t[self.heel_strikes_].tolist(), self.fpa_.tolist(), strict=True))
-        out["fpa"] = [by_onset.get(end, np.nan) for end in out["end"].tolist()]
+        onsets = t[self.heel_strikes_]
+        k = np.searchsorted(onsets, out["end_s"].to_numpy() - 1e-9)
+        fpa = np.append(self.fpa_, np.nan)
+        out["fpa_rad"] = fpa[np.minimum(k, len(self.fpa_))] if len(self.fpa_) else np.nan
         return out
