@@ -10,6 +10,7 @@ from .data import Recording, Result, Truth  # noqa: E402
 from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
 from .io import load  # noqa: E402
 from .pipeline import Pipeline  # noqa: E402
+from .session import Session, SessionResult  # noqa: E402
 
 __all__ = [
     "ConfigError",
@@ -19,6 +20,8 @@ __all__ = [
     "Recording",
     "RecordingError",
     "Result",
+    "Session",
+    "SessionResult",
     "Truth",
     "load",
     "__version__",

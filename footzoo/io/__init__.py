@@ -38,6 +38,16 @@ READERS: dict[str, Callable[..., Recording]] = {
 }
 
 
+#: What each CSV reader expects on the first line (shown when a header is not recognised).
+EXPECTED_HEADERS: dict[str, str] = {
+    "canonical": "columns t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z (optional mag_x..z, dist_*, true_*), "
+                 "SI units unless acc_unit/gyr_unit are declared",
+    "xio": "Time (s), Gyroscope X (deg/s), ..., Accelerometer X (g), ...",
+    "gaitmap": "two header rows: sensor,left_sensor,...,right_sensor,... then ,acc_x,...,gyr_z",
+    "sensorconnect": "Time, <device>:scaledAccelX, ..., <device>:scaledGyroX, ...",
+}
+
+
 def detect_format(path: str | Path) -> str:
     """Guess a file's format from its extension and first line."""
     p = Path(path)
@@ -60,8 +70,9 @@ def detect_format(path: str | Path) -> str:
         if canonical.matches(head):
             return "canonical"
         raise FormatError(
-            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}; "
-            f"pass format= one of {sorted(READERS)}"
+            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}. Expected one of: "
+            + "; ".join(f"{k}: {v}" for k, v in EXPECTED_HEADERS.items())
+            + f". Rename the columns, or pass format= one of {sorted(READERS)} (command line: --format)"
         )
     raise FormatError(f"{p}: unknown extension {suffix!r}; pass format= one of {sorted(READERS)}")
 
