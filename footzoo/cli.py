@@ -134,8 +134,16 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     """Check a config without running it."""
+    from .config import load_yaml
+    from .config_check import config_errors
     from .pipeline import Pipeline
 
+    errors = config_errors(load_yaml(args.config))
+    if errors:
+        print(f"{args.config}: {len(errors)} problem(s)", file=sys.stderr)
+        for e in errors:
+            print(f"  - {e}", file=sys.stderr)
+        return 2
     pipeline = Pipeline.from_yaml(args.config)
     print(f"{args.config}: valid")
     print(json.dumps(pipeline.to_dict(), indent=2))
