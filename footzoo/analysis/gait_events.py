@@ -19,7 +19,13 @@ footzoo's choices (not fixed by the paper): the stances come from the pipeline's
 stance detector instead of Rampp's DTW stride segmentation; TO is searched from
 the middle of the stance before the swing to ``p``, IC from ``p`` to the middle of
 the next stance; the TO minimum is refined to sub-sample time with a parabola
-through its three samples, the IC crossing by linear interpolation. Checked on
+through its three samples, the IC crossing by linear interpolation; a sample
+stands for the middle of its interval ``(t[k-1], t[k]]`` (footzoo's
+interval-average convention), so event times are half a period before the
+sample times. On the simulator's physical profile the rate's zero crossing is
+the true IC and its minimum lies half the pre-swing before the true toe-off
+(the simulated toe leaves the floor when the rotation about it ends, a real
+toe while the foot still rotates fast, see below). Checked on
 gaitmap's example (motion-capture events, ``stride_events_sample.csv``): TO lies
 1–2 samples after the ``ω_ml`` minimum and IC at the zero crossing, 2–3 samples
 before the impact peak of the accelerometer; the zero crossing that follows the
@@ -103,6 +109,10 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     """
     w = np.asarray(gyr, dtype=float)[:, 1]
     n = len(t)
+    # a sample is the mean over (t[k-1], t[k]] (footzoo's interval convention): it belongs to the middle
+    ts = np.asarray(t, dtype=float)
+    dt = np.diff(ts)
+    t = ts - 0.5 * np.concatenate([[np.median(dt)], dt])
     k = len(stances) - 1
     if k < 1:
         empty = np.zeros(0)
@@ -122,13 +132,14 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     ok = (pos < len(down)) & (c <= mid[1:]) & (w[p] > 0.0) & (w[j] < 0.0)
     c = np.where(ok, c, 1)
     # sub-sample refinement: linear crossing for IC, parabola through the minimum for TO
-    frac = w[c - 1] / (w[c - 1] - w[c])
+    den_c = w[c - 1] - w[c]
+    frac = np.where(ok, w[c - 1] / np.where(ok, den_c, 1.0), 0.0)
     ic = t[c - 1] + frac * (t[c] - t[c - 1])
     jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
     den = w[jl] - 2.0 * w[j] + w[jr]
     shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
     dt = np.where(shift >= 0, t[jr] - t[j], t[j] - t[jl])
     to = t[j] + shift * dt
-    to = np.where(ok, to, t[np.minimum(sw0, n - 1)])
-    ic = np.where(ok, ic, t[np.minimum(sw1, n - 1)])
+    to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
+    ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
     return GaitEvents(to=to, ic=ic, from_rate=ok)
