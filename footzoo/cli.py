@@ -92,7 +92,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     metrics = result.metrics
     if "pyshoe_trial_error" in rec.meta:
         metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
-    ref = f"; reference: {rec.truth.source or 'truth in the file'}" if rec.truth is not None else ""
+    ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
     _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
     if args.out:
         written = _write_result(result, rec, Path(args.out), args.plot)
