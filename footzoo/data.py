@@ -65,6 +65,11 @@ class Truth:
         Horizontal position of every footprint (m), first one included, in the
         dataset's own floor axes (compare after a 2-D rigid alignment, reflection
         allowed), e.g. Köroğlu's ground control points ``GCP_meters``.
+    stride_positions : DataFrame or None
+        Per-stride trajectories (e.g. gaitmap's ``position_sample.csv``):
+        ``stride`` (row of ``steps``), ``t_s`` (s), ``pos_x_m``, ``pos_y_m``,
+        ``pos_up_m`` (m, zeroed at the stride's start, right-handed with z up;
+        compare after a rotation about the vertical).
     source : str
         What the reference is (e.g. "VICON", "motion capture", "simulator").
     """
@@ -78,10 +83,11 @@ class Truth:
     dist: np.ndarray | None = None
     stride_count: int | None = None
     footprints: np.ndarray | None = None
+    stride_positions: pd.DataFrame | None = None
     source: str = ""
 
     def __repr__(self) -> str:
-        have = [k for k in ("pos", "vel", "quat", "stance", "steps", "dist", "footprints")
+        have = [k for k in ("pos", "vel", "quat", "stance", "steps", "dist", "footprints", "stride_positions")
                 if getattr(self, k) is not None]
         extra = f", stride_count={self.stride_count}" if self.stride_count is not None else ""
         src = f"{self.source!r}, " if self.source else ""
@@ -447,7 +453,8 @@ class Result:
         ``stride_count_ref``, ``stride_count_error``. With reference strides: the
         matched count and the median absolute IC/TO errors (s), stride-length
         RMS error (m), stride-time and FPA errors. With footprints: per-footprint
-        error after a 2-D rigid alignment. See :func:`footzoo.metrics.result_metrics`.
+        error after a 2-D rigid alignment. With per-stride trajectories: the
+        median per-stride 3-D path RMS after a yaw alignment. See :func:`footzoo.metrics.result_metrics`.
         """
         from .metrics import result_metrics
 

@@ -324,6 +324,35 @@ def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, f
     return out
 
 
+def stride_path_errors(t: np.ndarray, pos: np.ndarray, stride_positions: pd.DataFrame,
+                       turn: np.ndarray | None = None) -> dict[str, float]:
+    """3-D RMS error (m) of the estimated trajectory over each reference stride, after a yaw alignment.
+
+    Per stride the estimate (NED, interpolated at the reference times) is turned
+    into a right-handed z-up frame (east, north, up), both are zeroed at the
+    stride's first sample, the estimate is rotated about the vertical
+    (:func:`yaw_alignment`) and the RMS of the 3-D difference is taken.
+    Returns the median over the strides (``stride_path_rms_error_median_m``),
+    over the strides not flagged in ``turn`` when it is given.
+    """
+    enu = np.column_stack([pos[:, 1], pos[:, 0], -pos[:, 2]])
+    rms = []
+    for k, g in stride_positions.groupby("stride"):
+        if turn is not None and bool(turn[int(k)]):
+            continue
+        tt = g["t_s"].to_numpy(dtype=float)
+        if tt[0] < t[0] or tt[-1] > t[-1] or len(tt) < 2:
+            continue
+        e = np.column_stack([np.interp(tt, t, enu[:, i]) for i in range(3)])
+        r = g[["pos_x_m", "pos_y_m", "pos_up_m"]].to_numpy(dtype=float)
+        e, r = e - e[0], r - r[0]
+        e = rotate_about_vertical(e, yaw_alignment(e, r))
+        rms.append(float(np.sqrt(np.mean(np.sum((e - r) ** 2, axis=1)))))
+    if not rms:
+        return {}
+    return {"stride_path_rms_error_median_m": float(np.median(rms)), "stride_paths": float(len(rms))}
+
+
 def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, reference=None) -> dict[str, float]:
     """The numbers ``footzoo run`` prints: a summary of the run and its errors against the reference.
 
@@ -362,4 +391,7 @@ def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, referenc
         out.update(stride_errors(steps, ref.steps))
     if ref.footprints is not None:
         out.update(footprint_errors(steps, ref.footprints))
+    if ref.stride_positions is not None:
+        turn = ref.steps["turn"].to_numpy(dtype=bool) if ref.steps is not None and "turn" in ref.steps else None
+        out.update(stride_path_errors(t, pos, ref.stride_positions, turn))
     return out

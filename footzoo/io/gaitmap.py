@@ -26,7 +26,7 @@ import pandas as pd
 
 from ..data import Recording, Truth
 from ..errors import FormatError
-from .gaitmap_reference import has_reference, reference_strides
+from .gaitmap_reference import has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8
 FEET = ("left", "right")
@@ -56,7 +56,8 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
     When the folder also holds gaitmap's ``mocap_sample.csv`` and
     ``stride_events_sample.csv``, their per-stride events, stride lengths and
     foot progression angles become ``truth.steps``
-    (:func:`footzoo.io.gaitmap_reference.reference_strides`).
+    (:func:`footzoo.io.gaitmap_reference.reference_strides`) and the per-stride
+    trajectories of ``position_sample.csv`` ``truth.stride_positions``.
 
     Parameters
     ----------
@@ -85,5 +86,7 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
             "placement": f"{foot} foot instep"}
     truth = None
     if has_reference(path.parent):
-        truth = Truth(steps=reference_strides(path.parent, foot), source="motion capture (gaitmap)")
+        truth = Truth(steps=reference_strides(path.parent, foot),
+                      stride_positions=reference_stride_positions(path.parent, foot),
+                      source="motion capture (gaitmap)")
     return Recording.from_dataframe(frame, acc_unit="m/s^2", gyr_unit="deg/s", meta=meta, truth=truth, **options)

@@ -78,3 +78,31 @@ def reference_strides(folder: str | Path, foot: str, lag: float = 0.0) -> pd.Dat
     change = np.maximum(np.abs(np.diff(h, prepend=h[0])), np.abs(np.diff(h, append=h[-1])))
     out["turn"] = change > np.radians(20.0)
     return out
+
+
+def reference_stride_positions(folder: str | Path, foot: str) -> pd.DataFrame | None:
+    """Per-stride trajectories of ``position_sample.csv`` (motion capture, 100 Hz), or None without the file.
+
+    gaitmap's file holds, per stride ``s_id`` of ``stride_events_sample.csv``, the
+    position (m) zeroed at the stride's start (its first mid-stance), in a
+    right-handed lab frame with z up. Returns ``stride`` (row of
+    :func:`reference_strides` for this foot), ``t_s`` (IMU clock, s) and
+    ``pos_x_m``, ``pos_y_m``, ``pos_up_m``.
+    """
+    folder = Path(folder)
+    path = folder / "position_sample.csv"
+    if not path.exists():
+        return None
+    pos = pd.read_csv(path)
+    events = pd.read_csv(folder / "stride_events_sample.csv")
+    ids = events.loc[events.foot == foot, "s_id"].to_numpy()
+    start = events.loc[events.foot == foot, "start"].to_numpy() / IMU_RATE
+    pos = pos[pos.iloc[:, 0] == f"{foot}_sensor"]
+    row = pd.Series(np.arange(len(ids)), index=ids)
+    keep = pos["s_id"].isin(ids).to_numpy()
+    pos = pos[keep]
+    stride = row[pos["s_id"].to_numpy()].to_numpy()
+    return pd.DataFrame({"stride": stride, "t_s": start[stride] + pos["sample"].to_numpy() / MOCAP_RATE,
+                         "pos_x_m": pos["pos_x"].to_numpy(), "pos_y_m": pos["pos_y"].to_numpy(),
+                         "pos_up_m": pos["pos_z"].to_numpy()})
+
