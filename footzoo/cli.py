@@ -174,7 +174,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     out = write(rec, args.out)
     closed = "closed loop" if rec.truth.closed_loop else "open path"
     print(f"wrote {out} ({rec.n} samples at {rec.rate:.0f} Hz, {rec.t[-1]:.1f} s, {closed}, "
-          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} steps)")
+          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} strides)")
     return 0
 
 

@@ -68,8 +68,8 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
     """
     if foot not in FEET:
         raise FormatError(
-            f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right' "
-            "(command line: --foot left)"
+            f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right', "
+            "or read both with footzoo.Session.load(path) (command line: both feet unless --foot left|right)"
         )
     df = pd.read_csv(path, header=[0, 1], index_col=0)
     sensor = f"{foot}_sensor"
