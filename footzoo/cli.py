@@ -27,7 +27,10 @@ def _load_recording(args: argparse.Namespace):
     from .io import builtin_sample, load
 
     if args.data is None:
-        return builtin_sample()
+        rec = builtin_sample()
+        if getattr(args, "foot", None) in ("left", "right"):
+            rec.meta["foot"] = args.foot  # the sample does not say which foot it is from
+        return rec
     return load(args.data, format=args.format, **_reader_options(args))
 
 

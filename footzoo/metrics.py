@@ -205,6 +205,16 @@ def reference_steps(steps: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+def nearest_index(sorted_values: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """Index of the nearest element of the non-empty ascending ``sorted_values`` for each query (vectorised)."""
+    v = np.asarray(sorted_values, dtype=float)
+    q = np.asarray(queries, dtype=float)
+    if len(v) == 1:
+        return np.zeros(len(q), dtype=np.int64)
+    k = np.clip(np.searchsorted(v, q), 1, len(v) - 1)
+    return np.where(np.abs(v[k - 1] - q) <= np.abs(v[k] - q), k - 1, k)
+
+
 def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str = "to_s",
                   tolerance: float = 0.3) -> pd.DataFrame:
     """Pair each reference stride with the estimated stride nearest in time.
@@ -224,9 +234,7 @@ def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str = "t
         return pd.DataFrame(columns=[*ref.columns, *(f"est_{c}" for c in est.columns)])
     order = np.argsort(e)
     es = e[order]
-    k = np.clip(np.searchsorted(es, r), 1, len(es) - 1) if len(es) > 1 else np.zeros(len(r), int)
-    left = np.maximum(k - 1, 0)
-    nearest = np.where(np.abs(es[left] - r) <= np.abs(es[k] - r), left, k)
+    nearest = nearest_index(es, r)
     ok = np.abs(es[nearest] - r) <= tolerance
     matched = est.iloc[order[nearest[ok]]].reset_index(drop=True).add_prefix("est_")
     return pd.concat([ref[ok].reset_index(drop=True), matched], axis=1)

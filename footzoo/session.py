@@ -10,7 +10,8 @@ time from the other foot's initial contact to this foot's next initial contact.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -118,18 +119,15 @@ class SessionResult:
 
     results: dict[str, Result]
     name: str = "session"
-    _steps: pd.DataFrame | None = field(default=None, repr=False)
 
-    @property
+    @cached_property
     def steps(self) -> pd.DataFrame:
         """Stride tables of both feet, one after the other, with ``foot`` and ``step_time_s`` (s)."""
-        if self._steps is None:
-            per = {f: r.steps for f, r in self.results.items()}
-            st = step_times(per)
-            frames = [t.assign(step_time_s=st[f]).assign(foot=f) for f, t in per.items()]
-            cols = ["foot", *frames[0].columns.drop("foot")]
-            self._steps = pd.concat(frames, ignore_index=True)[cols]
-        return self._steps
+        per = {f: r.steps for f, r in self.results.items()}
+        st = step_times(per)
+        frames = [t.assign(step_time_s=st[f]).assign(foot=f) for f, t in per.items()]
+        cols = ["foot", *frames[0].columns.drop("foot")]
+        return pd.concat(frames, ignore_index=True)[cols]
 
     @property
     def per_foot(self) -> pd.DataFrame:

@@ -7,7 +7,7 @@ import pandas as pd
 
 from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
-from ..metrics import intervals
+from ..metrics import intervals, nearest_index
 from ..registry import Plugin, check_positive, register
 from .foot_vector import FootVector
 
@@ -127,12 +127,14 @@ class HuangFPA(Plugin):
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
         """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
 
-        That stance is the first one whose onset is at or after the stride's
-        initial contact ``end_s`` (the detector's onset follows the contact).
+        That stance is the one whose onset is nearest to the stride's initial
+        contact ``end_s`` (the detector's onset follows the contact by a fraction
+        of the stance; the other onsets are a stride away).
         """
         out = steps.copy()
         onsets = t[self.heel_strikes_]
-        k = np.searchsorted(onsets, out["end_s"].to_numpy() - 1e-9)
-        fpa = np.append(self.fpa_, np.nan)
-        out["fpa_rad"] = fpa[np.minimum(k, len(self.fpa_))] if len(self.fpa_) else np.nan
+        if len(onsets) == 0:
+            out["fpa_rad"] = np.nan
+            return out
+        out["fpa_rad"] = self.fpa_[nearest_index(onsets, out["end_s"].to_numpy(dtype=float))]
         return out

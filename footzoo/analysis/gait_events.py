@@ -1,7 +1,9 @@
 """Gait events per stride from the sagittal angular rate: toe-off (TO) and initial contact (IC).
 
-Method (Rampp et al. 2015, IEEE TBME 62(4), 1089-1097, Sec. II-C "Event detection",
-as implemented in gaitmap's ``RamppEventDetection``): the events of one stride
+Method (Rampp et al. 2015, "Inertial sensor-based stride parameter calculation from
+gait sequences in geriatric patients", IEEE TBME 62(4), 1089-1097, the gait event
+detection of its Methods section, which states the rules in prose, without numbered
+equations; implemented in gaitmap as ``RamppEventDetection``): the events of one stride
 are features of the foot's sagittal (medio-lateral) angular rate ``ω_ml`` between
 two stances. footzoo's body frame is FRD, so ``ω_ml`` is ``gyr_y`` (positive
 lifts the toe). Between two stances the rate has three landmarks:
