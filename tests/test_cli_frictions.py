@@ -111,3 +111,15 @@ def test_steps_csv_columns_carry_units(tmp_path):
     unit = re.compile(r"_(s|m|m_s|rad|steps_min)$")
     assert all(unit.search(c) for c in cols if c != "events_from_rate"), list(cols)
     assert "fpa_rad" in cols and "heading_rad" in cols
+
+
+def test_every_command_in_the_readme_parses():
+    """The README's `footzoo ...` lines (continuations joined, comments cut) are accepted by the parser."""
+    import shlex
+
+    parser = build_parser()
+    text = Path("README.md").read_text().replace("\\\n", " ")
+    commands = [line.split("#", 1)[0] for line in text.splitlines() if line.startswith("footzoo ")]
+    assert len(commands) >= 10
+    for cmd in commands:
+        parser.parse_args(shlex.split(cmd)[1:])
