@@ -180,3 +180,27 @@ def test_gaitmap_first_stride_is_a_real_step():
     # the first row is now the first step out of the standing (measured 1.30 m)
     assert steps["stride_length_m"].iloc[0] > 1.0
     assert np.isnan(steps["start_s"].iloc[0]) and steps["to_s"].iloc[0] > 1.0
+
+
+def test_any_stance_mask_and_rate_give_a_consistent_table():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    @settings(max_examples=60, deadline=None)
+    @given(st.lists(st.booleans(), min_size=3, max_size=400), st.integers(0, 2**32 - 1))
+    def check(mask, seed):
+        rng = np.random.default_rng(seed)
+        n = len(mask)
+        t = np.arange(n) / 100.0
+        stance = np.asarray(mask)
+        pos = np.cumsum(rng.normal(0.0, 0.05, (n, 3)), axis=0)
+        gyr = rng.normal(0.0, 2.0, (n, 3))
+        steps = segment_steps(t, stance, pos, gyr)
+        assert list(steps.columns) == STEP_COLUMNS
+        assert len(steps) == max(len(real_stances(stance, pos)) - 1, 0)
+        if len(steps):
+            assert (steps["swing_time_s"] > 0).all()
+            assert (steps["stride_time_s"].dropna() > 0).all()
+            assert steps["to_s"].between(t[0] - 0.01, t[-1]).all() and steps["end_s"].between(t[0], t[-1]).all()
+
+    check()
