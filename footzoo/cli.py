@@ -120,10 +120,10 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     if args.out:
         out = Path(args.out)
         for foot, r in res.results.items():
-            _write_result(r, session.recordings[foot], out / foot, args.plot)
+            written = _write_result(r, session.recordings[foot], out / foot, args.plot)
         res.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
         res.bilateral.to_csv(out / "bilateral.csv", float_format="%.9g")
-        print(f"wrote left/ and right/ (samples.csv, steps.csv, metrics.json), steps.csv and bilateral.csv to {out}")
+        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out}")
     return 0
 
 
