@@ -10,6 +10,7 @@ from .errors import ConfigError, FootzooError, FormatError, RecordingError  # no
 from .io import load  # noqa: E402
 from .pipeline import Pipeline  # noqa: E402
 from .registry import register  # noqa: E402
+from .session import Session, SessionResult  # noqa: E402
 
 __all__ = [
     "ConfigError",
@@ -19,6 +20,8 @@ __all__ = [
     "Recording",
     "RecordingError",
     "Result",
+    "Session",
+    "SessionResult",
     "Truth",
     "load",
     "register",

@@ -182,7 +182,7 @@ class Pipeline:
         config = self.to_dict()
         config["engine"] = nav["engine"]
         return Result(samples=_samples_table(rec.t, stance, nav), steps=steps, config=config, versions=versions(),
-                      recording=dict(rec.meta), diagnostics=diagnostics)
+                      recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
 
     def _use_mag(self, rec: Recording) -> bool:
         return rec.mag is not None and bool(getattr(self.orientation, "use_magnetometer", False))
@@ -246,7 +246,7 @@ class Pipeline:
 
     def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
         """Stage 4: the steps table, with the analysis plug-ins' columns."""
-        steps = segment_steps(rec.t, stance, pos)
+        steps = segment_steps(rec.t, stance, pos, rec.gyr)
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps

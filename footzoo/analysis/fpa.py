@@ -7,7 +7,7 @@ import pandas as pd
 
 from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
-from ..metrics import intervals
+from ..metrics import intervals, nearest_index
 from ..plugin import Analysis
 from ..registry import check_positive, register
 from .foot_vector import FootVector
@@ -125,8 +125,16 @@ class HuangFPA(Analysis):
         return self
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
-        """Add ``fpa`` (rad) to the step table: the FPA of the stance that ends each stride."""
+        """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
+
+        That stance is the one whose onset is nearest to the stride's initial
+        contact ``end_s`` (the detector's onset follows the contact by a fraction
+        of the stance; the other onsets are a stride away).
+        """
         out = steps.copy()
-        by_onset = dict(zip(t[self.heel_strikes_].tolist(), self.fpa_.tolist(), strict=True))
-        out["fpa"] = [by_onset.get(end, np.nan) for end in out["end"].tolist()]
+        onsets = t[self.heel_strikes_]
+        if len(onsets) == 0:
+            out["fpa_rad"] = np.nan
+            return out
+        out["fpa_rad"] = self.fpa_[nearest_index(onsets, out["end_s"].to_numpy(dtype=float))]
         return out
