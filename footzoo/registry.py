@@ -5,15 +5,16 @@ keyword parameters in ``__init__`` (paper defaults) and class attributes ``name`
 and ``units`` (unit of each parameter). ``build`` rejects unknown names and keys with the list
 of valid ones and a did-you-mean suggestion.
 
-The registry imports no plug-in module: the built-in packages are imported by name the first
-time a listing or a lookup needs them, then the installed packages' entry points (group
-``footzoo.plugins``).
+The registry imports no plug-in module: the built-in packages and every module in them are
+imported by name the first time a listing or a lookup needs them (so a new built-in plug-in is
+one new file), then the installed packages' entry points (group ``footzoo.plugins``).
 """
 
 from __future__ import annotations
 
 import importlib
 import inspect
+import pkgutil
 from typing import Any
 
 from .errors import ConfigError, did_you_mean
@@ -132,7 +133,10 @@ def _load_builtin() -> None:
         return
     _LOADED = True
     for package in BUILTIN_PACKAGES:
-        importlib.import_module(package)
+        module = importlib.import_module(package)
+        # every module of the package: a new built-in plug-in is one new file
+        for info in pkgutil.iter_modules(module.__path__):
+            importlib.import_module(f"{package}.{info.name}")
     try:
         extensions = importlib.import_module("footzoo.extensions")
     except ModuleNotFoundError:
