@@ -15,3 +15,11 @@ class ConfigError(FootzooError, ValueError):
 
 class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
+
+
+class FootzooWarning(UserWarning):
+    """A warning from footzoo: the result is computed but something in the input deserves a look."""
+
+
+class SensorWarning(FootzooWarning):
+    """Suspicious sensor data: saturated (clipped) axes, isolated spikes (glitches)."""
