@@ -16,10 +16,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from .checks import check_positive, check_range
 from .errors import ConfigError
 from .registry import did_you_mean
+from .yamlsafe import load_file
 
 TOP_LEVEL_KEYS: dict[str, str] = {
     "name": "pipeline name (text)",
@@ -36,14 +36,9 @@ REQUIRED = ("orientation", "detector")
 
 
 def load_yaml(path: str | Path) -> dict[str, Any]:
-    """Read a YAML file into a dict, with clear errors for missing or empty files."""
+    """Read a YAML config into a dict with the strict, bounded loader (:mod:`footzoo.yamlsafe`)."""
     p = Path(path)
-    if not p.exists():
-        raise ConfigError(f"config file {str(p)!r} does not exist; check the path (footzoo ships configs/*.yaml)")
-    try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as err:
-        raise ConfigError(f"{p}: not valid YAML: {err}") from None
+    data = load_file(p, ConfigError, "config file")
     if data is None:
         raise ConfigError(f"{p}: the file is empty; a config needs at least 'orientation' and 'detector'")
     if not isinstance(data, dict):
@@ -72,3 +67,15 @@ def check_top_level(d: dict[str, Any]) -> None:
     for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]")):
         if not isinstance(d.get(key, []) or [], list):
             raise ConfigError(f"{key} must be a list, e.g. {example}")
+
+
+#: Longest accepted ``init.duration`` (s): the still start used for the initial alignment.
+INIT_DURATION_MAX = 60.0
+
+
+def check_init(init: dict[str, Any]) -> dict[str, float]:
+    """Validate ``init`` (``duration`` in s, ``max_gyr`` in rad/s) and fill in the defaults."""
+    out = {**INIT_KEYS, **init}
+    out["duration"] = check_range("init.duration", out["duration"], 0.0, INIT_DURATION_MAX, "s", lo_open=True)
+    out["max_gyr"] = check_positive("init.max_gyr", out["max_gyr"], unit="rad/s")
+    return out

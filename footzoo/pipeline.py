@@ -12,12 +12,13 @@ import pandas as pd
 from . import __version__
 from .alignment import initial_attitude
 from .analysis.strides import segment_steps
-from .config import INIT_KEYS, check_top_level, load_yaml
+from .checks import GRAVITY_RANGE, check_range
+from .config import check_init, check_top_level, load_yaml
 from .conventions import GRAVITY, quat_to_euler
 from .data import Recording, Result
 from .errors import ConfigError
 from .filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
-from .registry import Plugin, build, check_positive
+from .registry import Plugin, build
 
 
 def _clone(p: Plugin) -> Plugin:
@@ -41,7 +42,7 @@ class Pipeline:
     name : str
         Pipeline name.
     gravity : float
-        g (m/s²).
+        g (m/s²), within :data:`footzoo.checks.GRAVITY_RANGE` (9.7–9.9).
     init : dict
         ``duration`` (s) and ``max_gyr`` (rad/s) of the still start used for alignment.
     """
@@ -61,8 +62,8 @@ class Pipeline:
         self.corrections = list(corrections or [])
         self.analysis = list(analysis or [])
         self.name = name
-        self.gravity = check_positive("gravity", gravity)
-        self.init = {**INIT_KEYS, **(init or {})}
+        self.gravity = check_range("gravity", gravity, *GRAVITY_RANGE, "m/s^2")
+        self.init = check_init(init or {})
         check_compatibility(orientation, detector, self.corrections)
 
     # ----------------------------------------------------------------- build

@@ -131,13 +131,5 @@ def _load_builtin() -> None:
     from . import analysis, corrections, detectors, orientation  # noqa: F401
 
 
-def check_positive(name: str, value: float, allow_zero: bool = False) -> float:
-    """Validate a numeric parameter; returns it as float."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be a number, got {value!r}") from None
-    if v != v or (v < 0 if allow_zero else v <= 0):
-        bound = ">= 0" if allow_zero else "> 0"
-        raise ConfigError(f"{name} must be {bound}, got {value!r}")
-    return v
+# parameter checks live in footzoo.checks (bottom layer); re-exported here for plug-ins
+from .checks import check_bool, check_positive, check_range, check_vector  # noqa: E402,F401
