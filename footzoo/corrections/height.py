@@ -28,10 +28,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..checks import check_bool, check_range
 from ..errors import ConfigError, RecordingError
 from ..filters.eskf import Layout, skew
 from ..filters.navigation import NavState
-from ..registry import Plugin, check_positive, register
+from ..registry import Plugin, register
 from ..yamlsafe import load_file
 
 #: Duong & Suh Table 1 in their IMU frame (x toward the floor), mapped to FRD: (x, y, z)_DS -> (y, z, x).
@@ -132,14 +133,14 @@ class HeightDistance(Plugin):
         self._r = _vectors("positions", pos)
         self._n = _vectors("directions", dirs, self._r.shape[0], nonzero=True)
         self._n = self._n / np.linalg.norm(self._n, axis=1, keepdims=True)
-        self.baseline = check_positive("baseline", baseline)
-        self.range_std = check_positive("range_std", range_std)
-        self.max_range = check_positive("max_range", max_range)
-        self.calibrate = bool(calibrate)
-        self.position_std = check_positive("position_std", position_std)
-        self.direction_std = check_positive("direction_std", direction_std)
-        self.constraint_std = check_positive("constraint_std", constraint_std)
-        self.baseline_std = check_positive("baseline_std", baseline_std)
+        self.baseline = check_range("baseline", baseline, 0.0, 1.0, "m", lo_open=True)
+        self.range_std = check_range("range_std", range_std, 1e-9, 1.0, "m")
+        self.max_range = check_range("max_range", max_range, 0.0, 10.0, "m", lo_open=True)
+        self.calibrate = check_bool("calibrate", calibrate)
+        self.position_std = check_range("position_std", position_std, 1e-9, 1.0, "m")
+        self.direction_std = check_range("direction_std", direction_std, 1e-9, 1.0, "1")
+        self.constraint_std = check_range("constraint_std", constraint_std, 1e-9, 1.0, "1")
+        self.baseline_std = check_range("baseline_std", baseline_std, 1e-9, 1.0, "m")
 
     @property
     def k(self) -> int:
@@ -291,7 +292,7 @@ class HeightFlatFloor(Plugin):
     units = {"height_std": "m"}
 
     def __init__(self, height_std: float = 0.001):
-        self.height_std = check_positive("height_std", height_std)
+        self.height_std = check_range("height_std", height_std, 1e-9, 1.0, "m")
 
     def blocks(self) -> list[tuple[str, int, float, float]]:
         """No extra states."""

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..registry import Plugin, check_positive, register
+from ..checks import check_range
+from ..registry import Plugin, register
 from .fqa_complementary import complementary_kernel
 
 
@@ -56,10 +57,10 @@ class INS(Plugin):
         position_noise: float = 0.0,
         initial_attitude_std: float = 0.01,
     ):
-        self.attitude_noise = check_positive("attitude_noise", attitude_noise, allow_zero=True)
-        self.velocity_noise = check_positive("velocity_noise", velocity_noise, allow_zero=True)
-        self.position_noise = check_positive("position_noise", position_noise, allow_zero=True)
-        self.initial_attitude_std = check_positive("initial_attitude_std", initial_attitude_std, allow_zero=True)
+        self.attitude_noise = check_range("attitude_noise", attitude_noise, 0.0, 1.0, "rad^2/s")
+        self.velocity_noise = check_range("velocity_noise", velocity_noise, 0.0, 100.0, "(m/s)^2/s")
+        self.position_noise = check_range("position_noise", position_noise, 0.0, 100.0, "m^2/s")
+        self.initial_attitude_std = check_range("initial_attitude_std", initial_attitude_std, 0.0, 3.1416, "rad")
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> INS:
         """Gyro integration from ``q0`` (no Kalman filter configured)."""
