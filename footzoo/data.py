@@ -15,8 +15,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .checks import check_positive
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
 from .errors import RecordingError
+from .sanity import check_impossible, scan
 
 ACC_COLS = ["acc_x", "acc_y", "acc_z"]
 GYR_COLS = ["gyr_x", "gyr_y", "gyr_z"]
@@ -113,6 +115,9 @@ class Recording:
         self.meta = dict(self.meta)
         self.meta.setdefault("name", "recording")
         self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
+        findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]))
+        if findings:
+            self.meta["sanity"] = findings
 
     @property
     def n(self) -> int:
@@ -294,6 +299,10 @@ def validate_recording(rec: Recording) -> None:
         raise RecordingError(f"dist must have {n} rows to match t, got {rec.dist.shape[0]}")
     if n < 3:
         raise RecordingError(f"the recording has only {n} sample(s); at least {MIN_DURATION} s is needed")
+    if rec.truth is not None:
+        _check_truth(rec.truth, n)
+    if rec.max_gap is not None:
+        rec.max_gap = check_positive("max_gap", rec.max_gap, unit="s")
     for name, arr in (("t", t), ("acc", acc), ("gyr", gyr), ("mag", rec.mag)):
         if arr is None:
             continue
@@ -333,6 +342,25 @@ def validate_recording(rec: Recording) -> None:
             f"{MIN_DURATION} s, starting with the foot still"
         )
     _check_units(rec)
+    check_impossible(t, acc, gyr)
+
+
+def _check_truth(truth: Truth, n: int) -> None:
+    """Ground truth must cover the IMU samples one to one (checked at load, not after a run)."""
+    for name, arr, width in (("pos", truth.pos, 3), ("vel", truth.vel, 3), ("quat", truth.quat, 4),
+                             ("stance", truth.stance, None), ("dist", truth.dist, None)):
+        if arr is None:
+            continue
+        shape = np.shape(arr)
+        if len(shape) == 0 or shape[0] != n:
+            rows = shape[0] if len(shape) else 0
+            raise RecordingError(
+                f"ground truth {name} has {rows} rows but the IMU has {n} samples: truth must have one row per "
+                f"IMU sample. {'Shorter: the reference stops early' if rows < n else 'Longer'}; trim both to the "
+                "common time span, or drop the truth"
+            )
+        if width is not None and (len(shape) != 2 or shape[1] != width):
+            raise RecordingError(f"ground truth {name} must have shape ({n}, {width}), got {shape}")
 
 
 def _check_units(rec: Recording) -> None:
@@ -355,10 +383,11 @@ def _check_units(rec: Recording) -> None:
             f"accelerometer magnitude at rest is {rest:.3f} m/s², far from g = {GRAVITY}; "
             "check the unit (acc_unit) and the sensor's calibration"
         )
-    peak = float(gyr_norm.max())
+    # 99th percentile, not the maximum: a few corrupt samples are reported as such (sanity.check_impossible)
+    peak = float(np.quantile(gyr_norm, 0.99))
     if peak > GYRO_DEG_S_SUSPICION:
         raise RecordingError(
-            f"gyroscope peak is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
+            f"gyroscope 99th-percentile rate is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
             "this looks like deg/s; declare gyr_unit: deg/s"
         )
 

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..data import Recording
-from ..errors import FormatError
+from ..errors import FootzooError, FormatError
 from ..registry import did_you_mean
 from . import canonical, gaitmap, pyshoe, sensorconnect, xio
 
@@ -38,6 +38,31 @@ READERS: dict[str, Callable[..., Recording]] = {
 }
 
 
+#: Longest header line read when detecting a format (characters).
+HEADER_MAX_CHARS = 64 * 1024
+
+
+def check_input_file(path: str | Path, what: str = "recording") -> Path:
+    """The path of an existing, readable, non-empty regular file, or a :class:`FormatError` saying why not."""
+    p = Path(path)
+    try:
+        if not p.exists():
+            raise FormatError(f"{what} {str(p)!r}: no such file; check the path")
+        if p.is_dir():
+            raise FormatError(f"{what} {str(p)!r} is a directory; give the path of a recording file inside it")
+        if not p.is_file():
+            raise FormatError(f"{what} {str(p)!r} is not a regular file (a device or pipe?); save the data to a file")
+        if p.stat().st_size == 0:
+            raise FormatError(f"{what} {str(p)!r}: the file is empty (0 bytes)")
+        with open(p, "rb") as fh:
+            fh.read(1)
+    except PermissionError:
+        raise FormatError(f"{what} {str(p)!r} is not readable (permission denied); fix its permissions") from None
+    except OSError as err:
+        raise FormatError(f"{what} {str(p)!r} cannot be read: {err.strerror or err}") from None
+    return p
+
+
 def detect_format(path: str | Path) -> str:
     """Guess a file's format from its extension and first line."""
     p = Path(path)
@@ -48,7 +73,7 @@ def detect_format(path: str | Path) -> str:
         return "canonical"
     if suffix in (".csv", ".txt"):
         with open(p, encoding="utf-8", errors="replace") as fh:
-            head = fh.readline()
+            head = fh.readline(HEADER_MAX_CHARS)
         if not head.strip():
             raise FormatError(f"{p}: the file is empty (no header line)")
         if xio.matches(head):
@@ -80,18 +105,32 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         Reader options, e.g. ``foot="left"`` for gaitmap, ``acc_unit="g"`` for
         canonical files, ``duplicates="drop"``.
     """
-    p = Path(path)
-    if not p.exists():
-        raise FormatError(f"{p}: no such file")
-    if p.stat().st_size == 0:
-        raise FormatError(f"{p}: the file is empty")
+    p = check_input_file(path)
+    if format is not None and format not in READERS:
+        raise FormatError(
+            f"unknown format {format!r}{did_you_mean(str(format), list(READERS))}; valid: {sorted(READERS)}"
+        )
     fmt = format or detect_format(p)
-    if fmt not in READERS:
-        raise FormatError(f"unknown format {fmt!r}{did_you_mean(fmt, list(READERS))}; valid: {sorted(READERS)}")
-    return READERS[fmt](p, **options)
+    try:
+        return READERS[fmt](p, **options)
+    except FootzooError:
+        raise
+    except TypeError as err:
+        if "unexpected keyword argument" in str(err):
+            raise FormatError(f"{fmt} reader: {err}; see help(footzoo.io.{fmt}.read) for its options") from err
+        raise FormatError(f"{p}: cannot read as {fmt}: {type(err).__name__}: {err}") from err
+    except UnicodeDecodeError as err:
+        raise FormatError(
+            f"{p}: not UTF-8 text (byte offset {err.start}); is it really a {fmt} file? Pass format= if not"
+        ) from err
+    except Exception as err:  # parsing untrusted bytes: any library error means "not this format"
+        raise FormatError(
+            f"{p}: cannot read as {fmt}: {type(err).__name__}: {str(err)[:300]}; check the file, or pass the "
+            f"right format= (one of {sorted(READERS)})"
+        ) from err
 
 
-__all__ = ["READERS", "builtin_sample", "detect_format", "load"]
+__all__ = ["READERS", "builtin_sample", "check_input_file", "detect_format", "load"]
 
 
 def builtin_sample() -> Recording:

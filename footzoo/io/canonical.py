@@ -20,6 +20,8 @@ from ..yamlsafe import load_file
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"
+#: ``pd.read_csv`` options that parse those digits back exactly (pandas 3 does by default).
+EXACT_CSV: dict[str, Any] = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 
 
 def matches(header: str) -> bool:
@@ -34,7 +36,7 @@ def read(path: Path, **options: Any) -> Recording:
         if path.suffix.lower() in (".parquet", ".pq"):
             df = pd.read_parquet(path)
         else:
-            df = pd.read_csv(path, comment="#", float_precision="round_trip")
+            df = pd.read_csv(path, comment="#", **EXACT_CSV)
     except UnicodeDecodeError as err:
         raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
     except (ValueError, OSError, pd.errors.ParserError) as err:
@@ -58,7 +60,7 @@ def read(path: Path, **options: Any) -> Recording:
         steps = path.with_name(path.name + ".steps.csv")
         if steps.exists():
             try:
-                rec.truth.steps = pd.read_csv(steps, float_precision="round_trip")
+                rec.truth.steps = pd.read_csv(steps, **EXACT_CSV)
             except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
                 raise FormatError(f"{steps}: cannot read the true steps: {err}; fix or delete the file") from None
     return rec
