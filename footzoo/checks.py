@@ -123,7 +123,7 @@ def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: s
                      "(for k in range(n): stream.push(t[k], acc[k], gyr[k])) or use Stream.run(recording)")
         raise RecordingError(f"{name} at t = {t!r} must have shape (3,), got {arr.shape}{extra}")
     if not np.isfinite(arr).all():
-        raise RecordingError(f"{name} at t = {t!r} is not finite ({arr.tolist()}); repair or drop the sample")
+        raise RecordingError(f"non-finite sample at t = {t!r}: {name} = {arr.tolist()}; repair or drop the sample")
     if bound is not None and np.abs(arr).max() > bound:
         raise RecordingError(
             f"{name} at t = {t!r} is {arr.tolist()} {unit}: beyond any body-worn IMU (|value| <= {bound:g} {unit}); "
@@ -177,7 +177,7 @@ def validate_sample(
     if previous_t is not None:
         if tf <= previous_t:
             raise RecordingError(
-                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in strictly increasing time"
+                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in order, strictly increasing in time"
             )
         gap = STREAM_MAX_GAP if max_gap is None else max_gap
         if tf - previous_t > gap:

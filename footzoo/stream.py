@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from .checks import validate_sample
 from .errors import ConfigError, RecordingError
 from .orientation.fqa import fqa
 
@@ -68,6 +69,8 @@ class Stream:
         dict with ``t``, ``quat`` (body -> NED), ``pos``, ``vel`` (NED) and
         ``stance`` for the newest sample.
         """
+        previous = self._buffer[-1][0] if self._buffer else None
+        t, acc, gyr, mag, dist = validate_sample(t, acc, gyr, mag, dist, previous, getattr(self, "max_gap", None))
         acc = np.asarray(acc, dtype=float).reshape(3)
         gyr = np.asarray(gyr, dtype=float).reshape(3)
         if not (np.isfinite(acc).all() and np.isfinite(gyr).all()):
