@@ -177,7 +177,7 @@ def validate_sample(
     if previous_t is not None:
         if tf <= previous_t:
             raise RecordingError(
-                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in order, strictly increasing in time"
+                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in order (increasing time)"
             )
         gap = STREAM_MAX_GAP if max_gap is None else max_gap
         if tf - previous_t > gap:

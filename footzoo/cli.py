@@ -1,15 +1,79 @@
-"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``."""
+"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``.
+
+Bad input never prints a Python traceback: the message names the input, the
+problem and the fix, and the exit code says which kind of problem it was
+(``--debug`` adds the traceback):
+
+====  ==============================================================================
+code  meaning
+====  ==============================================================================
+0     success
+1     internal error: a bug in footzoo (rerun with ``--debug`` and report it)
+2     usage or configuration error: bad arguments, config, study or calibration file
+3     data error: unreadable, malformed or implausible recording; unwritable output
+130   interrupted (Ctrl-C)
+====  ==============================================================================
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import traceback
 import warnings
 from pathlib import Path
 from typing import Any
 
-from .errors import FootzooError
+from .errors import ConfigError, FootzooError, FormatError, RecordingError
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_USAGE = 2
+EXIT_DATA = 3
+EXIT_INTERRUPTED = 130
+
+EXIT_CODES_HELP = """exit codes:
+  0    success
+  1    internal error (a bug in footzoo: rerun with --debug and report it)
+  2    usage or configuration error (arguments, config, study or calibration file)
+  3    data error (unreadable, malformed or implausible recording; unwritable output)
+  130  interrupted
+"""
+
+
+class OutputError(FootzooError, OSError):
+    """An output location cannot be written (exit code 3)."""
+
+
+def _writable_dir(path: str, option: str = "--out") -> Path:
+    """Create ``path`` if needed and check it is a writable directory, before any work is done."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{option} {path!r} exists and is not a directory; choose a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except PermissionError:
+        raise OutputError(f"{option} {path!r} cannot be created (permission denied); choose a writable place") from None
+    except OSError as err:
+        raise OutputError(f"{option} {path!r} cannot be created: {err.strerror or err}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable directory")
+    return out
+
+
+def _writable_file(path: str, option: str = "--out") -> Path:
+    """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
+    p = Path(path)
+    if p.is_dir():
+        raise OutputError(f"{option} {path!r} is a directory; give a file name")
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"{option} {path!r}: the folder {str(folder)!r} does not exist; create it first")
+    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable place")
+    return p
 
 
 def _load_recording(args: argparse.Namespace):
@@ -29,6 +93,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .pipeline import Pipeline
 
     pipeline = Pipeline.from_yaml(args.config)
+    out = _writable_dir(args.out) if args.out else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rec = _load_recording(args)
@@ -45,11 +110,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     print(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz)")
     for key, value in metrics.items():
         print(f"  {key:26s} {value:.4f}" if isinstance(value, float) else f"  {key:26s} {value}")
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        result.samples.to_csv(out / "samples.csv", index=False, float_format="%.9g")
-        result.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
+    if out is not None:
+        from .io.canonical import FLOAT_FORMAT
+
+        result.samples.to_csv(out / "samples.csv", index=False, float_format=FLOAT_FORMAT)
+        result.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
         payload = {"metrics": metrics, "config": result.config, "versions": result.versions,
                    "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
         (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
@@ -91,6 +156,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .io.canonical import write
     from .sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_calibration, simulate_pendulum
 
+    _writable_file(args.out)
     biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
     noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
     if args.scenario == "pendulum":
@@ -118,6 +184,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     from .analysis.foot_vector import calibrate_foot_vector
 
+    _writable_file(args.out)
     rec = _load_recording(args)
     fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
                                flex=tuple(args.flex) if args.flex else None)
@@ -161,9 +228,14 @@ def cmd_list_compat(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``footzoo`` command."""
     parser = argparse.ArgumentParser(
-        prog="footzoo", description="Foot-mounted IMU motion estimation: a zoo of published building blocks."
+        prog="footzoo", description="Foot-mounted IMU motion estimation: a zoo of published building blocks.",
+        epilog=EXIT_CODES_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the Python traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
     run.add_argument("config", help="pipeline YAML, e.g. configs/yun2012.yaml")
@@ -223,14 +295,58 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]:
+    """Sub-command parsers that also take ``--debug`` and list the exit codes in their help."""
+
+    class SubParser(argparse.ArgumentParser):
+        def __init__(self, **kwargs: Any):
+            kwargs.setdefault("parents", [common])
+            kwargs.setdefault("epilog", EXIT_CODES_HELP)
+            kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+            super().__init__(**kwargs)
+
+    return SubParser
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"footzoo: warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``footzoo`` console script."""
+    """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
     args = build_parser().parse_args(argv)
+    debug = bool(getattr(args, "debug", False))
+    if not debug:
+        warnings.showwarning = _show_warning
     try:
         return args.func(args)
-    except FootzooError as err:
-        print(f"footzoo: error: {err}", file=sys.stderr)
-        return 2
+    except KeyboardInterrupt:
+        print("footzoo: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as err:  # the command line's last line of defence: no traceback unless --debug
+        if debug:
+            traceback.print_exc()
+        code, text = _classify(err)
+        print(f"footzoo: {text}", file=sys.stderr)
+        return code
+
+
+def _classify(err: Exception) -> tuple[int, str]:
+    """Exit code and message for an exception leaving a command."""
+    if isinstance(err, (RecordingError, FormatError, OutputError)):
+        return EXIT_DATA, f"error: {err}"
+    if isinstance(err, (ConfigError, FootzooError)):
+        return EXIT_USAGE, f"error: {err}"
+    if isinstance(err, PermissionError):
+        return EXIT_DATA, (f"error: permission denied: {err.filename!r}; check the file's permissions or choose "
+                           "another location")
+    if isinstance(err, OSError):
+        where = f" {err.filename!r}" if err.filename else ""
+        return EXIT_DATA, f"error: cannot access{where}: {err.strerror or err}"
+    if isinstance(err, MemoryError):
+        return EXIT_DATA, "error: out of memory; use a smaller recording or study"
+    return EXIT_INTERNAL, (f"internal error: {type(err).__name__}: {err}. This is a bug in footzoo: rerun with "
+                           "--debug and report the traceback")
 
 
 if __name__ == "__main__":
