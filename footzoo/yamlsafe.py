@@ -194,8 +194,9 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
     """
     if len(text) > MAX_BYTES:
         raise error(f"{source}: the YAML text is larger than {MAX_BYTES} characters; footzoo reads no larger file")
-    loader = StrictLoader(text)
+    loader = None
     try:
+        loader = StrictLoader(text)  # the reader rejects control characters here already
         node = loader.get_single_node()
         if node is None:
             return None
@@ -210,7 +211,8 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
     except RecursionError:
         raise error(f"{source}: YAML refused: nested too deeply") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str = "YAML file") -> Any:
