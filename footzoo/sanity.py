@@ -12,7 +12,10 @@ Run by :func:`footzoo.data.validate_recording` on every :class:`~footzoo.data.Re
   as long as the true signal stays beyond it. An axis whose largest (or smallest)
   value repeats on at least :data:`SATURATION_MIN_RUN` consecutive samples, and
   lies beyond :data:`SATURATION_FLOOR` of its sensor (2 g, 2 rad/s, so that a
-  still or constant axis is not flagged), is reported: a
+  still or constant axis is not flagged), is reported — unless the axis is
+  piecewise constant elsewhere too (more than :data:`PLATEAU_FRACTION` of its
+  other consecutive samples repeat exactly: a noise-free simulation whose
+  profile has flat tops; real recordings repeat at most 7 %): a
   :class:`~footzoo.errors.SensorWarning` naming the axis, the value, the sample
   and time ranges; the estimate is computed but its velocity and position
   underestimate the motion in those samples.
@@ -42,6 +45,8 @@ from .errors import RecordingError, SensorWarning
 SATURATION_MIN_RUN = 3
 #: |value| below which an axis's extreme is never called saturation: acc (m/s²), gyr (rad/s).
 SATURATION_FLOOR = {"acc": 2.0 * GRAVITY, "gyr": 2.0}
+#: Fraction of exactly repeated consecutive samples (away from the rail) above which an axis is piecewise constant.
+PLATEAU_FRACTION = 0.25
 #: Height of a single-sample gyroscope spike above its neighbours' change reported as a glitch (rad/s).
 GLITCH_JUMP = 15.0
 _AXES = "xyz"
@@ -85,7 +90,11 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
             for rail in {float(x.max()), float(x.min())}:
                 if abs(rail) < SATURATION_FLOOR[name]:
                     continue
-                runs = _runs(x == rail, SATURATION_MIN_RUN)
+                at_rail = x == rail
+                runs = _runs(at_rail, SATURATION_MIN_RUN)
+                away = ~(at_rail[1:] | at_rail[:-1])
+                if runs and away.any() and np.mean((x[1:] == x[:-1])[away]) > PLATEAU_FRACTION:
+                    continue  # flat tops are the signal's shape (noise-free simulation), not clipping
                 if runs:
                     found.append({"axis": f"{name}_{_AXES[j]}", "value": rail,
                                   "samples": int(sum(e - s for s, e in runs)),
