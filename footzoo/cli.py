@@ -47,6 +47,23 @@ class OutputError(FootzooError, OSError):
     """An output location cannot be written (exit code 3)."""
 
 
+def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
+    """An argparse ``type``: a finite number in [lo, hi] (a usage error, exit code 2, otherwise)."""
+
+    def parse(text: str) -> float | int:
+        try:
+            value = int(text) if integer else float(text)
+        except ValueError:
+            kind = "a whole number" if integer else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
+        if not (lo <= value <= hi):  # also rejects nan
+            u = f" {unit}" if unit else ""
+            raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must lie in [{lo:g}, {hi:g}]{u}")
+        return value
+
+    return parse
+
+
 def _writable_dir(path: str, option: str = "--out") -> Path:
     """Create ``path`` if needed and check it is a writable directory, before any work is done."""
     out = Path(path)
@@ -250,16 +267,22 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
                                           "calibration"])
     sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
-    sim.add_argument("--strides", type=int, default=100, help="strides of a straight walk (default 100)")
-    sim.add_argument("--stride-length", type=float, default=1.2, help="stride length in m (default 1.2)")
-    sim.add_argument("--rate", type=float, default=50.0, help="sampling rate in Hz (default 50)")
+    sim.add_argument("--strides", type=_number(1, 100_000, integer=True), default=100,
+                     help="strides of a straight walk (default 100)")
+    sim.add_argument("--stride-length", type=_number(0.05, 5.0, "m"), default=1.2,
+                     help="stride length in m (default 1.2)")
+    sim.add_argument("--rate", type=_number(10.0, 20_000.0, "Hz"), default=50.0,
+                     help="sampling rate in Hz (default 50)")
     sim.add_argument("--profile", choices=["paper", "physical"], default="paper", help="stance kinematics")
     sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
-    sim.add_argument("--noise-scale", type=float, default=1.0, help="factor on Table II noise σ (default 1)")
+    sim.add_argument("--noise-scale", type=_number(0.0, 1000.0), default=1.0,
+                     help="factor on Table II noise σ (default 1)")
     sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
     sim.add_argument("--seed", type=int, default=0)
-    sim.add_argument("--fpa", type=float, default=0.0, help="foot progression angle in deg (toe-out +)")
-    sim.add_argument("--mount-yaw", type=float, default=0.0, help="sensor yaw on the foot in deg")
+    sim.add_argument("--fpa", type=_number(-90.0, 90.0, "deg"), default=0.0,
+                     help="foot progression angle in deg (toe-out +)")
+    sim.add_argument("--mount-yaw", type=_number(-180.0, 180.0, "deg"), default=0.0,
+                     help="sensor yaw on the foot in deg")
     sim.add_argument("--foot", choices=["right", "left"], default="right")
     sim.add_argument("--distance-sensors", action="store_true", help="add two VL6180-like range sensors")
     sim.add_argument("--disturbance", action="store_true", help="add a magnetic disturbance (first 10 m north)")
@@ -269,8 +292,10 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--data", required=True, help="calibration recording")
     cal.add_argument("--format", help="reader format (default: detect)")
     cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
-    cal.add_argument("--still", nargs=2, type=float, metavar=("T0", "T1"), help="still period (s); default: found")
-    cal.add_argument("--flex", nargs=2, type=float, metavar=("T0", "T1"), help="flexion period (s); default: found")
+    cal.add_argument("--still", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="still period (s); default: found")
+    cal.add_argument("--flex", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="flexion period (s); default: found")
     cal.add_argument("--out", required=True, help="YAML file to write")
     cal.set_defaults(func=cmd_calibrate)
 
