@@ -339,7 +339,10 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help (0) or a usage error (2, message already printed)
+        return int(stop.code) if isinstance(stop.code, int) else EXIT_USAGE
     debug = bool(getattr(args, "debug", False))
     if not debug:
         warnings.showwarning = _show_warning

@@ -31,6 +31,8 @@ TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
 MIN_DURATION = 1.0
 #: Default largest accepted gap between samples, in median sample periods.
 DEFAULT_MAX_GAP_PERIODS = 5.0
+#: Plausible median sampling rate of a foot-mounted IMU (Hz); outside it the time stamps are not in seconds.
+RATE_RANGE = (10.0, 20_000.0)
 #: Gyro peak (in the declared unit rad/s) above which the data must be in deg/s.
 GYRO_DEG_S_SUSPICION = 50.0
 
@@ -102,15 +104,19 @@ class Recording:
     max_gap: float | None = None
 
     def __post_init__(self) -> None:
-        self.t = np.ascontiguousarray(self.t, dtype=float)
-        self.acc = np.ascontiguousarray(self.acc, dtype=float)
-        self.gyr = np.ascontiguousarray(self.gyr, dtype=float)
+        self.t = _floats("t", self.t)
+        self.acc = _floats("acc", self.acc)
+        self.gyr = _floats("gyr", self.gyr)
         if self.mag is not None:
-            self.mag = np.ascontiguousarray(self.mag, dtype=float)
+            self.mag = _floats("mag", self.mag)
         if self.dist is not None:
-            self.dist = np.ascontiguousarray(self.dist, dtype=float)
+            self.dist = _floats("dist", self.dist)
             if self.dist.ndim == 1:
                 self.dist = self.dist[:, None]
+        if not isinstance(self.meta, dict):
+            raise RecordingError(f"meta must be a dict, got {type(self.meta).__name__}")
+        if self.truth is not None and not isinstance(self.truth, Truth):
+            raise RecordingError(f"truth must be a footzoo Truth, got {type(self.truth).__name__}")
         validate_recording(self)
         self.meta = dict(self.meta)
         self.meta.setdefault("name", "recording")
@@ -217,6 +223,11 @@ class Recording:
                     frame = pd.DataFrame(values).interpolate(limit_direction="both")
                     return frame.to_numpy(dtype=float)
                 row, col = np.argwhere(bad)[0]
+                if bad[:, col].all():
+                    raise RecordingError(
+                        f"column {cols[col]!r} holds no numbers (first value {df[cols[col]].iloc[0]!r}); check the "
+                        "file's delimiter and decimal separator (footzoo reads ',' between values and '.' in numbers)"
+                    )
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
                     f"first at row {row} (t = {t[row]!r}); drop or repair those rows, "
@@ -260,12 +271,31 @@ class Recording:
         return pd.DataFrame(cols)
 
 
+def _floats(name: str, value: Any) -> np.ndarray:
+    """``value`` as a contiguous float array, or a RecordingError naming the input."""
+    try:
+        return np.ascontiguousarray(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise RecordingError(
+            f"{name} must be numbers (an array of floats), got {type(value).__name__}: {err}"
+        ) from None
+
+
 def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
     def get(cols: list[str]) -> np.ndarray | None:
         return df[cols].to_numpy(dtype=float) if all(c in df.columns for c in cols) else None
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
-    stance = df["true_stance"].to_numpy().astype(bool) if "true_stance" in df.columns else None
+    stance = None
+    if "true_stance" in df.columns:
+        flags = pd.to_numeric(df["true_stance"], errors="coerce").to_numpy(dtype=float)
+        if not np.isin(flags, (0.0, 1.0)).all():
+            k = int(np.argmax(~np.isin(flags, (0.0, 1.0))))
+            raise RecordingError(
+                f"column 'true_stance' must hold 0 or 1 in every row, got {df['true_stance'].iloc[k]!r} at row {k}; "
+                "fix the column or drop it"
+            )
+        stance = flags.astype(bool)
     dist_cols = sorted(c for c in df.columns if c.startswith("true_dist_"))
     dist = df[dist_cols].to_numpy(dtype=float) if dist_cols else None
     if pos is None and vel is None and quat is None and stance is None:
@@ -327,6 +357,12 @@ def validate_recording(rec: Recording) -> None:
             "remove them, or pass duplicates='drop' to drop repeated rows (a warning gives the count)"
         )
     period = float(np.median(dt))
+    if not RATE_RANGE[0] <= 1.0 / period <= RATE_RANGE[1]:
+        raise RecordingError(
+            f"the median sampling rate is {1.0 / period:.6g} Hz (period {period:.6g}), outside the plausible "
+            f"{RATE_RANGE[0]:g}-{RATE_RANGE[1]:g} Hz of a foot-mounted IMU: are the time stamps in ms, µs or ns? "
+            "footzoo needs t in seconds (divide by 1e3, 1e6 or 1e9)"
+        )
     max_gap = rec.max_gap if rec.max_gap is not None else DEFAULT_MAX_GAP_PERIODS * period
     if np.any(dt > max_gap):
         k = int(np.argmax(dt > max_gap))

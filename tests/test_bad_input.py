@@ -90,6 +90,17 @@ def _pyshoe(tmp: Path, walk: Recording, gt_rows: int | None = None, imu_cols: in
     return p
 
 
+_TEXT_COLUMN = "t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n" + "".join(
+    f'{k / 100},"0,1",0,-9.8,0,0,0\n' for k in range(300))
+
+
+def _stance_text(tmp: Path, walk: Recording) -> Path:
+    df = walk.to_dataframe()
+    df["true_stance"] = np.where(df["true_stance"] == 1, "yes", "no")
+    df.to_csv(tmp / "s.csv", index=False)
+    return tmp / "s.csv"
+
+
 def _with_meta(tmp: Path, walk: Recording, sidecar: str | bytes) -> Callable[[], object]:
     p = _csv(tmp, walk)
     side = p.with_name(p.name + ".meta.yaml")
@@ -183,6 +194,21 @@ CASES = [
          "gyr_z is -1e+30 rad/s at sample 50"),
     Case("acc-nan", lambda d, w: _modified(w, acc=((7, 1), np.nan)), RecordingError, "non-finite"),
     Case("t-inf", lambda d, w: _modified(w, t=((-1,), np.inf)), RecordingError, "t has 1 non-finite"),
+    Case("time-in-ms", lambda d, w: (lambda: Recording(t=w.t * 1e3, acc=w.acc, gyr=w.gyr)), RecordingError,
+         "are the time stamps in ms"),
+    Case("time-in-ns", lambda d, w: (lambda: Recording(t=w.t * 1e9 + 1.7e18, acc=w.acc, gyr=w.gyr)), RecordingError,
+         "footzoo needs t in seconds"),
+    Case("decimal-comma", lambda d, w: (lambda: load(_text(d, "c.csv", "t;acc_x;acc_y;acc_z;gyr_x;gyr_y;gyr_z\n"
+                                                            "0;0,1;0;-9,8;0;0;0\n"), format="canonical")),
+         RecordingError, "missing column(s)"),
+    Case("text-column", lambda d, w: (lambda: load(_text(d, "c.csv", _TEXT_COLUMN))), RecordingError,
+         "column 'acc_x' holds no numbers (first value '0,1')"),
+    Case("truth-stance-text", lambda d, w: (lambda: load(_stance_text(d, w))), RecordingError,
+         "column 'true_stance' must hold 0 or 1"),
+    Case("recording-text-values", lambda d, w: (lambda: Recording(t=["a"] * 5, acc=w.acc[:5], gyr=w.gyr[:5])),
+         RecordingError, "t must be numbers"),
+    Case("recording-meta-not-dict", lambda d, w: (lambda: Recording(t=w.t, acc=w.acc, gyr=w.gyr, meta=[1])),
+         RecordingError, "meta must be a dict"),
     # ---------------------------------------------------------------- YAML
     Case("config-invalid-yaml", lambda d, w: _config(d, "orientation: {type: [\n"), ConfigError, "not valid YAML"),
     Case("config-latin1", lambda d, w: _config(d, ("name: caf\xe9\n" + YUN).encode("latin-1")), ConfigError,
@@ -386,6 +412,10 @@ CLI_CASES = [
                                        str(_text(d, "f.txt", "x"))], EXIT_DATA, "is not a directory"),
     ("simulate-out-missing-folder", lambda d, w: ["simulate", "straight", "--out", str(d / "no" / "x.csv")],
      EXIT_DATA, "does not exist"),
+    ("simulate-negative-rate", lambda d, w: ["simulate", "straight", "--rate", "-5", "--out", str(d / "s.csv")],
+     EXIT_USAGE, "argument --rate: -5 Hz is out of range"),
+    ("simulate-nan-noise", lambda d, w: ["simulate", "straight", "--noise-scale", "nan", "--out", str(d / "s.csv")],
+     EXIT_USAGE, "argument --noise-scale"),
     ("config-gravity", lambda d, w: ["validate", str(_text(d, "g.yaml", _with(YUN, gravity="98.1")))], EXIT_USAGE,
      "gravity = 98.1"),
     ("config-latin1", lambda d, w: ["validate", str(_text(d, "l.yaml", b"name: caf\xe9\n"))], EXIT_USAGE,
