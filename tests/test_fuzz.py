@@ -207,6 +207,27 @@ def live_samples(t, acc, gyr, previous) -> None:
     _only_footzoo_errors(lambda: validate_sample(t, acc, gyr, None, None, previous, None))
 
 
+_STREAM_PIPELINE = Path(__file__).resolve().parents[1] / "configs" / "nguyen2016.yaml"
+SAMPLE = st.tuples(st.floats(0.002, 0.05), st.lists(st.floats(-60.0, 60.0), min_size=3, max_size=3),
+                   st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))
+
+
+def stream_pushes(samples: list, use_mag: bool, offset: float) -> None:
+    """A live stream fed odd but well-formed samples: only footzoo errors, finite estimates."""
+    from footzoo.stream import Stream
+
+    stream = Stream(Pipeline.from_yaml(_STREAM_PIPELINE))
+    t = offset
+    for k, (dt, acc, gyr) in enumerate(samples):
+        t += dt
+        acc = [acc[0] * 0.01, acc[1] * 0.01, -9.81 + acc[2] * 0.01] if k < 60 else acc  # a still start
+        gyr = [g * 0.001 for g in gyr] if k < 60 else gyr
+        est = _only_footzoo_errors(lambda t=t, acc=acc, gyr=gyr: stream.push(t, acc, gyr, [0.2, 0.0, 0.4] if use_mag
+                                                                             else None))
+        if est is not None:
+            assert np.isfinite(est["pos"]).all() and np.isfinite(est["quat"]).all()
+
+
 NUM = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(), st.text(max_size=3), st.none())
 PROPERTIES = {
     "readers_on_random_bytes": (readers_on_random_bytes, (st.binary(max_size=2048),
@@ -216,6 +237,8 @@ PROPERTIES = {
     "yaml_text": (yaml_text, (st.one_of(YAMLISH, st.text(max_size=200)),)),
     "config_files": (config_files, (configs(),)),
     "study_mappings": (study_mappings, (studies(),)),
+    "stream_pushes": (stream_pushes, (st.lists(SAMPLE, min_size=0, max_size=120), st.booleans(),
+                                      st.sampled_from([0.0, 1.7e9]))),
     "live_samples": (live_samples, (NUM, st.one_of(NUM, st.lists(NUM, max_size=4), st.lists(st.lists(NUM))),
                                     st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=4),
                                     st.one_of(st.none(), st.floats(allow_nan=False)))),
