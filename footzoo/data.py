@@ -178,6 +178,8 @@ class Recording:
         max_gap : float, optional
             Largest accepted gap (s); default 5 median sample periods.
         """
+        if not isinstance(df, pd.DataFrame):
+            raise RecordingError(f"from_dataframe expects a pandas DataFrame, got {type(df).__name__}")
         _check_choice("acc_unit", acc_unit, ACC_UNITS)
         _check_choice("gyr_unit", gyr_unit, GYR_UNITS)
         _check_choice("dist_unit", dist_unit, DIST_UNITS)
@@ -304,7 +306,7 @@ def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
 
 
 def _check_choice(name: str, value: str, allowed) -> None:
-    if value not in allowed:
+    if not isinstance(value, str) or value not in allowed:
         raise RecordingError(f"{name}={value!r} is not supported; use one of {list(allowed)}")
 
 

@@ -209,6 +209,11 @@ CASES = [
          RecordingError, "t must be numbers"),
     Case("recording-meta-not-dict", lambda d, w: (lambda: Recording(t=w.t, acc=w.acc, gyr=w.gyr, meta=[1])),
          RecordingError, "meta must be a dict"),
+    Case("path-not-a-path", lambda d, w: (lambda: load(123)), FormatError, "must be a file path"),
+    Case("dataframe-not-a-dataframe", lambda d, w: (lambda: Recording.from_dataframe([1, 2])), RecordingError,
+         "expects a pandas DataFrame"),
+    Case("unit-not-text", lambda d, w: (lambda: Recording.from_dataframe(w.to_dataframe(), acc_unit=["g"])),
+         RecordingError, "acc_unit=['g'] is not supported"),
     # ---------------------------------------------------------------- YAML
     Case("config-invalid-yaml", lambda d, w: _config(d, "orientation: {type: [\n"), ConfigError, "not valid YAML"),
     Case("config-latin1", lambda d, w: _config(d, ("name: caf\xe9\n" + YUN).encode("latin-1")), ConfigError,

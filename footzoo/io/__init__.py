@@ -20,6 +20,7 @@ sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -44,6 +45,8 @@ HEADER_MAX_CHARS = 64 * 1024
 
 def check_input_file(path: str | Path, what: str = "recording") -> Path:
     """The path of an existing, readable, non-empty regular file, or a :class:`FormatError` saying why not."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise FormatError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
     p = Path(path)
     try:
         if not p.exists():
