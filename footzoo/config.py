@@ -75,6 +75,12 @@ INIT_DURATION_MAX = 60.0
 
 def check_init(init: dict[str, Any]) -> dict[str, float]:
     """Validate ``init`` (``duration`` in s, ``max_gyr`` in rad/s) and fill in the defaults."""
+    if not isinstance(init, dict):
+        raise ConfigError(f"init must be a mapping like {{duration: 0.5, max_gyr: 0.6}}, got {init!r}")
+    unknown = [k for k in init if k not in INIT_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown init key {unknown[0]!r}{did_you_mean(str(unknown[0]), list(INIT_KEYS))}; "
+                          f"valid: {list(INIT_KEYS)}")
     out = {**INIT_KEYS, **init}
     out["duration"] = check_range("init.duration", out["duration"], 0.0, INIT_DURATION_MAX, "s", lo_open=True)
     out["max_gyr"] = check_positive("init.max_gyr", out["max_gyr"], unit="rad/s")
