@@ -399,6 +399,16 @@ def _check_truth(truth: Truth, n: int) -> None:
             )
         if width is not None and (len(shape) != 2 or shape[1] != width):
             raise RecordingError(f"ground truth {name} must have shape ({n}, {width}), got {shape}")
+        if width is not None:
+            bad = ~np.isfinite(np.asarray(arr, dtype=float)).all(axis=1)
+            if bad.any():
+                k = int(np.argmax(bad))
+                where = (f"the reference stops at sample {k} while the IMU has {n} samples" if bad[k:].all()
+                         else f"{int(bad.sum())} row(s) are not finite, the first at sample {k}")
+                raise RecordingError(
+                    f"ground truth {name}: {where}; truth must cover every IMU sample: trim the recording to the "
+                    "reference's time span, or drop the truth columns"
+                )
 
 
 def _check_units(rec: Recording) -> None:

@@ -94,6 +94,13 @@ _TEXT_COLUMN = "t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n" + "".join(
     f'{k / 100},"0,1",0,-9.8,0,0,0\n' for k in range(300))
 
 
+def _truth_ends_early(tmp: Path, walk: Recording) -> Path:
+    df = walk.to_dataframe()
+    df.loc[df.index[-50:], ["true_pos_n", "true_pos_e", "true_pos_d"]] = np.nan  # empty cells at the end
+    df.to_csv(tmp / "short.csv", index=False)
+    return tmp / "short.csv"
+
+
 def _stance_text(tmp: Path, walk: Recording) -> Path:
     df = walk.to_dataframe()
     df["true_stance"] = np.where(df["true_stance"] == 1, "yes", "no")
@@ -182,6 +189,8 @@ CASES = [
     Case("truth-shorter-direct", lambda d, w: (lambda: Recording(t=w.t, acc=w.acc, gyr=w.gyr,
                                                                   truth=Truth(pos=w.truth.pos[:-10]))),
          RecordingError, "truth must have one row per IMU sample"),
+    Case("truth-ends-early-in-csv", lambda d, w: (lambda: load(_truth_ends_early(d, w))), RecordingError,
+         "ground truth pos: the reference stops at sample"),
     Case("pyshoe-imu-wrong-shape", lambda d, w: (lambda: load(_pyshoe(d, w, imu_cols=4))), FormatError,
          "'imu' must be N x 6"),
     Case("gaitmap-rate-inf", lambda d, w: (lambda: load(_text(d, "g.csv", "sensor,left_sensor\n"), format="gaitmap",
