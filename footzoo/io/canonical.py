@@ -14,6 +14,7 @@ from typing import Any
 import pandas as pd
 import yaml
 
+from ..checks import check_bool
 from ..data import Recording
 from ..errors import FormatError
 from ..yamlsafe import load_file
@@ -69,6 +70,7 @@ def read(path: Path, **options: Any) -> Recording:
 def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     """Write a recording (with truth columns) as canonical CSV or Parquet plus a sidecar."""
     p = Path(path)
+    closed_loop = check_bool("closed_loop", closed_loop)
     df = rec.to_dataframe()
     if p.suffix.lower() in (".parquet", ".pq"):
         df.to_parquet(p, index=False)
