@@ -490,3 +490,61 @@ def test_cli_console_script_has_no_traceback(tmp_path):
     helptext = subprocess.run([sys.executable, "-m", "footzoo", "--help"], capture_output=True, text=True, cwd=ROOT,
                               env=env).stdout
     assert "exit codes:" in helptext and "3    data error" in helptext
+
+
+# --------------------------------------------------------------------------- parameter ranges
+def _ranged_parameters() -> list[tuple[str, str, str, float]]:
+    """Every (kind, plug-in, parameter, edge value) of a range-checked parameter, read from its error message."""
+    import re
+
+    from footzoo.registry import available, build
+
+    out = []
+    for kind in ("orientation", "detector", "correction"):
+        for name, cls in sorted(available(kind).items()):
+            for p in cls.param_names():
+                try:
+                    build(kind, {"type": name, p: 1e300})
+                    continue
+                except ConfigError as err:
+                    m = re.search(r"must lie in ([\[(])([-0-9.e+]+), ([-0-9.e+]+)([\])])", str(err))
+                if m:
+                    lo = float(m[2]) if m[1] == "[" else float(m[2]) + 1e-6
+                    hi = float(m[3]) if m[4] == "]" else float(m[3]) - 1e-6
+                    out += [(kind, name, p, lo), (kind, name, p, hi)]
+    return out
+
+
+RANGED = _ranged_parameters()
+
+
+@pytest.fixture(scope="module")
+def sensors_walk() -> Recording:
+    return simulate(n_strides=4, rate=50.0, noise=NoiseModel(seed=1), distance_sensors=True)
+
+
+@pytest.mark.parametrize("kind, name, param, value", RANGED, ids=[f"{n}.{p}={v:g}" for _, n, p, v in RANGED])
+def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name, param, value, sensors_walk):
+    """The documented ranges are safe: no NaN or crash at either end (or a clear footzoo error)."""
+    yun, nguyen, duong = (load_yaml(ROOT / "configs" / f"{c}.yaml") for c in ("yun2012", "nguyen2016", "duong2015"))
+    if kind == "orientation":
+        cfg = nguyen if name == "ins" else yun
+        cfg["orientation"] = {"type": name, param: value}
+    elif kind == "detector":
+        cfg = yun
+        cfg["detector"] = {"type": name, param: value}
+    else:
+        cfg = duong if name == "height_distance" else yun if name == "zvu_dedrift" else nguyen
+        drop = {name, "ekf_zupt"} if name == "zupt" else {name}
+        cfg["corrections"] = [c for c in cfg["corrections"] if c["type"] not in drop] + [{"type": name, param: value}]
+    pipeline = Pipeline.from_dict(cfg)
+    try:
+        result = pipeline.run(sensors_walk)
+    except RecordingError as err:  # e.g. a 1 µm max_range leaves no valid range reading: said clearly
+        assert "height_distance" in str(err)
+        return
+    assert np.isfinite(result.pos).all() and np.isfinite(result.quat).all()
+
+
+def test_range_checked_parameters_were_found():
+    assert len(RANGED) >= 50  # both ends of every range-checked parameter
