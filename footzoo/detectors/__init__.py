@@ -1,5 +1,6 @@
 """Stance/swing detectors."""
 
+from .adaptive_shoe import AdaptiveSHOE
 from .amvd import AMVD
 from .angular_rate_fsm import AngularRateFSM
 from .ared import ARED
@@ -10,5 +11,5 @@ from .runs import dated_and_online_states
 from .shoe import SHOE, HuangStance
 from .windowed import Windowed
 
-__all__ = ["AMVD", "ARED", "DGP", "MBGTD", "SHOE", "AngularRateFSM", "HuangStance", "Oracle", "Windowed",
-           "dated_and_online_states"]
+__all__ = ["AMVD", "ARED", "DGP", "MBGTD", "SHOE", "AdaptiveSHOE", "AngularRateFSM", "HuangStance", "Oracle",
+           "Windowed", "dated_and_online_states"]
