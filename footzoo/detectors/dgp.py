@@ -11,6 +11,11 @@ from ..conventions import GRAVITY
 from ..registry import Plugin, check_positive, register
 
 
+def _count(x: float) -> int:
+    """Nearest whole number of samples, halves rounded up, immune to the last bits of a median rate."""
+    return int(math.floor(x + 0.5 + 1e-6))
+
+
 def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
     """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and of the last ``lag`` samples."""
     w = 2 * f + 1
@@ -272,14 +277,14 @@ class DGP(Plugin):
 
     def begin(self, rate: float) -> None:
         """Fresh state for a recording sampled at ``rate`` (Hz)."""
-        f = max(int(round((self.window * rate - 1) / 2)), 1)
-        self._n_c = max(int(round(self.condition_window * rate)), 1)
+        f = max(_count((self.window * rate - 1) / 2), 1)
+        self._n_c = max(_count(self.condition_window * rate), 1)
         self._w = 2 * f + 1
-        self._lag = max(int(round(rate / self.reference_rate)), 1)
+        self._lag = max(_count(rate / self.reference_rate), 1)
         self._scale = rate / (self.reference_rate * self._lag)
-        self._min_swing = int(round(self.min_swing * rate))
+        self._min_swing = _count(self.min_swing * rate)
         self._stat_state = dgp_statistic_state(f, self._n_c, self._lag)
-        delay = max(int(round(2 * rate / self.reference_rate)), 1)
+        delay = max(_count(2 * rate / self.reference_rate), 1)
         self._state = dgp_initial_state(self.initial_delay, self.initial_threshold, delay)
 
     def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
