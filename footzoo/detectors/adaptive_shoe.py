@@ -55,6 +55,14 @@ class AdaptiveSHOE(SHOE):
     simplification). ``γ_max`` caps the growth (footzoo's guard: without it, any
     long motion would end in a false stance).
 
+    Defaults (footzoo's): γ_0 = 1e4, τ = 0.5 s, γ_max = 5e5, min_swing = 0.15 s,
+    chosen on PyShoe's 36 VICON trials (PyShoe's 2-D error, pipelines
+    ``yun2012`` and ``duong2015_zupt`` with this detector) by the mean over the
+    motion classes (walking, running, slow, inverted) of the log median ratio to
+    PyShoe's per-trial best, never per trial; leaving any one class out picks
+    a setting of the same family (τ 0.5–1 s, γ_max 2e5–5e5). On the simulator
+    they give 0 % gait-phase error on the mixed-speed walk at 100 and 200 Hz.
+
     Parameters
     ----------
     threshold : float
@@ -86,8 +94,8 @@ class AdaptiveSHOE(SHOE):
     units = {**SHOE.units, "time_constant": "s", "max_threshold": "1", "min_swing": "s"}
 
     def __init__(self, threshold: float = 1e4, window: float = 0.025, sigma_a: float = 0.01,
-                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.3, max_threshold: float = 3e5,
-                 min_swing: float = 0.03):
+                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.5, max_threshold: float = 5e5,
+                 min_swing: float = 0.15):
         super().__init__(threshold, window, sigma_a, sigma_g)
         self.time_constant = check_positive("time_constant", time_constant)
         self.max_threshold = check_positive("max_threshold", max_threshold)
