@@ -155,7 +155,7 @@ class Pipeline:
         return kalman if needs_filter else []
 
     # ------------------------------------------------------------------- run
-    def run(self, rec: Recording, engine: str = "auto") -> Result:
+    def run(self, rec: Recording, engine: str = "auto", covariance: bool = False) -> Result:
         """Estimate attitude, velocity, position and steps for one recording.
 
         Parameters
@@ -167,6 +167,9 @@ class Pipeline:
             or the reference loop on filterpy's ``KalmanFilter``; ``auto`` takes the compiled
             one when every correction's measurement model compiles, else the reference with a
             warning. Both give the same numbers.
+        covariance : bool
+            Keep the Kalman filter's variances per sample in ``Result.diagnostics['P_diag']``
+            ((N, n), n × 8 bytes per sample; off by default).
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
@@ -177,7 +180,7 @@ class Pipeline:
         stance = detector.stance_
         q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
         quat = self.orient(rec, stance, q0)
-        nav = self.navigate(rec, stance, q0, quat, engine)
+        nav = self.navigate(rec, stance, q0, quat, engine, covariance)
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
         diagnostics = {"detector_statistic": detector.statistic_, **nav["diagnostics"]}
         config = self.to_dict()
@@ -209,14 +212,16 @@ class Pipeline:
         return self.orientation.clone().estimate(rec.t, rec.acc, rec.gyr, mag, stance, q0).quat_
 
     def navigate(self, rec: Recording, stance: np.ndarray, q0: np.ndarray, quat: np.ndarray | None,
-                 engine: str = "auto") -> dict[str, Any]:
+                 engine: str = "auto", covariance: bool = False) -> dict[str, Any]:
         """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections."""
         kalman = [c.clone() for c in self.filter_corrections]
         if kalman:
             samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
             eng = self.kalman_engine(kalman, samples, engine)
-            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, smoother=self.smoother == "rts")
-            out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"], P_diag=out["P_diag"])
+            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother == "rts")
+            out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
+            if covariance:
+                out["diagnostics"]["P_diag"] = out["P_diag"]
             out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
             out["engine"] = eng.engine
             return out

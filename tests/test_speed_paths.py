@@ -26,8 +26,8 @@ def walk():
 @pytest.mark.parametrize("name", KALMAN)
 def test_compiled_kalman_loop_equals_the_filterpy_reference(walk, name):
     p = Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
-    ref = p.run(walk, engine="reference")
-    fast = p.run(walk, engine="fast")
+    ref = p.run(walk, engine="reference", covariance=True)
+    fast = p.run(walk, engine="fast", covariance=True)
     for col in ("pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "qw", "qx", "qy", "qz"):
         a, b = ref.samples[col].to_numpy(), fast.samples[col].to_numpy()
         assert np.max(np.abs(a - b)) <= 1e-9 * max(np.max(np.abs(a)), 1.0), col
