@@ -55,10 +55,9 @@ def cmd_run(args: argparse.Namespace) -> int:
         (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
         written = ["samples.csv", "steps.csv", "metrics.json"]
         if args.plot:
-            from .plots import plot_trajectory
+            from .plots import plot_run
 
-            plot_trajectory(result, out / "trajectory.png", rec)
-            written.append("trajectory.png")
+            written += [p.name for p in plot_run(result, out, rec)]
         print(f"wrote {', '.join(written)} to {out}")
     elif args.plot:
         print("--plot needs --out DIR (where trajectory.png is written)", file=sys.stderr)
@@ -171,7 +170,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--format", help="canonical, xio, pyshoe, gaitmap or sensorconnect (default: detect)")
     run.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
     run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
-    run.add_argument("--plot", action="store_true", help="also write trajectory.png (needs --out)")
+    run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
+                     "errors (with a reference), strides, fpa (.png, needs --out)")
     run.set_defaults(func=cmd_run)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")

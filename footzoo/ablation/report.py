@@ -208,11 +208,14 @@ def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[st
     return written
 
 
-def _grid(plt, n: int, size: float = 2.6, max_cols: int = 5):
+def _grid(plt, n: int, size: float = 2.6, max_cols: int = 8):
+    """``n`` small panels in rows of at most ``max_cols`` (the caller gives them equal limits)."""
     ncol = min(max_cols, max(1, int(np.ceil(np.sqrt(n)))))
     nrow = int(np.ceil(n / ncol))
-    fig, axes = plt.subplots(nrow, ncol, figsize=(size * ncol + 0.4, size * nrow + 0.8), squeeze=False,
-                             layout="constrained")
+    # a fixed layout: constrained layout costs seconds per figure with a hundred panels
+    w, h = size * ncol + 0.6, size * nrow + 1.0
+    fig, axes = plt.subplots(nrow, ncol, figsize=(w, h), squeeze=False)
+    fig.subplots_adjust(left=0.5 / w, right=1 - 0.1 / w, bottom=0.4 / h, top=1 - 1.2 / h, wspace=0.3, hspace=0.5)
     for ax in axes.flat[n:]:
         ax.set_visible(False)
     return fig, list(axes.flat[:n])
@@ -252,7 +255,6 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
                 if ok.sum() > 2:
                     tr = rotate_about_vertical(tr, yaw_alignment(tr[ok], ref[ok]))
             curves.append((labels.get(r["key"], r["key"]), tr))
-        curves.sort(key=lambda c: c[0])
         frame = "estimates yaw-aligned to the reference" if ref is not None else "estimates as computed"
         if len(curves) <= MAX_OVERLAID:
             fig, ax = plt.subplots(figsize=(6.5, 6), layout="constrained")
@@ -317,18 +319,34 @@ def metric_figure(d: pd.DataFrame, factor: str, metric: str):
         raw = list(dict.fromkeys(d[factor].tolist()))
         names = level_labels(factor, raw)
         groups = [d[d[factor].astype(str) == str(lv)]["value"].to_numpy(float) for lv in raw]
-        fig, ax = plt.subplots(figsize=(max(4.5, 0.9 * len(raw) + 2), 4), layout="constrained")
-        ax.boxplot([g[np.isfinite(g)] for g in groups], showfliers=False, widths=0.6)
+        leaf = factor.split(".")[-1] + "="  # the axis label names the factor already
+        ticks = [textwrap.fill(names[str(v)].removeprefix(leaf), 22) for v in raw]
+        horizontal = len(raw) > 25  # many levels: one row each, readable labels
+        if horizontal:
+            fig, ax = plt.subplots(figsize=(7, 0.22 * len(raw) + 1.2), layout="constrained")
+        else:
+            width = max(4.5, 0.9 * len(raw) + 2)
+            fig, ax = plt.subplots(figsize=(width, 4), layout="constrained")
+        ax.boxplot([g[np.isfinite(g)] for g in groups], showfliers=False, widths=0.6,
+                   orientation="horizontal" if horizontal else "vertical")
         rng = np.random.default_rng(0)
         for i, g in enumerate(groups, start=1):
-            ax.plot(i + rng.uniform(-0.15, 0.15, g.size), g, "o", ms=3, color="C0", alpha=0.6)
-        scale = _scale(ax, np.concatenate(groups) if groups else np.array([]))
-        ticks = [textwrap.fill(names[str(v)], 22) for v in raw]
-        slanted = len(raw) > 3 and max(len(t) for t in ticks) > 8
-        ax.set_xticks(range(1, len(raw) + 1), ticks, rotation=30 if slanted else 0, ha="right" if slanted else "center",
-                      fontsize=8)
-        ax.set_xlabel(factor)
-        ax.set_ylabel(metric_label(metric) + (" (log scale)" if scale != "linear" else ""))
+            jitter = i + rng.uniform(-0.15, 0.15, g.size)
+            ax.plot(*((g, jitter) if horizontal else (jitter, g)), "o", ms=3, color="C0", alpha=0.6)
+        values = np.concatenate(groups) if groups else np.array([])
+        scale = _scale(ax, values, axis="x" if horizontal else "y")
+        label = metric_label(metric) + (" (log scale)" if scale != "linear" else "")
+        if horizontal:
+            ax.set_yticks(range(1, len(raw) + 1), ticks, fontsize=7)
+            ax.invert_yaxis()
+            ax.set_ylabel(factor)
+            ax.set_xlabel(label)
+        else:
+            slanted = sum(min(len(t), 22) for t in ticks) * 0.075 > width - 1
+            ax.set_xticks(range(1, len(raw) + 1), ticks, rotation=30 if slanted else 0,
+                          ha="right" if slanted else "center", fontsize=8)
+            ax.set_xlabel(factor)
+            ax.set_ylabel(label)
         ax.set_title(f"{metric_label(metric)} by {factor} (dots: runs)", loc="left")
         return fig
 
@@ -371,7 +389,7 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
     @styled
     def build():
         plt = pyplot()
-        names = sorted(groups)
+        names = list(groups)  # in the study's order of levels
         if len(names) <= MAX_OVERLAID:
             fig, ax = plt.subplots(figsize=(6, 6), layout="constrained")
             for i, name in enumerate(names):
