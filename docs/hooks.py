@@ -29,8 +29,18 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:  # document the checkout being built, not another installed copy
-    sys.path.insert(0, str(ROOT))
+
+
+def use_checkout() -> None:
+    """Document the checkout being built, not another installed copy of footzoo.
+
+    Called from the events (mkdocs removes the first ``sys.path`` entry after loading a hook file).
+    """
+    if not sys.path or sys.path[0] != str(ROOT):
+        sys.path.insert(0, str(ROOT))
+    mod = sys.modules.get("footzoo")
+    if mod is not None and not str(getattr(mod, "__file__", "")).startswith(str(ROOT)):
+        raise RuntimeError(f"footzoo was imported from {mod.__file__} before the docs hook could use {ROOT}")
 
 log = logging.getLogger("mkdocs.hooks.footzoo")
 
@@ -288,6 +298,7 @@ def _expand(nav: list[Any], table: dict[str, list[Any]]) -> list[Any]:
 
 
 def on_config(config, **_):
+    use_checkout()
     config["nav"] = _expand(config["nav"], {"zoo/index.md": plugin_nav(), "readers/index.md": reader_nav()})
     return config
 
@@ -296,6 +307,7 @@ def on_files(files, config, **_):
     from mkdocs.structure.files import File
 
     global _gallery_dir
+    use_checkout()
     pages = {**plugin_pages(), **reader_pages()}
     if os.environ.get("FOOTZOO_DOCS_NO_GALLERY"):
         pages["gallery/index.md"] = "# Gallery\n\nNot rendered in this build (`FOOTZOO_DOCS_NO_GALLERY` is set).\n"

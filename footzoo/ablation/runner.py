@@ -120,8 +120,11 @@ def run_study(
     max_runs : int, optional
         Stop after this many new runs (what an interruption leaves behind).
 
-    The table's ``attrs`` hold ``computed`` and ``cached`` run counts and the
-    per-run records (``runs``) with trajectories and threshold sweeps.
+    Returns
+    -------
+    DataFrame
+        The tidy table. Its ``attrs`` hold ``computed`` and ``cached`` run counts and the
+        per-run records (``runs``) with trajectories and threshold sweeps.
     """
     if not isinstance(study, Study):
         study = Study.from_yaml(study)
