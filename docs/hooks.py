@@ -65,7 +65,8 @@ def numpy_section(doc: str, name: str) -> dict[str, str]:
             j, current = i + 2, []
             while j < len(lines):
                 line = lines[j]
-                if j + 1 < len(lines) and line.strip() and set(lines[j + 1].strip()) == {"-"} and not line.startswith(" "):
+                underlined = j + 1 < len(lines) and set(lines[j + 1].strip()) == {"-"}
+                if underlined and line.strip() and not line.startswith(" "):
                     break  # next section
                 if line and not line.startswith(" "):
                     current = [p.strip() for p in line.split(":")[0].split(",")]
@@ -209,8 +210,8 @@ def reader_pages() -> dict[str, str]:
                 lines.append("Other keywords (units, `duplicates`, `nan_policy`, `max_gap`) go to "
                              "[`Recording.from_dataframe`](../api.md#footzoo.data.Recording.from_dataframe).")
         lines += ["", "## Format, units, axis map and reference data", "",
-                  f"::: {modname}", "    options:", "      show_root_heading: false", "      show_root_toc_entry: false",
-                  "      members: false", ""]
+                  f"::: {modname}", "    options:", "      show_root_heading: false",
+                  "      show_root_toc_entry: false", "      members: false", ""]
         pages[f"readers/{fmt}.md"] = "\n".join(lines)
     for modname in others:
         mod = importlib.import_module(modname)

@@ -327,8 +327,12 @@ def metric_figure(d: pd.DataFrame, factor: str, metric: str):
         else:
             width = max(4.5, 0.9 * len(raw) + 2)
             fig, ax = plt.subplots(figsize=(width, 4), layout="constrained")
-        ax.boxplot([g[np.isfinite(g)] for g in groups], showfliers=False, widths=0.6,
-                   orientation="horizontal" if horizontal else "vertical")
+        import matplotlib
+
+        # matplotlib 3.10 renamed vert= to orientation=
+        new_api = tuple(int(x) for x in matplotlib.__version__.split(".")[:2]) >= (3, 10)
+        turn = {"orientation": "horizontal" if horizontal else "vertical"} if new_api else {"vert": not horizontal}
+        ax.boxplot([g[np.isfinite(g)] for g in groups], showfliers=False, widths=0.6, **turn)
         rng = np.random.default_rng(0)
         for i, g in enumerate(groups, start=1):
             jitter = i + rng.uniform(-0.15, 0.15, g.size)
