@@ -32,6 +32,8 @@ if TYPE_CHECKING:  # pragma: no cover
 REFERENCE_STYLE: dict[str, Any] = {"color": "k", "ls": "--", "lw": 1.0}
 #: Shade of stance periods.
 STANCE_COLOR = "0.88"
+#: Smallest span of the FPA axis (deg).
+MIN_FPA_SPAN = 6.0
 #: Largest number of points drawn per line; longer series are decimated for drawing only.
 MAX_POINTS = 20000
 
@@ -444,19 +446,25 @@ def fpa_figure(result: Result, recording: Recording | None = None) -> Figure | N
     ref = step_column(ref_steps, "fpa") if ref_steps is not None else None
     if ref is not None and len(ref[0]) == len(fpa):
         ax.plot(x, ref[0], "x", color="k", ms=5, label="reference")
-    ax.axhline(0, color="0.4", lw=0.6)
+    finite = fpa[np.isfinite(fpa)]
+    if finite.min() < 0 < finite.max():
+        ax.axhline(0, color="0.4", lw=0.6)
     ax.set_xlabel("stride number")
     ax.set_ylabel("foot progression angle (deg, toe-out +)")
     ax.legend(loc="lower right")
-    finite = fpa[np.isfinite(fpa)]
-    hist.hist(finite, bins=min(20, max(5, finite.size // 3)), orientation="horizontal", color="C1", alpha=0.7)
+    lim = robust_limits(finite)
+    if lim is not None:
+        ax.set_ylim(*lim)
+    lo, hi = ax.get_ylim()
+    if hi - lo < MIN_FPA_SPAN:  # do not blow sensor noise up to a full axis
+        mid = (lo + hi) / 2
+        lo, hi = mid - MIN_FPA_SPAN / 2, mid + MIN_FPA_SPAN / 2
+        ax.set_ylim(lo, hi)
+    hist.hist(finite, bins=np.linspace(lo, hi, 31), orientation="horizontal", color="C1", alpha=0.7)
     med = float(np.median(finite))
     hist.axhline(med, color="k", lw=0.8, label=f"median {med:.1f}°")
     hist.set_xlabel("strides")
     hist.legend(loc="lower right")
-    lim = robust_limits(finite)
-    if lim is not None:
-        ax.set_ylim(*lim)
     fig.suptitle(f"{_title(result, recording)}: foot progression angle")
     fig.tight_layout()
     return fig
