@@ -324,3 +324,11 @@ def on_files(files, config, **_):
             files.remove(existing)
         files.append(File.generated(config, uri, content=text))
     return files
+
+
+_ROLE = re.compile(r":(?:func|class|mod|meth|attr|data|obj):(<code>)~?")
+
+
+def on_page_content(html, **_):
+    """Docstrings use Sphinx roles (``:func:`name```), which Markdown renders as text: keep the code only."""
+    return _ROLE.sub(r"\1", html)
