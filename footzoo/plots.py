@@ -126,13 +126,14 @@ def step_column(steps: pd.DataFrame, name: str) -> tuple[np.ndarray, str] | None
     """Values of a per-stride quantity and its display unit, whatever the column's unit suffix.
 
     ``name`` is the quantity without unit (``stride_length``, ``fpa``, ``stance_time``...);
-    columns ``name``, ``name_m``, ``name_s``, ``name_deg``, ``name_rad`` and
-    ``name_pct`` are recognised. Angles are returned in degrees (a plain
+    columns ``name``, ``name_m``, ``name_s``, ``name_deg``, ``name_rad``,
+    ``name_pct``, ``name_m_s`` and ``name_steps_min`` are recognised. Angles are returned in degrees (a plain
     ``heading`` or ``fpa`` column is in radians, footzoo's internal unit).
     """
     angles = ("fpa", "heading")
     for suffix, unit in (("_deg", "deg"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"), ("_pct", "%"),
-                         ("_m_per_s", "m/s"), ("_per_min", "1/min"), ("", "")):
+                         ("_m_s", "m/s"), ("_m_per_s", "m/s"), ("_steps_min", "steps/min"), ("_per_min", "1/min"),
+                         ("", "")):
         col = name + suffix
         if col in steps.columns:
             v = pd.to_numeric(steps[col], errors="coerce").to_numpy(dtype=float)
@@ -173,7 +174,7 @@ def robust_limits(values: np.ndarray, k: float = 6.0, rel: float = 0.5) -> tuple
     if v.min() >= lo and v.max() <= hi:
         return None
     inside = v[(v >= lo) & (v <= hi)]
-    pad = 0.1 * max(float(inside.max() - inside.min()), mad, 1e-9)
+    pad = max(0.1 * float(inside.max() - inside.min()), mad, 0.02 * abs(med), 1e-9)
     return float(inside.min() - pad), float(inside.max() + pad)
 
 
@@ -194,12 +195,23 @@ def _clip_outliers(ax: Axes, x: np.ndarray, y: np.ndarray, color: str) -> int:
     return n
 
 
+def time_column(steps: pd.DataFrame, *names: str) -> str | None:
+    """The first of ``name_s`` / ``name`` (for each of ``names``) that ``steps`` has, or None."""
+    for name in names:
+        for col in (f"{name}_s", name):
+            if col in steps.columns:
+                return col
+    return None
+
+
 def _stride_ends(result: Result) -> tuple[np.ndarray, np.ndarray] | None:
     """Times (s) and positions (K, 3) of the stride borders (every stride's start, and the last end)."""
     steps = result.steps
-    if len(steps) == 0 or "start" not in steps or "end" not in steps:
+    start, end = time_column(steps, "start"), time_column(steps, "end")
+    if len(steps) == 0 or start is None or end is None:
         return None
-    times = np.append(steps["start"].to_numpy(float), float(steps["end"].iloc[-1]))
+    times = np.append(steps[start].to_numpy(float), float(steps[end].iloc[-1]))
+    times = times[np.isfinite(times)]
     t = result.samples["t"].to_numpy()
     pos = result.pos
     return times, np.column_stack([np.interp(times, t, pos[:, i]) for i in range(3)])
@@ -355,6 +367,20 @@ def states_figure(result: Result, recording: Recording | None = None,
         bars.append(("true stance", np.asarray(truth.stance, dtype=bool), "k"))
     for k, (_, mask, color) in enumerate(bars[::-1]):
         ax_bars.fill_between(t[sel], k + 0.1, k + 0.9, where=mask[sel], step="mid", color=color, alpha=0.45, lw=0)
+    # gait events of the stride table (initial contact = a stride's end; toe-off when the table has it)
+    steps = result.steps
+    top = len(bars) - 0.05
+    t0, t1 = t[sel][0], t[sel][-1]
+    for names, marker, label in ((("ic", "end"), "v", "initial contact"), (("to", "toe_off"), "^", "toe-off")):
+        col = time_column(steps, *names) if len(steps) else None
+        if col is not None:
+            ev = steps[col].to_numpy(float)
+            ev = ev[np.isfinite(ev) & (ev >= t0) & (ev <= t1)]
+            if ev.size:
+                ax_bars.plot(ev, np.full(ev.size, top), marker, color="C3" if marker == "v" else "C2", ms=5,
+                             ls="none", label=label, clip_on=False)
+    if ax_bars.get_legend_handles_labels()[0]:
+        ax_bars.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax_bars.set_ylim(0, len(bars))
     ax_bars.set_yticks([k + 0.5 for k in range(len(bars))], [b[0] for b in bars[::-1]])
     ax_bars.grid(False)
@@ -386,13 +412,15 @@ def strides_figure(result: Result, recording: Recording | None = None) -> Figure
     plt = pyplot()
     ref_steps = recording.truth.steps if recording is not None and recording.truth is not None else None
     matched = None
-    if ref_steps is not None and len(ref_steps) and "end" in ref_steps and "end" in steps and "stride_length" in steps:
+    if ref_steps is not None and len(ref_steps):
         from .metrics import match_strides
 
         try:
             matched = match_strides(steps, ref_steps)
-        except (KeyError, ValueError):
+        except (KeyError, ValueError, TypeError):  # tables without the columns to pair strides by
             matched = None
+    end_col = time_column(steps, "end")
+    est_end = time_column(matched, "est_end") if matched is not None else None
     n = len(found)
     ncol = 2 if n > 2 else 1
     nrow = int(np.ceil(n / ncol))
@@ -403,12 +431,17 @@ def strides_figure(result: Result, recording: Recording | None = None) -> Figure
         ax.plot(x, values, "o-", color="C0", ms=3.5, lw=0.8, label="estimate")
         finite = values[np.isfinite(values)]
         med = f": median {np.median(finite):.3g}" if finite.size else ""
-        if matched is not None and len(matched) and "est_end" in matched:
+        if matched is not None and len(matched) and est_end is not None and end_col is not None:
             ref = step_column(matched, name)
-            if ref is not None:
-                at = np.searchsorted(steps["end"].to_numpy(float), matched["est_end"].to_numpy(float))
+            if ref is not None:  # at the stride number of the matched estimate
+                at = np.searchsorted(steps[end_col].to_numpy(float), matched[est_end].to_numpy(float))
                 ax.plot(at, ref[0], "x", color="k", ms=5, label="reference")
         _clip_outliers(ax, x, values, "C0")
+        lo, hi = ax.get_ylim()
+        if finite.size and hi - lo < 0.05 * abs(float(np.median(finite))):  # mm on a metre is not a swing
+            half = 0.025 * abs(float(np.median(finite)))
+            ax.set_ylim((lo + hi) / 2 - half, (lo + hi) / 2 + half)
+        ax.ticklabel_format(axis="y", useOffset=False)
         ax.set_ylabel(unit)
         ax.set_title(f"{label}{med}{' ' + unit if unit and med else ''}", loc="left")
     for ax in axes[-1]:

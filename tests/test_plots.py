@@ -129,6 +129,30 @@ def test_strides_figure_uses_gait_event_columns_and_reference(walk):
     close(fig)
 
 
+def test_stride_table_with_unit_names_and_gait_events(walk):
+    """A stride table whose columns carry units (``start_s``, ``to_s``, ``stride_length_m`` ...)."""
+    rec, res = walk
+    st = res.steps
+    steps = pd.DataFrame({"start_s": st["start"], "to_s": st["start"] + 0.45, "end_s": st["end"],
+                          "stride_time_s": st["stride_time"], "stance_time_s": 0.6, "swing_time_s": 0.4,
+                          "stride_length_m": st["stride_length"], "speed_m_s": st["speed"],
+                          "heading_rad": st["heading"], "max_clearance_m": st["max_clearance"], "fpa_rad": 0.1})
+    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
+                               diagnostics=res.diagnostics)
+    fig = strides_figure(res2, rec)
+    titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
+    assert titles == {"stride length", "stride time", "stance time", "swing time", "speed", "max. foot clearance",
+                      "foot progression angle"}
+    close(fig)
+    fig = trajectory_figure(res2, rec)
+    assert f"stride borders ({len(steps)} strides)" in legend_texts(fig)
+    close(fig)
+    fig = states_figure(res2, rec, window=(2.0, 6.0))
+    events = [t for ax in fig.axes if ax.get_legend() for t in [x.get_text() for x in ax.get_legend().get_texts()]]
+    assert "initial contact" in events and "toe-off" in events
+    close(fig)
+
+
 def test_step_column_units():
     steps = pd.DataFrame({"fpa": [np.radians(10.0)], "heading_deg": [5.0], "stride_length_m": [1.2],
                           "stride_time": [1.1]})
@@ -138,6 +162,7 @@ def test_step_column_units():
     assert step_column(steps, "stride_length")[1] == "m"
     assert step_column(steps, "stride_time")[1] == "s"
     assert step_column(steps, "swing_time") is None
+    assert step_column(pd.DataFrame({"speed_m_s": [1.0]}), "speed")[1] == "m/s"
 
 
 def test_robust_limits_keep_a_precise_series_and_drop_a_standing_stride():
