@@ -271,7 +271,7 @@ def run_gallery(out: Path) -> dict[str, str]:
         log.info("gallery: %s ran in %.1f s", script.name, time.perf_counter() - t0)
         title, _, text = mod_doc.partition("\n")
         sections += [f"## {title.strip() or script.stem}", "", text.strip(), ""]
-        for png in sorted(target.glob("*.png")):
+        for png in sorted(target.glob("*.png"), key=lambda f: (f.stat().st_mtime_ns, f.name)):  # as drawn
             sections += [f"![{script.stem}: {png.stem}]({script.stem}/{png.name})", ""]
         sections += [f'??? example "Source: docs/gallery/{script.name}"', "", "    ```python"]
         sections += [("    " + line).rstrip() for line in body.strip("\n").splitlines()]

@@ -4,8 +4,8 @@ footzoo's built-in sample is x-io Technologies' Gait-Tracking example (NGIMU on 
 400 Hz, a closed walk of about 25 m). Without a reference the figures show the estimate
 alone: the stride borders along the path, the height drift (the loop closes horizontally to
 about 0.1 m but not vertically), the detector's statistic on a log scale and the stance it
-produces. The first "stride" includes the initial standing; the stride figure sets such
-outliers aside (triangles on the edge) so they do not flatten the other strides.
+produces. In the stride figure, outliers (a "stride" that includes a standing pause, say) are
+set aside as triangles on the axis edge so that they do not flatten the other strides.
 """
 
 import sys
