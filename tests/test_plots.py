@@ -281,6 +281,25 @@ def test_plot_study_writes_its_files(tmp_path):
         assert p.read_bytes()[:4] == b"\x89PNG"
 
 
+def test_a_diverging_run_does_not_shrink_the_other_panels():
+    runs = fake_runs(10, n_recordings=1)
+    tr = np.asarray(runs[3]["trajectory"])
+    tr[:, 1:3] *= 50.0  # one configuration diverges to 1 km
+    runs[3]["trajectory"] = tr.tolist()
+    for with_reference in (True, False):
+        rs = [dict(r) for r in runs]
+        if not with_reference:
+            for r in rs:
+                r.pop("reference")
+        fig = study_trajectories(rs, run_labels(rs, FACTORS), "walk_0")
+        panels = [ax for ax in fig.axes if ax.get_visible()]
+        lo, hi = panels[0].get_xlim()
+        assert 20 < hi - lo < 40  # the 20 m circle fills the frame
+        notes = [[t.get_text() for t in ax.texts] for ax in panels]
+        assert notes[3] == ["leaves the frame"] and notes[0] == []
+        close(fig)
+
+
 def test_outlier_puts_the_box_plot_on_a_log_scale():
     runs = fake_runs(4, n_recordings=3, outlier=True)
     table = table_of(runs, FACTORS)

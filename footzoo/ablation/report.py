@@ -269,11 +269,7 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
             fig.legend(loc="outside lower center", ncol=2 if len(curves) > 3 else len(curves) + (ref is not None))
             return fig
         fig, axes = _grid(plt, len(curves))
-        allp = np.vstack([tr for _, tr in curves] + ([ref] if ref is not None else []))
-        allp = allp[np.all(np.isfinite(allp), axis=1)]
-        lo, hi = allp.min(axis=0), allp.max(axis=0)
-        half = 0.55 * max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)
-        mid = (lo + hi) / 2
+        mid, half = _common_frame([tr for _, tr in curves], ref)
         for ax, (label, tr) in zip(axes, curves, strict=True):
             if ref is not None:
                 ax.plot(ref[:, 1], ref[:, 0], **REFERENCE_STYLE)
@@ -283,11 +279,40 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
             ax.set_aspect("equal")
             ax.set_title(label, fontsize=8)
             ax.tick_params(labelsize=7)
+            finite = tr[np.all(np.isfinite(tr), axis=1)]
+            if finite.size and np.any(np.abs(finite[:, :2] - mid[:2]) > half):
+                ax.annotate("leaves the frame", (0.98, 0.02), xycoords="axes fraction", ha="right", va="bottom",
+                            fontsize=7, color="C3")
         fig.suptitle(f"{recording}: {frame}" + (" (dashed: reference)" if ref is not None else "") +
                      "; axes in m, north up")
         return fig
 
     return build()
+
+
+def _common_frame(curves: list[np.ndarray], ref: np.ndarray | None) -> tuple[np.ndarray, float]:
+    """Centre and half-width (m) of one square frame for all panels, robust to diverging runs.
+
+    The frame covers the reference (or, without one, every run whose extent is at
+    most three times the median extent), with a margin; a run that diverges far
+    beyond it would otherwise shrink every other panel to a dot.
+    """
+    def box(p: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        p = p[np.all(np.isfinite(p), axis=1)]
+        return (p.min(axis=0), p.max(axis=0)) if len(p) else None
+
+    boxes = [b for b in (box(c) for c in curves) if b is not None]
+    if ref is not None and box(ref) is not None:
+        keep = [box(ref)]
+    else:
+        extent = np.array([float(np.max(hi[:2] - lo[:2])) for lo, hi in boxes]) if boxes else np.array([1.0])
+        keep = [b for b, e in zip(boxes, extent, strict=True) if e <= 3 * np.median(extent)] or boxes
+    if not keep:
+        return np.zeros(3), 1.0
+    lo = np.min([b[0] for b in keep], axis=0)
+    hi = np.max([b[1] for b in keep], axis=0)
+    half = 0.65 * max(float(hi[0] - lo[0]), float(hi[1] - lo[1]), 1e-3)
+    return (lo + hi) / 2, half
 
 
 def _scale(ax, values: np.ndarray, axis: str = "y") -> str:
