@@ -249,7 +249,16 @@ def test_eight_configs_share_one_axis_with_the_legend_outside(tmp_path):
     roc = roc_figure(runs, run_labels(runs, FACTORS, only=["detector.threshold"]))
     texts = legend_texts(roc)
     assert len(texts) == 8 and texts[0].startswith("threshold=0.1 (AUC ")
+    fpr = np.linspace(0, 1, 11)  # the fake sweep of configuration 0: tpr = fpr^0.1, trapezoid rule
+    assert texts[0] == f"threshold=0.1 (AUC {np.trapezoid(fpr ** 0.1, fpr):.3f})"
+    assert roc.axes[0].get_xscale() == "linear"  # some AUCs are below 0.9
     close(roc)
+    steep = fake_runs(1, n_recordings=1)
+    steep[0]["roc"] = np.column_stack([fpr, fpr ** 0.02, fpr]).tolist()  # AUC 0.93: crowded top-left corner
+    roc = roc_figure(steep, run_labels(steep, FACTORS))
+    assert roc.axes[0].get_xscale() == "log"
+    close(roc)
+
 
 
 def test_many_configs_get_small_multiples(tmp_path):

@@ -388,7 +388,11 @@ def _auc(fpr: np.ndarray, tpr: np.ndarray) -> float:
     return float(np.sum(np.diff(x) * (y[1:] + y[:-1]) / 2))
 
 
-def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
+#: Smallest false stance rate shown on a logarithmic ROC axis.
+FPR_FLOOR = 1e-3
+
+
+def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str], log_fpr: bool | None = None):
     """Stance-detection ROC of the threshold sweeps, one curve per detector configuration.
 
     Runs that differ only outside the detector have the same sweep and are
@@ -396,6 +400,9 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
     its recordings at each false-stance rate (recordings as thin lines); the
     legend gives the mean area under the curve. Up to :data:`MAX_OVERLAID`
     configurations share one axis with the legend below it, more get a panel each.
+    ``log_fpr`` puts the false stance rate on a log scale (from :data:`FPR_FLOOR`);
+    by default it does when every curve's AUC exceeds 0.9, i.e. when the curves
+    crowd into the top-left corner.
     """
     from ..plots import pyplot, styled
 
@@ -406,7 +413,7 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
             groups.setdefault(label, {}).setdefault(r["recording"], np.asarray(r["roc"], float))
     if not groups:
         return None
-    grid = np.linspace(0.0, 1.0, 101)
+    grid = np.concatenate([[0.0], np.logspace(np.log10(FPR_FLOOR), 0.0, 120)])
 
     def mean_curve(curves: dict[str, np.ndarray]) -> tuple[np.ndarray, float]:
         tprs = []
@@ -415,6 +422,12 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
             tprs.append(np.interp(grid, c[order, 2], c[order, 1]))
         return np.mean(tprs, axis=0), float(np.mean([_auc(c[:, 2], c[:, 1]) for c in curves.values()]))
 
+    means = {name: mean_curve(curves) for name, curves in groups.items()}
+    log = all(auc > 0.9 for _, auc in means.values()) if log_fpr is None else log_fpr
+
+    def fx(x: np.ndarray) -> np.ndarray:
+        return np.maximum(x, FPR_FLOOR) if log else x
+
     @styled
     def build():
         plt = pyplot()
@@ -422,11 +435,11 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
         if len(names) <= MAX_OVERLAID:
             fig, ax = plt.subplots(figsize=(6, 6), layout="constrained")
             for i, name in enumerate(names):
-                m, auc = mean_curve(groups[name])
-                ax.plot(grid, m, lw=1.5, color=f"C{i}", label=f"{name} (AUC {auc:.3f})")
+                m, auc = means[name]
+                ax.plot(fx(grid), m, lw=1.5, color=f"C{i}", label=f"{name} (AUC {auc:.3f})")
                 if len(groups[name]) > 1:
                     for c in groups[name].values():
-                        ax.plot(c[:, 2], c[:, 1], lw=0.5, color=f"C{i}", alpha=0.35)
+                        ax.plot(fx(c[:, 2]), c[:, 1], lw=0.5, color=f"C{i}", alpha=0.35)
             axes = [ax]
             fig.legend(loc="outside lower center", ncol=2 if len(names) > 2 else len(names))
             ax.set_title("stance detection: threshold sweep" +
@@ -435,21 +448,28 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str]):
             fig, axes = _grid(plt, len(names), size=2.3)
             for ax, name in zip(axes, names, strict=True):
                 for c in groups[name].values():
-                    ax.plot(c[:, 2], c[:, 1], lw=0.5, color="0.6")
-                m, auc = mean_curve(groups[name])
-                ax.plot(grid, m, lw=1.5, color="C0")
+                    ax.plot(fx(c[:, 2]), c[:, 1], lw=0.5, color="0.6")
+                m, auc = means[name]
+                ax.plot(fx(grid), m, lw=1.5, color="C0")
                 ax.set_title(f"{name}\nAUC {auc:.3f}", fontsize=8)
                 ax.tick_params(labelsize=7)
             fig.suptitle("stance detection: threshold sweeps (grey: single recordings, blue: mean); "
                          "x false stance rate, y true stance rate")
         for ax in axes:
-            ax.plot([0, 1], [0, 1], ":", color="0.5", lw=0.6)
-            ax.set_xlim(0, 1)
+            ax.plot(fx(grid), grid, ":", color="0.5", lw=0.6)  # chance
             ax.set_ylim(0, 1.02)
-            ax.set_aspect("equal")
+            if log:
+                ax.set_xscale("log")
+                ax.set_xlim(FPR_FLOOR, 1)
+            else:
+                ax.set_xlim(0, 1)
+                ax.set_aspect("equal")
         if len(axes) == 1:
-            axes[0].set_xlabel("false stance rate")
+            axes[0].set_xlabel("false stance rate" + (f" (log scale, below {FPR_FLOOR:g} at the edge)" if log else ""))
             axes[0].set_ylabel("true stance rate")
+        elif log:
+            fig.text(0.5, 0.005, f"false stance rate on a log scale (below {FPR_FLOOR:g} at the edge)", ha="center",
+                     fontsize=8)
         return fig
 
     return build()
