@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .data import Recording, Result
+from .errors import ConfigError, RecordingError
 from .metrics import rotate_about_vertical, yaw_alignment
 
 P = ParamSpec("P")
@@ -88,17 +89,28 @@ def _stride(n: int) -> int:
     return max(1, int(np.ceil(n / MAX_POINTS)))
 
 
+def check_pair(result: Result, recording: Recording | None) -> None:
+    """Refuse a recording that is not the one the result was computed from (their samples must match)."""
+    if recording is None:
+        return
+    n = len(result.samples)
+    if recording.n != n:
+        raise RecordingError(
+            f"the recording {recording.name!r} has {recording.n} samples but the result has {n}: pass the "
+            "recording the result was computed from (the one given to Pipeline.run)"
+        )
+
+
 def aligned_reference(result: Result, recording: Recording | None) -> np.ndarray | None:
     """The reference positions (N, 3, m) in the estimate's frame: same start, yaw-aligned; None without one.
 
     Samples where the reference is missing (NaN, e.g. occluded markers) stay NaN.
     """
+    check_pair(result, recording)
     if recording is None or recording.truth is None or recording.truth.pos is None:
         return None
     ref = np.asarray(recording.truth.pos, dtype=float)
     pos = result.pos
-    if ref.shape != pos.shape:
-        return None
     ok = np.all(np.isfinite(ref), axis=1) & np.all(np.isfinite(pos), axis=1)
     if ok.sum() < 2:
         return None
@@ -318,12 +330,14 @@ def states_figure(result: Result, recording: Recording | None = None,
     """
     from .conventions import quat_to_euler
 
+    check_pair(result, recording)
     plt = pyplot()
     smp = result.samples
     t = smp["t"].to_numpy()
     sel = np.ones(len(t), dtype=bool) if window is None else (t >= window[0]) & (t <= window[1])
     if not sel.any():
-        raise ValueError(f"window {window} (s) is outside the recording ({t[0]:.2f}–{t[-1]:.2f} s)")
+        raise ConfigError(f"window {window} (s) is outside the recording ({t[0]:.2f}–{t[-1]:.2f} s); "
+                          "give (t0, t1) in seconds within it, or None for the whole recording")
     idx = np.flatnonzero(sel)[:: _stride(int(sel.sum()))]
     truth = recording.truth if recording is not None else None
     stance = result.stance
@@ -403,6 +417,7 @@ def strides_figure(result: Result, recording: Recording | None = None) -> Figure
     standing) are drawn as triangles on the axis edge so they do not flatten the
     rest. None when the run found no stride.
     """
+    check_pair(result, recording)
     steps = result.steps
     if len(steps) == 0:
         return None

@@ -105,8 +105,16 @@ def test_no_truth_gives_no_error_figure_and_no_reference(walk, tmp_path):
 
 def test_states_window_outside_the_recording_is_a_clear_error(walk):
     rec, res = walk
-    with pytest.raises(ValueError, match="outside the recording"):
+    with pytest.raises(footzoo.ConfigError, match="outside the recording"):
         states_figure(res, rec, window=(1e4, 2e4))
+
+
+def test_a_recording_that_does_not_match_the_result_is_refused(walk):
+    rec, res = walk
+    other = simulate(n_strides=4, rate=100.0)
+    for figure in (trajectory_figure, errors_figure, states_figure, strides_figure):
+        with pytest.raises(footzoo.RecordingError, match="pass the recording the result was computed from"):
+            figure(res, other)
 
 
 def test_strides_figure_uses_gait_event_columns_and_reference(walk):
