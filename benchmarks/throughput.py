@@ -58,7 +58,7 @@ def config_rates(rec: footzoo.Recording, ref_rec: footzoo.Recording) -> list[dic
         p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
         p.run(ref_rec)  # compile / warm up
         fast = rate_of(lambda p=p: p.run(rec), rec.n, repeat=3)
-        kalman = any(c.role == "kalman" for c in p.corrections)
+        kalman = bool(p.filter_corrections)
         if kalman:
             ref = rate_of(lambda p=p: p.run(ref_rec, engine="reference"), ref_rec.n)
             ref_name = "filterpy loop"

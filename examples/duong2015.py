@@ -21,8 +21,8 @@ CONFIGS = {"duong2015": "proposed method", "duong2015_zupt": "K.F. (zero velocit
            "duong2015_zupt_height": "K.F. (zero velocity + height updating)"}
 PAPER_TABLE2_WALKING = {"duong2015": (0.0208, 0.0118, 0.0030), "duong2015_zupt": (0.0243, 0.0131, 0.0121),
                         "duong2015_zupt_height": (0.0247, 0.0130, 0.0095)}
-BASE = {"orientation": {"type": "ins", "attitude_noise": 1.7e-6, "velocity_noise": 8.3e-5,
-                        "initial_attitude_std": 0.063}, "detector": {"type": "windowed"}}
+BASE = {"orientation": {"type": "ins"}, "detector": {"type": "windowed"},
+        "navigation": {"attitude_noise": 1.7e-6, "velocity_noise": 8.3e-5, "initial_attitude_std": 0.063}}
 
 
 def walk(seed: int):

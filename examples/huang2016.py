@@ -39,8 +39,8 @@ def simulated_conditions() -> pd.DataFrame:
                            fpa=np.radians(fpa), mount_yaw=np.radians(MOUNT_YAW), noise=NoiseModel(seed=1),
                            clearance=0.12)
             steps = pipeline.run(rec).steps
-            err = np.degrees(steps["fpa"].dropna().to_numpy()) - fpa
-            sl = steps["stride_length"].to_numpy()[1:-1]
+            err = np.degrees(steps["fpa_rad"].dropna().to_numpy()) - fpa
+            sl = steps["stride_length_m"].to_numpy()[1:-1]
             rows.append({"speed_m_s": speed, "gait": gait, "true_fpa_deg": fpa, "fpa_mean_err_deg": err.mean(),
                          "fpa_rms_err_deg": np.sqrt(np.mean(err**2)),
                          "stride_len_max_err_pct": 100 * np.max(np.abs(sl - length)) / length})
@@ -56,11 +56,11 @@ def gaitmap(folder: Path) -> pd.DataFrame:
         m = match_strides(steps, reference_strides(folder, foot))
         for turn in (False, True):
             s = m[m["turn"] == turn]
-            el = s["est_stride_length"] - s["stride_length"]
-            ef = np.degrees(s["est_fpa"] - s["fpa"])
+            el = s["est_stride_length_m"] - s["stride_length_m"]
+            ef = np.degrees(s["est_fpa_rad"] - s["fpa_rad"])
             rows.append({"foot": foot, "strides": "turn" if turn else "straight", "n": len(s),
-                         "ref_stride_len_m": s["stride_length"].mean(), "stride_len_mean_err_m": el.mean(),
-                         "stride_len_rms_m": np.sqrt(np.mean(el**2)), "ref_fpa_deg": np.degrees(s["fpa"]).mean(),
+                         "ref_stride_len_m": s["stride_length_m"].mean(), "stride_len_mean_err_m": el.mean(),
+                         "stride_len_rms_m": np.sqrt(np.mean(el**2)), "ref_fpa_deg": np.degrees(s["fpa_rad"]).mean(),
                          "fpa_mean_err_deg": ef.mean(), "fpa_rms_deg": np.sqrt(np.mean(ef**2)),
                          "fpa_rms_after_offset_deg": np.sqrt(np.mean((ef - ef.mean()) ** 2))})
     return pd.DataFrame(rows)

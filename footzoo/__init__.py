@@ -4,12 +4,13 @@ Conventions: NED navigation frame, FRD body frame, scalar-first body -> NED
 quaternions, SI units (see :mod:`footzoo.conventions`).
 """
 
-__version__ = "0.1.0"
-
+from ._version import __version__  # noqa: E402
 from .data import Recording, Result, Truth  # noqa: E402
 from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
 from .io import load  # noqa: E402
 from .pipeline import Pipeline  # noqa: E402
+from .registry import register  # noqa: E402
+from .session import Session, SessionResult  # noqa: E402
 
 __all__ = [
     "ConfigError",
@@ -19,7 +20,10 @@ __all__ = [
     "Recording",
     "RecordingError",
     "Result",
+    "Session",
+    "SessionResult",
     "Truth",
     "load",
+    "register",
     "__version__",
 ]

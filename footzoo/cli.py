@@ -9,59 +9,120 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from .errors import FootzooError
+from .conventions import ACC_UNITS, GYR_UNITS
+from .errors import FootzooError, FormatError
+
+
+def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
+    options: dict[str, Any] = {}
+    if getattr(args, "foot", None) and args.foot != "both":
+        options["foot"] = args.foot
+    for key in ("acc_unit", "gyr_unit"):
+        if getattr(args, key, None):
+            options[key] = getattr(args, key)
+    return options
 
 
 def _load_recording(args: argparse.Namespace):
     from .io import builtin_sample, load
 
     if args.data is None:
-        return builtin_sample()
-    options: dict[str, Any] = {}
-    if args.foot:
-        options["foot"] = args.foot
-    return load(args.data, format=args.format, **options)
+        rec = builtin_sample()
+        if getattr(args, "foot", None) in ("left", "right"):
+            rec.meta["foot"] = args.foot  # the sample does not say which foot it is from
+        return rec
+    return load(args.data, format=args.format, **_reader_options(args))
+
+
+def _two_feet(args: argparse.Namespace) -> bool:
+    """Run both feet: ``--foot both``, or a gaitmap file with both sensors and no ``--foot``."""
+    if args.data is None:
+        if args.foot == "both":
+            raise FormatError("--foot both needs --data with a two-foot file (gaitmap)")
+        return False
+    if args.foot not in (None, "both"):
+        return False
+    from .io import detect_format
+    from .io.gaitmap import feet
+
+    fmt = args.format or detect_format(args.data)
+    if fmt != "gaitmap":
+        if args.foot == "both":
+            raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file")
+        return False
+    return len(feet(Path(args.data))) == 2 or args.foot == "both"
+
+
+def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
+    print(title)
+    for key, value in metrics.items():
+        print(f"  {key:32s} {value:.4f}" if isinstance(value, float) else f"  {key:32s} {value}")
+
+
+def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
+    """samples.csv, steps.csv (units in the column names), metrics.json and optionally the run's figures."""
+    out.mkdir(parents=True, exist_ok=True)
+    result.samples.to_csv(out / "samples.csv", index=False, float_format="%.9g")
+    result.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
+    payload = {"metrics": result.metrics, "config": result.config, "versions": result.versions,
+               "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
+    (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
+    written = ["samples.csv", "steps.csv", "metrics.json"]
+    if plot:
+        from .plots import plot_run
+
+        written += [p.name for p in plot_run(result, out, rec)]
+    return written
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Run a pipeline on a recording; print metrics; optionally write outputs."""
-    from .metrics import trajectory_metrics
+    """Run a pipeline on a recording (or both feet of a session); print metrics; optionally write outputs."""
     from .pipeline import Pipeline
 
     pipeline = Pipeline.from_yaml(args.config)
+    if args.plot and not args.out:
+        print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
+        return 2
+    if _two_feet(args):
+        return _run_session(args, pipeline)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rec = _load_recording(args)
     for w in caught:
         print(f"note: {w.message}", file=sys.stderr)
     result = pipeline.run(rec)
-    truth = rec.truth
-    closed = bool(truth is not None and truth.closed_loop)
-    metrics = trajectory_metrics(result.pos, truth.pos if truth is not None else None, closed)
-    metrics["steps"] = int(len(result.steps))
-    metrics["duration_s"] = float(rec.t[-1] - rec.t[0])
+    metrics = result.metrics
     if "pyshoe_trial_error" in rec.meta:
         metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
-    print(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz)")
-    for key, value in metrics.items():
-        print(f"  {key:26s} {value:.4f}" if isinstance(value, float) else f"  {key:26s} {value}")
+    ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
+    _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
+    if args.out:
+        written = _write_result(result, rec, Path(args.out), args.plot)
+        print(f"wrote {', '.join(written)} to {args.out}")
+    return 0
+
+
+def _run_session(args: argparse.Namespace, pipeline) -> int:
+    """Both feet of a gaitmap file: per-foot metrics, the bilateral table, per-foot outputs."""
+    from .session import Session
+
+    options = _reader_options(args)
+    session = Session.load(args.data, format=args.format, **options)
+    res = session.run(pipeline)
+    for foot, r in res.results.items():
+        rec = session.recordings[foot]
+        ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
+        _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})",
+                       r.metrics)
+    print("bilateral (medians; symmetry index = 100 |L - R| / mean, %)")
+    print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
     if args.out:
         out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        result.samples.to_csv(out / "samples.csv", index=False, float_format="%.9g")
-        result.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
-        payload = {"metrics": metrics, "config": result.config, "versions": result.versions,
-                   "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
-        (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
-        written = ["samples.csv", "steps.csv", "metrics.json"]
-        if args.plot:
-            from .plots import plot_run
-
-            written += [p.name for p in plot_run(result, out, rec)]
-        print(f"wrote {', '.join(written)} to {out}")
-    elif args.plot:
-        print("--plot needs --out DIR (where trajectory.png is written)", file=sys.stderr)
-        return 2
+        for foot, r in res.results.items():
+            written = _write_result(r, session.recordings[foot], out / foot, args.plot)
+        res.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
+        res.bilateral.to_csv(out / "bilateral.csv", float_format="%.9g")
+        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out}")
     return 0
 
 
@@ -75,8 +136,16 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     """Check a config without running it."""
+    from .config import load_yaml
+    from .config_check import config_errors
     from .pipeline import Pipeline
 
+    errors = config_errors(load_yaml(args.config))
+    if errors:
+        print(f"{args.config}: {len(errors)} problem(s)", file=sys.stderr)
+        for e in errors:
+            print(f"  - {e}", file=sys.stderr)
+        return 2
     pipeline = Pipeline.from_yaml(args.config)
     print(f"{args.config}: valid")
     print(json.dumps(pipeline.to_dict(), indent=2))
@@ -107,7 +176,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     out = write(rec, args.out)
     closed = "closed loop" if rec.truth.closed_loop else "open path"
     print(f"wrote {out} ({rec.n} samples at {rec.rate:.0f} Hz, {rec.t[-1]:.1f} s, {closed}, "
-          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} steps)")
+          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} strides)")
     return 0
 
 
@@ -168,7 +237,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("config", help="pipeline YAML, e.g. configs/yun2012.yaml")
     run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
     run.add_argument("--format", help="canonical, xio, pyshoe, gaitmap or sensorconnect (default: detect)")
-    run.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
+    run.add_argument("--foot", choices=["left", "right", "both"],
+                     help="foot to read from a two-foot file (gaitmap; default: both when the file has both), "
+                          "or the foot a one-foot recording is from")
+    run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
+    run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
     run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
     run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
                      "errors (with a reference), strides, fpa (.png, needs --out)")
@@ -197,6 +270,8 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--data", required=True, help="calibration recording")
     cal.add_argument("--format", help="reader format (default: detect)")
     cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
+    cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
+    cal.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
     cal.add_argument("--still", nargs=2, type=float, metavar=("T0", "T1"), help="still period (s); default: found")
     cal.add_argument("--flex", nargs=2, type=float, metavar=("T0", "T1"), help="flexion period (s); default: found")
     cal.add_argument("--out", required=True, help="YAML file to write")

@@ -63,8 +63,8 @@ def compatibility_matrix() -> str:
         for o in orientations:
             why = check({"orientation": {"type": o}, "detector": {"type": "angular_rate_fsm"}, "corrections": [a, b]})
             if why:
-                pair_reasons.add(why.split(":", 1)[-1].strip()[:160])
+                pair_reasons.add(why.split(":", 1)[-1].strip())
     lines += [f"- {r}" for r in sorted(pair_reasons)]
     if reasons:
-        lines += ["", "Single corrections are rejected when:"] + [f"- {r[:160]}" for r in sorted(reasons)]
+        lines += ["", "Single corrections are rejected when:"] + [f"- {r}" for r in sorted(reasons)]
     return "\n".join(lines) + "\n"

@@ -18,8 +18,7 @@ from typing import Any
 
 import yaml
 
-from .errors import ConfigError
-from .registry import did_you_mean
+from .errors import ConfigError, did_you_mean
 
 TOP_LEVEL_KEYS: dict[str, str] = {
     "name": "pipeline name (text)",
@@ -30,6 +29,10 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
+    "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
+    "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
+                  "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
+                  "initial_position_std: m}",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")
@@ -52,23 +55,34 @@ def load_yaml(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def check_top_level(d: dict[str, Any]) -> None:
-    """Reject unknown or missing top-level keys, listing the valid ones."""
+def top_level_errors(d: dict[str, Any]) -> list[str]:
+    """Every problem with the top-level keys of a config (unknown, missing, badly typed), as messages."""
     if not isinstance(d, dict):
-        raise ConfigError(f"a config must be a mapping, got {type(d).__name__}")
+        return [f"a config must be a mapping, got {type(d).__name__}"]
+    errors = []
     valid = list(TOP_LEVEL_KEYS)
     for key in d:
         if key not in TOP_LEVEL_KEYS:
-            raise ConfigError(f"unknown config key {key!r}{did_you_mean(key, valid)}; valid keys: {valid}")
+            errors.append(f"unknown config key {key!r}{did_you_mean(key, valid)}; valid keys: {valid}")
     for key in REQUIRED:
         if key not in d:
-            raise ConfigError(f"config is missing {key!r} ({TOP_LEVEL_KEYS[key]})")
+            errors.append(f"config is missing {key!r} ({TOP_LEVEL_KEYS[key]})")
     init = d.get("init", {}) or {}
     if not isinstance(init, dict):
-        raise ConfigError(f"init must be a mapping like {{duration: 0.5}}, got {init!r}")
-    for key in init:
-        if key not in INIT_KEYS:
-            raise ConfigError(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; valid: {list(INIT_KEYS)}")
+        errors.append(f"init must be a mapping like {{duration: 0.5}}, got {init!r}")
+    else:
+        for key in init:
+            if key not in INIT_KEYS:
+                errors.append(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; "
+                              f"valid: {list(INIT_KEYS)}")
     for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]")):
         if not isinstance(d.get(key, []) or [], list):
-            raise ConfigError(f"{key} must be a list, e.g. {example}")
+            errors.append(f"{key} must be a list, e.g. {example}")
+    return errors
+
+
+def check_top_level(d: dict[str, Any]) -> None:
+    """Reject unknown or missing top-level keys, listing the valid ones (every problem in one message)."""
+    errors = top_level_errors(d)
+    if errors:
+        raise ConfigError("; ".join(errors))

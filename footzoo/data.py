@@ -49,12 +49,29 @@ class Truth:
     stance : (N,) bool ndarray or None
         True where the sensor's velocity is zero.
     steps : DataFrame or None
-        One row per step (start, end in s; stride length in m; heading and
-        foot progression angle in rad), where known.
+        Reference strides, one row per stride, columns as in
+        :func:`footzoo.analysis.strides.segment_steps` where known: ``start_s``,
+        ``to_s``, ``end_s`` (IC, toe-off, next IC; s), ``stride_length_m``,
+        ``heading_rad``, ``fpa_rad``, ``turn`` (bool). Simulator files written
+        before the unit names (``swing_start``/``swing_end``, ``stride_length``,
+        ``heading``, ``fpa``) are read too (:func:`footzoo.metrics.reference_steps`).
     closed_loop : bool
         The walk ends where it started (loop-closure metrics apply).
     dist : (N, k) ndarray or None
         True range of each distance sensor (m), NaN where it has no sample.
+    stride_count : int or None
+        Strides counted by hand (PyShoe's trials, Köroğlu's ``numberOfStrides``).
+    footprints : (K, 2) ndarray or None
+        Horizontal position of every footprint (m), first one included, in the
+        dataset's own floor axes (compare after a 2-D rigid alignment, reflection
+        allowed), e.g. Köroğlu's ground control points ``GCP_meters``.
+    stride_positions : DataFrame or None
+        Per-stride trajectories (e.g. gaitmap's ``position_sample.csv``):
+        ``stride`` (row of ``steps``), ``t_s`` (s), ``pos_x_m``, ``pos_y_m``,
+        ``pos_up_m`` (m, zeroed at the stride's start, right-handed with z up;
+        compare after a rotation about the vertical).
+    source : str
+        What the reference is (e.g. "VICON", "motion capture", "simulator").
     """
 
     pos: np.ndarray | None = None
@@ -64,6 +81,17 @@ class Truth:
     steps: pd.DataFrame | None = None
     closed_loop: bool = False
     dist: np.ndarray | None = None
+    stride_count: int | None = None
+    footprints: np.ndarray | None = None
+    stride_positions: pd.DataFrame | None = None
+    source: str = ""
+
+    def __repr__(self) -> str:
+        have = [k for k in ("pos", "vel", "quat", "stance", "steps", "dist", "footprints", "stride_positions")
+                if getattr(self, k) is not None]
+        extra = f", stride_count={self.stride_count}" if self.stride_count is not None else ""
+        src = f"{self.source!r}, " if self.source else ""
+        return f"Truth({src}{', '.join(have) or 'nothing'}{extra}, closed_loop={self.closed_loop})"
 
 
 @dataclass
@@ -113,6 +141,12 @@ class Recording:
         self.meta = dict(self.meta)
         self.meta.setdefault("name", "recording")
         self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
+
+    def __repr__(self) -> str:
+        channels = ["acc", "gyr"] + [k for k in ("mag", "dist") if getattr(self, k) is not None]
+        truth = "" if self.truth is None else f", truth={self.truth!r}"
+        return (f"Recording({self.name!r}, n={self.n}, rate={self.rate:.1f} Hz, "
+                f"duration={self.t[-1] - self.t[0]:.2f} s, channels={channels}{truth})")
 
     @property
     def n(self) -> int:
@@ -375,9 +409,12 @@ class Result:
         ``acc_n, acc_e, acc_d`` (motion acceleration, gravity removed, m/s²),
         ``stance`` (bool).
     steps : DataFrame
-        Per step (one swing between two stances): ``start``, ``end`` (s),
-        ``duration`` (s), ``stride_length`` (m, horizontal), ``heading`` (rad),
-        ``start_n, start_e, end_n, end_e`` (m).
+        Per stride, units in the column names (see
+        :func:`footzoo.analysis.strides.segment_steps`): ``start_s``, ``to_s``,
+        ``end_s`` (initial contact, toe-off, next initial contact), stride, stance
+        and swing time (s), ``cadence_steps_min``, ``stride_length_m``,
+        ``speed_m_s``, ``heading_rad``, mid-stance positions (m),
+        ``max_clearance_m``; ``fpa_rad`` with an FPA analysis.
     config : dict
         The resolved configuration (every parameter, defaults filled in).
     versions : dict
@@ -386,6 +423,9 @@ class Result:
         The recording's metadata.
     diagnostics : dict
         Plug-in statistics (e.g. detector test statistic), arrays by name.
+    reference : Truth or None
+        The recording's reference (simulator truth, VICON, motion-capture events,
+        footprints, hand-counted strides), used by :attr:`metrics`.
     """
 
     samples: pd.DataFrame
@@ -394,6 +434,32 @@ class Result:
     versions: dict[str, str]
     recording: dict[str, Any] = field(default_factory=dict)
     diagnostics: dict[str, Any] = field(default_factory=dict)
+    reference: Truth | None = None
+
+    def __repr__(self) -> str:
+        name = self.recording.get("name", "recording")
+        return (f"Result({self.config.get('name', 'pipeline')!r} on {name!r}, {len(self.samples)} samples, "
+                f"{len(self.steps)} strides, reference={'yes' if self.reference is not None else 'no'})")
+
+    @property
+    def metrics(self) -> dict[str, float]:
+        """Summary and errors against the recording's reference, one number per key (units in the keys).
+
+        Always: ``duration_s``, ``path_length_m`` (horizontal), ``strides``,
+        median ``stride_time_s``, ``cadence_steps_min``, ``stride_length_m``,
+        ``stance_time_s``, ``swing_time_s``. With a closed-loop reference: loop
+        closure. With reference positions: ``armse_3d_m`` (after a least-squares
+        yaw alignment) and ``pyshoe_error_m``. With a hand count:
+        ``stride_count_ref``, ``stride_count_error``. With reference strides: the
+        matched count and the median absolute IC/TO errors (s), stride-length
+        RMS error (m), stride-time and FPA errors. With footprints: per-footprint
+        error after a 2-D rigid alignment. With per-stride trajectories: the
+        median per-stride 3-D path RMS after a yaw alignment. See :func:`footzoo.metrics.result_metrics`.
+        """
+        from .metrics import result_metrics
+
+        t = self.samples["t"].to_numpy()
+        return result_metrics(t, self.pos, self.steps, self.reference)
 
     @property
     def pos(self) -> np.ndarray:

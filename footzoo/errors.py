@@ -1,5 +1,7 @@
 """Exceptions footzoo raises; every message names the problem and the fix."""
 
+import difflib
+
 
 class FootzooError(Exception):
     """Base class of footzoo's own errors."""
@@ -15,3 +17,13 @@ class ConfigError(FootzooError, ValueError):
 
 class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
+
+
+class FootzooWarning(UserWarning):
+    """Something footzoo handled but you should know: a bridged gap, a fallback engine, a clipped sensor, …"""
+
+
+def did_you_mean(word: str, options: list[str]) -> str:
+    """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
+    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""

@@ -6,6 +6,7 @@ All positions are (N, 3) arrays in NED (m). Horizontal means north-east.
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 
 def path_length(pos: np.ndarray, horizontal: bool = True) -> float:
@@ -183,23 +184,222 @@ def step_detection(stance: np.ndarray, truth: np.ndarray, t: np.ndarray) -> dict
 # --------------------------------------------------------------------------- strides
 
 
-def match_strides(estimated, reference, tolerance: float = 0.5, min_fraction: float = 0.3):
-    """Pair estimated and reference strides by their end times.
+#: Older simulator step tables (before unit names) -> reference column names.
+_LEGACY_STEP_NAMES = {"swing_start": "to_s", "swing_end": "end_s", "stride_length": "stride_length_m",
+                      "heading": "heading_rad", "fpa": "fpa_rad"}
 
-    Estimated strides shorter than ``min_fraction`` of the median stride length
-    (split stances, shuffles) are left out; each reference stride takes the
-    estimated stride whose ``end`` is nearest to its own, within ``tolerance``
-    seconds. Returns a DataFrame with the reference columns and ``est_*`` columns.
+
+def reference_steps(steps: pd.DataFrame) -> pd.DataFrame:
+    """A reference stride table with footzoo's column names (see :class:`footzoo.data.Truth`).
+
+    The simulator's step table (``swing_start`` = toe-off, ``swing_end`` =
+    initial contact, ``stride_length``, ``heading``, ``fpa``) is renamed and given
+    ``start_s``, the previous stride's initial contact (NaN for the first).
     """
-    import pandas as pd
+    out = steps.rename(columns={k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns
+                                and v not in steps.columns})
+    if "swing_end" in steps.columns:  # simulator table: its own start/end are heel-off and foot-flat
+        out = out.drop(columns=[c for c in ("start", "end") if c in out.columns])
+        ic = out["end_s"].to_numpy(dtype=float)
+        out.insert(0, "start_s", np.concatenate([[np.nan], ic[:-1]]))
+    return out
 
-    est = estimated[estimated["stride_length"] >= min_fraction * estimated["stride_length"].median()]
-    rows = []
-    ends = est["end"].to_numpy()
-    for _, r in reference.iterrows():
-        if ends.size == 0:
-            break
-        j = int(np.argmin(np.abs(ends - r["end"])))
-        if abs(ends[j] - r["end"]) <= tolerance:
-            rows.append({**r.to_dict(), **{f"est_{k}": v for k, v in est.iloc[j].to_dict().items()}})
-    return pd.DataFrame(rows)
+
+def nearest_index(sorted_values: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """Index of the nearest element of the non-empty ascending ``sorted_values`` for each query (vectorised)."""
+    v = np.asarray(sorted_values, dtype=float)
+    q = np.asarray(queries, dtype=float)
+    if len(v) == 1:
+        return np.zeros(len(q), dtype=np.int64)
+    k = np.clip(np.searchsorted(v, q), 1, len(v) - 1)
+    return np.where(np.abs(v[k - 1] - q) <= np.abs(v[k] - q), k - 1, k)
+
+
+def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str = "to_s",
+                  tolerance: float = 0.3) -> pd.DataFrame:
+    """Pair each reference stride with the estimated stride nearest in time.
+
+    Strides are paired by the column ``on`` (default the toe-off ``to_s``, which
+    every stride has), each reference stride taking the nearest estimated one
+    within ``tolerance`` (s). Vectorised. Returns the matched reference rows with
+    the estimate's columns added as ``est_<column>``.
+    """
+    est = estimated.reset_index(drop=True)
+    ref = reference_steps(reference).reset_index(drop=True)
+    if on not in ref.columns and "end_s" in ref.columns:
+        on = "end_s"
+    e = est[on].to_numpy(dtype=float)
+    r = ref[on].to_numpy(dtype=float)
+    if len(e) == 0 or len(r) == 0:
+        return pd.DataFrame(columns=[*ref.columns, *(f"est_{c}" for c in est.columns)])
+    order = np.argsort(e)
+    es = e[order]
+    nearest = nearest_index(es, r)
+    ok = np.abs(es[nearest] - r) <= tolerance
+    matched = est.iloc[order[nearest[ok]]].reset_index(drop=True).add_prefix("est_")
+    return pd.concat([ref[ok].reset_index(drop=True), matched], axis=1)
+
+
+def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: float = 0.3) -> dict[str, float]:
+    """Per-stride errors (estimate − reference) of the matched strides (:func:`match_strides`).
+
+    Returns the count of reference and matched strides, and where both sides
+    have the column: median absolute error of the initial contact
+    (``ic_error_median_abs_s``, on ``end_s``) and toe-off (``to_error_median_abs_s``),
+    mean signed errors, stride-time error, stride-length RMS and mean error (m),
+    and FPA mean and RMS error (deg). Turn strides (``turn``) are left out of
+    the stride-length and FPA errors.
+    """
+    m = match_strides(estimated, reference, tolerance=tolerance)
+    out: dict[str, float] = {"ref_strides": float(len(reference)), "matched_strides": float(len(m))}
+    if len(m) == 0:
+        return out
+    straight = ~m["turn"].to_numpy(dtype=bool) if "turn" in m.columns else np.ones(len(m), bool)
+
+    def diff(col: str, mask=None) -> np.ndarray | None:
+        if col not in m.columns or f"est_{col}" not in m.columns:
+            return None
+        d = m[f"est_{col}"].to_numpy(dtype=float) - m[col].to_numpy(dtype=float)
+        d = d[mask] if mask is not None else d
+        return d[np.isfinite(d)]
+
+    for col, name in (("end_s", "ic"), ("to_s", "to")):
+        d = diff(col)
+        if d is not None and d.size:
+            out[f"{name}_error_median_abs_s"] = float(np.median(np.abs(d)))
+            out[f"{name}_error_mean_s"] = float(np.mean(d))
+    if "end_s" in m.columns and "start_s" in m.columns:
+        ref_time = m["end_s"].to_numpy(float) - m["start_s"].to_numpy(float)
+        d = m["est_stride_time_s"].to_numpy(float) - ref_time
+        d = d[np.isfinite(d)]
+        if d.size:
+            out["stride_time_error_median_abs_s"] = float(np.median(np.abs(d)))
+    d = diff("stride_length_m", straight)
+    if d is not None and d.size:
+        out["stride_length_rms_error_m"] = float(np.sqrt(np.mean(d**2)))
+        out["stride_length_mean_error_m"] = float(np.mean(d))
+    d = diff("fpa_rad", straight)
+    if d is not None and d.size:
+        d = np.degrees(d)
+        out["fpa_mean_error_deg"] = float(np.mean(d))
+        out["fpa_rms_error_deg"] = float(np.sqrt(np.mean(d**2)))
+    return out
+
+
+def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> tuple[np.ndarray, bool]:
+    """Least-squares 2-D rotation + translation of ``est`` onto ``ref`` (Kabsch), optionally a reflection.
+
+    Returns the aligned points and whether a reflection was used (it is taken
+    only when it fits better: datasets such as Köroğlu's flip an axis).
+    """
+    e = np.asarray(est, float)[:, :2]
+    r = np.asarray(ref, float)[:, :2]
+    best = None
+    for mirror in ((False, True) if reflection else (False,)):
+        ee = e * np.array([1.0, -1.0]) if mirror else e
+        ce, cr = ee.mean(axis=0), r.mean(axis=0)
+        h = (ee - ce).T @ (r - cr)
+        u, _, vt = np.linalg.svd(h)
+        d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+        rot = vt.T @ np.diag([1.0, d]) @ u.T
+        aligned = (ee - ce) @ rot.T + cr
+        err = float(np.sum((aligned - r) ** 2))
+        if best is None or err < best[0]:
+            best = (err, aligned, mirror)
+    return best[1], best[2]
+
+
+def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, float]:
+    """Error of every footprint (mid-stance position) against measured footprints, e.g. Köroğlu's GCPs.
+
+    The estimated footprints are the first stride's start and every stride's
+    end (K + 1 points for K strides). Compared only when the counts agree;
+    after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
+    the mean and RMS distances (m) and the end-point distance are returned.
+    """
+    fp = np.asarray(footprints, float)
+    out: dict[str, float] = {"footprints_ref": float(len(fp))}
+    if len(steps) == 0:
+        return out
+    est = np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
+    out["footprints_est"] = float(len(est))
+    if len(est) != len(fp):
+        return out
+    aligned, _ = rigid_align_2d(est, fp)
+    d = np.linalg.norm(aligned - fp, axis=1)
+    out.update(footprint_error_mean_m=float(d.mean()), footprint_error_rms_m=float(np.sqrt(np.mean(d**2))),
+               footprint_error_end_m=float(d[-1]))
+    return out
+
+
+def stride_path_errors(t: np.ndarray, pos: np.ndarray, stride_positions: pd.DataFrame,
+                       turn: np.ndarray | None = None) -> dict[str, float]:
+    """3-D RMS error (m) of the estimated trajectory over each reference stride, after a yaw alignment.
+
+    Per stride the estimate (NED, interpolated at the reference times) is turned
+    into a right-handed z-up frame (east, north, up), both are zeroed at the
+    stride's first sample, the estimate is rotated about the vertical
+    (:func:`yaw_alignment`) and the RMS of the 3-D difference is taken.
+    Returns the median over the strides (``stride_path_rms_error_median_m``),
+    over the strides not flagged in ``turn`` when it is given.
+    """
+    enu = np.column_stack([pos[:, 1], pos[:, 0], -pos[:, 2]])
+    rms = []
+    for k, g in stride_positions.groupby("stride"):
+        if turn is not None and bool(turn[int(k)]):
+            continue
+        tt = g["t_s"].to_numpy(dtype=float)
+        if tt[0] < t[0] or tt[-1] > t[-1] or len(tt) < 2:
+            continue
+        e = np.column_stack([np.interp(tt, t, enu[:, i]) for i in range(3)])
+        r = g[["pos_x_m", "pos_y_m", "pos_up_m"]].to_numpy(dtype=float)
+        e, r = e - e[0], r - r[0]
+        e = rotate_about_vertical(e, yaw_alignment(e, r))
+        rms.append(float(np.sqrt(np.mean(np.sum((e - r) ** 2, axis=1)))))
+    if not rms:
+        return {}
+    return {"stride_path_rms_error_median_m": float(np.median(rms)), "stride_paths": float(len(rms))}
+
+
+def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, reference=None) -> dict[str, float]:
+    """The numbers ``footzoo run`` prints: a summary of the run and its errors against the reference.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Time (s).
+    pos : (N, 3) ndarray
+        Estimated position, NED (m).
+    steps : DataFrame
+        The stride table (:func:`footzoo.analysis.strides.segment_steps`).
+    reference : Truth, optional
+        The recording's reference.
+
+    Returns
+    -------
+    dict
+        Keys carry their unit; see :attr:`footzoo.data.Result.metrics`.
+    """
+    ref = reference
+    closed = bool(ref is not None and ref.closed_loop)
+    out: dict[str, float] = {"duration_s": float(t[-1] - t[0])}
+    out.update(trajectory_metrics(pos, ref.pos if ref is not None else None, closed))
+    out["strides"] = float(len(steps))
+    for col in ("stride_time_s", "cadence_steps_min", "stride_length_m", "stance_time_s", "swing_time_s"):
+        if col in steps.columns:
+            v = steps[col].to_numpy(dtype=float)
+            v = v[np.isfinite(v)]
+            out[f"median_{col}"] = float(np.median(v)) if v.size else float("nan")
+    if ref is None:
+        return out
+    if ref.stride_count is not None:
+        out["stride_count_ref"] = float(ref.stride_count)
+        out["stride_count_error"] = float(len(steps) - ref.stride_count)
+    if ref.steps is not None and len(ref.steps):
+        out.update(stride_errors(steps, ref.steps))
+    if ref.footprints is not None:
+        out.update(footprint_errors(steps, ref.footprints))
+    if ref.stride_positions is not None:
+        turn = ref.steps["turn"].to_numpy(dtype=bool) if ref.steps is not None and "turn" in ref.steps else None
+        out.update(stride_path_errors(t, pos, ref.stride_positions, turn))
+    return out

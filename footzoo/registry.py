@@ -1,62 +1,58 @@
 """Plug-in registry: ``register`` by kind and name, ``build`` from a spec, ``describe``.
 
-A plug-in is a class with keyword parameters in ``__init__`` (paper defaults),
-class attributes ``kind``, ``name``, ``paper`` and ``units`` (unit of each
-parameter), and one action method. ``build`` rejects unknown names and keys
-with the list of valid ones and a did-you-mean suggestion.
+A plug-in is a subclass of one of the kinds' base classes in :mod:`footzoo.plugin`, with
+keyword parameters in ``__init__`` (paper defaults) and class attributes ``name``, ``paper``
+and ``units`` (unit of each parameter). ``build`` rejects unknown names and keys with the list
+of valid ones and a did-you-mean suggestion.
+
+The registry imports no plug-in module: the built-in packages and every module in them are
+imported by name the first time a listing or a lookup needs them (so a new built-in plug-in is
+one new file), then the installed packages' entry points (group ``footzoo.plugins``).
 """
 
 from __future__ import annotations
 
-import difflib
+import importlib
 import inspect
-from typing import Any, ClassVar
+import pkgutil
+from typing import Any
 
-from .errors import ConfigError
+from .errors import ConfigError, did_you_mean
+from .plugin import BASES, Plugin
 
-KINDS: tuple[str, ...] = ("orientation", "detector", "correction", "analysis")
+KINDS: tuple[str, ...] = tuple(BASES)
+#: Packages whose import registers the built-in plug-ins.
+BUILTIN_PACKAGES: tuple[str, ...] = ("footzoo.orientation", "footzoo.detectors", "footzoo.corrections",
+                                     "footzoo.analysis")
 
 _REGISTRY: dict[str, dict[str, type[Plugin]]] = {k: {} for k in KINDS}
-
-
-class Plugin:
-    """Base class: parameters only in ``__init__``, estimates in attributes ending in ``_``."""
-
-    kind: ClassVar[str] = ""
-    name: ClassVar[str] = ""
-    paper: ClassVar[str] = ""
-    units: ClassVar[dict[str, str]] = {}
-    role: ClassVar[str] = ""  # corrections: "velocity", "heading" or "kalman"
-
-    @classmethod
-    def param_names(cls) -> list[str]:
-        """The constructor's parameter names, in order."""
-        sig = inspect.signature(cls.__init__)
-        return [p for p in sig.parameters if p != "self"]
-
-    def get_params(self) -> dict[str, Any]:
-        """Current parameter values (scikit-learn style)."""
-        return {p: getattr(self, p) for p in self.param_names()}
-
-    def __repr__(self) -> str:
-        args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        return f"{type(self).__name__}({args})"
+_LOADED = False
 
 
 def register(cls: type[Plugin]) -> type[Plugin]:
-    """Class decorator: make a plug-in available under ``cls.kind`` / ``cls.name``."""
+    """Class decorator: make a plug-in available under its kind and ``cls.name``.
+
+    Registering the same class again (a module imported twice) is a no-op; another class under a
+    taken name is an error.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, Plugin)):
+        raise TypeError(f"register expects a plug-in class deriving from footzoo.plugin's base classes, got {cls!r}")
     if cls.kind not in _REGISTRY:
-        raise ValueError(f"unknown plug-in kind {cls.kind!r}; kinds are {list(KINDS)}")
-    if cls.name in _REGISTRY[cls.kind]:
-        raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered")
+        raise ValueError(f"{cls.__name__}: unknown plug-in kind {cls.kind!r}; kinds are {list(KINDS)}")
+    bases = BASES[cls.kind]
+    if not issubclass(cls, bases):
+        names = " or ".join(f"footzoo.plugin.{b.__name__}" for b in bases)
+        raise TypeError(f"{cls.__name__}: a {cls.kind} plug-in derives from {names}")
+    if not cls.name or not isinstance(cls.name, str):
+        raise ValueError(f"{cls.__name__}: set the class attribute name = '...' (the YAML type)")
+    old = _REGISTRY[cls.kind].get(cls.name)
+    if old is not None and old is not cls:
+        same = f"{old.__module__}.{old.__qualname__}" == f"{cls.__module__}.{cls.__qualname__}"
+        if not same:
+            raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered "
+                             f"({old.__module__}.{old.__qualname__}); choose another name")
     _REGISTRY[cls.kind][cls.name] = cls
     return cls
-
-
-def did_you_mean(word: str, options: list[str]) -> str:
-    """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
-    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def available(kind: str) -> dict[str, type[Plugin]]:
@@ -92,7 +88,11 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
     params = {k: v for k, v in spec.items() if k != "type"}
     cls = get(kind, spec["type"], where)
     allowed = cls.param_names()
+    moved = getattr(cls, "moved", {})
     for key in params:
+        if key in moved:
+            raise ConfigError(f"{where}: {key!r} of {kind} {cls.name!r} is now set as {moved[key]} "
+                              f"(a top-level block of the pipeline config); move it there")
         if key not in allowed:
             raise ConfigError(
                 f"{where}: unknown parameter {key!r} for {kind} {cls.name!r}"
@@ -127,8 +127,23 @@ def describe(kind: str | None = None) -> str:
 
 
 def _load_builtin() -> None:
-    # importing the packages registers their plug-ins
-    from . import analysis, corrections, detectors, orientation  # noqa: F401
+    """Import the built-in plug-in packages and the installed entry points, once."""
+    global _LOADED
+    if _LOADED:
+        return
+    _LOADED = True
+    for package in BUILTIN_PACKAGES:
+        module = importlib.import_module(package)
+        # every module of the package: a new built-in plug-in is one new file
+        for info in pkgutil.iter_modules(module.__path__):
+            importlib.import_module(f"{package}.{info.name}")
+    try:
+        extensions = importlib.import_module("footzoo.extensions")
+    except ModuleNotFoundError:
+        return
+    loader = getattr(extensions, "load_entry_points", None)
+    if loader is not None:
+        loader()
 
 
 def check_positive(name: str, value: float, allow_zero: bool = False) -> float:

@@ -1,28 +1,29 @@
 """Live estimation: push one sample, get the current estimate.
 
-For pipelines whose output at a sample depends only on the samples up to it —
-the strapdown INS with Kalman-filter corrections (``ekf_zupt``, ``zupt``,
-``hdr``, ``height_flat_floor``, ``height_distance``) and the causal ``dgp``
-detector, i.e. Nguyen & La's real-time system — :class:`Stream` gives exactly
-what :meth:`Pipeline.run` gives on the whole recording. It holds the filter's
-state between samples and feeds the same compiled loop two samples at a time.
+For pipelines whose output at a sample depends only on the samples up to it — an orientation
+the Kalman filter carries (the INS), a ``causal`` detector and Kalman corrections only, i.e.
+Nguyen & La's real-time system — :class:`Stream` gives exactly what :meth:`Pipeline.run` gives
+on the whole recording. It holds the filter's state between samples and advances the same
+engine (compiled, or the reference for a correction that does not compile) two samples at a
+time, with the same measurement models, built by the same :meth:`Pipeline.kalman_engine`.
 
-DGP and the filter run their compiled loops from carried state, one sample at
-a time. The stream needs the foot still for ``init.duration`` seconds at the start
-(the batch run can also look later and carry the attitude back; a live
-system cannot), and takes the sampling rate for DGP's windows from that
-still period (the batch run from the whole recording: the same for a
-regular clock).
+The stream needs the foot still for ``init.duration`` seconds at the start (the batch run can
+also look later and carry the attitude back; a live system cannot). A detector's windows in
+seconds become samples at the sampling ``rate``: give the sensor's nominal rate (the batch run
+uses the recording's median rate, :attr:`Recording.rate`; :meth:`Stream.run` passes it), or
+leave it out and the stream measures it over the still start, with a warning.
 """
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
 
-from .errors import ConfigError, RecordingError
+from .errors import ConfigError, FootzooWarning, RecordingError
 from .orientation.fqa import fqa
+from .plugin import KalmanCorrection, Samples
 
 
 class Stream:
@@ -32,27 +33,38 @@ class Stream:
     ----------
     pipeline : Pipeline
         A causal pipeline (see the module docstring); others are rejected with the reason.
+    rate : float, optional
+        Nominal sampling rate (Hz) for the detector's windows; default: measured over the still start.
+    engine : {"auto", "fast", "reference"}
+        As :meth:`Pipeline.run`.
 
     Examples
     --------
-    >>> s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))      # doctest: +SKIP
+    >>> s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"), rate=100.0)   # doctest: +SKIP
     >>> est = s.push(t, acc, gyr)          # None until the still start has been seen
     """
 
-    def __init__(self, pipeline):
+    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto"):
         self.pipeline = pipeline
+        self.rate = rate
+        self.engine = engine
         reasons = []
-        if pipeline.orientation.name != "ins":
-            reasons.append(f"orientation {pipeline.orientation.name!r} (live: orientation ins)")
-        if pipeline.detector.name != "dgp":
-            reasons.append(f"detector {pipeline.detector.name!r} looks ahead or dates switches back (live: dgp)")
+        if not pipeline.orientation.carried_by_filter:
+            reasons.append(f"orientation {pipeline.orientation.name!r} is not carried by the Kalman filter "
+                           "(live: an orientation such as ins)")
+        det = pipeline.detector
+        if not (det.causal and hasattr(det, "begin") and hasattr(det, "step")):
+            reasons.append(f"detector {det.name!r} looks ahead or dates switches back (live: a causal detector "
+                           "such as dgp)")
         for c in pipeline.corrections:
-            if c.role not in ("kalman", "heading"):
+            if not (isinstance(c, KalmanCorrection) and c.causal):
                 reasons.append(f"correction {c.name!r} corrects a swing after it ends")
-        if not any(c.role == "kalman" for c in pipeline.corrections):
+        if not pipeline.filter_corrections:
             reasons.append("no Kalman-filter correction")
         if pipeline.analysis:
             reasons.append("analysis plug-ins run on whole recordings")
+        if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
+            reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
         if reasons:
             raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
         self.init = dict(pipeline.init)
@@ -90,63 +102,60 @@ class Stream:
         return self._step(float(t), acc, gyr, mag, dist)
 
     def _start(self) -> None:
-        from .pipeline import _clone, _run_kalman_setup
-
         b = self._buffer
         t = np.array([s[0] for s in b])
-        t0 = t[0]
-        window = t <= t0 + self.init["duration"]
-        self._n_init = int(window.sum())
-        gyr = np.array([s[2] for s in b[: self._n_init]])
+        window = t <= t[0] + self.init["duration"]
+        self._n_init = n = int(window.sum())
+        gyr = np.array([s[2] for s in b[:n]])
         if np.linalg.norm(gyr, axis=1).max() > self.init["max_gyr"]:
             raise RecordingError(
                 f"the stream did not start still: |ω| exceeds init.max_gyr = {self.init['max_gyr']} rad/s within "
                 f"the first {self.init['duration']} s; start it with the foot at rest"
             )
-        acc = np.array([s[1] for s in b[: self._n_init]])
-        use_mag = b[0][3] is not None
-        mag = np.array([s[3] for s in b[: self._n_init]]) if use_mag else None
+        acc = np.array([s[1] for s in b[:n]])
+        mag = np.array([s[3] for s in b[:n]]) if b[0][3] is not None else None
+        dist = np.array([s[4] for s in b[:n]]) if b[0][4] is not None else None
         q0 = fqa(acc.mean(axis=0)[None, :], None if mag is None else mag.mean(axis=0)[None, :])[0]
-        rate = 1.0 / float(np.median(np.diff(t[: self._n_init])))
-        self._dgp = _clone(self.pipeline.detector)
-        self._dgp.begin(rate)
-        dist = np.array([s[4] if s[4] is not None else np.zeros(0) for s in b[: self._n_init]], dtype=float)
-        corrections = [_clone(c) for c in self.pipeline.corrections]
-        # the batch order: Kalman corrections, then the heading reduction
-        measurements = [c for c in corrections if c.role == "kalman"] + [c for c in corrections if c.role == "heading"]
-        k_sensors = next((m.k for m in measurements if m.name == "height_distance"), 0)
-        dist = dist[:, :k_sensors] if dist.ndim == 2 and dist.shape[1] >= k_sensors else np.zeros((len(dist), 0))
-        if k_sensors and dist.shape[1] < k_sensors:
-            raise RecordingError(f"height_distance needs {k_sensors} distance readings per sample")
-        self._setup = _run_kalman_setup(self.pipeline.orientation, measurements, dist, self.pipeline.gravity, q0)
+        rate = self.rate
+        if rate is None:
+            rate = 1.0 / float(np.median(np.diff(t[:n])))
+            warnings.warn(f"Stream: no rate given; using {rate:.2f} Hz measured over the still start (a batch run "
+                          "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
+                          FootzooWarning, stacklevel=3)
+        self._detector = self.pipeline.detector.clone()
+        self._detector.begin(rate)
+        self._corrections = [c.clone() for c in self.pipeline.filter_corrections]
+        samples = Samples(t[:n], acc, gyr, mag, dist, np.ones(n, dtype=bool))
+        self._engine = self.pipeline.kalman_engine(self._corrections, samples, self.engine)
+        nav0 = np.zeros(16)
+        nav0[:4] = q0
+        self._state = self._engine.start(nav0)
         self._ready = True
         self._prev = None
-        for sample in b[: self._n_init]:
+        for sample in b[:n]:
             self._step(*sample)
 
     def _step(self, t, acc, gyr, mag, dist) -> dict[str, Any]:
-        from .filters.eskf_fast import eskf_kernel
-
         self.k += 1
-        stance = bool(self._dgp.step(np.array([t]), acc[None, :], gyr[None, :])[-1][0])
-        s = self._setup
+        stance = bool(self._detector.step(np.array([t]), acc[None, :], gyr[None, :])[0])
         in_init = self.k < self._n_init
-        row = np.full((1, s["k_sensors"]), np.nan) if dist is None else dist[None, : s["k_sensors"]]
-        valid = np.isfinite(row) & (row <= s["max_range"])
+        sample = (t, acc, gyr, mag, dist, stance, in_init)
         if self._prev is None:
-            self._prev = (t, acc, gyr, stance, row, valid, in_init)
-            return self._emit({"t": t, "quat": s["nav"][:4].copy(), "pos": np.zeros(3), "vel": np.zeros(3),
+            self._prev = sample
+            nav = self._state["nav"] if isinstance(self._state, dict) else self._state.nav
+            return self._emit({"t": t, "quat": nav[:4].copy(), "pos": np.zeros(3), "vel": np.zeros(3),
                                "stance": stance})
-        pt, pa, pg, ps, prow, pvalid, pinit = self._prev
-        res = eskf_kernel(
-            np.array([pt, t]), np.vstack([pa, acc]), np.vstack([pg, gyr]), np.array([ps, stance]),
-            s["ext"], s["use_ext"], s["idx"], s["n"], s["q"], s["gravity"], s["order"],
-            *s["par"], np.vstack([prow, row]).astype(float), np.vstack([pvalid, valid]),
-            np.array([pinit, in_init]), s["init_dist"], s["init_valid"], s["r_d"], s["n_d"], *s["dist_par"],
-            s["nav"], s["P"], s["scal"], self.k - 1,
-        )
-        self._prev = (t, acc, gyr, stance, row, valid, in_init)
-        return self._emit({"t": t, "quat": res[0][1], "pos": res[2][1], "vel": res[1][1], "stance": stance})
+        pair = list(zip(self._prev, sample, strict=True))
+        self._prev = sample
+        ts, accs, gyrs = np.array(pair[0]), np.vstack(pair[1]), np.vstack(pair[2])
+        mags = None if mag is None else np.vstack(pair[3])
+        dists = None if dist is None else np.vstack(pair[4])
+        chunk = Samples(ts, accs, gyrs, mags, dists, np.array(pair[6], dtype=bool))
+        data = [np.ascontiguousarray(c.sample_data(chunk), dtype=float) for c in self._corrections]
+        out = self._engine.advance(self._state, ts, accs, gyrs, np.array(pair[5], dtype=bool), None, data,
+                                   self.k - 1, covariance=False)
+        return self._emit({"t": t, "quat": out["quat"][1], "pos": out["pos"][1], "vel": out["vel"][1],
+                           "stance": stance})
 
     def _emit(self, est: dict[str, Any]) -> dict[str, Any]:
         if self.log is not None:
@@ -154,7 +163,13 @@ class Stream:
         return est
 
     def run(self, rec) -> dict[str, np.ndarray]:
-        """Push a whole recording sample by sample; every sample's estimate (for tests and latency)."""
+        """Push a whole recording sample by sample; every sample's estimate (for tests and latency).
+
+        Uses the recording's rate (:attr:`Recording.rate`) when the stream was made without one, as
+        the batch run does.
+        """
+        if self.rate is None and not self._ready:
+            self.rate = rec.rate
         self.log = []
         for k in range(rec.n):
             self.push(rec.t[k], rec.acc[k], rec.gyr[k], None if rec.mag is None else rec.mag[k],

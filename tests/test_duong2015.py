@@ -82,8 +82,8 @@ def test_calibration_recovers_the_height_relevant_mounting_and_helps_the_9_state
     true_r, true_n = np.array(TABLE1_POSITIONS), np.array(TABLE1_DIRECTIONS)
     off_r = true_r + np.array([[0.004, 0.0, 0.003], [-0.003, 0.0, -0.003]])
     off_n = quat_rotate(quat_from_euler(0.0, np.radians(3.0), 0.0), true_n)
-    base = {"orientation": {"type": "ins", "attitude_noise": 1.7e-6, "velocity_noise": 8.3e-5,
-                            "initial_attitude_std": 0.063}, "detector": {"type": "windowed"}}
+    base = {"orientation": {"type": "ins"}, "detector": {"type": "windowed"},
+            "navigation": {"attitude_noise": 1.7e-6, "velocity_noise": 8.3e-5, "initial_attitude_std": 0.063}}
 
     def run(positions, directions, calibrate, **kw):
         corr = {"type": "height_distance", "positions": np.asarray(positions).tolist(),

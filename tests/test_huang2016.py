@@ -102,17 +102,17 @@ def test_fpa_and_stride_length_in_the_nine_treadmill_conditions(speed, gait, foo
            "corrections": [{"type": "zvu_dedrift"}],
            "analysis": [{"type": "huang_fpa", "calibration": str(foot_calibration)}]}
     steps = Pipeline.from_dict(cfg).run(rec).steps
-    est = np.degrees(steps["fpa"].to_numpy())
+    est = np.degrees(steps["fpa_rad"].to_numpy())
     err = est[np.isfinite(est)] - fpa
     assert err.size >= 38
     # measured: mean error 0.04-0.06°, RMS below 0.1° in all nine conditions
     assert abs(err.mean()) <= 0.2 and np.sqrt(np.mean(err**2)) <= 1.0
     # stride lengths within 1 % (measured: below 0.35 %), first and last stride excluded (standing)
-    sl = steps["stride_length"].to_numpy()[1:-1]
+    sl = steps["stride_length_m"].to_numpy()[1:-1]
     assert np.all(np.abs(sl - length) / length < 0.01)
     # stride time, cadence and speed follow
-    np.testing.assert_allclose(steps["stride_time"].to_numpy()[1:-1], cycle, atol=0.02)
-    np.testing.assert_allclose(steps["speed"].to_numpy()[1:-1], length / cycle, rtol=0.02)
+    np.testing.assert_allclose(steps["stride_time_s"].to_numpy()[1:-1], cycle, atol=0.02)
+    np.testing.assert_allclose(steps["speed_m_s"].to_numpy()[1:-1], length / cycle, rtol=0.02)
 
 
 @pytest.mark.parametrize("foot", ["left", "right"])
@@ -128,9 +128,9 @@ def test_gaitmap_stride_length_and_fpa_against_motion_capture(foot):
     m = match_strides(steps, ref)
     straight = m[~m["turn"]]
     assert len(straight) == int((~ref["turn"]).sum())
-    sl_err = straight["est_stride_length"] - straight["stride_length"]
+    sl_err = straight["est_stride_length_m"] - straight["stride_length_m"]
     assert np.sqrt(np.mean(sl_err**2)) < 0.06  # measured 0.043 m (left), 0.046 m (right)
-    fpa_err = np.degrees(straight["est_fpa"] - straight["fpa"])
+    fpa_err = np.degrees(straight["est_fpa_rad"] - straight["fpa_rad"])
     # the sensor's x axis (gaitmap's foot frame) is turned 9-11° toe-out from the heel->toe markers;
     # after removing that constant offset (as Huang et al. did) the RMS is 1.6° (left) and 2.9° (right)
     assert 5.0 < fpa_err.mean() < 14.0

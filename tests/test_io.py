@@ -76,8 +76,8 @@ def test_gaitmap_feet_turn_like_the_markers(foot):
     rec = load(folder / "imu_sample.csv", foot=foot)
     res = Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
     m = match_strides(res.steps, reference_strides(folder, foot))
-    ref_turn = np.unwrap(m["heading"].to_numpy())  # lab frame, z up: counter-clockwise positive
-    est_turn = np.unwrap(m["est_heading"].to_numpy())  # NED: clockwise seen from above positive
+    ref_turn = np.unwrap(m["heading_rad"].to_numpy())  # lab frame, z up: counter-clockwise positive
+    est_turn = np.unwrap(m["est_heading_rad"].to_numpy())  # NED: clockwise seen from above positive
     assert abs(ref_turn[-1] - ref_turn[0]) > np.radians(150)
     assert np.sign(est_turn[-1] - est_turn[0]) == -np.sign(ref_turn[-1] - ref_turn[0])
 

@@ -37,9 +37,10 @@ def test_result_carries_config_and_versions(walk_result):
     assert walk_result.config["orientation"]["static_gain"] == 1.05
     assert {"footzoo", "numpy", "pandas"} <= set(walk_result.versions)
     steps = walk_result.steps
-    assert {"start", "end", "stride_length", "heading"} <= set(steps.columns)
-    assert (steps["end"] > steps["start"]).all()
-    assert steps["stride_length"].between(0.3, 2.0).all()
+    assert {"start_s", "to_s", "end_s", "stride_length_m", "heading_rad"} <= set(steps.columns)
+    assert (steps["end_s"] > steps["to_s"]).all()
+    assert (steps["to_s"].iloc[1:] > steps["start_s"].iloc[1:]).all()
+    assert steps["stride_length_m"].between(0.3, 2.0).all()
 
 
 def test_pyshoe_trial_matches_the_published_best():

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import textwrap
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -53,8 +54,9 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     table.to_csv(out / "results.csv", index=False)
     try:
         table.to_parquet(out / "results.parquet", index=False)
-    except ImportError:  # pyarrow not installed: CSV only
-        pass
+    except ImportError:  # pyarrow not installed: CSV only, and say so
+        warnings.warn("pyarrow is not installed: wrote results.csv but not results.parquet "
+                      "(pip install 'footzoo[parquet]' or pyarrow to get it)", stacklevel=2)
     md, tex = [], []
     for f in ["base", *factors]:
         s = summarise(table, f)

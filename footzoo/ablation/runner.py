@@ -28,8 +28,8 @@ def _metrics(rec, res, metric_names: list[str] | None) -> dict[str, float]:
         sd = step_detection(res.stance, truth.stance, rec.t)
         m["gait_phase_error_rate"] = sd["error_rate"]
         m["step_count_error"] = float(sd["step_count_error"])
-    if "fpa" in res.steps:
-        fpa = res.steps["fpa"].dropna()
+    if "fpa_rad" in res.steps:
+        fpa = res.steps["fpa_rad"].dropna()
         if len(fpa):
             m["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
     if metric_names:

@@ -14,8 +14,7 @@ from typing import Any
 import yaml
 
 from ..config import load_yaml
-from ..errors import ConfigError
-from ..registry import did_you_mean
+from ..errors import ConfigError, did_you_mean
 
 STUDY_KEYS = {
     "name": "study name",
@@ -44,7 +43,7 @@ class RecordingSpec:
         if self.path is not None:
             digest = hashlib.sha256(Path(self.path).read_bytes()).hexdigest()
             return json.dumps({"file": digest, "format": self.format, "options": self.options}, sort_keys=True)
-        from .. import __version__
+        from .._version import __version__
 
         return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": __version__}, sort_keys=True,
                           default=str)

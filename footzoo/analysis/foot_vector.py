@@ -52,7 +52,8 @@ class FootVector:
         """Read a file written by :meth:`save`."""
         p = Path(path)
         if not p.exists():
-            raise ConfigError(f"foot-vector calibration {str(p)!r} does not exist; create it with footzoo calibrate")
+            raise ConfigError(f"foot-vector calibration {str(p)!r} does not exist; create it with "
+                              "footzoo calibrate --data CALIB_RECORDING --out foot.yaml")
         data = yaml.safe_load(p.read_text()) or {}
         if "foot_vector" not in data:
             raise ConfigError(f"{p}: no 'foot_vector' entry; was it written by footzoo calibrate?")

@@ -7,13 +7,14 @@ import pandas as pd
 
 from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
-from ..metrics import intervals
-from ..registry import Plugin, check_positive, register
+from ..metrics import intervals, nearest_index
+from ..plugin import Analysis
+from ..registry import check_positive, register
 from .foot_vector import FootVector
 
 
 @register
-class HuangFPA(Plugin):
+class HuangFPA(Analysis):
     """Foot progression angle per step from a foot vector and a filtered heading vector.
 
     Huang et al. 2016, IEEE TBME, Sec. II-C–E: the foot vector ``f`` fixed in
@@ -53,7 +54,6 @@ class HuangFPA(Plugin):
         Sample index of each heel strike (stance onset).
     """
 
-    kind = "analysis"
     name = "huang_fpa"
     paper = "Huang et al. 2016, IEEE TBME, Sec. II-C to II-E, eqs. 11-16"
     units = {"alpha": "1", "window": "fraction of stance", "stance_fraction": "fraction of stride",
@@ -125,8 +125,16 @@ class HuangFPA(Plugin):
         return self
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
-        """Add ``fpa`` (rad) to the step table: the FPA of the stance that ends each stride."""
+        """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
+
+        That stance is the one whose onset is nearest to the stride's initial
+        contact ``end_s`` (the detector's onset follows the contact by a fraction
+        of the stance; the other onsets are a stride away).
+        """
         out = steps.copy()
-        by_onset = dict(zip(t[self.heel_strikes_].tolist(), self.fpa_.tolist(), strict=True))
-        out["fpa"] = [by_onset.get(end, np.nan) for end in out["end"].tolist()]
+        onsets = t[self.heel_strikes_]
+        if len(onsets) == 0:
+            out["fpa_rad"] = np.nan
+            return out
+        out["fpa_rad"] = self.fpa_[nearest_index(onsets, out["end_s"].to_numpy(dtype=float))]
         return out

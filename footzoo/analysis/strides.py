@@ -1,4 +1,7 @@
-"""Stride segmentation and per-stride parameters from the stance mask and the trajectory."""
+"""Strides and their parameters from the stance mask, the gait events and the trajectory.
+
+Column names carry their unit (``_s``, ``_m``, ``_m_s``, ``_rad``, ``_steps_min``).
+"""
 
 from __future__ import annotations
 
@@ -6,46 +9,105 @@ import numpy as np
 import pandas as pd
 
 from ..metrics import intervals
+from .gait_events import detect_gait_events, segment_argext
 
+#: Columns of :func:`segment_steps`, units in the names.
 STEP_COLUMNS = [
-    "start", "end", "stride_time", "cadence", "stride_length", "speed", "heading",
-    "start_n", "start_e", "end_n", "end_e", "max_clearance",
+    "start_s", "to_s", "end_s", "stride_time_s", "stance_time_s", "swing_time_s", "cadence_steps_min",
+    "stride_length_m", "speed_m_s", "heading_rad", "start_n_m", "start_e_m", "end_n_m", "end_e_m",
+    "max_clearance_m", "events_from_rate",
 ]
 
 
-def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
-    """One row per stride: from one stance onset (heel strike) to the next.
+def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float = 0.1) -> np.ndarray:
+    """Stance intervals ``(start, stop)`` with the gaps that are not steps closed.
+
+    A gap between two stances is a step when the foot moved at least
+    ``min_stride_length`` (m, horizontal) between the middles of the two stances;
+    otherwise (a shuffle, a stance split by a twitch) the two stances are joined.
+    """
+    st = intervals(stance)
+    if len(st) < 2:
+        return st
+    for _ in range(3):  # joining moves the middles; repeat until stable (usually once)
+        mid = (st[:, 0] + st[:, 1] - 1) // 2
+        d = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T)
+        keep = d >= min_stride_length
+        if keep.all():
+            break
+        st = np.column_stack([np.concatenate([st[:1, 0], st[1:, 0][keep]]),
+                              np.concatenate([st[:-1, 1][keep], st[-1:, 1]])])
+    return st
+
+
+def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.ndarray | None = None,
+                  min_stride_length: float = 0.1, max_stance_time: float = 2.0) -> pd.DataFrame:
+    """One row per stride: the stance from its initial contact, its toe-off, the swing to the next contact.
+
+    Strides start at the first real step: the standing before the first toe-off
+    is not a stride, and gaps between stances that do not move the foot
+    (shuffles, split stances; see :func:`real_stances`) are not steps. The
+    events come from the sagittal angular rate (:mod:`footzoo.analysis.gait_events`)
+    when ``gyr`` is given, otherwise from the stance edges. Vectorised: no Python
+    loop over samples or strides.
 
     Parameters
     ----------
     t : (N,) ndarray
         Time (s).
     stance : (N,) bool ndarray
-        Stance flag.
+        Stance flag of the detector.
     pos : (N, 3) ndarray
         Position in NED (m).
+    gyr : (N, 3) ndarray, optional
+        Angular rate in FRD (rad/s) for the gait events.
+    min_stride_length : float
+        Shortest displacement (m) between two stances that counts as a step.
+    max_stance_time : float
+        A stance longer than this (s) is a pause: the stride after it has no
+        start (``start_s`` and the times that need it are NaN), like the first.
 
     Returns
     -------
     DataFrame
-        ``start``, ``end`` (s, the two stance onsets), ``stride_time`` (s),
-        ``cadence`` (steps/min, two steps per stride of one foot),
-        ``stride_length`` (m, horizontal distance between the middles of the two
-        stances), ``speed`` (m/s), ``heading`` (rad, direction of that
-        displacement, north = 0, east = +π/2), start/end north and east (m),
-        ``max_clearance`` (m, highest point of the swing above the first stance,
-        up positive).
+        Row i is the gait cycle around swing i: ``start_s`` (IC beginning the
+        stance, s; NaN after standing), ``to_s`` (toe-off, s), ``end_s`` (IC ending
+        the swing, s), ``stride_time_s`` = end − start, ``stance_time_s`` = TO −
+        start, ``swing_time_s`` = end − TO, ``cadence_steps_min`` (two steps per
+        stride of one foot: 120 / stride time), ``stride_length_m`` (horizontal
+        displacement between the middles of the stances before and after the
+        swing), ``speed_m_s`` (stride length / stride time), ``heading_rad``
+        (direction of that displacement, north = 0, east = +π/2), ``start_n_m``,
+        ``start_e_m``, ``end_n_m``, ``end_e_m`` (the two mid-stance positions, m),
+        ``max_clearance_m`` (highest point of the swing above the first
+        mid-stance, up positive) and ``events_from_rate`` (False where the events
+        fell back to the stance edges).
     """
-    st = intervals(stance)
-    rows = []
-    for (a0, b0), (a1, b1) in zip(st[:-1], st[1:], strict=True):
-        m0, m1 = (a0 + b0 - 1) // 2, (a1 + b1 - 1) // 2
-        d = pos[m1, :2] - pos[m0, :2]
-        length = float(np.hypot(*d))
-        stride_time = float(t[a1] - t[a0])
-        rows.append([
-            t[a0], t[a1], stride_time, 120.0 / stride_time, length, length / stride_time,
-            float(np.arctan2(d[1], d[0])), pos[m0, 0], pos[m0, 1], pos[m1, 0], pos[m1, 1],
-            float(np.max(pos[m0, 2] - pos[b0 - 1:a1 + 1, 2])),
-        ])
-    return pd.DataFrame(rows, columns=STEP_COLUMNS)
+    t = np.asarray(t, dtype=float)
+    pos = np.asarray(pos, dtype=float)
+    st = real_stances(stance, pos, min_stride_length)
+    if len(st) < 2:
+        return pd.DataFrame({c: pd.Series(dtype=bool if c == "events_from_rate" else float) for c in STEP_COLUMNS})
+    n = len(t)
+    a, b = st[:, 0], st[:, 1]
+    mid = (a + b - 1) // 2
+    if gyr is not None:
+        ev = detect_gait_events(t, gyr, st)
+        to, ic, from_rate = ev.to, ev.ic, ev.from_rate
+    else:
+        to, ic, from_rate = t[np.minimum(b[:-1], n - 1)], t[a[1:]], np.zeros(len(st) - 1, bool)
+    start = np.concatenate([[np.nan], ic[:-1]])
+    stance_time = to - start
+    start[stance_time > max_stance_time] = np.nan
+    stride_time = ic - start
+    d = pos[mid[1:], :2] - pos[mid[:-1], :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    top = segment_argext(-pos[:, 2], np.maximum(b[:-1] - 1, 0), np.minimum(a[1:] + 1, n), largest=True)
+    return pd.DataFrame({
+        "start_s": start, "to_s": to, "end_s": ic, "stride_time_s": stride_time, "stance_time_s": to - start,
+        "swing_time_s": ic - to, "cadence_steps_min": 120.0 / stride_time, "stride_length_m": length,
+        "speed_m_s": length / stride_time, "heading_rad": np.arctan2(d[:, 1], d[:, 0]),
+        "start_n_m": pos[mid[:-1], 0], "start_e_m": pos[mid[:-1], 1], "end_n_m": pos[mid[1:], 0],
+        "end_e_m": pos[mid[1:], 1], "max_clearance_m": pos[mid[:-1], 2] - pos[top, 2],
+        "events_from_rate": from_rate,
+    }, columns=STEP_COLUMNS)

@@ -4,13 +4,37 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.eskf import Layout
-from ..filters.navigation import NavState
-from ..registry import Plugin, check_positive, register
+from ..filters.measurement import GYRO_BIAS, VEL, MeasurementModel, StateBlock, measurement_function
+from ..plugin import KalmanCorrection, Samples
+from ..registry import check_positive, register
+
+
+@measurement_function
+def zero_velocity_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[1]``, ``δω = ω̂ − 0`` (eq. 30).
+
+    ``par`` = (velocity σ m/s, zero-rate on/off, rate σ rad/s).
+    """
+    if not stance:
+        return m
+    vel = idx[VEL]
+    for i in range(3):
+        H[m, vel + i] = 1.0
+        z[m] = nav[7 + i]
+        R[m] = par[0] * par[0]
+        m += 1
+    if par[1] != 0.0:
+        gb = idx[GYRO_BIAS]
+        for i in range(3):
+            H[m, gb + i] = 1.0
+            z[m] = w[i]
+            R[m] = par[2] * par[2]
+            m += 1
+    return m
 
 
 @register
-class EKFZUPT(Plugin):
+class EKFZUPT(KalmanCorrection):
     """Error-state EKF zero-velocity update with optional bias states and zero-rate measurement.
 
     Nguyen & La 2016, IEEE THMS 46(6), Sec. IV, eqs. 28–52 and Algorithm 2: in
@@ -43,9 +67,8 @@ class EKFZUPT(Plugin):
         Bias random-walk variance growth ((rad/s)²/s, (m/s²)²/s).
     """
 
-    kind = "correction"
     name = "ekf_zupt"
-    role = "kalman"
+    observes = ("velocity", "angular_rate")
     paper = "Nguyen & La 2016, IEEE THMS 46(6), eqs. 28-52, Algorithm 2, Sec. VI"
     units = {"velocity_std": "m/s", "rate_std": "rad/s", "gyro_bias_std": "rad/s", "accel_bias_std": "m/s^2",
              "gyro_bias_noise": "(rad/s)^2/s", "accel_bias_noise": "(m/s^2)^2/s"}
@@ -74,36 +97,25 @@ class EKFZUPT(Plugin):
         self.gyro_bias_noise = check_positive("gyro_bias_noise", gyro_bias_noise, allow_zero=True)
         self.accel_bias_noise = check_positive("accel_bias_noise", accel_bias_noise, allow_zero=True)
 
-    def blocks(self) -> list[tuple[str, int, float, float]]:
-        """Core blocks this correction enables: (name, size, initial variance, variance growth per s)."""
+    def state_blocks(self) -> list[StateBlock]:
+        """The core bias blocks this correction switches on (initial variance, variance growth per s)."""
         out = []
         if self.gyro_bias:
-            out.append(("gyro_bias", 3, self.gyro_bias_std**2, self.gyro_bias_noise))
+            out.append(StateBlock("gyro_bias", 3, self.gyro_bias_std**2, self.gyro_bias_noise))
         if self.accel_bias:
-            out.append(("acc_bias", 3, self.accel_bias_std**2, self.accel_bias_noise))
+            out.append(StateBlock("acc_bias", 3, self.accel_bias_std**2, self.accel_bias_noise))
         return out
 
-    def begin(self, n: int, layout: Layout) -> None:
-        """Prepare the measurement matrices."""
-        self._h_vel = np.zeros((3, layout.n))
-        self._h_vel[:, layout["vel"]] = np.eye(3)
-        self._r_vel = np.eye(3) * self.velocity_std**2
-        if self.zero_rate:
-            self._h_rate = np.zeros((3, layout.n))
-            self._h_rate[:, layout["gyro_bias"]] = np.eye(3)
-            self._r_rate = np.eye(3) * self.rate_std**2
+    def requires_attitude_state(self) -> bool:
+        """The gyro bias and the zero-rate measurement act through the attitude error."""
+        return self.gyro_bias or self.zero_rate
 
-    def measure(self, nav: NavState) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """In stance: ``δv = v − 0`` (eq. 29) and ``δω = ω − 0`` (eq. 30)."""
-        if not nav.stance:
-            return []
-        rows = [(nav.v.copy(), self._h_vel, self._r_vel)]
-        if self.zero_rate:
-            rows.append((nav.w.copy(), self._h_rate, self._r_rate))
-        return rows
-
-    def after(self, nav: NavState) -> None:
-        """Nothing to remember."""
+    def model(self, samples: Samples) -> MeasurementModel:
+        """Velocity rows (and angular-rate rows with ``zero_rate``) in every stance sample."""
+        return MeasurementModel(
+            measure=zero_velocity_measure, max_rows=6 if self.zero_rate else 3,
+            par=np.array([self.velocity_std, 1.0 if self.zero_rate else 0.0, self.rate_std]),
+        )
 
 
 @register

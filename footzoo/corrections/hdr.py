@@ -7,10 +7,10 @@ import math
 import numpy as np
 
 from ..conventions import quat_yaw, wrap_angle
-from ..filters.eskf import Layout
-from ..filters.navigation import NavState
+from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
 from ..metrics import intervals
-from ..registry import Plugin, check_positive, register
+from ..plugin import AccelerationCorrection, KalmanCorrection, Samples
+from ..registry import check_positive, register
 
 
 def heading_bias(yaw: float, previous: list[float], threshold: float) -> float | None:
@@ -26,8 +26,40 @@ def heading_bias(yaw: float, previous: list[float], threshold: float) -> float |
     return d if abs(d) <= threshold else None
 
 
+@measurement_function
+def heading_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """In stance: δψ of the current yaw against the two previous stances' final yaws (eqs. 23–24, 28).
+
+    ``par`` = (th_γ rad, σ_ψ rad); ``mem`` = (was stance, last yaw, stance ends seen, γ^{T_{i−1}},
+    γ^{T_{i−2}}).
+    """
+    if not stance or mem[2] < 2:
+        return m
+    a, b = mem[3], mem[4]
+    mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
+    d = yaw_of(nav) - mean
+    d = -((-d + math.pi) % (2 * math.pi) - math.pi)  # wrap to (-π, π], as conventions.wrap_angle
+    if abs(d) > par[0]:
+        return m
+    H[m, idx[ATT] + 2] = 1.0
+    z[m] = d
+    R[m] = par[1] * par[1]
+    return m + 1
+
+
+@after_function
+def heading_after(k, nav, stance, idx, par, mem):
+    """Record the final heading of each stance (γ^{T_i}), after the update."""
+    if mem[0] != 0.0 and not stance and k > 1:
+        mem[4] = mem[3]
+        mem[3] = mem[1]
+        mem[2] += 1.0
+    mem[0] = 1.0 if stance else 0.0
+    mem[1] = yaw_of(nav)
+
+
 @register
-class HDR(Plugin):
+class HDR(AccelerationCorrection, KalmanCorrection):
     """Heuristic heading reduction: people mostly walk straight.
 
     Nguyen & La 2016, IEEE THMS 46(6), Sec. III-C, eqs. 23–27. The heading bias
@@ -58,9 +90,8 @@ class HDR(Plugin):
         δψ applied after each stance (rad; NaN where rejected), post mode.
     """
 
-    kind = "correction"
     name = "hdr"
-    role = "heading"
+    observes = ("heading",)
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-C, eqs. 23-27"
     units = {"threshold": "rad", "yaw_std": "rad"}
 
@@ -91,29 +122,12 @@ class HDR(Plugin):
         return out
 
     # ------------------------------------------------------------- with the EKF: eq. 28
-    def blocks(self) -> list[tuple[str, int, float, float]]:
-        """No extra states."""
-        return []
+    def requires_attitude_state(self) -> bool:
+        """δψ observes the attitude error's vertical component."""
+        return True
 
-    def begin(self, n: int, layout: Layout) -> None:
-        """Reset the history of stance-end headings."""
-        self._ends: list[float] = []
-        self._was_stance = True
-        self._last_yaw = 0.0
-        self._h = np.zeros((1, layout.n))
-        self._h[0, layout["att"].start + 2] = 1.0
-        self._r = np.array([[self.yaw_std**2]])
-
-    def measure(self, nav: NavState) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """In stance: δψ of the current yaw against the two previous stances (eqs. 23–24, 28)."""
-        if not nav.stance:
-            return []
-        d = heading_bias(nav.yaw(), self._ends, self.threshold)
-        return [] if d is None else [(np.array([d]), self._h, self._r)]
-
-    def after(self, nav: NavState) -> None:
-        """Record the final heading of each stance (T_i)."""
-        if self._was_stance and not nav.stance and nav.k > 1:
-            self._ends.append(self._last_yaw)
-        self._was_stance = nav.stance
-        self._last_yaw = nav.yaw()
+    def model(self, samples: Samples) -> MeasurementModel:
+        """One heading row in stance samples once two stances have ended."""
+        return MeasurementModel(measure=heading_measure, after=heading_after, max_rows=1,
+                                par=np.array([self.threshold, self.yaw_std]),
+                                mem=np.array([1.0, 0.0, 0.0, 0.0, 0.0]))

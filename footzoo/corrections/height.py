@@ -23,15 +23,16 @@ origin on the floor).
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from ..errors import ConfigError, RecordingError
-from ..filters.eskf import Layout, skew
-from ..filters.navigation import NavState
-from ..registry import Plugin, check_positive, register
+from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
+from ..plugin import KalmanCorrection, Samples
+from ..registry import check_positive, register
 
 #: Duong & Suh Table 1 in their IMU frame (x toward the floor), mapped to FRD: (x, y, z)_DS -> (y, z, x).
 TABLE1_POSITIONS = [[0.080, 0.0, -0.008], [-0.062, 0.0, -0.006]]
@@ -49,8 +50,104 @@ def _vectors(name: str, value, count: int | None = None) -> np.ndarray:
     return arr
 
 
+@measurement_function
+def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """Rows of eqs. 14–15 for each valid range reading, with eqs. 18 and 20 when calibrating.
+
+    ``par`` = (σ_range m, calibrate, σ_constraint, z_AB m, σ_AB m, k sensors, n_init, the initial
+    still period's readings (n_init × k, m) and their validity (n_init × k)); ``mem`` = (floor
+    height m, floor known, r̂ (k × 3, m), n̂ (k × 3)); ``data`` = (in the still start, the k
+    readings m, their validity); ``idx`` after the core: the offsets of r̄_j then n̄_j.
+    """
+    ks = int(par[5])
+    n_init = int(par[6])
+    calibrate = par[1] != 0.0
+    w_, x_, y_, z_ = nav[0], nav[1], nav[2], nav[3]
+    # third row of C(q): the height component of a body vector in NED
+    c0 = 2.0 * (x_ * z_ - w_ * y_)
+    c1 = 2.0 * (y_ * z_ + w_ * x_)
+    c2 = 1.0 - 2.0 * (x_ * x_ + y_ * y_)
+    if mem[1] == 0.0:
+        if data[0] != 0.0:
+            return m
+        total = 0.0
+        count = 0
+        for j in range(ks):
+            for s in range(n_init):
+                if par[7 + n_init * ks + s * ks + j] != 0.0:
+                    reading = par[7 + s * ks + j]
+                    r = 2 + 3 * j
+                    nn = 2 + 3 * ks + 3 * j
+                    total += (c0 * (mem[r] + mem[nn] * reading) + c1 * (mem[r + 1] + mem[nn + 1] * reading)
+                              + c2 * (mem[r + 2] + mem[nn + 2] * reading))
+                    count += 1
+        mem[0] = total / count
+        mem[1] = 1.0
+    # first two rows of C(q), for the attitude columns
+    a00, a01, a02 = 1 - 2 * (y_ * y_ + z_ * z_), 2 * (x_ * y_ - w_ * z_), 2 * (x_ * z_ + w_ * y_)
+    a10, a11, a12 = 2 * (x_ * y_ + w_ * z_), 1 - 2 * (x_ * x_ + z_ * z_), 2 * (y_ * z_ - w_ * x_)
+    rows = 0
+    for j in range(ks):
+        if data[1 + ks + j] == 0.0:
+            continue
+        reading = data[1 + j]
+        r = 2 + 3 * j
+        nn = 2 + 3 * ks + 3 * j
+        b0 = mem[r] + mem[nn] * reading
+        b1 = mem[r + 1] + mem[nn + 1] * reading
+        b2 = mem[r + 2] + mem[nn + 2] * reading
+        u0 = a00 * b0 + a01 * b1 + a02 * b2
+        u1 = a10 * b0 + a11 * b1 + a12 * b2
+        u2 = c0 * b0 + c1 * b1 + c2 * b2
+        if idx[ATT] >= 0:  # e_zᵀ [u×] δφ
+            H[m, idx[ATT]] = -u1
+            H[m, idx[ATT] + 1] = u0
+        H[m, idx[POS] + 2] = -1.0
+        if calibrate:
+            cr = idx[OWN + j]
+            cn = idx[OWN + ks + j]
+            H[m, cr], H[m, cr + 1], H[m, cr + 2] = c0, c1, c2
+            H[m, cn], H[m, cn + 1], H[m, cn + 2] = reading * c0, reading * c1, reading * c2
+        z[m] = mem[0] - (nav[6] + u2)
+        scale = c0 * mem[nn] + c1 * mem[nn + 1] + c2 * mem[nn + 2]
+        R[m] = (scale * par[0]) ** 2
+        m += 1
+        rows += 1
+    if rows > 0 and calibrate:
+        for j in range(ks):  # eqs. 16-18: n̂ᵀ n̄ = 0
+            cn = idx[OWN + ks + j]
+            nn = 2 + 3 * ks + 3 * j
+            H[m, cn], H[m, cn + 1], H[m, cn + 2] = mem[nn], mem[nn + 1], mem[nn + 2]
+            z[m] = 0.0
+            R[m] = par[2] * par[2]
+            m += 1
+        d0, d1, d2 = mem[2] - mem[5], mem[3] - mem[6], mem[4] - mem[7]  # eqs. 19-20: ‖r_A − r_B‖ = z_AB
+        norm = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        ca, cb = idx[OWN], idx[OWN + 1]
+        H[m, ca], H[m, ca + 1], H[m, ca + 2] = d0 / norm, d1 / norm, d2 / norm
+        H[m, cb], H[m, cb + 1], H[m, cb + 2] = -d0 / norm, -d1 / norm, -d2 / norm
+        z[m] = par[3] - norm
+        R[m] = par[4] * par[4]
+        m += 1
+    return m
+
+
+@feedback_function
+def distance_feedback(dx, idx, par, mem):
+    """Add the calibration errors to the mounting estimates (eq. 1)."""
+    if par[1] == 0.0:
+        return
+    ks = int(par[5])
+    for j in range(ks):
+        cr = idx[OWN + j]
+        cn = idx[OWN + ks + j]
+        for i in range(3):
+            mem[2 + 3 * j + i] += dx[cr + i]
+            mem[2 + 3 * ks + 3 * j + i] += dx[cn + i]
+
+
 @register
-class HeightDistance(Plugin):
+class HeightDistance(KalmanCorrection):
     """Height from downward distance sensors, with optional mounting calibration.
 
     Duong & Suh 2015, Sensors 15, eqs. 1, 9–20 and Table 1. Each valid range
@@ -95,10 +192,9 @@ class HeightDistance(Plugin):
         YAML file written by :func:`save_calibration`; replaces positions and directions.
     """
 
-    kind = "correction"
     name = "height_distance"
-    role = "kalman"
-    needs_recording = True
+    needs_distance = True
+    observes = ("floor_distance",)
     paper = "Duong & Suh 2015, Sensors 15, eqs. 1, 9-20, 24, Table 1"
     units = {"positions": "m", "directions": "1", "baseline": "m", "range_std": "m", "max_range": "m",
              "position_std": "m", "direction_std": "1", "constraint_std": "1", "baseline_std": "m"}
@@ -141,107 +237,52 @@ class HeightDistance(Plugin):
         """Number of sensors."""
         return self._r.shape[0]
 
-    def blocks(self) -> list[tuple[str, int, float, float]]:
+    def state_blocks(self) -> list[StateBlock]:
         """Calibration states r̄_j, n̄_j of each sensor (with ``calibrate``)."""
         if not self.calibrate:
             return []
-        return ([(f"cal_r{j}", 3, self.position_std**2, 0.0) for j in range(self.k)]
-                + [(f"cal_n{j}", 3, self.direction_std**2, 0.0) for j in range(self.k)])
+        return ([StateBlock(f"cal_r{j}", 3, self.position_std**2) for j in range(self.k)]
+                + [StateBlock(f"cal_n{j}", 3, self.direction_std**2) for j in range(self.k)])
 
-    def bind(self, dist: np.ndarray | None, t: np.ndarray, init_window: np.ndarray) -> None:
-        """Attach the recording's range columns (m, NaN between samples)."""
-        if dist is None or dist.shape[1] < self.k:
-            have = 0 if dist is None else dist.shape[1]
+    def _readings(self, dist: np.ndarray | None) -> np.ndarray:
+        if dist is None or dist.ndim != 2 or dist.shape[1] < self.k:
+            have = 0 if dist is None or dist.ndim != 2 else dist.shape[1]
             raise RecordingError(
                 f"height_distance needs {self.k} distance-sensor columns (dist_a, dist_b, … in m); the recording has "
                 f"{have}: load a recording with distance sensors or remove height_distance"
             )
-        self._dist = dist[:, : self.k]
-        valid = np.isfinite(self._dist) & (self._dist <= self.max_range)
-        self._valid = valid
-        self._init_window = init_window
-        if not np.any(valid[init_window]):
+        return np.asarray(dist[:, : self.k], dtype=float)
+
+    def sample_data(self, samples: Samples) -> np.ndarray:
+        """Per sample: in the still start (0/1), the k readings (m), their validity (0/1)."""
+        d = self._readings(samples.dist)
+        valid = np.isfinite(d) & (d <= self.max_range)
+        return np.column_stack([np.asarray(samples.init_window, float), np.where(valid, d, 0.0),
+                                valid.astype(float)])
+
+    def model(self, samples: Samples) -> MeasurementModel:
+        """Range rows; the floor height comes from the still start's readings (the sensor starts at height 0)."""
+        d = self._readings(samples.dist)[np.asarray(samples.init_window, bool)]
+        valid = np.isfinite(d) & (d <= self.max_range)
+        if not valid.any():
             raise RecordingError(
                 "height_distance: no valid range reading during the initial still period, so the floor height is "
                 "unknown; check the distance columns' unit (m) and max_range"
             )
-
-    def begin(self, n: int, layout: Layout) -> None:
-        """Reset the floor height (set from the first still samples)."""
-        self._layout = layout
-        self._floor: float | None = None
-
-    def _row(self, nav: NavState, j: int, reading: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        from ..conventions import quat_to_matrix
-
-        c = quat_to_matrix(nav.q)
-        layout = self._layout
-        u = c @ (self._r[j] + self._n[j] * reading)
-        h = np.zeros((1, layout.n))
-        if layout.has("att"):
-            h[0, layout["att"]] = skew(u)[2]
-        h[0, layout["pos"].start + 2] = -1.0
-        if self.calibrate:
-            h[0, layout[f"cal_r{j}"]] = c[2]
-            h[0, layout[f"cal_n{j}"]] = reading * c[2]
-        z = np.array([self._floor - (nav.p[2] + u[2])])
-        scale = (c @ self._n[j])[2]
-        return z, h, np.array([[(scale * self.range_std) ** 2]])
-
-    def measure(self, nav: NavState) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """Rows of eqs. 14–15 for each valid reading, with eqs. 18 and 20 when calibrating."""
-        k = nav.k
-        if self._floor is None:
-            if not self._init_window[k]:
-                self._floor = self._estimate_floor(nav)
-            else:
-                return []
-        rows = [self._row(nav, j, float(self._dist[k, j])) for j in range(self.k) if self._valid[k, j]]
-        if rows and self.calibrate:
-            rows += self._constraints()
-        return rows
-
-    def _estimate_floor(self, nav: NavState) -> float:
-        """Floor height from the initial still period: mean of [Ĉ(r̂ + n̂ z)]_z (the sensor starts at height 0)."""
-        from ..conventions import quat_to_matrix
-
-        c = quat_to_matrix(nav.q)
-        heights = []
-        w = self._init_window
-        for j in range(self.k):
-            z = self._dist[w & self._valid[:, j], j]
-            heights += list((c @ (self._r[j][:, None] + np.outer(self._n[j], z)))[2])
-        return float(np.mean(heights))
-
-    def _constraints(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        layout = self._layout
-        rows = []
-        for j in range(self.k):  # eqs. 16-18: n̂ᵀ n̄ = 0
-            h = np.zeros((1, layout.n))
-            h[0, layout[f"cal_n{j}"]] = self._n[j]
-            rows.append((np.zeros(1), h, np.array([[self.constraint_std**2]])))
-        d = self._r[0] - self._r[1]  # eqs. 19-20: ‖r_A − r_B‖ = z_AB
-        norm = float(np.linalg.norm(d))
-        h = np.zeros((1, layout.n))
-        h[0, layout["cal_r0"]] = d / norm
-        h[0, layout["cal_r1"]] = -d / norm
-        rows.append((np.array([self.baseline - norm]), h, np.array([[self.baseline_std**2]])))
-        return rows
-
-    def feedback(self, dx: np.ndarray, layout: Layout) -> None:
-        """Add the calibration errors to the mounting estimates (eq. 1)."""
-        if not self.calibrate:
-            return
-        for j in range(self.k):
-            self._r[j] = self._r[j] + dx[layout[f"cal_r{j}"]]
-            self._n[j] = self._n[j] + dx[layout[f"cal_n{j}"]]
-
-    def after(self, nav: NavState) -> None:
-        """Nothing to remember."""
-
-    def calibration_result(self) -> dict[str, list[list[float]]]:
-        """The current mounting estimate (body frame, FRD)."""
-        return {"positions": self._r.tolist(), "directions": self._n.tolist()}
+        n_init = d.shape[0]
+        par = np.concatenate([[self.range_std, 1.0 if self.calibrate else 0.0, self.constraint_std, self.baseline,
+                               self.baseline_std, self.k, n_init], np.where(valid, d, 0.0).ravel(),
+                              valid.astype(float).ravel()])
+        mem = np.concatenate([[0.0, 0.0], self._r.ravel(), self._n.ravel()])
+        k = self.k
+        return MeasurementModel(
+            measure=distance_measure, feedback=distance_feedback, par=par, mem=mem,
+            max_rows=k + (k + 1 if self.calibrate else 0),
+            block_names=[b.name for b in self.state_blocks()],
+            diagnostics=lambda mem: {"distance_calibration": {
+                "positions": mem[2:2 + 3 * k].reshape(k, 3).tolist(),
+                "directions": mem[2 + 3 * k:2 + 6 * k].reshape(k, 3).tolist()}},
+        )
 
 
 def save_calibration(calibration: dict, path: str | Path) -> Path:
@@ -264,8 +305,19 @@ def load_calibration(path: str | Path) -> dict:
     return data
 
 
+@measurement_function
+def flat_floor_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """In stance: the height error ``p̂_z − 0`` (the pipeline starts at the origin); ``par`` = (σ m,)."""
+    if not stance:
+        return m
+    H[m, idx[POS] + 2] = 1.0
+    z[m] = nav[6]
+    R[m] = par[0] * par[0]
+    return m + 1
+
+
 @register
-class HeightFlatFloor(Plugin):
+class HeightFlatFloor(KalmanCorrection):
     """Zero velocity + height updating: the foot is on a flat floor in every stance.
 
     Duong & Suh 2015, Sensors 15, Sec. 5 ("K.F. (zero velocity + height
@@ -279,28 +331,14 @@ class HeightFlatFloor(Plugin):
         Measurement noise of the height (m).
     """
 
-    kind = "correction"
     name = "height_flat_floor"
-    role = "kalman"
+    observes = ("height",)
     paper = "Duong & Suh 2015, Sensors 15, Sec. 5 (zero velocity + height updating)"
     units = {"height_std": "m"}
 
     def __init__(self, height_std: float = 0.001):
         self.height_std = check_positive("height_std", height_std)
 
-    def blocks(self) -> list[tuple[str, int, float, float]]:
-        """No extra states."""
-        return []
-
-    def begin(self, n: int, layout: Layout) -> None:
-        """Build the measurement row (the initial height is 0: the pipeline starts at the origin)."""
-        self._h = np.zeros((1, layout.n))
-        self._h[0, layout["pos"].start + 2] = 1.0
-        self._r = np.array([[self.height_std**2]])
-
-    def measure(self, nav: NavState) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """In stance: the height error ``p̂_z − 0``."""
-        return [(np.array([nav.p[2]]), self._h, self._r)] if nav.stance else []
-
-    def after(self, nav: NavState) -> None:
-        """Nothing to remember."""
+    def model(self, samples: Samples) -> MeasurementModel:
+        """One height row in every stance sample."""
+        return MeasurementModel(measure=flat_floor_measure, max_rows=1, par=np.array([self.height_std]))

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..filters.strapdown import integrate_position
-from ..registry import Plugin, register
+from ..plugin import VelocityCorrection
+from ..registry import register
 
 
 def swing_segments(stance: np.ndarray) -> list[tuple[int, int]]:
@@ -68,7 +69,7 @@ def zvu_dedrift(t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> tuple
 
 
 @register
-class ZVUDedrift(Plugin):
+class ZVUDedrift(VelocityCorrection):
     """Zero-velocity update with linear dedrift of each swing's velocity.
 
     Yun et al. 2012, IEEE TIM 61(7), Sec. II-B, eqs. 5–10: the motion
@@ -88,9 +89,7 @@ class ZVUDedrift(Plugin):
         Estimated acceleration drift ε of each swing (m/s²).
     """
 
-    kind = "correction"
     name = "zvu_dedrift"
-    role = "velocity"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-B, eqs. 5-10"
     units: dict[str, str] = {}
 

@@ -6,12 +6,13 @@ import math
 
 import numpy as np
 
-from ..registry import Plugin, check_positive, register
+from ..plugin import Detector
+from ..registry import check_positive, register
 from .runs import dated_and_online_states
 
 
 @register
-class AngularRateFSM(Plugin):
+class AngularRateFSM(Detector):
     """Two-state STANCE/SWING machine on the angular-rate magnitude |ω|.
 
     Yun et al. 2012, IEEE TIM 61(7), Sec. II-C (Figs. 5–6) and II-D. The machine
@@ -42,7 +43,6 @@ class AngularRateFSM(Plugin):
         Γ_th in samples.
     """
 
-    kind = "detector"
     name = "angular_rate_fsm"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-C/II-D, Figs. 5-6"
     units = {"threshold": "rad/s", "min_duration": "s"}

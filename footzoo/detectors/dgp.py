@@ -8,7 +8,8 @@ import numpy as np
 
 from .._jit import njit
 from ..conventions import GRAVITY
-from ..registry import Plugin, check_positive, register
+from ..plugin import Detector
+from ..registry import check_positive, register
 
 
 def dgp_statistic_state(f: int, n_c: int) -> tuple[np.ndarray, ...]:
@@ -159,7 +160,7 @@ def dgp_kernel(
 
 
 @register
-class DGP(Plugin):
+class DGP(Detector):
     """Dynamic gait phase detection with a threshold learned from each step's swing.
 
     Nguyen & La 2016, IEEE THMS 46(6), Sec. III-A, eqs. 3–15 and Algorithm 1:
@@ -211,8 +212,8 @@ class DGP(Plugin):
         Stance flag (causal: both the same).
     """
 
-    kind = "detector"
     name = "dgp"
+    causal = True
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-A, eqs. 3-15, Algorithm 1"
     units = {"window": "s", "condition_window": "s", "initial_delay": "1", "initial_threshold": "1",
              "reference_rate": "Hz", "min_swing": "s"}
@@ -243,17 +244,21 @@ class DGP(Plugin):
         self._stat_state = dgp_statistic_state(f, self._n_c)
         self._state = dgp_initial_state(self.initial_delay, self.initial_threshold)
 
-    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
-        """Process the next samples (a whole recording, or one live sample) from the carried state."""
+    def _advance(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
         s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
         s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing)
         return s_c, d_g, s_d, max_cd, th, stance
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
+        """Stance of the next samples (one live sample, or a chunk) from the carried state (after :meth:`begin`)."""
+        return self._advance(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
+                             np.ascontiguousarray(gyr, dtype=float))[-1]
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> DGP:
         """Detect stance over a recording (eqs. 3–15)."""
         rate = 1.0 / float(np.median(np.diff(t)))
         self.begin(rate)
-        self.s_c_, self.d_g_, self.s_d_, self.statistic_, self.threshold_, stance = self.step(
+        self.s_c_, self.d_g_, self.s_d_, self.statistic_, self.threshold_, stance = self._advance(
             np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
             np.ascontiguousarray(gyr, dtype=float))
         self.stance_ = stance

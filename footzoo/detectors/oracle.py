@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import RecordingError
-from ..registry import Plugin, register
+from ..plugin import Detector
+from ..registry import register
 
 
 @register
-class Oracle(Plugin):
+class Oracle(Detector):
     """Stance from the recording's ground truth (simulator or dataset labels).
 
     Not from a paper: the upper bound for ablations — how well a pipeline does
@@ -24,7 +25,6 @@ class Oracle(Plugin):
         0 in stance, 1 in swing.
     """
 
-    kind = "detector"
     name = "oracle"
     paper = "none (ground truth, for ablations)"
     needs_truth = True

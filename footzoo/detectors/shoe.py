@@ -8,7 +8,8 @@ import numpy as np
 
 from .._jit import njit
 from ..conventions import GRAVITY
-from ..registry import Plugin, check_positive, register
+from ..plugin import Detector
+from ..registry import check_positive, register
 from .runs import dated_and_online_states
 
 
@@ -43,7 +44,7 @@ def shoe_statistic(acc: np.ndarray, gyr: np.ndarray, window: int, sigma_a: float
 
 
 @register
-class SHOE(Plugin):
+class SHOE(Detector):
     """Stance hypothesis optimal detector (generalised likelihood ratio test).
 
     Skog, Händel, Nilsson & Rantakokko, "Zero-velocity detection — an algorithm
@@ -72,7 +73,6 @@ class SHOE(Plugin):
         Stance flag (the centred window makes it W/2 samples late when live).
     """
 
-    kind = "detector"
     name = "shoe"
     paper = "Skog et al. 2010, IEEE TBME 57(11) (cited by Yun 2012 and Huang 2016)"
     units = {"threshold": "1", "window": "s", "sigma_a": "m/s^2", "sigma_g": "rad/s"}

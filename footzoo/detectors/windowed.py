@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..registry import Plugin, check_positive, register
+from ..plugin import Detector
+from ..registry import check_positive, register
 from .windows import row_norms, window_max
 
 
 @register
-class Windowed(Plugin):
+class Windowed(Detector):
     """Stationary when the gyro and the accelerometer's changes stay small around the sample.
 
     Duong & Suh 2015, Sensors 15, eq. 21: sample k is in a zero-velocity
@@ -43,7 +44,6 @@ class Windowed(Plugin):
         Zero-velocity flag.
     """
 
-    kind = "detector"
     name = "windowed"
     paper = "Duong & Suh 2015, Sensors 15, eq. 21"
     units = {"gyro_threshold": "rad/s", "acc_diff_threshold": "m/s^2", "gyro_window": "s", "acc_window": "s"}

@@ -28,8 +28,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
-
 
 @dataclass
 class Layout:

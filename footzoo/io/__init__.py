@@ -25,8 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..data import Recording
-from ..errors import FormatError
-from ..registry import did_you_mean
+from ..errors import FormatError, did_you_mean
 from . import canonical, gaitmap, pyshoe, sensorconnect, xio
 
 READERS: dict[str, Callable[..., Recording]] = {
@@ -35,6 +34,16 @@ READERS: dict[str, Callable[..., Recording]] = {
     "pyshoe": pyshoe.read,
     "gaitmap": gaitmap.read,
     "sensorconnect": sensorconnect.read,
+}
+
+
+#: What each CSV reader expects on the first line (shown when a header is not recognised).
+EXPECTED_HEADERS: dict[str, str] = {
+    "canonical": "columns t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z (optional mag_x..z, dist_*, true_*), "
+                 "SI units unless acc_unit/gyr_unit are declared",
+    "xio": "Time (s), Gyroscope X (deg/s), ..., Accelerometer X (g), ...",
+    "gaitmap": "two header rows: sensor,left_sensor,...,right_sensor,... then ,acc_x,...,gyr_z",
+    "sensorconnect": "Time, <device>:scaledAccelX, ..., <device>:scaledGyroX, ...",
 }
 
 
@@ -60,8 +69,9 @@ def detect_format(path: str | Path) -> str:
         if canonical.matches(head):
             return "canonical"
         raise FormatError(
-            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}; "
-            f"pass format= one of {sorted(READERS)}"
+            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}. Expected one of: "
+            + "; ".join(f"{k}: {v}" for k, v in EXPECTED_HEADERS.items())
+            + f". Rename the columns, or pass format= one of {sorted(READERS)} (command line: --format)"
         )
     raise FormatError(f"{p}: unknown extension {suffix!r}; pass format= one of {sorted(READERS)}")
 
@@ -77,8 +87,11 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         One of ``canonical``, ``xio``, ``pyshoe``, ``gaitmap``, ``sensorconnect``;
         detected from the file when omitted.
     **options
-        Reader options, e.g. ``foot="left"`` for gaitmap, ``acc_unit="g"`` for
-        canonical files, ``duplicates="drop"``.
+        Reader options, e.g. ``foot="left"`` for gaitmap (which sensor to read;
+        for other formats it declares the foot, and must agree with a format
+        that knows it: PyShoe's sensor is on the right foot), ``acc_unit="g"``
+        and ``gyr_unit="deg/s"`` for canonical files (the other formats fix
+        their units), ``duplicates="drop"``.
     """
     p = Path(path)
     if not p.exists():
@@ -88,7 +101,33 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     fmt = format or detect_format(p)
     if fmt not in READERS:
         raise FormatError(f"unknown format {fmt!r}{did_you_mean(fmt, list(READERS))}; valid: {sorted(READERS)}")
-    return READERS[fmt](p, **options)
+    for key in ("acc_unit", "gyr_unit"):
+        fixed = FIXED_UNITS.get(fmt, {}).get(key)
+        if key in options and fixed is not None:
+            if options[key] != fixed:
+                raise FormatError(f"{p}: {fmt} files store {key.split('_')[0]} in {fixed}; "
+                                  f"{key}={options[key]!r} cannot apply (drop the option)")
+            del options[key]
+    foot = options.pop("foot", None) if fmt != "gaitmap" else None
+    if foot is not None and foot not in ("left", "right"):
+        raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
+    rec = READERS[fmt](p, **options)
+    if foot is not None:
+        known = rec.meta.get("foot")
+        if known is not None and known != foot:
+            raise FormatError(f"{p}: this {fmt} recording is from the {known} foot; drop --foot {foot} "
+                              f"(or pass --foot {known})")
+        rec.meta["foot"] = foot
+    return rec
+
+
+#: Units a format fixes (a reader converts them itself); canonical files take acc_unit/gyr_unit.
+FIXED_UNITS: dict[str, dict[str, str]] = {
+    "xio": {"acc_unit": "g", "gyr_unit": "deg/s"},
+    "pyshoe": {"acc_unit": "m/s^2", "gyr_unit": "rad/s"},
+    "gaitmap": {"acc_unit": "m/s^2", "gyr_unit": "deg/s"},
+    "sensorconnect": {"acc_unit": "g", "gyr_unit": "rad/s"},
+}
 
 
 __all__ = ["READERS", "builtin_sample", "detect_format", "load"]

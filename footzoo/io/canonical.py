@@ -3,7 +3,8 @@
 SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``).
 A file written by ``footzoo simulate`` also carries its ground truth in
 ``true_*`` columns, a sidecar ``<file>.meta.yaml`` (metadata and the
-``closed_loop`` marker) and the true steps in ``<file>.steps.csv``.
+``closed_loop`` marker) and the true steps in ``<file>.steps.csv`` (every true
+stride: its row count becomes ``truth.stride_count``).
 """
 
 from __future__ import annotations
@@ -43,6 +44,9 @@ def read(path: Path, **options: Any) -> Recording:
         steps = path.with_name(path.name + ".steps.csv")
         if steps.exists():
             rec.truth.steps = pd.read_csv(steps)
+            rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
+        if meta.get("source") == "footzoo.sim":
+            rec.truth.source = "simulator"
     return rec
 
 

@@ -24,8 +24,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..data import Recording
+from ..data import Recording, Truth
 from ..errors import FormatError
+from .gaitmap_reference import has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8
 FEET = ("left", "right")
@@ -42,8 +43,21 @@ def matches(header: str) -> bool:
     return header.startswith("sensor,") and "_sensor" in header
 
 
+def feet(path: Path) -> list[str]:
+    """The feet a gaitmap file holds (``left``, ``right``), from its first header row."""
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        head = fh.readline()
+    return [f for f in FEET if f"{f}_sensor" in head]
+
+
 def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: Any) -> Recording:
     """Read one foot of a gaitmap ``imu_sample.csv``.
+
+    When the folder also holds gaitmap's ``mocap_sample.csv`` and
+    ``stride_events_sample.csv``, their per-stride events, stride lengths and
+    foot progression angles become ``truth.steps``
+    (:func:`footzoo.io.gaitmap_reference.reference_strides`) and the per-stride
+    trajectories of ``position_sample.csv`` ``truth.stride_positions``.
 
     Parameters
     ----------
@@ -54,8 +68,8 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
     """
     if foot not in FEET:
         raise FormatError(
-            f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right' "
-            "(command line: --foot left)"
+            f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right', "
+            "or read both with footzoo.Session.load(path) (command line: both feet unless --foot left|right)"
         )
     df = pd.read_csv(path, header=[0, 1], index_col=0)
     sensor = f"{foot}_sensor"
@@ -70,4 +84,9 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
     frame.insert(0, "t", np.arange(len(frame)) / rate)
     meta = {"name": f"{path.stem}_{foot}", "source": str(path), "format": "gaitmap", "foot": foot,
             "placement": f"{foot} foot instep"}
-    return Recording.from_dataframe(frame, acc_unit="m/s^2", gyr_unit="deg/s", meta=meta, **options)
+    truth = None
+    if has_reference(path.parent):
+        truth = Truth(steps=reference_strides(path.parent, foot),
+                      stride_positions=reference_stride_positions(path.parent, foot),
+                      source="motion capture (gaitmap)")
+    return Recording.from_dataframe(frame, acc_unit="m/s^2", gyr_unit="deg/s", meta=meta, truth=truth, **options)

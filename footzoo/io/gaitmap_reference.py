@@ -2,8 +2,11 @@
 
 ``mocap_sample.csv`` holds markers L/R_TOE, L/R_FCC (heel) and L/R_FM5 in mm at
 100 Hz, lab frame with z up; ``stride_events_sample.csv`` holds per stride
-``start`` and ``end`` (minimum foot velocity, i.e. mid-stance) in IMU samples at
-204.8 Hz. Per stride: the stride length is the horizontal distance the heel
+``start`` and ``end`` (minimum foot velocity, i.e. mid-stance), ``pre_ic`` (the
+initial contact before ``start``), ``tc`` (toe-off) and ``ic`` (the initial
+contact before ``end``), in IMU samples at 204.8 Hz. These become footzoo's
+stride columns ``start_s`` (pre_ic), ``to_s`` (tc), ``end_s`` (ic), and
+``ms_start_s``/``ms_end_s`` (the mid-stances). Per stride: the stride length is the horizontal distance the heel
 marker moved from ``start`` to ``end`` (each position a 0.1 s mean around the
 event); the line of progression is that displacement; the foot progression
 angle of the stance at ``end`` is the angle of the heel→toe axis against it,
@@ -24,8 +27,14 @@ IMU_RATE = 204.8
 MOCAP_RATE = 100.0
 
 
-def reference_strides(folder: str | Path, foot: str, lag: float = 0.02) -> pd.DataFrame:
-    """Per-stride reference from the markers: ``start``, ``end`` (s), ``stride_length`` (m), ``fpa``, ``heading`` (rad).
+def has_reference(folder: str | Path) -> bool:
+    """True when ``folder`` holds gaitmap's motion-capture reference files."""
+    folder = Path(folder)
+    return (folder / "mocap_sample.csv").exists() and (folder / "stride_events_sample.csv").exists()
+
+
+def reference_strides(folder: str | Path, foot: str, lag: float = 0.0) -> pd.DataFrame:
+    """Per-stride reference: events (s), ``stride_length_m``, ``fpa_rad``, ``heading_rad``, ``turn``.
 
     Parameters
     ----------
@@ -33,7 +42,10 @@ def reference_strides(folder: str | Path, foot: str, lag: float = 0.02) -> pd.Da
         Folder holding ``mocap_sample.csv`` and ``stride_events_sample.csv``.
     foot : {"left", "right"}
     lag : float
-        Motion capture lags the IMU by about 20 ms (cross-correlation).
+        Delay (s) of the motion capture against the IMU. Cross-correlating the
+        foot's sagittal angular rate from the heel->toe markers with the gyro
+        gives -2 ms for both feet (correlation 0.99), so the default is 0; the
+        marker positions are 0.1 s means, which a 20 ms shift barely changes.
     """
     folder = Path(folder)
     try:
@@ -57,11 +69,40 @@ def reference_strides(folder: str | Path, foot: str, lag: float = 0.02) -> pd.Da
         axis = around(toe, t1) - around(heel, t1)
         prog = np.arctan2(d[1], d[0])
         fpa = sign * np.angle(np.exp(1j * (np.arctan2(axis[1], axis[0]) - prog)))
-        rows.append({"start": t0, "end": t1, "stride_length": float(np.hypot(*d)), "fpa": float(fpa),
-                     "heading": float(prog)})
+        rows.append({"start_s": ev.pre_ic / IMU_RATE, "to_s": ev.tc / IMU_RATE, "end_s": ev.ic / IMU_RATE,
+                     "ms_start_s": t0, "ms_end_s": t1, "stride_length_m": float(np.hypot(*d)),
+                     "fpa_rad": float(fpa), "heading_rad": float(prog)})
     out = pd.DataFrame(rows)
     # a turn stride changes direction by more than 20° against its neighbours
-    h = np.unwrap(out["heading"].to_numpy())
+    h = np.unwrap(out["heading_rad"].to_numpy())
     change = np.maximum(np.abs(np.diff(h, prepend=h[0])), np.abs(np.diff(h, append=h[-1])))
     out["turn"] = change > np.radians(20.0)
     return out
+
+
+def reference_stride_positions(folder: str | Path, foot: str) -> pd.DataFrame | None:
+    """Per-stride trajectories of ``position_sample.csv`` (motion capture, 100 Hz), or None without the file.
+
+    gaitmap's file holds, per stride ``s_id`` of ``stride_events_sample.csv``, the
+    position (m) zeroed at the stride's start (its first mid-stance), in a
+    right-handed lab frame with z up. Returns ``stride`` (row of
+    :func:`reference_strides` for this foot), ``t_s`` (IMU clock, s) and
+    ``pos_x_m``, ``pos_y_m``, ``pos_up_m``.
+    """
+    folder = Path(folder)
+    path = folder / "position_sample.csv"
+    if not path.exists():
+        return None
+    pos = pd.read_csv(path)
+    events = pd.read_csv(folder / "stride_events_sample.csv")
+    ids = events.loc[events.foot == foot, "s_id"].to_numpy()
+    start = events.loc[events.foot == foot, "start"].to_numpy() / IMU_RATE
+    pos = pos[pos.iloc[:, 0] == f"{foot}_sensor"]
+    row = pd.Series(np.arange(len(ids)), index=ids)
+    keep = pos["s_id"].isin(ids).to_numpy()
+    pos = pos[keep]
+    stride = row[pos["s_id"].to_numpy()].to_numpy()
+    return pd.DataFrame({"stride": stride, "t_s": start[stride] + pos["sample"].to_numpy() / MOCAP_RATE,
+                         "pos_x_m": pos["pos_x"].to_numpy(), "pos_y_m": pos["pos_y"].to_numpy(),
+                         "pos_up_m": pos["pos_z"].to_numpy()})
+

@@ -6,6 +6,11 @@ reference is mirrored with respect to the IMU frame: a right-handed NED
 estimate matches ``gt · [1, 1, −1]`` (negate z only), which is what the
 :class:`~footzoo.data.Truth` holds (z down, horizontal axes VICON's, so compare
 after a rotation about the vertical). ``zv_vicon_opt`` becomes the stance truth.
+The sensor is on the right shoe: ``meta["foot"] = "right"``. When the folder
+holds the dataset's ``trials.csv``, the trial's hand-counted strides
+(``n_strides_manual_koroglu``) become ``truth.stride_count`` and its walking tag
+(``bipedal_tag_koroglu``: 1 walking, 0 not bipedal, −1 doubtful) goes to
+``meta["bipedal_tag"]``.
 """
 
 from __future__ import annotations
@@ -39,10 +44,32 @@ def read(path: Path, **options: Any) -> Recording:
         stance = np.asarray(d["zv_vicon_opt"]).ravel().astype(bool) if "zv_vicon_opt" in d else None
         mirror = np.array([1.0, 1.0, -1.0])  # VICON z up and mirrored: negate z only
         truth = Truth(pos=np.asarray(d["gt"], dtype=float) * mirror, stance=stance)
-    meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe",
+    meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe", "foot": "right",
                             "placement": "right shoe instep (LORD MicroStrain)"}
+    trial = _trial_row(path)
+    if trial is not None:
+        truth = truth or Truth()
+        truth.stride_count = int(trial["n_strides_manual_koroglu"])
+        meta["bipedal_tag"] = int(trial["bipedal_tag_koroglu"])
+    if truth is not None:
+        truth.source = "VICON (PyShoe)"
     if "trial_error" in d:
         errors = np.ravel(d["trial_error"]).astype(float)
         meta["pyshoe_trial_error"] = {k: float(e) for k, e in zip(TRIAL_ERROR_DETECTORS, errors, strict=True)}
     rec = Recording(t=t, acc=imu[:, :3], gyr=imu[:, 3:6], meta=meta, truth=truth, **options)
     return rec
+
+
+def _trial_row(path: Path) -> dict[str, Any] | None:
+    """The trial's row of the dataset's ``trials.csv`` (next to the ``.mat``), if any."""
+    table = path.with_name("trials.csv")
+    if not table.exists():
+        return None
+    import pandas as pd
+
+    df = pd.read_csv(table, dtype={"trial": str})
+    rows = df[df["trial"] == path.stem]
+    needed = {"n_strides_manual_koroglu", "bipedal_tag_koroglu"}
+    if rows.empty or not needed <= set(df.columns):
+        return None
+    return rows.iloc[0].to_dict()

@@ -5,6 +5,11 @@ Columns ``Time`` (s) and ``<device>:scaledAccelX/Y/Z`` (g),
 is x forward, y right, z down (at rest acc_z ≈ −1 g): the axis map is the
 identity. The sensor's own roll/pitch/yaw columns are kept in ``meta`` only
 as column names; footzoo does not use them.
+
+Köroğlu's experiments ship a ``<name>.mat`` next to the CSV with the ground
+control points: ``GCP_meters`` (K×2, every footprint measured on the floor
+tiles, m), ``numberOfStrides`` and ``GCP_exist_and_correct``. When it is there
+the reader loads it into ``truth.footprints`` and ``truth.stride_count``.
 """
 
 from __future__ import annotations
@@ -12,9 +17,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
-from ..data import Recording
+from ..data import Recording, Truth
 from ..errors import FormatError
 
 SIGNALS = {
@@ -44,4 +50,24 @@ def read(path: Path, **options: Any) -> Recording:
         raise FormatError(f"{path}: not a SensorConnect export with scaled signals, missing {missing}")
     keep = [c for c in ["t", *SIGNALS.values()] if c in df.columns]
     meta = {"name": path.stem, "source": str(path), "format": "sensorconnect", "mag_unit": "Gauss"}
-    return Recording.from_dataframe(df[keep], acc_unit="g", gyr_unit="rad/s", meta=meta, **options)
+    return Recording.from_dataframe(df[keep], acc_unit="g", gyr_unit="rad/s", meta=meta,
+                                    truth=footprint_reference(path.with_suffix(".mat")), **options)
+
+
+def footprint_reference(path: Path) -> Truth | None:
+    """Köroğlu's ground control points (``GCP_meters``, ``numberOfStrides``) from a ``.mat`` file, if present."""
+    if not path.exists():
+        return None
+    import scipy.io as sio
+
+    try:
+        d = sio.loadmat(path)
+    except Exception as err:  # scipy raises several types for bad files
+        raise FormatError(f"{path}: cannot read the ground-control-point file: {err}") from None
+    if "GCP_meters" not in d:
+        return None
+    if "GCP_exist_and_correct" in d and not bool(np.ravel(d["GCP_exist_and_correct"])[0]):
+        return None
+    count = int(np.ravel(d["numberOfStrides"])[0]) if "numberOfStrides" in d else None
+    return Truth(footprints=np.asarray(d["GCP_meters"], dtype=float), stride_count=count,
+                 source="ground control points (Köroğlu)")

@@ -62,5 +62,5 @@ def read(
     meta = {"name": path.stem, "source": str(path), "format": "xio", "placement": "foot (NGIMU, tilted ~30°)"}
     return Recording.from_dataframe(
         df, acc_unit="g", gyr_unit="deg/s", duplicates=duplicates, max_gap=max_gap, meta=meta,
-        truth=Truth(closed_loop=closed_loop), **options,
+        truth=Truth(closed_loop=closed_loop, source="closed loop (x-io)" if closed_loop else ""), **options,
     )

@@ -7,7 +7,8 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..registry import Plugin, check_positive, register
+from ..plugin import Orientation
+from ..registry import check_positive, register
 from .fqa import fqa_sample
 
 
@@ -119,7 +120,7 @@ def static_quaternion(acc: np.ndarray, gyr: np.ndarray, dt: np.ndarray, mag: np.
 
 
 @register
-class FQAComplementary(Plugin):
+class FQAComplementary(Orientation):
     """Adaptive-gain quaternion complementary filter with an FQA static branch.
 
     Yun, Calusdian, Bachmann & McGhee, IEEE TIM 61(7), 2012, Sec. II-A, eqs. 2–4
@@ -155,7 +156,6 @@ class FQAComplementary(Plugin):
         Gain used at each sample (1/s).
     """
 
-    kind = "orientation"
     name = "fqa_complementary"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
     units = {"static_gain": "1/s", "dynamic_gain": "1/s"}

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..registry import Plugin, check_positive, register
+from ..plugin import Orientation
+from ..registry import register
 from .fqa_complementary import complementary_kernel
 
 
 @register
-class INS(Plugin):
+class INS(Orientation):
     """Strapdown attitude from the gyro, corrected by the error-state Kalman filter.
 
     Nguyen & La 2016, eqs. 37–39 and 51–52 (attitude propagation and feedback);
@@ -20,21 +21,10 @@ class INS(Plugin):
     With a Kalman correction (``ekf_zupt``, ``zupt``) the attitude error is a
     state of that filter; without one, this is plain gyro integration.
 
-    The process noise of the error state is given as variance growth per
-    second. Nguyen & La (Sec. VI) set ``Q = diag(1e-4·I, 0, 0, 1e-4·I, 0)`` per
-    sample; at the 100 Hz the paper's sample counts assume, that is 0.01 per
-    second for attitude (rad²) and velocity ((m/s)²).
-
-    Parameters
-    ----------
-    attitude_noise : float
-        Attitude error variance growth (rad²/s).
-    velocity_noise : float
-        Velocity error variance growth ((m/s)²/s).
-    position_noise : float
-        Position error variance growth (m²/s); paper: 0.
-    initial_attitude_std : float
-        Standard deviation of the initial attitude error (rad).
+    The filter's process noise and initial uncertainty (attitude, velocity,
+    position) are the INS core's and are set under ``navigation:`` in the
+    pipeline's YAML (:class:`footzoo.filters.engine.NavigationNoise`), whatever the
+    orientation source.
 
     Attributes
     ----------
@@ -42,24 +32,18 @@ class INS(Plugin):
         Attitude from gyro integration (only when run without a Kalman filter).
     """
 
-    kind = "orientation"
     name = "ins"
     paper = "Nguyen & La 2016, eqs. 37-39, 51-52, Sec. VI (Q); Duong & Suh 2015, eqs. 3-8"
-    units = {"attitude_noise": "rad^2/s", "velocity_noise": "(m/s)^2/s", "position_noise": "m^2/s",
-             "initial_attitude_std": "rad"}
+    units: dict[str, str] = {}
+    carried_by_filter = True
+    causal = True
     use_magnetometer = True  # for the initial alignment only
+    #: Parameters that moved to the pipeline's ``navigation:`` block.
+    moved = {p: f"navigation.{p}" for p in ("attitude_noise", "velocity_noise", "position_noise",
+                                             "initial_attitude_std")}
 
-    def __init__(
-        self,
-        attitude_noise: float = 0.01,
-        velocity_noise: float = 0.01,
-        position_noise: float = 0.0,
-        initial_attitude_std: float = 0.01,
-    ):
-        self.attitude_noise = check_positive("attitude_noise", attitude_noise, allow_zero=True)
-        self.velocity_noise = check_positive("velocity_noise", velocity_noise, allow_zero=True)
-        self.position_noise = check_positive("position_noise", position_noise, allow_zero=True)
-        self.initial_attitude_std = check_positive("initial_attitude_std", initial_attitude_std, allow_zero=True)
+    def __init__(self) -> None:
+        pass
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> INS:
         """Gyro integration from ``q0`` (no Kalman filter configured)."""

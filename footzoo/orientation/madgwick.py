@@ -7,7 +7,8 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..registry import Plugin, check_positive, register
+from ..plugin import Orientation
+from ..registry import check_positive, register
 
 
 @njit
@@ -92,7 +93,7 @@ def _grad(w, x, y, z, dx, dy, dz, sx, sy, sz):
 
 
 @register
-class Madgwick(Plugin):
+class Madgwick(Orientation):
     """Madgwick's gradient-descent orientation filter, as used by Huang et al. 2016.
 
     Huang, Jirattigalachote, Cutkosky, Zhu & Shull, IEEE TBME 2016, Sec. II-A,
@@ -119,7 +120,6 @@ class Madgwick(Plugin):
         β (rad/s).
     """
 
-    kind = "orientation"
     name = "madgwick"
     paper = "Huang et al. 2016, IEEE TBME, eqs. 1-10 (Madgwick 2011)"
     units = {"gyro_error": "rad/s"}

@@ -156,7 +156,7 @@ def simulate(
     stance = state["still"] & mid & np.concatenate([[True], state["still"][:-1]])
     step_table = pd.DataFrame(timeline.steps)
     truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=stance, steps=step_table,
-                  closed_loop=closed, dist=true_dist)
+                  closed_loop=closed, dist=true_dist, stride_count=len(step_table), source="simulator")
     meta = {
         "name": f"sim_{path}", "source": "footzoo.sim", "format": "simulated", "profile": profile,
         "sampling": sampling, "foot": foot, "seed": seed,

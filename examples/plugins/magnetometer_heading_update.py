@@ -1,0 +1,119 @@
+"""A Kalman correction as a footzoo plug-in: the magnetometer heading update (MAGU) in stance.
+
+Jiménez, Seco, Prieto & Guevara, "Indoor Pedestrian Navigation using an INS/EKF framework for
+Yaw Drift Reduction and a Foot-mounted IMU", WPNC 2010 (the MAGU update): while the foot is
+still, the heading of the Earth's field seen by the magnetometer is compared with its heading at
+the start; the difference is the filter's heading error. Readings whose magnitude or dip angle
+depart from the start's are rejected as disturbed (a common gate; the thresholds are ours).
+
+With footzoo's conventions (NED, ``C_est = (I + [δφ×]) C_true``): the field in NED computed with
+the estimated attitude is the true one turned by δψ about the vertical, so its heading
+``ψ_m = atan2(m_E, m_N)`` exceeds the reference ``ψ_0`` by δψ, the measurement is
+``z = wrap(ψ_m − ψ_0)`` and its H row picks the attitude error's z component (as HDR's).
+
+The reference ``ψ_0``, magnitude and dip are the means over the still start (the alignment
+period), learnt inside the filter, so the correction also runs live.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import footzoo
+from footzoo.filters.measurement import ATT, MeasurementModel, measurement_function
+from footzoo.plugin import KalmanCorrection, Samples
+
+
+@measurement_function
+def magu_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """``par`` = (σ_ψ rad, magnitude tolerance (fraction), dip tolerance rad); ``data`` = (in the
+    still start, reading valid, m_x, m_y, m_z); ``mem`` = (Σm_N, Σm_E, Σm_D, Σ|m|, count,
+    reference ready, ψ_0, |m|_0, dip_0)."""
+    if data[1] == 0.0:
+        return m
+    qw, qx, qy, qz = nav[0], nav[1], nav[2], nav[3]
+    mx, my, mz = data[2], data[3], data[4]
+    m_n = (1 - 2 * (qy * qy + qz * qz)) * mx + 2 * (qx * qy - qw * qz) * my + 2 * (qx * qz + qw * qy) * mz
+    m_e = 2 * (qx * qy + qw * qz) * mx + (1 - 2 * (qx * qx + qz * qz)) * my + 2 * (qy * qz - qw * qx) * mz
+    m_d = 2 * (qx * qz - qw * qy) * mx + 2 * (qy * qz + qw * qx) * my + (1 - 2 * (qx * qx + qy * qy)) * mz
+    norm = math.sqrt(mx * mx + my * my + mz * mz)
+    if data[0] != 0.0:  # still start: accumulate the reference
+        mem[0] += m_n
+        mem[1] += m_e
+        mem[2] += m_d
+        mem[3] += norm
+        mem[4] += 1.0
+        return m
+    if mem[5] == 0.0:
+        if mem[4] == 0.0:
+            return m
+        mem[6] = math.atan2(mem[1], mem[0])
+        mem[7] = mem[3] / mem[4]
+        mem[8] = math.atan2(mem[2], math.sqrt(mem[0] * mem[0] + mem[1] * mem[1]))
+        mem[5] = 1.0
+    if not stance:
+        return m
+    dip = math.atan2(m_d, math.sqrt(m_n * m_n + m_e * m_e))
+    if abs(norm - mem[7]) > par[1] * mem[7] or abs(dip - mem[8]) > par[2]:
+        return m  # disturbed field: no update
+    d = math.atan2(m_e, m_n) - mem[6]
+    d = -((-d + math.pi) % (2 * math.pi) - math.pi)
+    H[m, idx[ATT] + 2] = 1.0
+    z[m] = d
+    R[m] = par[0] * par[0]
+    return m + 1
+
+
+@footzoo.register
+class MagnetometerHeadingUpdate(KalmanCorrection):
+    """Magnetometer heading update in stance, with disturbance rejection (Jiménez et al. 2010, MAGU).
+
+    ``z = wrap(ψ_m − ψ_0)`` with ``ψ_m`` the heading of the field in NED under the estimated
+    attitude and ``ψ_0`` its mean over the still start; H picks the attitude error's z component.
+
+    Parameters
+    ----------
+    heading_std : float
+        Measurement noise of the magnetic heading (rad).
+    norm_tolerance : float
+        Reject readings whose magnitude differs from the start's by more than this fraction (1).
+    dip_tolerance : float
+        Reject readings whose dip angle differs from the start's by more than this (rad).
+    """
+
+    name = "magnetometer_heading"
+    paper = "Jiménez, Seco, Prieto & Guevara 2010, WPNC (MAGU)"
+    units = {"heading_std": "rad", "norm_tolerance": "1", "dip_tolerance": "rad"}
+    needs_magnetometer = True
+    observes = ("magnetic_heading",)
+
+    def __init__(self, heading_std: float = 0.1, norm_tolerance: float = 0.05, dip_tolerance: float = 0.05):
+        for name, value in (("heading_std", heading_std), ("norm_tolerance", norm_tolerance),
+                            ("dip_tolerance", dip_tolerance)):
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
+                    and value > 0):
+                raise footzoo.ConfigError(f"{name} must be a positive number ({self.units[name]}), got {value!r}")
+        self.heading_std = float(heading_std)
+        self.norm_tolerance = float(norm_tolerance)
+        self.dip_tolerance = float(dip_tolerance)
+
+    def requires_attitude_state(self) -> bool:
+        """The heading error is the attitude error's z component."""
+        return True
+
+    def sample_data(self, samples: Samples) -> np.ndarray:
+        """Per sample: in the still start, reading valid, the magnetometer reading (any unit)."""
+        if samples.mag is None:
+            raise footzoo.RecordingError("magnetometer_heading needs a magnetometer (mag_x, mag_y, mag_z)")
+        mag = np.asarray(samples.mag, dtype=float)
+        valid = np.isfinite(mag).all(axis=1) & (np.linalg.norm(mag, axis=1) > 0)
+        return np.column_stack([np.asarray(samples.init_window, float), valid.astype(float),
+                                np.where(valid[:, None], mag, 0.0)])
+
+    def model(self, samples: Samples) -> MeasurementModel:
+        """One heading row per undisturbed stance sample."""
+        return MeasurementModel(measure=magu_measure, max_rows=1,
+                                par=np.array([self.heading_std, self.norm_tolerance, self.dip_tolerance]),
+                                mem=np.zeros(9))

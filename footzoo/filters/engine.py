@@ -1,0 +1,303 @@
+"""The error-state Kalman engine: state layout, measurement models, compiled or reference loop.
+
+The engine takes what the plug-ins hand it — whether the attitude is a filter state, the
+corrections' :class:`~footzoo.filters.measurement.StateBlock` lists and
+:class:`~footzoo.filters.measurement.MeasurementModel` objects — and the INS core's noise
+(:class:`NavigationNoise`). It knows no plug-in by name. ``engine="fast"`` runs the compiled
+loop, ``"reference"`` the filterpy loop, ``"auto"`` the compiled one when every model compiles
+(else the reference, with a one-line warning saying which model and why).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError, FootzooWarning
+from .eskf import ErrorStateFilter, Layout
+from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock
+
+ENGINES = ("auto", "fast", "reference")
+# the compiled loop takes the models' functions as first-class function values, which numba marks
+# "experimental" (stable since numba 0.53 for functions with an explicit signature, as here)
+warnings.filterwarnings("ignore", message=".*First-class function type feature is experimental")
+
+
+@dataclass
+class NavigationNoise:
+    """Process noise and initial uncertainty of the INS core of the error-state filter.
+
+    Set in a pipeline's YAML under ``navigation:``, whatever the orientation source. Nguyen &
+    La 2016 (Sec. VI) set ``Q = diag(1e-4·I, 0, 0, 1e-4·I, 0)`` per sample; at the 100 Hz
+    their sample counts assume that is 0.01 per second for attitude (rad²) and velocity
+    ((m/s)²) — the defaults. Duong & Suh 2015 (Table 1) give per-sample sensor variances;
+    their config converts them.
+
+    Parameters
+    ----------
+    attitude_noise : float
+        Attitude error variance growth (rad²/s); used when the attitude is a filter state.
+    velocity_noise : float
+        Velocity error variance growth ((m/s)²/s).
+    position_noise : float
+        Position error variance growth (m²/s); paper: 0.
+    initial_attitude_std : float
+        Standard deviation of the initial attitude error (rad).
+    initial_velocity_std : float
+        Standard deviation of the initial velocity error (m/s); the start is still: 0.
+    initial_position_std : float
+        Standard deviation of the initial position error (m); the origin is the start: 0.
+    """
+
+    attitude_noise: float = 0.01
+    velocity_noise: float = 0.01
+    position_noise: float = 0.0
+    initial_attitude_std: float = 0.01
+    initial_velocity_std: float = 0.0
+    initial_position_std: float = 0.0
+
+    units = {"attitude_noise": "rad^2/s", "velocity_noise": "(m/s)^2/s", "position_noise": "m^2/s",
+             "initial_attitude_std": "rad", "initial_velocity_std": "m/s", "initial_position_std": "m"}
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ConfigError(f"navigation.{f.name} must be a number in {self.units[f.name]}, got {value!r}")
+            value = float(value)
+            if not np.isfinite(value) or value < 0:
+                raise ConfigError(
+                    f"navigation.{f.name} must be finite and >= 0 ({self.units[f.name]}), got {value!r}")
+            setattr(self, f.name, value)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any] | None) -> NavigationNoise:
+        """Build from a YAML mapping, rejecting unknown keys with the valid ones."""
+        d = dict(d or {})
+        valid = [f.name for f in fields(cls)]
+        unknown = [k for k in d if k not in valid]
+        if unknown:
+            raise ConfigError(f"navigation: unknown key(s) {unknown}; valid keys: {valid}")
+        return cls(**d)
+
+    def to_dict(self) -> dict[str, float]:
+        """Every value, for ``Result.config``."""
+        return asdict(self)
+
+
+def assemble(carries_attitude: bool, blocks: list[StateBlock], noise: NavigationNoise):
+    """Error-state layout, initial variances and variance growth per second.
+
+    Order (Nguyen & La eq. 31): ``att`` (when the filter carries the attitude), ``gyro_bias``,
+    ``pos``, ``vel``, ``acc_bias`` (each bias only when a correction switches it on), then the
+    corrections' own blocks in the order they are listed.
+    """
+    core: dict[str, StateBlock] = {}
+    extra: list[StateBlock] = []
+    for b in blocks:
+        if b.name in ("gyro_bias", "acc_bias"):
+            if b.size != 3:
+                raise ConfigError(f"state block {b.name!r} has 3 states, a correction declared {b.size}")
+            core.setdefault(b.name, b)
+        elif b.name in CORE_BLOCKS:
+            raise ConfigError(f"state block {b.name!r} belongs to the INS core; name a correction's block otherwise")
+        else:
+            extra.append(b)
+    order: list[StateBlock] = []
+    if carries_attitude:
+        order.append(StateBlock("att", 3, noise.initial_attitude_std**2, noise.attitude_noise))
+    if "gyro_bias" in core:
+        order.append(core["gyro_bias"])
+    order.append(StateBlock("pos", 3, noise.initial_position_std**2, noise.position_noise))
+    order.append(StateBlock("vel", 3, noise.initial_velocity_std**2, noise.velocity_noise))
+    if "acc_bias" in core:
+        order.append(core["acc_bias"])
+    order += extra
+    layout = Layout([(b.name, b.size) for b in order])
+    p0 = np.concatenate([np.full(b.size, float(b.initial_variance)) for b in order])
+    q = np.concatenate([np.full(b.size, float(b.noise)) for b in order])
+    return layout, p0, q
+
+
+def block_offsets(layout: Layout, own: list[str]) -> np.ndarray:
+    """``idx`` of one model: the core blocks' offsets (−1 if absent), then its own blocks'."""
+    names = list(CORE_BLOCKS) + list(own)
+    return np.array([layout[b].start if layout.has(b) else -1 for b in names], dtype=np.int64)
+
+
+@dataclass
+class Packed:
+    """Everything the compiled loop needs besides the signals; carried between stream steps."""
+
+    core: tuple
+    nav: np.ndarray
+    P: np.ndarray
+    mems: np.ndarray
+    functions: tuple
+    arrays: tuple
+    data_widths: list[int]
+
+
+class KalmanEngine:
+    """One error-state filter run (or stream) over a recording.
+
+    Parameters
+    ----------
+    carries_attitude : bool
+        The attitude error is a state (INS orientation); otherwise ``quat_ext`` is used.
+    blocks : list of StateBlock
+        All blocks the corrections declare, in order.
+    models : list of MeasurementModel
+        The corrections' measurement models, in stacking order.
+    own_blocks : list of list of str
+        Each model's own block names.
+    noise : NavigationNoise
+        INS core noise.
+    gravity : float
+        g (m/s²).
+    engine : {"auto", "fast", "reference"}
+        Which loop.
+    """
+
+    def __init__(self, carries_attitude: bool, blocks: list[StateBlock], models: list[MeasurementModel],
+                 noise: NavigationNoise, gravity: float, engine: str = "auto", names: list[str] | None = None):
+        if engine not in ENGINES:
+            raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+        self.layout, self.p0, self.q = assemble(carries_attitude, blocks, noise)
+        self.carries_attitude = carries_attitude
+        self.gravity = float(gravity)
+        self.names = names or [f"correction {i}" for i in range(len(models))]
+        self.idx = [block_offsets(self.layout, m.block_names) for m in models]
+        self.models = models
+        self.engine = self._choose(engine)
+
+    def _choose(self, engine: str) -> str:
+        if engine == "reference":
+            return engine
+        compiled = []
+        for name, m in zip(self.names, self.models, strict=True):
+            try:
+                compiled.append(m.compiled())
+            except NotCompilable as err:
+                if engine == "fast":
+                    raise ConfigError(f"engine='fast': {name} cannot be compiled ({err}); use engine='reference' "
+                                      "or make its measurement functions numba-compilable") from None
+                warnings.warn(f"{name}: measurement model not compilable ({err}); running the reference engine",
+                              FootzooWarning, stacklevel=4)
+                return "reference"
+        self.models = compiled
+        return "fast"
+
+    # ------------------------------------------------------------------ runs
+    def run(self, t, acc, gyr, stance, q0, quat_ext=None, covariance: bool = True,
+            smoother: bool = False) -> dict[str, Any]:
+        """Filter a whole recording; returns the trajectories and each model's diagnostics.
+
+        With ``smoother`` the trajectories are the RTS-smoothed ones (:mod:`footzoo.filters.smoother`)
+        and the forward pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
+        """
+        nav0 = np.zeros(16)
+        nav0[:4] = quat_ext[0] if quat_ext is not None else q0
+        state = self.start(nav0)
+        out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
+                           smoother)
+        out["diagnostics"] = self.diagnostics(state)
+        if smoother:
+            from .smoother import rts_backward
+
+            for key in ("quat", "vel", "pos"):
+                out[f"{key}_forward"] = out[key].copy()
+            core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
+            rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
+                         out["pos"], out["gyro_bias"], out["acc_bias"])
+        del out["gains"], out["dxs"]
+        return out
+
+    def start(self, nav0: np.ndarray) -> Any:
+        """The filter's state before sample 0 (resumable with :meth:`advance`)."""
+        if self.engine == "reference":
+            kf = ErrorStateFilter(self.layout, self.p0, self.q)
+            models = [MeasurementModel(**{**m.__dict__, "mem": np.array(m.mem, dtype=float)}) for m in self.models]
+            return {"kf": kf, "models": models, "nav": np.array(nav0, dtype=float)}
+        return self.pack(nav0)
+
+    def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
+                covariance: bool = True, smoother: bool = False) -> dict[str, np.ndarray]:
+        """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state."""
+        n = len(t)
+        if self.engine == "reference":
+            from .kalman_reference import run_reference
+
+            return run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
+                                 state["nav"], self.gravity, data, k0, smoother)
+        nx = self.layout.n
+        out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
+               "acc_nav": np.empty((n, 3)), "gyro_bias": np.empty((n, 3)), "acc_bias": np.empty((n, 3)),
+               "P_diag": np.empty((n if covariance else 0, nx)),
+               "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
+        self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
+        return out
+
+    def diagnostics(self, state: Any) -> dict[str, Any]:
+        """The models' results (e.g. a calibration) from their memory."""
+        mems = [m.mem for m in state["models"]] if self.engine == "reference" else self.unpack_mems(state)
+        diag: dict[str, Any] = {}
+        for m, mem in zip(self.models, mems, strict=True):
+            if m.diagnostics is not None:
+                diag.update(m.diagnostics(mem))
+        return diag
+
+    # -------------------------------------------------------- compiled pieces
+    def pack(self, nav0: np.ndarray) -> Packed:
+        """Initial state and the models' arrays in the compiled loop's structured form."""
+        models = self.models
+        core = (np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64),
+                np.ascontiguousarray(self.q, dtype=float), self.gravity, not self.carries_attitude,
+                max(1, sum(m.max_rows for m in models)))
+        width = max(len(i) for i in self.idx)
+        m_idx = np.full((len(models), width), -1, dtype=np.int64)
+        for j, ix in enumerate(self.idx):
+            m_idx[j, : len(ix)] = ix
+        par = np.concatenate([np.asarray(m.par, float).ravel() for m in models] + [np.zeros(0)])
+        par_off = np.cumsum([0] + [np.asarray(m.par).size for m in models]).astype(np.int64)
+        mems = np.concatenate([np.asarray(m.mem, float).ravel() for m in models] + [np.zeros(0)])
+        mem_off = np.cumsum([0] + [np.asarray(m.mem).size for m in models]).astype(np.int64)
+        widths = [0 if m.data is None else m.data.shape[1] for m in models]
+        data_off = np.cumsum([0] + widths).astype(np.int64)
+        functions = (tuple(m.measure for m in models), tuple(m.feedback for m in models),
+                     tuple(m.after for m in models))
+        arrays = (m_idx, par, par_off, mem_off, data_off)
+        return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays, widths)
+
+    @staticmethod
+    def stack_data(datas: list[np.ndarray | None], n: int) -> np.ndarray:
+        """The models' per-sample inputs side by side, (n, Σd)."""
+        cols = [d for d in datas if d is not None and d.shape[1]]
+        return np.ascontiguousarray(np.hstack(cols), dtype=float) if cols else np.zeros((n, 0))
+
+    def unpack_mems(self, packed: Packed) -> list[np.ndarray]:
+        """Each model's memory after a run."""
+        off = packed.arrays[3]
+        return [packed.mems[off[j]:off[j + 1]] for j in range(len(self.models))]
+
+    @staticmethod
+    def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
+        """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
+        from .kalman_fast import eskf_loop
+
+        ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
+        m_idx, par, par_off, mem_off, data_off = packed.arrays
+        measures, feedbacks, afters = packed.functions
+        eskf_loop(
+            (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
+             np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext),
+            packed.core,
+            (packed.nav, packed.P, packed.mems),
+            (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off),
+            (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"], out["P_diag"],
+             out["gains"], out["dxs"]),
+            k0,
+        )

@@ -1,0 +1,139 @@
+"""Reference sample loop of the Kalman-filter pipelines: strapdown INS + filterpy's ``KalmanFilter``.
+
+Readable and slow: numpy for the mechanisation, :class:`~footzoo.filters.eskf.ErrorStateFilter`
+(filterpy) for the covariance, and every correction's measurement model called through the same
+functions the compiled loop (:mod:`footzoo.filters.kalman_fast`) calls. A test keeps the two equal.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..conventions import quat_from_rotvec, quat_mul, quat_to_matrix
+from .eskf import ErrorStateFilter, Layout, transition
+from .measurement import MeasurementModel
+from .smoother import smoother_gain
+
+
+def run_reference(
+    t: np.ndarray,
+    acc: np.ndarray,
+    gyr: np.ndarray,
+    stance: np.ndarray,
+    quat_ext: np.ndarray | None,
+    layout: Layout,
+    kf: ErrorStateFilter,
+    models: list[MeasurementModel],
+    idx: list[np.ndarray],
+    nav0: np.ndarray,
+    gravity: float,
+    data: list[np.ndarray] | None = None,
+    k0: int = 0,
+    smooth: bool = False,
+) -> dict[str, np.ndarray]:
+    """Strapdown mechanisation with error-state Kalman corrections (Nguyen & La 2016, eqs. 37–52).
+
+    Attitude: with an ``att`` block, ``q_k = q_{k-1} ⊗ exp((ω_k − b̂_g) dt)`` (the exact form
+    of eq. 37 for a rate constant over the interval); otherwise ``quat_ext[k]``. Velocity and
+    position: mid-interval rotation, trapezoidal position (eqs. 46–48). Every sample the
+    covariance is predicted (eq. 44); the models' rows are stacked into one update, the error
+    fed back (eqs. 49–52) and reset.
+
+    Parameters
+    ----------
+    t, acc, gyr, stance : arrays
+        Time (s), specific force (m/s²), angular rate (rad/s), gait phase.
+    quat_ext : (N, 4) ndarray or None
+        External attitude (body → NED) when the filter carries none.
+    layout, kf : Layout, ErrorStateFilter
+        State blocks and the filter (initial covariance and process noise set).
+    models : list of MeasurementModel
+        The corrections' models, in stacking order (their ``mem`` is updated in place).
+    idx : list of (5 + b,) int arrays
+        Block offsets for each model (see :mod:`footzoo.filters.measurement`).
+    nav0 : (16,) ndarray
+        Nominal state at sample 0 (updated in place to the last sample's).
+    gravity : float
+        g (m/s²).
+    data : list of (N, d) arrays, optional
+        Each model's per-sample inputs for these samples (default: the models' ``data``).
+    k0 : int
+        Index of sample 0 in the whole recording (a stream's running count).
+    smooth : bool
+        Also return ``gains`` (N, n, n) and ``dxs`` (N, n) for :mod:`footzoo.filters.smoother`.
+
+    Returns
+    -------
+    dict
+        ``quat`` (N, 4), ``vel``, ``pos``, ``acc_nav`` (motion acceleration), ``gyro_bias``,
+        ``acc_bias`` (N, 3), ``P_diag`` (N, n).
+    """
+    n = t.shape[0]
+    has = layout.has
+    ins = has("att")
+    g_n = np.array([0.0, 0.0, gravity])
+    nav = nav0
+    data = data if data is not None else [m.data for m in models]
+    m_max = sum(m.max_rows for m in models)
+    out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
+    out["quat"] = np.zeros((n, 4))
+    out["P_diag"] = np.zeros((n, layout.n))
+    out["gains"] = np.zeros((n if smooth else 0, layout.n, layout.n))
+    out["dxs"] = np.zeros((n if smooth else 0, layout.n))
+    work = (np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)),
+            np.empty(layout.n, dtype=np.int64))
+    _store(out, 0, nav, np.zeros(3), kf.P)
+    for k in range(1, n):
+        dt = t[k] - t[k - 1]
+        w = gyr[k] - nav[10:13]
+        f = acc[k] - nav[13:16]
+        q_prev = nav[:4].copy()
+        nav[:4] = quat_mul(q_prev, quat_from_rotvec(w * dt)) if ins else quat_ext[k]
+        q = nav[:4]
+        q_mid = q_prev + q if np.dot(q_prev, q) >= 0 else q - q_prev
+        c = quat_to_matrix(q_mid / np.linalg.norm(q_mid))
+        f_n = c @ f
+        a_n = f_n + g_n
+        v_prev = nav[7:10].copy()
+        nav[7:10] = v_prev + a_n * dt
+        nav[4:7] = nav[4:7] + 0.5 * (v_prev + nav[7:10]) * dt
+        F = transition(layout, c, f_n, dt)
+        p_post = kf.P.copy()
+        kf.predict(F, dt)
+        if smooth:
+            smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
+        z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
+        m = 0
+        st = bool(stance[k])
+        for model, ix, d in zip(models, idx, data, strict=True):
+            row = d[k] if d is not None and d.shape[1] else np.zeros(0)
+            m = int(model.measure(k0 + k, float(t[k]), nav, w, f, st, ix, model.par, model.mem, row, z, H, R, m))
+        if m:
+            dx = kf.update(z[:m], H[:m], np.diag(R[:m]))
+            if ins:
+                qn = quat_mul(quat_from_rotvec(-dx[layout["att"]]), nav[:4])
+                nav[:4] = qn / np.linalg.norm(qn)
+            nav[4:7] -= dx[layout["pos"]]
+            nav[7:10] -= dx[layout["vel"]]
+            if has("gyro_bias"):
+                nav[10:13] += dx[layout["gyro_bias"]]
+            if has("acc_bias"):
+                nav[13:16] += dx[layout["acc_bias"]]
+            for model, ix in zip(models, idx, strict=True):
+                model.feedback(dx, ix, model.par, model.mem)
+            if smooth:
+                out["dxs"][k] = dx
+        for model, ix in zip(models, idx, strict=True):
+            model.after(k0 + k, nav, st, ix, model.par, model.mem)
+        _store(out, k, nav, a_n, kf.P)
+    return out
+
+
+def _store(out: dict[str, np.ndarray], k: int, nav: np.ndarray, a_n: np.ndarray, P: np.ndarray) -> None:
+    out["quat"][k] = nav[:4]
+    out["pos"][k] = nav[4:7]
+    out["vel"][k] = nav[7:10]
+    out["gyro_bias"][k] = nav[10:13]
+    out["acc_bias"][k] = nav[13:16]
+    out["acc_nav"][k] = a_n
+    out["P_diag"][k] = np.diag(P)

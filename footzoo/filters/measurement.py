@@ -1,0 +1,214 @@
+"""The contract between a Kalman correction and the error-state engine.
+
+A Kalman correction owns its measurement model: a few plain-array functions
+and the arrays they work on, collected in a :class:`MeasurementModel`. The
+compiled loop (:mod:`footzoo.filters.kalman_fast`), the filterpy reference loop
+(:mod:`footzoo.filters.kalman_reference`) and the live stream all call the same
+functions; the engine knows no correction by name.
+
+The three functions (compile them with :func:`measurement_function`,
+:func:`feedback_function` and :func:`after_function`)::
+
+    measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m) -> m_new
+    feedback(dx, idx, par, mem) -> None
+    after(k, nav, stance, idx, par, mem) -> None
+
+Arguments:
+
+``k`` (int)
+    Index of the sample in the whole recording (or stream).
+``t`` (float, s)
+    Its time.
+``nav`` ((16,) float)
+    The nominal state: ``nav[Q:Q+4]`` attitude quaternion (body → NED, scalar
+    first), ``nav[P:P+3]`` position (m, NED), ``nav[V:V+3]`` velocity (m/s),
+    ``nav[BG:BG+3]`` gyro bias and ``nav[BA:BA+3]`` accelerometer bias
+    estimates (rad/s, m/s²). Read only.
+``w``, ``f`` ((3,) float)
+    Bias-corrected angular rate (rad/s) and specific force (m/s²), body frame.
+``stance`` (bool)
+    The detector's gait phase at this sample.
+``idx`` ((5 + b,) int)
+    Offsets of the error-state blocks: ``idx[ATT]``, ``idx[GYRO_BIAS]``,
+    ``idx[POS]``, ``idx[VEL]``, ``idx[ACC_BIAS]`` (−1 where the block is
+    absent), then the offsets of the correction's own blocks in the order of
+    its :meth:`state_blocks`.
+``par`` ((p,) float)
+    The correction's constants (read only).
+``mem`` ((s,) float)
+    The correction's memory, carried from sample to sample (read/write).
+``data`` ((d,) float)
+    This sample's row of the correction's per-sample inputs.
+``z``, ``H``, ``R``
+    Buffers for this sample's stacked measurement: write rows ``m, m+1, …``
+    of the residual ``z`` (measured − predicted, with the engine's sign: the
+    error state is estimate − truth), the **nonzero** entries of the
+    measurement matrix ``H`` (the engine keeps every other entry zero) and
+    the measurement noise variance ``R`` (diagonal: rows are independent; a
+    correlated measurement can be whitened first). Write at most the
+    model's ``max_rows`` rows.
+``m`` (int)
+    First free row; return the next free row (``m`` when there is nothing
+    to measure).
+``dx`` ((n,) float)
+    The error estimated by the update, fed back by the engine to the core
+    states; ``feedback`` applies the correction's own blocks to its memory.
+
+``after`` runs once per sample after the update and feedback (bookkeeping
+that needs the corrected state, e.g. the heading at the end of a stance).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._jit import HAVE_NUMBA, numba
+
+#: Offsets in ``nav``: quaternion, position, velocity, gyro bias, accelerometer bias.
+Q, P, V, BG, BA = 0, 4, 7, 10, 13
+NAV_SIZE = 16
+#: Positions in ``idx`` of the core blocks' offsets; a correction's own blocks follow from ``OWN``.
+ATT, GYRO_BIAS, POS, VEL, ACC_BIAS, OWN = 0, 1, 2, 3, 4, 5
+CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
+
+if HAVE_NUMBA:
+    from numba import types as _t
+
+    MEASURE_SIGNATURE = _t.int64(
+        _t.int64, _t.float64, _t.float64[::1], _t.float64[::1], _t.float64[::1], _t.boolean, _t.int64[::1],
+        _t.float64[:], _t.float64[:], _t.float64[:], _t.float64[::1], _t.float64[:, ::1], _t.float64[::1],
+        _t.int64,
+    )
+    FEEDBACK_SIGNATURE = _t.none(_t.float64[::1], _t.int64[::1], _t.float64[:], _t.float64[:])
+    AFTER_SIGNATURE = _t.none(_t.int64, _t.float64[::1], _t.boolean, _t.int64[::1], _t.float64[:], _t.float64[:])
+else:  # pragma: no cover - exercised with FOOTZOO_DISABLE_JIT=1
+    MEASURE_SIGNATURE = FEEDBACK_SIGNATURE = AFTER_SIGNATURE = None
+
+
+class NotCompilable(Exception):
+    """A measurement model's functions cannot be compiled; carries the reason."""
+
+
+def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[..., Any]:
+    if not HAVE_NUMBA:
+        return fn
+    if isinstance(fn, numba.core.registry.CPUDispatcher):
+        if fn.signatures and all(tuple(s) == tuple(signature.args) for s in fn.signatures):
+            return fn
+        fn = fn.py_func
+    try:
+        return numba.njit(signature, cache=True, nogil=True)(fn)
+    except Exception as err:  # numba raises many types; the message is what matters
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise NotCompilable(f"{role} function {getattr(fn, '__qualname__', fn)!r}: {first}") from None
+
+
+def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
+    """Compile a ``measure`` function with the engine's signature (plain Python without numba).
+
+    Use as a decorator in a correction's module. A function that does not
+    compile raises :class:`NotCompilable` with numba's reason; leave the
+    decorator off to run such a correction on the reference engine.
+    """
+    return _compile(fn, MEASURE_SIGNATURE, "measure")
+
+
+def feedback_function(fn: Callable[..., None]) -> Callable[..., None]:
+    """Compile a ``feedback`` function with the engine's signature."""
+    return _compile(fn, FEEDBACK_SIGNATURE, "feedback")
+
+
+def after_function(fn: Callable[..., None]) -> Callable[..., None]:
+    """Compile an ``after`` function with the engine's signature."""
+    return _compile(fn, AFTER_SIGNATURE, "after")
+
+
+def _no_feedback(dx, idx, par, mem):  # noqa: ARG001 - the signature is the contract
+    return None
+
+
+def _no_after(k, nav, stance, idx, par, mem):  # noqa: ARG001
+    return None
+
+
+NO_FEEDBACK = feedback_function(_no_feedback)
+NO_AFTER = after_function(_no_after)
+
+
+@dataclass
+class StateBlock:
+    """An error-state block a correction adds (or a core bias block it switches on).
+
+    Parameters
+    ----------
+    name : str
+        Block name; ``gyro_bias`` and ``acc_bias`` enable the core bias blocks, any other name
+        is the correction's own.
+    size : int
+        Number of states.
+    initial_variance : float
+        Initial variance of each state (unit² of the state).
+    noise : float
+        Variance growth per second of each state (unit²/s).
+    """
+
+    name: str
+    size: int
+    initial_variance: float
+    noise: float = 0.0
+
+
+@dataclass
+class MeasurementModel:
+    """What a Kalman correction hands the engine (see the module docstring for the function contract).
+
+    Attributes
+    ----------
+    measure, feedback, after : callable
+        The model's functions.
+    max_rows : int
+        Most rows ``measure`` writes at one sample.
+    par : (p,) ndarray
+        Constants.
+    mem : (s,) ndarray
+        Initial memory (the engine works on a copy).
+    data : (N, d) ndarray
+        Per-sample inputs, one row per sample (``d`` may be 0).
+    block_names : list of str
+        The correction's own blocks, in ``idx`` order after the core ones.
+    diagnostics : callable, optional
+        ``diagnostics(mem) -> dict`` of results to keep in ``Result.diagnostics`` after the run.
+    """
+
+    measure: Callable[..., int]
+    max_rows: int
+    par: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    mem: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    data: np.ndarray | None = None
+    feedback: Callable[..., None] = NO_FEEDBACK
+    after: Callable[..., None] = NO_AFTER
+    block_names: list[str] = field(default_factory=list)
+    diagnostics: Callable[[np.ndarray], dict[str, Any]] | None = None
+
+    def compiled(self) -> MeasurementModel:
+        """The same model with its functions compiled; raises :class:`NotCompilable` with the reason."""
+        return MeasurementModel(
+            measure=measurement_function(self.measure), max_rows=self.max_rows, par=self.par, mem=self.mem,
+            data=self.data, feedback=feedback_function(self.feedback), after=after_function(self.after),
+            block_names=self.block_names, diagnostics=self.diagnostics,
+        )
+
+
+def yaw_of(nav: np.ndarray) -> float:
+    """Z-Y-X heading of ``nav``'s attitude (rad); usable inside compiled measurement functions."""
+    w, x, y, z = nav[0], nav[1], nav[2], nav[3]
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+if HAVE_NUMBA:
+    yaw_of = numba.njit(cache=True, nogil=True)(yaw_of)
