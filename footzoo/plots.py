@@ -216,17 +216,18 @@ def time_column(steps: pd.DataFrame, *names: str) -> str | None:
     return None
 
 
-def _stride_ends(result: Result) -> tuple[np.ndarray, np.ndarray] | None:
-    """Times (s) and positions (K, 3) of the stride borders (every stride's start, and the last end)."""
+def _stride_ends(result: Result) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Stride numbers, end times (s) and end positions (K, 3) of the strides whose end is known."""
     steps = result.steps
-    start, end = time_column(steps, "start"), time_column(steps, "end")
-    if len(steps) == 0 or start is None or end is None:
+    end = time_column(steps, "end")
+    if len(steps) == 0 or end is None:
         return None
-    times = np.append(steps[start].to_numpy(float), float(steps[end].iloc[-1]))
-    times = times[np.isfinite(times)]
+    times = steps[end].to_numpy(float)
+    number = np.flatnonzero(np.isfinite(times))
+    times = times[number]
     t = result.samples["t"].to_numpy()
     pos = result.pos
-    return times, np.column_stack([np.interp(times, t, pos[:, i]) for i in range(3)])
+    return number, times, np.column_stack([np.interp(times, t, pos[:, i]) for i in range(3)])
 
 
 def _legend_below(ax: Axes, ncol: int = 4) -> None:
@@ -246,7 +247,7 @@ def _title(result: Result, recording: Recording | None) -> str:
 
 @styled
 def trajectory_figure(result: Result, recording: Recording | None = None) -> Figure:
-    """Top view (east vs north) with stride borders numbered, and height over time with stance shaded.
+    """Top view (east vs north) with the stride ends numbered, and height over time with stance shaded.
 
     The reference (``recording.truth.pos``), when present, is drawn yaw-aligned in black dashes.
     """
@@ -262,13 +263,13 @@ def trajectory_figure(result: Result, recording: Recording | None = None) -> Fig
     top.plot(pos[::s, 1], pos[::s, 0], color="C0", lw=1.3, label="estimate")
     ends = _stride_ends(result)
     if ends is not None:
-        _, p = ends
+        number, _, p = ends
         top.plot(p[:, 1], p[:, 0], "o", ms=3.5, mfc="white", mec="C0", mew=1,
-                 label=f"stride borders ({len(p) - 1} strides)")
+                 label=f"stride ends, numbered ({len(result.steps)} strides)")
         every = max(1, int(np.ceil(len(p) / 12)))
-        for i in range(0, len(p), every):
-            top.annotate(str(i), (p[i, 1], p[i, 0]), textcoords="offset points", xytext=(3, 3), fontsize=7,
-                         color="C0")
+        for k in range(0, len(p), every):
+            top.annotate(str(number[k]), (p[k, 1], p[k, 0]), textcoords="offset points", xytext=(3, 3),
+                         fontsize=7, color="C0")
     top.plot(pos[0, 1], pos[0, 0], "^", color="C2", ms=8, label="start")
     top.plot(pos[-1, 1], pos[-1, 0], "s", color="C3", ms=7, label="end")
     top.set_xlabel("east (m)")
@@ -527,7 +528,7 @@ def plot_run(result: Result, out: str | Path, recording: Recording | None = None
              window: tuple[float, float] | None = None) -> list[Path]:
     """Write the run's figures into the folder ``out``; returns the files written.
 
-    ``trajectory.png`` (top view with stride borders and reference, height),
+    ``trajectory.png`` (top view with numbered stride ends and reference, height),
     ``states.png`` (attitude, velocity, gait phase; ``window`` in s limits it),
     ``errors.png`` (only with a reference), ``strides.png`` and ``fpa.png``
     (only when the run found strides / foot progression angles).

@@ -78,7 +78,7 @@ def test_reference_is_aligned_onto_the_estimate(walk):
     assert np.allclose(aligned_reference(fake, rec), fake.pos, atol=1e-9)
     fig = trajectory_figure(res, rec)
     assert "reference (yaw-aligned)" in legend_texts(fig)
-    assert any(t.startswith("stride borders (") for t in legend_texts(fig))
+    assert f"stride ends, numbered ({len(res.steps)} strides)" in legend_texts(fig)
     close(fig)
 
 
@@ -120,44 +120,42 @@ def test_a_recording_that_does_not_match_the_result_is_refused(walk):
 def test_strides_figure_uses_gait_event_columns_and_reference(walk):
     rec, res = walk
     steps = res.steps.copy()
-    # columns another part of footzoo may add, with units in their names
-    steps["stance_time_s"] = 0.6
-    steps["swing_time_s"] = 0.4
-    steps["fpa_deg"] = 8.0
-    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions)
+    steps["fpa_deg"] = 8.0  # as the huang_fpa analysis adds it
+    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
+                               diagnostics=res.diagnostics)
     fig = strides_figure(res2, rec)
     titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_visible()]
     assert any(t.startswith("stance time") for t in titles)
     assert any(t.startswith("swing time") for t in titles)
     assert any(t.startswith("foot progression angle: median 8 deg") for t in titles)
-    assert "reference" in legend_texts(fig)
+    assert "reference" in legend_texts(fig)  # the simulator's true strides, matched by time
     close(fig)
     fig = fpa_figure(res2, rec)
-    assert fig is not None
-    close(fig)
-
-
-def test_stride_table_with_unit_names_and_gait_events(walk):
-    """A stride table whose columns carry units (``start_s``, ``to_s``, ``stride_length_m`` ...)."""
-    rec, res = walk
-    st = res.steps
-    steps = pd.DataFrame({"start_s": st["start"], "to_s": st["start"] + 0.45, "end_s": st["end"],
-                          "stride_time_s": st["stride_time"], "stance_time_s": 0.6, "swing_time_s": 0.4,
-                          "stride_length_m": st["stride_length"], "speed_m_s": st["speed"],
-                          "heading_rad": st["heading"], "max_clearance_m": st["max_clearance"], "fpa_rad": 0.1})
-    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
-                               diagnostics=res.diagnostics)
-    fig = strides_figure(res2, rec)
-    titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
-    assert titles == {"stride length", "stride time", "stance time", "swing time", "speed", "max. foot clearance",
-                      "foot progression angle"}
-    close(fig)
-    fig = trajectory_figure(res2, rec)
-    assert f"stride borders ({len(steps)} strides)" in legend_texts(fig)
+    assert "reference" in legend_texts(fig)
     close(fig)
     fig = states_figure(res2, rec, window=(2.0, 6.0))
     events = [t for ax in fig.axes if ax.get_legend() for t in [x.get_text() for x in ax.get_legend().get_texts()]]
     assert "initial contact" in events and "toe-off" in events
+    close(fig)
+
+
+def test_stride_table_without_units_in_its_names(walk):
+    """An older stride table (``start``, ``end``, ``stride_length`` ..., angles in rad) draws the same panels."""
+    rec, res = walk
+    st = res.steps
+    legacy = pd.DataFrame({"start": st["start_s"], "end": st["end_s"], "stride_time": st["stride_time_s"],
+                           "stride_length": st["stride_length_m"], "speed": st["speed_m_s"],
+                           "heading": st["heading_rad"], "max_clearance": st["max_clearance_m"], "fpa": 0.1})
+    res2 = footzoo.data.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
+                               diagnostics=res.diagnostics)
+    fig = strides_figure(res2, rec)
+    titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
+    assert titles == {"stride length", "stride time", "speed", "max. foot clearance", "foot progression angle"}
+    fpa_title = [ax.get_title(loc="left") for ax in fig.axes if ax.get_title(loc="left").startswith("foot")]
+    assert fpa_title == [f"foot progression angle: median {np.degrees(0.1):.3g} deg"]
+    close(fig)
+    fig = trajectory_figure(res2, rec)
+    assert f"stride ends, numbered ({len(legacy)} strides)" in legend_texts(fig)
     close(fig)
 
 
