@@ -46,9 +46,8 @@ log = logging.getLogger("mkdocs.hooks.footzoo")
 
 KIND_TITLES = {"orientation": "Orientation", "detector": "Stance detectors", "correction": "Corrections",
                "analysis": "Analysis"}
-#: Class attributes shown as a plug-in's capabilities when it declares them.
-CAPABILITIES = ("role", "causal", "can_stream", "needs_magnetometer", "needs_truth", "needs_distance",
-                "state_blocks", "states")
+#: Class attributes of a plug-in that are not capabilities.
+NOT_CAPABILITIES = {"kind", "name", "paper", "units"}
 
 _gallery_dir: Path | None = None
 
@@ -77,6 +76,29 @@ def numpy_section(doc: str, name: str) -> dict[str, str]:
                         out[p] = (out[p] + " " + line.strip()).strip()
                 j += 1
             break
+    return out
+
+
+def capabilities(cls: type) -> dict[str, str]:
+    """The declared class attributes (``causal``, ``needs_magnetometer``, ``observes`` ...) of a plug-in class.
+
+    Every annotated class attribute of its bases that holds a flag, a name or a tuple of names,
+    so a capability added to the base classes appears without an edit here.
+    """
+    names: list[str] = []
+    for base in reversed(cls.__mro__):
+        for n in vars(base).get("__annotations__", {}):
+            if n not in names and n not in NOT_CAPABILITIES and not n.startswith("_"):
+                names.append(n)
+    out = {}
+    for n in names:
+        v = getattr(cls, n, None)
+        if isinstance(v, bool):
+            out[n] = "yes" if v else "no"
+        elif isinstance(v, str) and v:
+            out[n] = f"`{v}`"
+        elif isinstance(v, tuple) and v and all(isinstance(x, str) for x in v):
+            out[n] = ", ".join(f"`{x}`" for x in v)
     return out
 
 
@@ -124,9 +146,9 @@ def plugin_pages() -> dict[str, str]:
             if paper:
                 lines += [f"**Paper:** {paper}", ""]
             lines += [f"**Class:** `{cls.__module__}.{cls.__qualname__}`", ""]
-            caps = [(c, getattr(cls, c)) for c in CAPABILITIES if getattr(cls, c, None) not in (None, "", (), [], {})]
+            caps = capabilities(cls)
             if caps:
-                lines += ["**Capabilities:** " + ", ".join(f"`{c}` = `{v!r}`" for c, v in caps), ""]
+                lines += ["**Capabilities:** " + ", ".join(f"`{c}`: {v}" for c, v in caps.items()), ""]
             names = [p for p in sig.parameters if p != "self" and sig.parameters[p].kind not in
                      (inspect.Parameter.VAR_KEYWORD, inspect.Parameter.VAR_POSITIONAL)]
             spec: dict[str, Any] = {"type": name}
