@@ -190,9 +190,11 @@ def robust_limits(values: np.ndarray, k: float = 6.0, rel: float = 0.5) -> tuple
     return float(inside.min() - pad), float(inside.max() + pad)
 
 
-def _clip_outliers(ax: Axes, x: np.ndarray, y: np.ndarray, color: str) -> int:
-    """Limit the y axis to the bulk of ``y``; draw outliers as triangles at the edge. Returns their count."""
-    lim = robust_limits(y)
+def _clip_outliers(ax: Axes, x: np.ndarray, y: np.ndarray, color: str, also: np.ndarray | None = None) -> int:
+    """Limit the y axis to the bulk of ``y`` (and of ``also``, e.g. the reference values, which it keeps in view);
+    draw the outliers of ``y`` as triangles at the edge. Returns their count."""
+    both = y if also is None else np.concatenate([y, np.asarray(also, dtype=float)])
+    lim = robust_limits(both)
     if lim is None:
         return 0
     lo, hi = lim
@@ -228,6 +230,27 @@ def _stride_ends(result: Result) -> tuple[np.ndarray, np.ndarray, np.ndarray] | 
     t = result.samples["t"].to_numpy()
     pos = result.pos
     return number, times, np.column_stack([np.interp(times, t, pos[:, i]) for i in range(3)])
+
+
+def reference_strides(steps: pd.DataFrame, recording: Recording | None) -> tuple[np.ndarray, pd.DataFrame] | None:
+    """The recording's reference strides paired with the estimated ones, and the stride number of each pair.
+
+    Pairs by time with :func:`footzoo.metrics.match_strides`; None without reference strides or
+    when the tables lack the columns to pair them by.
+    """
+    ref = recording.truth.steps if recording is not None and recording.truth is not None else None
+    if ref is None or len(ref) == 0 or len(steps) == 0:
+        return None
+    from .metrics import match_strides
+
+    try:
+        matched = match_strides(steps, ref)
+    except (KeyError, ValueError, TypeError):  # tables without the columns to pair strides by
+        return None
+    end, est_end = time_column(steps, "end"), time_column(matched, "est_end")
+    if len(matched) == 0 or end is None or est_end is None:
+        return None
+    return np.searchsorted(steps[end].to_numpy(float), matched[est_end].to_numpy(float)), matched
 
 
 def _legend_below(ax: Axes, ncol: int = 4) -> None:
@@ -426,17 +449,7 @@ def strides_figure(result: Result, recording: Recording | None = None) -> Figure
     if not found:
         return None
     plt = pyplot()
-    ref_steps = recording.truth.steps if recording is not None and recording.truth is not None else None
-    matched = None
-    if ref_steps is not None and len(ref_steps):
-        from .metrics import match_strides
-
-        try:
-            matched = match_strides(steps, ref_steps)
-        except (KeyError, ValueError, TypeError):  # tables without the columns to pair strides by
-            matched = None
-    end_col = time_column(steps, "end")
-    est_end = time_column(matched, "est_end") if matched is not None else None
+    reference = reference_strides(steps, recording)
     n = len(found)
     ncol = 2 if n > 2 else 1
     nrow = int(np.ceil(n / ncol))
@@ -447,12 +460,10 @@ def strides_figure(result: Result, recording: Recording | None = None) -> Figure
         ax.plot(x, values, "o-", color="C0", ms=3.5, lw=0.8, label="estimate")
         finite = values[np.isfinite(values)]
         med = f": median {np.median(finite):.3g}" if finite.size else ""
-        if matched is not None and len(matched) and est_end is not None and end_col is not None:
-            ref = step_column(matched, name)
-            if ref is not None:  # at the stride number of the matched estimate
-                at = np.searchsorted(steps[end_col].to_numpy(float), matched[est_end].to_numpy(float))
-                ax.plot(at, ref[0], "x", color="k", ms=5, label="reference")
-        _clip_outliers(ax, x, values, "C0")
+        ref = step_column(reference[1], name) if reference is not None else None
+        if ref is not None:
+            ax.plot(reference[0], ref[0], "x", color="k", ms=5, label="reference")
+        _clip_outliers(ax, x, values, "C0", also=ref[0] if ref is not None else None)
         lo, hi = ax.get_ylim()
         if finite.size and hi - lo < 0.05 * abs(float(np.median(finite))):  # mm on a metre is not a swing
             half = 0.025 * abs(float(np.median(finite)))
@@ -488,22 +499,20 @@ def fpa_figure(result: Result, recording: Recording | None = None) -> Figure | N
         return None
     plt = pyplot()
     fpa = col[0]
-    fig, (ax, hist) = plt.subplots(1, 2, figsize=(9, 3.4), gridspec_kw={"width_ratios": [2.2, 1]}, sharey=True)
+    fig, (ax, hist) = plt.subplots(1, 2, figsize=(9, 3.8), gridspec_kw={"width_ratios": [2.2, 1]}, sharey=True,
+                                   layout="constrained")
     x = np.arange(len(fpa))
     ax.plot(x, fpa, "o-", ms=3.5, lw=0.8, color="C1", label="estimate")
-    ref_steps = recording.truth.steps if recording is not None and recording.truth is not None else None
-    ref = step_column(ref_steps, "fpa") if ref_steps is not None else None
-    if ref is not None and len(ref[0]) == len(fpa):
-        ax.plot(x, ref[0], "x", color="k", ms=5, label="reference")
+    reference = reference_strides(result.steps, recording)
+    ref = step_column(reference[1], "fpa") if reference is not None else None
+    if ref is not None:
+        ax.plot(reference[0], ref[0], "x", color="k", ms=5, label="reference")
     finite = fpa[np.isfinite(fpa)]
     if finite.min() < 0 < finite.max():
         ax.axhline(0, color="0.4", lw=0.6)
     ax.set_xlabel("stride number")
     ax.set_ylabel("foot progression angle (deg, toe-out +)")
-    ax.legend(loc="lower right")
-    lim = robust_limits(finite)
-    if lim is not None:
-        ax.set_ylim(*lim)
+    _clip_outliers(ax, x, fpa, "C1", also=ref[0] if ref is not None else None)
     lo, hi = ax.get_ylim()
     if hi - lo < MIN_FPA_SPAN:  # do not blow sensor noise up to a full axis
         mid = (lo + hi) / 2
@@ -513,9 +522,8 @@ def fpa_figure(result: Result, recording: Recording | None = None) -> Figure | N
     med = float(np.median(finite))
     hist.axhline(med, color="k", lw=0.8, label=f"median {med:.1f}°")
     hist.set_xlabel("strides")
-    hist.legend(loc="lower right")
+    fig.legend(loc="outside lower center", ncol=3)
     fig.suptitle(f"{_title(result, recording)}: foot progression angle")
-    fig.tight_layout()
     return fig
 
 
