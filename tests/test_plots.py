@@ -132,6 +132,11 @@ def test_strides_figure_uses_gait_event_columns_and_reference(walk):
     close(fig)
     fig = fpa_figure(res2, rec)
     assert "reference" in legend_texts(fig)
+    ax = fig.axes[0]
+    ref_y = next(line.get_ydata() for line in ax.lines if line.get_label() == "reference")
+    assert np.allclose(ref_y, 8.0, atol=0.5)  # the simulator's true FPA (deg)
+    lo, hi = ax.get_ylim()
+    assert lo <= ref_y.min() and ref_y.max() <= hi  # kept in view
     close(fig)
     fig = states_figure(res2, rec, window=(2.0, 6.0))
     events = [t for ax in fig.axes if ax.get_legend() for t in [x.get_text() for x in ax.get_legend().get_texts()]]
