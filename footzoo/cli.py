@@ -1,16 +1,34 @@
-"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``."""
+"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``.
+
+Bad input never prints a Python traceback: the message names the input, the
+problem and the fix, and the exit code says which kind of problem it was
+(``--debug`` adds the traceback):
+
+====  ==============================================================================
+code  meaning
+====  ==============================================================================
+0     success
+1     internal error: a bug in footzoo (rerun with ``--debug`` and report it)
+2     usage or configuration error: bad arguments, config, study or calibration file
+3     data error: unreadable, malformed or implausible recording; unwritable output
+130   interrupted (Ctrl-C)
+====  ==============================================================================
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import traceback
 import warnings
 from pathlib import Path
 from typing import Any
 
 from .conventions import ACC_UNITS, GYR_UNITS
-from .errors import FootzooError, FormatError
+from .errors import ConfigError, FootzooError, FormatError, RecordingError
+from .io.canonical import FLOAT_FORMAT
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -21,6 +39,70 @@ def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
         if getattr(args, key, None):
             options[key] = getattr(args, key)
     return options
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_USAGE = 2
+EXIT_DATA = 3
+EXIT_INTERRUPTED = 130
+
+EXIT_CODES_HELP = """exit codes:
+  0    success
+  1    internal error (a bug in footzoo: rerun with --debug and report it)
+  2    usage or configuration error (arguments, config, study or calibration file)
+  3    data error (unreadable, malformed or implausible recording; unwritable output)
+  130  interrupted
+"""
+
+
+class OutputError(FootzooError, OSError):
+    """An output location cannot be written (exit code 3)."""
+
+
+def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
+    """An argparse ``type``: a finite number in [lo, hi] (a usage error, exit code 2, otherwise)."""
+
+    def parse(text: str) -> float | int:
+        try:
+            value = int(text) if integer else float(text)
+        except ValueError:
+            kind = "a whole number" if integer else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
+        if not (lo <= value <= hi):  # also rejects nan
+            u = f" {unit}" if unit else ""
+            raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must lie in [{lo:g}, {hi:g}]{u}")
+        return value
+
+    return parse
+
+
+def _writable_dir(path: str, option: str = "--out") -> Path:
+    """Create ``path`` if needed and check it is a writable directory, before any work is done."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{option} {path!r} exists and is not a directory; choose a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except PermissionError:
+        raise OutputError(f"{option} {path!r} cannot be created (permission denied); choose a writable place") from None
+    except OSError as err:
+        raise OutputError(f"{option} {path!r} cannot be created: {err.strerror or err}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable directory")
+    return out
+
+
+def _writable_file(path: str, option: str = "--out") -> Path:
+    """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
+    p = Path(path)
+    if p.is_dir():
+        raise OutputError(f"{option} {path!r} is a directory; give a file name")
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"{option} {path!r}: the folder {str(folder)!r} does not exist; create it first")
+    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable place")
+    return p
 
 
 def _load_recording(args: argparse.Namespace):
@@ -42,10 +124,10 @@ def _two_feet(args: argparse.Namespace) -> bool:
         return False
     if args.foot not in (None, "both"):
         return False
-    from .io import detect_format
+    from .io import check_input_file, detect_format
     from .io.gaitmap import feet
 
-    fmt = args.format or detect_format(args.data)
+    fmt = args.format or detect_format(check_input_file(args.data))
     if fmt != "gaitmap":
         if args.foot == "both":
             raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file")
@@ -62,8 +144,8 @@ def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
 def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
     """samples.csv, steps.csv (units in the column names), metrics.json and optionally the run's figures."""
     out.mkdir(parents=True, exist_ok=True)
-    result.samples.to_csv(out / "samples.csv", index=False, float_format="%.9g")
-    result.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
+    result.samples.to_csv(out / "samples.csv", index=False, float_format=FLOAT_FORMAT)
+    result.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
     payload = {"metrics": result.metrics, "config": result.config, "versions": result.versions,
                "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
     (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
@@ -80,6 +162,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .pipeline import Pipeline
 
     pipeline = Pipeline.from_yaml(args.config)
+    out = _writable_dir(args.out) if args.out else None
     if args.plot and not args.out:
         print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
         return 2
@@ -96,8 +179,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
     ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
     _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
-    if args.out:
-        written = _write_result(result, rec, Path(args.out), args.plot)
+    if out is not None:
+        written = _write_result(result, rec, out, args.plot)
         print(f"wrote {', '.join(written)} to {args.out}")
     return 0
 
@@ -120,8 +203,8 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
         out = Path(args.out)
         for foot, r in res.results.items():
             written = _write_result(r, session.recordings[foot], out / foot, args.plot)
-        res.steps.to_csv(out / "steps.csv", index=False, float_format="%.9g")
-        res.bilateral.to_csv(out / "bilateral.csv", float_format="%.9g")
+        res.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
+        res.bilateral.to_csv(out / "bilateral.csv", float_format=FLOAT_FORMAT)
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out}")
     return 0
 
@@ -159,6 +242,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .io.canonical import write
     from .sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_calibration, simulate_pendulum
 
+    _writable_file(args.out)
     biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
     noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
     if args.scenario == "pendulum":
@@ -186,6 +270,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     from .analysis.foot_vector import calibrate_foot_vector
 
+    _writable_file(args.out)
     rec = _load_recording(args)
     fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
                                flex=tuple(args.flex) if args.flex else None)
@@ -229,9 +314,14 @@ def cmd_list_compat(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``footzoo`` command."""
     parser = argparse.ArgumentParser(
-        prog="footzoo", description="Foot-mounted IMU motion estimation: a zoo of published building blocks."
+        prog="footzoo", description="Foot-mounted IMU motion estimation: a zoo of published building blocks.",
+        epilog=EXIT_CODES_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the Python traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
     run.add_argument("config", help="pipeline YAML, e.g. configs/yun2012.yaml")
@@ -251,16 +341,22 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
                                           "calibration"])
     sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
-    sim.add_argument("--strides", type=int, default=100, help="strides of a straight walk (default 100)")
-    sim.add_argument("--stride-length", type=float, default=1.2, help="stride length in m (default 1.2)")
-    sim.add_argument("--rate", type=float, default=50.0, help="sampling rate in Hz (default 50)")
+    sim.add_argument("--strides", type=_number(1, 100_000, integer=True), default=100,
+                     help="strides of a straight walk (default 100)")
+    sim.add_argument("--stride-length", type=_number(0.05, 5.0, "m"), default=1.2,
+                     help="stride length in m (default 1.2)")
+    sim.add_argument("--rate", type=_number(10.0, 20_000.0, "Hz"), default=50.0,
+                     help="sampling rate in Hz (default 50)")
     sim.add_argument("--profile", choices=["paper", "physical"], default="paper", help="stance kinematics")
     sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
-    sim.add_argument("--noise-scale", type=float, default=1.0, help="factor on Table II noise σ (default 1)")
+    sim.add_argument("--noise-scale", type=_number(0.0, 1000.0), default=1.0,
+                     help="factor on Table II noise σ (default 1)")
     sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
     sim.add_argument("--seed", type=int, default=0)
-    sim.add_argument("--fpa", type=float, default=0.0, help="foot progression angle in deg (toe-out +)")
-    sim.add_argument("--mount-yaw", type=float, default=0.0, help="sensor yaw on the foot in deg")
+    sim.add_argument("--fpa", type=_number(-90.0, 90.0, "deg"), default=0.0,
+                     help="foot progression angle in deg (toe-out +)")
+    sim.add_argument("--mount-yaw", type=_number(-180.0, 180.0, "deg"), default=0.0,
+                     help="sensor yaw on the foot in deg")
     sim.add_argument("--foot", choices=["right", "left"], default="right")
     sim.add_argument("--distance-sensors", action="store_true", help="add two VL6180-like range sensors")
     sim.add_argument("--disturbance", action="store_true", help="add a magnetic disturbance (first 10 m north)")
@@ -272,8 +368,10 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
     cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
     cal.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
-    cal.add_argument("--still", nargs=2, type=float, metavar=("T0", "T1"), help="still period (s); default: found")
-    cal.add_argument("--flex", nargs=2, type=float, metavar=("T0", "T1"), help="flexion period (s); default: found")
+    cal.add_argument("--still", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="still period (s); default: found")
+    cal.add_argument("--flex", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="flexion period (s); default: found")
     cal.add_argument("--out", required=True, help="YAML file to write")
     cal.set_defaults(func=cmd_calibrate)
 
@@ -298,14 +396,65 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]:
+    """Sub-command parsers that also take ``--debug`` and list the exit codes in their help."""
+
+    class SubParser(argparse.ArgumentParser):
+        def __init__(self, **kwargs: Any):
+            kwargs.setdefault("parents", [common])
+            kwargs.setdefault("epilog", EXIT_CODES_HELP)
+            kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+            super().__init__(**kwargs)
+
+    return SubParser
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"footzoo: warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``footzoo`` console script."""
-    args = build_parser().parse_args(argv)
+    """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help (0) or a usage error (2, message already printed)
+        return int(stop.code) if isinstance(stop.code, int) else EXIT_USAGE
+    debug = bool(getattr(args, "debug", False))
+    if not debug:
+        warnings.showwarning = _show_warning
     try:
         return args.func(args)
-    except FootzooError as err:
-        print(f"footzoo: error: {err}", file=sys.stderr)
-        return 2
+    except KeyboardInterrupt:
+        print("footzoo: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: not an error
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_OK
+    except Exception as err:  # the command line's last line of defence: no traceback unless --debug
+        if debug:
+            traceback.print_exc()
+        code, text = _classify(err)
+        print(f"footzoo: {text}", file=sys.stderr)
+        return code
+
+
+def _classify(err: Exception) -> tuple[int, str]:
+    """Exit code and message for an exception leaving a command."""
+    if isinstance(err, (RecordingError, FormatError, OutputError)):
+        return EXIT_DATA, f"error: {err}"
+    if isinstance(err, (ConfigError, FootzooError)):
+        return EXIT_USAGE, f"error: {err}"
+    if isinstance(err, PermissionError):
+        return EXIT_DATA, (f"error: permission denied: {err.filename!r}; check the file's permissions or choose "
+                           "another location")
+    if isinstance(err, OSError):
+        where = f" {err.filename!r}" if err.filename else ""
+        return EXIT_DATA, f"error: cannot access{where}: {err.strerror or err}"
+    if isinstance(err, MemoryError):
+        return EXIT_DATA, "error: out of memory; use a smaller recording or study"
+    return EXIT_INTERNAL, (f"internal error: {type(err).__name__}: {err}. This is a bug in footzoo: rerun with "
+                           "--debug and report the traceback")
 
 
 if __name__ == "__main__":

@@ -16,9 +16,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from .checks import check_positive, check_range
 from .errors import ConfigError, did_you_mean
+from .yamlsafe import load_file
 
 TOP_LEVEL_KEYS: dict[str, str] = {
     "name": "pipeline name (text)",
@@ -39,14 +39,9 @@ REQUIRED = ("orientation", "detector")
 
 
 def load_yaml(path: str | Path) -> dict[str, Any]:
-    """Read a YAML file into a dict, with clear errors for missing or empty files."""
+    """Read a YAML config into a dict with the strict, bounded loader (:mod:`footzoo.yamlsafe`)."""
     p = Path(path)
-    if not p.exists():
-        raise ConfigError(f"config file {str(p)!r} does not exist; check the path (footzoo ships configs/*.yaml)")
-    try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as err:
-        raise ConfigError(f"{p}: not valid YAML: {err}") from None
+    data = load_file(p, ConfigError, "config file")
     if data is None:
         raise ConfigError(f"{p}: the file is empty; a config needs at least 'orientation' and 'detector'")
     if not isinstance(data, dict):
@@ -86,3 +81,21 @@ def check_top_level(d: dict[str, Any]) -> None:
     errors = top_level_errors(d)
     if errors:
         raise ConfigError("; ".join(errors))
+
+
+#: Longest accepted ``init.duration`` (s): the still start used for the initial alignment.
+INIT_DURATION_MAX = 60.0
+
+
+def check_init(init: dict[str, Any]) -> dict[str, float]:
+    """Validate ``init`` (``duration`` in s, ``max_gyr`` in rad/s) and fill in the defaults."""
+    if not isinstance(init, dict):
+        raise ConfigError(f"init must be a mapping like {{duration: 0.5, max_gyr: 0.6}}, got {init!r}")
+    unknown = [k for k in init if k not in INIT_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown init key {unknown[0]!r}{did_you_mean(str(unknown[0]), list(INIT_KEYS))}; "
+                          f"valid: {list(INIT_KEYS)}")
+    out = {**INIT_KEYS, **init}
+    out["duration"] = check_range("init.duration", out["duration"], 0.0, INIT_DURATION_MAX, "s", lo_open=True)
+    out["max_gyr"] = check_positive("init.max_gyr", out["max_gyr"], unit="rad/s")
+    return out

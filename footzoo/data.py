@@ -15,8 +15,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .checks import check_positive
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
 from .errors import RecordingError
+from .sanity import check_impossible, scan
 
 ACC_COLS = ["acc_x", "acc_y", "acc_z"]
 GYR_COLS = ["gyr_x", "gyr_y", "gyr_z"]
@@ -29,6 +31,8 @@ TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
 MIN_DURATION = 1.0
 #: Default largest accepted gap between samples, in median sample periods.
 DEFAULT_MAX_GAP_PERIODS = 5.0
+#: Plausible median sampling rate of a foot-mounted IMU (Hz); outside it the time stamps are not in seconds.
+RATE_RANGE = (10.0, 20_000.0)
 #: Gyro peak (in the declared unit rad/s) above which the data must be in deg/s.
 GYRO_DEG_S_SUSPICION = 50.0
 
@@ -128,19 +132,26 @@ class Recording:
     max_gap: float | None = None
 
     def __post_init__(self) -> None:
-        self.t = np.ascontiguousarray(self.t, dtype=float)
-        self.acc = np.ascontiguousarray(self.acc, dtype=float)
-        self.gyr = np.ascontiguousarray(self.gyr, dtype=float)
+        self.t = _floats("t", self.t)
+        self.acc = _floats("acc", self.acc)
+        self.gyr = _floats("gyr", self.gyr)
         if self.mag is not None:
-            self.mag = np.ascontiguousarray(self.mag, dtype=float)
+            self.mag = _floats("mag", self.mag)
         if self.dist is not None:
-            self.dist = np.ascontiguousarray(self.dist, dtype=float)
+            self.dist = _floats("dist", self.dist)
             if self.dist.ndim == 1:
                 self.dist = self.dist[:, None]
+        if not isinstance(self.meta, dict):
+            raise RecordingError(f"meta must be a dict, got {type(self.meta).__name__}")
+        if self.truth is not None and not isinstance(self.truth, Truth):
+            raise RecordingError(f"truth must be a footzoo Truth, got {type(self.truth).__name__}")
         validate_recording(self)
         self.meta = dict(self.meta)
         self.meta.setdefault("name", "recording")
         self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
+        findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]))
+        if findings:
+            self.meta["sanity"] = findings
 
     def __repr__(self) -> str:
         channels = ["acc", "gyr"] + [k for k in ("mag", "dist") if getattr(self, k) is not None]
@@ -201,6 +212,8 @@ class Recording:
         max_gap : float, optional
             Largest accepted gap (s); default 5 median sample periods.
         """
+        if not isinstance(df, pd.DataFrame):
+            raise RecordingError(f"from_dataframe expects a pandas DataFrame, got {type(df).__name__}")
         _check_choice("acc_unit", acc_unit, ACC_UNITS)
         _check_choice("gyr_unit", gyr_unit, GYR_UNITS)
         _check_choice("dist_unit", dist_unit, DIST_UNITS)
@@ -246,6 +259,11 @@ class Recording:
                     frame = pd.DataFrame(values).interpolate(limit_direction="both")
                     return frame.to_numpy(dtype=float)
                 row, col = np.argwhere(bad)[0]
+                if bad[:, col].all():
+                    raise RecordingError(
+                        f"column {cols[col]!r} holds no numbers (first value {df[cols[col]].iloc[0]!r}); check the "
+                        "file's delimiter and decimal separator (footzoo reads ',' between values and '.' in numbers)"
+                    )
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
                     f"first at row {row} (t = {t[row]!r}); drop or repair those rows, "
@@ -289,12 +307,31 @@ class Recording:
         return pd.DataFrame(cols)
 
 
+def _floats(name: str, value: Any) -> np.ndarray:
+    """``value`` as a contiguous float array, or a RecordingError naming the input."""
+    try:
+        return np.ascontiguousarray(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise RecordingError(
+            f"{name} must be numbers (an array of floats), got {type(value).__name__}: {err}"
+        ) from None
+
+
 def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
     def get(cols: list[str]) -> np.ndarray | None:
         return df[cols].to_numpy(dtype=float) if all(c in df.columns for c in cols) else None
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
-    stance = df["true_stance"].to_numpy().astype(bool) if "true_stance" in df.columns else None
+    stance = None
+    if "true_stance" in df.columns:
+        flags = pd.to_numeric(df["true_stance"], errors="coerce").to_numpy(dtype=float)
+        if not np.isin(flags, (0.0, 1.0)).all():
+            k = int(np.argmax(~np.isin(flags, (0.0, 1.0))))
+            raise RecordingError(
+                f"column 'true_stance' must hold 0 or 1 in every row, got {df['true_stance'].iloc[k]!r} at row {k}; "
+                "fix the column or drop it"
+            )
+        stance = flags.astype(bool)
     dist_cols = sorted(c for c in df.columns if c.startswith("true_dist_"))
     dist = df[dist_cols].to_numpy(dtype=float) if dist_cols else None
     if pos is None and vel is None and quat is None and stance is None:
@@ -303,7 +340,7 @@ def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
 
 
 def _check_choice(name: str, value: str, allowed) -> None:
-    if value not in allowed:
+    if not isinstance(value, str) or value not in allowed:
         raise RecordingError(f"{name}={value!r} is not supported; use one of {list(allowed)}")
 
 
@@ -328,6 +365,10 @@ def validate_recording(rec: Recording) -> None:
         raise RecordingError(f"dist must have {n} rows to match t, got {rec.dist.shape[0]}")
     if n < 3:
         raise RecordingError(f"the recording has only {n} sample(s); at least {MIN_DURATION} s is needed")
+    if rec.truth is not None:
+        _check_truth(rec.truth, n)
+    if rec.max_gap is not None:
+        rec.max_gap = check_positive("max_gap", rec.max_gap, unit="s")
     for name, arr in (("t", t), ("acc", acc), ("gyr", gyr), ("mag", rec.mag)):
         if arr is None:
             continue
@@ -352,6 +393,12 @@ def validate_recording(rec: Recording) -> None:
             "remove them, or pass duplicates='drop' to drop repeated rows (a warning gives the count)"
         )
     period = float(np.median(dt))
+    if not RATE_RANGE[0] <= 1.0 / period <= RATE_RANGE[1]:
+        raise RecordingError(
+            f"the median sampling rate is {1.0 / period:.6g} Hz (period {period:.6g}), outside the plausible "
+            f"{RATE_RANGE[0]:g}-{RATE_RANGE[1]:g} Hz of a foot-mounted IMU: are the time stamps in ms, µs or ns? "
+            "footzoo needs t in seconds (divide by 1e3, 1e6 or 1e9)"
+        )
     max_gap = rec.max_gap if rec.max_gap is not None else DEFAULT_MAX_GAP_PERIODS * period
     if np.any(dt > max_gap):
         k = int(np.argmax(dt > max_gap))
@@ -367,6 +414,35 @@ def validate_recording(rec: Recording) -> None:
             f"{MIN_DURATION} s, starting with the foot still"
         )
     _check_units(rec)
+    check_impossible(t, acc, gyr)
+
+
+def _check_truth(truth: Truth, n: int) -> None:
+    """Ground truth must cover the IMU samples one to one (checked at load, not after a run)."""
+    for name, arr, width in (("pos", truth.pos, 3), ("vel", truth.vel, 3), ("quat", truth.quat, 4),
+                             ("stance", truth.stance, None), ("dist", truth.dist, None)):
+        if arr is None:
+            continue
+        shape = np.shape(arr)
+        if len(shape) == 0 or shape[0] != n:
+            rows = shape[0] if len(shape) else 0
+            raise RecordingError(
+                f"ground truth {name} has {rows} rows but the IMU has {n} samples: truth must have one row per "
+                f"IMU sample. {'Shorter: the reference stops early' if rows < n else 'Longer'}; trim both to the "
+                "common time span, or drop the truth"
+            )
+        if width is not None and (len(shape) != 2 or shape[1] != width):
+            raise RecordingError(f"ground truth {name} must have shape ({n}, {width}), got {shape}")
+        if width is not None:
+            bad = ~np.isfinite(np.asarray(arr, dtype=float)).all(axis=1)
+            if bad.any():
+                k = int(np.argmax(bad))
+                where = (f"the reference stops at sample {k} while the IMU has {n} samples" if bad[k:].all()
+                         else f"{int(bad.sum())} row(s) are not finite, the first at sample {k}")
+                raise RecordingError(
+                    f"ground truth {name}: {where}; truth must cover every IMU sample: trim the recording to the "
+                    "reference's time span, or drop the truth columns"
+                )
 
 
 def _check_units(rec: Recording) -> None:
@@ -389,10 +465,11 @@ def _check_units(rec: Recording) -> None:
             f"accelerometer magnitude at rest is {rest:.3f} m/s², far from g = {GRAVITY}; "
             "check the unit (acc_unit) and the sensor's calibration"
         )
-    peak = float(gyr_norm.max())
+    # 99th percentile, not the maximum: a few corrupt samples are reported as such (sanity.check_impossible)
+    peak = float(np.quantile(gyr_norm, 0.99))
     if peak > GYRO_DEG_S_SUSPICION:
         raise RecordingError(
-            f"gyroscope peak is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
+            f"gyroscope 99th-percentile rate is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
             "this looks like deg/s; declare gyr_unit: deg/s"
         )
 

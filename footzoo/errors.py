@@ -20,7 +20,11 @@ class FormatError(FootzooError, ValueError):
 
 
 class FootzooWarning(UserWarning):
-    """Something footzoo handled but you should know: a bridged gap, a fallback engine, a clipped sensor, …"""
+    """A warning from footzoo: the result is computed but something in the input deserves a look."""
+
+
+class SensorWarning(FootzooWarning):
+    """Suspicious sensor data: saturated (clipped) axes, isolated spikes (glitches)."""
 
 
 def did_you_mean(word: str, options: list[str]) -> str:

@@ -18,7 +18,8 @@ import pandas as pd
 from ._version import __version__
 from .alignment import initial_attitude
 from .analysis.strides import segment_steps
-from .config import INIT_KEYS, check_top_level, load_yaml
+from .checks import GRAVITY_RANGE, check_range
+from .config import check_init, check_top_level, load_yaml
 from .conventions import GRAVITY, quat_to_euler
 from .data import Recording, Result
 from .errors import ConfigError, RecordingError
@@ -34,7 +35,7 @@ from .plugin import (
     Samples,
     VelocityCorrection,
 )
-from .registry import build, check_positive
+from .registry import build
 
 
 class Pipeline:
@@ -51,7 +52,7 @@ class Pipeline:
     name : str
         Pipeline name.
     gravity : float
-        g (m/s²).
+        g (m/s²), within :data:`footzoo.checks.GRAVITY_RANGE` (9.7–9.9).
     init : dict
         ``duration`` (s) and ``max_gyr`` (rad/s) of the still start used for alignment.
     analysis : list of Analysis
@@ -83,8 +84,8 @@ class Pipeline:
         self.corrections = list(corrections or [])
         self.analysis = list(analysis or [])
         self.name = name
-        self.gravity = check_positive("gravity", gravity)
-        self.init = {**INIT_KEYS, **(init or {})}
+        self.gravity = check_range("gravity", gravity, *GRAVITY_RANGE, "m/s^2")
+        self.init = check_init(init or {})
         self.navigation = (navigation if isinstance(navigation, NavigationNoise)
                            else NavigationNoise.from_dict(navigation))
         check_compatibility(orientation, detector, self.corrections)

@@ -17,6 +17,7 @@ import inspect
 import pkgutil
 from typing import Any
 
+from .checks import check_bool, check_positive, check_range, check_vector  # noqa: F401 - re-exported for plug-ins
 from .errors import ConfigError, did_you_mean
 from .plugin import BASES, Plugin
 
@@ -145,14 +146,3 @@ def _load_builtin() -> None:
     if loader is not None:
         loader()
 
-
-def check_positive(name: str, value: float, allow_zero: bool = False) -> float:
-    """Validate a numeric parameter; returns it as float."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be a number, got {value!r}") from None
-    if v != v or (v < 0 if allow_zero else v <= 0):
-        bound = ">= 0" if allow_zero else "> 0"
-        raise ConfigError(f"{name} must be {bound}, got {value!r}")
-    return v

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from .checks import validate_sample
 from .errors import ConfigError, FootzooWarning, RecordingError
 from .orientation.fqa import fqa
 from .plugin import KalmanCorrection, Samples
@@ -37,6 +38,8 @@ class Stream:
         Nominal sampling rate (Hz) for the detector's windows; default: measured over the still start.
     engine : {"auto", "fast", "reference"}
         As :meth:`Pipeline.run`.
+    max_gap : float
+        Longest accepted time between two pushed samples (s); a longer gap is an error.
 
     Examples
     --------
@@ -44,10 +47,12 @@ class Stream:
     >>> est = s.push(t, acc, gyr)          # None until the still start has been seen
     """
 
-    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto"):
+    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1):
         self.pipeline = pipeline
         self.rate = rate
         self.engine = engine
+        self.max_gap = max_gap
+        self._dist_width: int | None = None
         reasons = []
         if not pipeline.orientation.carried_by_filter:
             reasons.append(f"orientation {pipeline.orientation.name!r} is not carried by the Kalman filter "
@@ -65,6 +70,8 @@ class Stream:
             reasons.append("analysis plug-ins run on whole recordings")
         if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
+        if not (isinstance(max_gap, (int, float)) and not isinstance(max_gap, bool) and 0 < max_gap < np.inf):
+            reasons.append(f"max_gap must be a positive number of seconds, got {max_gap!r}")
         if reasons:
             raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
         self.init = dict(pipeline.init)
@@ -80,14 +87,12 @@ class Stream:
         dict with ``t``, ``quat`` (body -> NED), ``pos``, ``vel`` (NED) and
         ``stance`` for the newest sample.
         """
+        previous = self._buffer[-1][0] if self._buffer else None
+        t, acc, gyr, mag, dist = validate_sample(t, acc, gyr, mag, dist, previous, self.max_gap)
         acc = np.asarray(acc, dtype=float).reshape(3)
         gyr = np.asarray(gyr, dtype=float).reshape(3)
-        if not (np.isfinite(acc).all() and np.isfinite(gyr).all()):
-            raise RecordingError(f"non-finite sample at t = {t}: repair it before pushing")
         mag = None if mag is None else np.asarray(mag, dtype=float).reshape(3)
-        dist = None if dist is None else np.asarray(dist, dtype=float).reshape(-1)
-        if self._buffer and t <= self._buffer[-1][0]:
-            raise RecordingError(f"time went from {self._buffer[-1][0]} to {t}: samples must arrive in order")
+        dist = self._distance_row(dist)
         self._buffer.append((float(t), acc, gyr, mag, dist))
         if not self._ready:
             if t - self._buffer[0][0] <= self.init["duration"]:
@@ -100,6 +105,21 @@ class Stream:
             return out
         self._buffer = self._buffer[-1:]
         return self._step(float(t), acc, gyr, mag, dist)
+
+    def _distance_row(self, dist) -> np.ndarray | None:
+        """Readings of the distance sensors (m); NaN for a sample without them once a stream has them."""
+        if dist is None:
+            return None if self._dist_width is None else np.full(self._dist_width, np.nan)
+        row = np.asarray(dist, dtype=float).reshape(-1)
+        if self._dist_width is None:
+            if self._buffer:
+                raise RecordingError("distance readings started after the first sample: push dist (NaN where a "
+                                     "sensor has no reading) with every sample from the first one")
+            self._dist_width = row.size
+        elif row.size != self._dist_width:
+            raise RecordingError(f"dist has {row.size} readings, earlier samples had {self._dist_width}: push the "
+                                 "same sensors every time (NaN where one has no reading)")
+        return row
 
     def _start(self) -> None:
         b = self._buffer

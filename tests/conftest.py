@@ -15,3 +15,15 @@ def data_file(*parts: str) -> Path:
     if not p.exists():
         pytest.skip(f"shared data not available: {p}")
     return p
+
+
+def pytest_collection_modifyitems(config, items):
+    """Skip ``nightly`` tests (long fuzz profiles) unless ``-m nightly`` or ``FOOTZOO_NIGHTLY=1``."""
+    import os
+
+    if os.environ.get("FOOTZOO_NIGHTLY") == "1" or "nightly" in (config.getoption("-m") or ""):
+        return
+    skip = pytest.mark.skip(reason="nightly profile: run with -m nightly or FOOTZOO_NIGHTLY=1")
+    for item in items:
+        if "nightly" in item.keywords:
+            item.add_marker(skip)

@@ -43,7 +43,8 @@ def test_unknown_parameter_lists_valid_parameters():
 
 
 def test_bad_value_names_the_parameter():
-    with pytest.raises(ConfigError, match=r"detector \(angular_rate_fsm\): threshold must be > 0, got -1"):
+    with pytest.raises(ConfigError, match=r"detector \(angular_rate_fsm\): threshold = -1 rad/s is out of range: "
+                                          r"it must lie in \(0, 50\] rad/s"):
         Pipeline.from_dict(with_(detector={"type": "angular_rate_fsm", "threshold": -1}))
 
 

@@ -13,7 +13,7 @@ def frame(n=400, rate=100.0, acc_scale=1.0, gyr_scale=1.0):
     t = np.arange(n) / rate
     acc = np.tile([0.0, 0.0, -9.81], (n, 1)) + rng.normal(scale=0.02, size=(n, 3))
     gyr = rng.normal(scale=0.01, size=(n, 3))
-    gyr[200:260, 1] = 5.0  # a swing
+    gyr[200:260, 1] += 5.0  # a swing (noisy: a constant 5.0 would read as a clipped gyro)
     df = pd.DataFrame({"t": t})
     for i, a in enumerate("xyz"):
         df[f"acc_{a}"] = acc[:, i] * acc_scale

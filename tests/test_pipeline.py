@@ -114,9 +114,9 @@ def test_cli_list_shows_every_plugin(capsys):
 def test_cli_reports_bad_data_cleanly(tmp_path, capsys):
     bad = tmp_path / "bad.csv"
     bad.write_text("t,acc_x,acc_y,acc_z,gyr_x,gyr_y\n0,0,0,-9.8,0,0\n")
-    assert main(["run", CONFIG, "--data", str(bad)]) == 2
+    assert main(["run", CONFIG, "--data", str(bad)]) == 3  # data error
     assert "missing column(s) ['gyr_z']" in capsys.readouterr().err
     odd = tmp_path / "odd.csv"
     odd.write_text("a,b\n1,2\n")
-    assert main(["run", CONFIG, "--data", str(odd)]) == 2
+    assert main(["run", CONFIG, "--data", str(odd)]) == 3
     assert "cannot tell the format" in capsys.readouterr().err

@@ -73,7 +73,7 @@ def test_a_one_foot_file_is_not_a_session(tmp_path, capsys):
     path = data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat")
     with pytest.raises(FormatError, match="holds one foot"):
         Session.load(path)
-    assert main(["run", YUN, "--data", str(path), "--foot", "both"]) == 2
+    assert main(["run", YUN, "--data", str(path), "--foot", "both"]) == 3  # a data error
     assert "--foot both needs a gaitmap file" in capsys.readouterr().err
 
 
@@ -111,7 +111,7 @@ def test_pyshoe_trial_knows_its_foot_and_hand_counted_strides(capsys):
     # --foot right agrees with the file; --foot left is refused with the reason, not a TypeError
     assert main(["run", YUN, "--data", str(path), "--foot", "right"]) == 0
     assert "stride_count_error" in capsys.readouterr().out
-    assert main(["run", YUN, "--data", str(path), "--foot", "left"]) == 2
+    assert main(["run", YUN, "--data", str(path), "--foot", "left"]) == 3  # a data error
     assert "from the right foot" in capsys.readouterr().err
 
 

@@ -60,3 +60,15 @@ def test_bad_live_input_is_reported(walk):
     with pytest.raises(RecordingError, match="did not start still"):
         for k in range(k0, k0 + 80):
             moving.push(walk.t[k], walk.acc[k], walk.gyr[k])
+
+
+def test_distance_readings_missing_on_some_samples_count_as_no_reading(walk):
+    p = Pipeline.from_dict({"orientation": {"type": "ins"}, "detector": {"type": "dgp"},
+                            "corrections": [{"type": "zupt"}, {"type": "height_distance"}]})
+    s = Stream(p, rate=walk.rate)
+    for k in range(200):
+        s.push(walk.t[k], walk.acc[k], walk.gyr[k], dist=None if k % 3 == 1 else walk.dist[k])
+    late = Stream(p, rate=walk.rate)
+    late.push(walk.t[0], walk.acc[0], walk.gyr[0])
+    with pytest.raises(RecordingError, match="distance readings started after the first sample"):
+        late.push(walk.t[1], walk.acc[1], walk.gyr[1], dist=walk.dist[1])

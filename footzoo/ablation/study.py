@@ -11,10 +11,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from ..config import load_yaml
 from ..errors import ConfigError, did_you_mean
+from ..yamlsafe import load_file
 
 STUDY_KEYS = {
     "name": "study name",
@@ -93,12 +92,13 @@ class Study:
     def from_yaml(cls, path: str | Path) -> Study:
         """Read and check a study file; paths in it are relative to the file."""
         p = Path(path)
-        if not p.exists():
-            raise ConfigError(f"study file {str(p)!r} does not exist")
-        data = yaml.safe_load(p.read_text())
+        data = load_file(p, ConfigError, "study file")
         if not isinstance(data, dict):
             raise ConfigError(f"{p}: a study must be a mapping with base, factors, recordings")
-        return cls.from_dict(data, root=p.parent)
+        try:
+            return cls.from_dict(data, root=p.parent)
+        except ConfigError as err:
+            raise ConfigError(f"{p}: {err}") from None
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
@@ -122,16 +122,27 @@ class Study:
         factors = d.get("factors") or {}
         if not isinstance(factors, dict):
             raise ConfigError("factors must map dotted paths to lists of values, e.g. {detector.type: [dgp, shoe]}")
+        for k in factors:
+            if not isinstance(k, str) or not k:
+                raise ConfigError(f"factor names must be dotted paths like detector.threshold, got {k!r}")
         factors = {k: (v if isinstance(v, list) else [v]) for k, v in factors.items()}
         recordings = []
+        if not isinstance(d["recordings"] or [], list):
+            raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
         for i, r in enumerate(d["recordings"] or []):
             recordings += _expand_recording(r, root, i)
         if not recordings:
             raise ConfigError("the study has no recordings (check the globs)")
         metrics = d.get("metrics")
+        if metrics is not None and (not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics)):
+            raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}")
         sweep = d.get("sweep") or {}
-        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics,
-                   int(sweep.get("points", 0)) if isinstance(sweep, dict) else 0)
+        if not isinstance(sweep, dict) or set(sweep) - {"points"}:
+            raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
+        points = sweep.get("points", 0)
+        if isinstance(points, bool) or not isinstance(points, int) or points < 0:
+            raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
+        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points)
 
     def cells(self) -> list[Cell]:
         """Every base × factor combination × recording."""
@@ -159,14 +170,24 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
     if "path" in r:
         pattern = r["path"]
+        if not isinstance(pattern, str) or not pattern:
+            raise ConfigError(f"recordings[{i}].path must be a file path or glob (text), got {pattern!r}")
+        if r.get("format") is not None and not isinstance(r["format"], str):
+            raise ConfigError(f"recordings[{i}].format must be a format name, got {r['format']!r}")
         matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
         if not matches:
             raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
         opts = {k: v for k, v in r.items() if k not in ("path", "format")}
         return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts) for m in matches]
+    if not isinstance(r["simulate"], dict):
+        raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
     sim = dict(r["simulate"])
     seeds = r.get("seeds", [0])
-    repeats = int(r.get("repeats", 1))
+    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) for s in seeds):
+        raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers, got {seeds!r}")
+    repeats = r.get("repeats", 1)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
     seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
     return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s)) for s in seeds]

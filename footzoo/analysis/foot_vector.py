@@ -8,9 +8,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..checks import check_vector
 from ..data import Recording
 from ..errors import ConfigError, RecordingError
 from ..metrics import intervals
+from ..yamlsafe import load_file
 
 
 @dataclass
@@ -51,16 +53,22 @@ class FootVector:
     def load(cls, path: str | Path) -> FootVector:
         """Read a file written by :meth:`save`."""
         p = Path(path)
-        if not p.exists():
-            raise ConfigError(f"foot-vector calibration {str(p)!r} does not exist; create it with "
-                              "footzoo calibrate --data CALIB_RECORDING --out foot.yaml")
-        data = yaml.safe_load(p.read_text()) or {}
-        if "foot_vector" not in data:
+        data = load_file(p, ConfigError, "foot-vector calibration (create it with footzoo calibrate)") or {}
+        if not isinstance(data, dict) or "foot_vector" not in data:
             raise ConfigError(f"{p}: no 'foot_vector' entry; was it written by footzoo calibrate?")
-        v = np.asarray(data["foot_vector"], float)
-        return cls(v / np.linalg.norm(v), np.asarray(data.get("gravity_axis", [0, 0, 1]), float),
-                   np.asarray(data.get("rotation_axis", [0, 1, 0]), float),
-                   tuple(data.get("still_s", (np.nan, np.nan))), tuple(data.get("flex_s", (np.nan, np.nan))))
+        try:
+            v = np.asarray(check_vector("foot_vector", data["foot_vector"], nonzero=True))
+            g = np.asarray(check_vector("gravity_axis", data.get("gravity_axis", [0, 0, 1]), nonzero=True))
+            k = np.asarray(check_vector("rotation_axis", data.get("rotation_axis", [0, 1, 0]), nonzero=True))
+            periods = [data.get(key, (np.nan, np.nan)) for key in ("still_s", "flex_s")]
+            for key, value in zip(("still_s", "flex_s"), periods, strict=True):
+                if not isinstance(value, (list, tuple)) or len(value) != 2 or not all(
+                        isinstance(x, (int, float)) and not isinstance(x, bool) for x in value):
+                    raise ConfigError(f"{key} must be [t0, t1] in s, got {value!r}")
+        except ConfigError as err:
+            raise ConfigError(f"{p}: {err}; recreate the file with footzoo calibrate") from None
+        return cls(v / np.linalg.norm(v), g, k, tuple(float(x) for x in periods[0]),
+                   tuple(float(x) for x in periods[1]))
 
 
 def calibrate_foot_vector(

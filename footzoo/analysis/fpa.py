@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..checks import check_range, check_vector
 from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
 from ..metrics import intervals, nearest_index
@@ -71,14 +72,14 @@ class HuangFPA(Analysis):
         self.alpha = check_positive("alpha", alpha)
         if not self.alpha <= 1.0:
             raise ConfigError(f"alpha must be in (0, 1], got {alpha}")
-        if len(window) != 2 or not 0.0 <= float(window[0]) < float(window[1]) <= 1.0:
+        window = check_vector("window", window, 2)
+        if not 0.0 <= window[0] < window[1] <= 1.0:
             raise ConfigError(f"window must be [start, end] fractions of the stance with 0 <= start < end <= 1, "
                               f"got {window}")
         self.window = [float(window[0]), float(window[1])]
-        self.stance_fraction = check_positive("stance_fraction", stance_fraction)
-        self.foot_vector = [float(v) for v in foot_vector]
-        if len(self.foot_vector) != 3 or np.linalg.norm(self.foot_vector) == 0:
-            raise ConfigError(f"foot_vector must be a non-zero [x, y, z], got {foot_vector}")
+        self.stance_fraction = check_range("stance_fraction", stance_fraction, 0.0, 1.0, "fraction of stride",
+                                           lo_open=True)
+        self.foot_vector = check_vector("foot_vector", foot_vector, 3, nonzero=True, unit="sensor frame")
         self.calibration = calibration
         if calibration is not None:
             FootVector.load(calibration)  # fail early on a bad file

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import check_bool, check_range
 from ..filters.measurement import GYRO_BIAS, VEL, MeasurementModel, StateBlock, measurement_function
 from ..plugin import KalmanCorrection, Samples
-from ..registry import check_positive, register
+from ..registry import register
 
 
 @measurement_function
@@ -85,17 +86,17 @@ class EKFZUPT(KalmanCorrection):
         gyro_bias_noise: float = 0.0,
         accel_bias_noise: float = 0.0,
     ):
-        self.gyro_bias = bool(gyro_bias)
-        self.accel_bias = bool(accel_bias)
-        self.zero_rate = bool(zero_rate)
+        self.gyro_bias = check_bool("gyro_bias", gyro_bias)
+        self.accel_bias = check_bool("accel_bias", accel_bias)
+        self.zero_rate = check_bool("zero_rate", zero_rate)
         if self.zero_rate and not self.gyro_bias:
             raise ValueError("zero_rate measures the gyro bias: it needs gyro_bias: true")
-        self.velocity_std = check_positive("velocity_std", velocity_std)
-        self.rate_std = check_positive("rate_std", rate_std)
-        self.gyro_bias_std = check_positive("gyro_bias_std", gyro_bias_std, allow_zero=True)
-        self.accel_bias_std = check_positive("accel_bias_std", accel_bias_std, allow_zero=True)
-        self.gyro_bias_noise = check_positive("gyro_bias_noise", gyro_bias_noise, allow_zero=True)
-        self.accel_bias_noise = check_positive("accel_bias_noise", accel_bias_noise, allow_zero=True)
+        self.velocity_std = check_range("velocity_std", velocity_std, 1e-9, 10.0, "m/s")
+        self.rate_std = check_range("rate_std", rate_std, 1e-9, 10.0, "rad/s")
+        self.gyro_bias_std = check_range("gyro_bias_std", gyro_bias_std, 0.0, 1.0, "rad/s")
+        self.accel_bias_std = check_range("accel_bias_std", accel_bias_std, 0.0, 10.0, "m/s^2")
+        self.gyro_bias_noise = check_range("gyro_bias_noise", gyro_bias_noise, 0.0, 1.0, "rad/s/sqrt(s)")
+        self.accel_bias_noise = check_range("accel_bias_noise", accel_bias_noise, 0.0, 10.0, "m/s^2/sqrt(s)")
 
     def state_blocks(self) -> list[StateBlock]:
         """The core bias blocks this correction switches on (initial variance, variance growth per s)."""

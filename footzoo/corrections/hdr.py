@@ -6,11 +6,12 @@ import math
 
 import numpy as np
 
+from ..checks import check_range
 from ..conventions import quat_yaw, wrap_angle
 from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
 from ..metrics import intervals
 from ..plugin import AccelerationCorrection, KalmanCorrection, Samples
-from ..registry import check_positive, register
+from ..registry import register
 
 
 def heading_bias(yaw: float, previous: list[float], threshold: float) -> float | None:
@@ -96,8 +97,8 @@ class HDR(AccelerationCorrection, KalmanCorrection):
     units = {"threshold": "rad", "yaw_std": "rad"}
 
     def __init__(self, threshold: float = 0.5, yaw_std: float = 0.1):
-        self.threshold = check_positive("threshold", threshold)
-        self.yaw_std = check_positive("yaw_std", yaw_std)
+        self.threshold = check_range("threshold", threshold, 0.0, 3.1416, "rad", lo_open=True)
+        self.yaw_std = check_range("yaw_std", yaw_std, 1e-9, 3.1416, "rad")
 
     # ------------------------------------------------------------- no EKF: eqs. 25-27
     def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:

@@ -29,10 +29,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..checks import check_bool, check_range
 from ..errors import ConfigError, RecordingError
 from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
 from ..plugin import KalmanCorrection, Samples
-from ..registry import check_positive, register
+from ..registry import register
+from ..yamlsafe import load_file
 
 #: Duong & Suh Table 1 in their IMU frame (x toward the floor), mapped to FRD: (x, y, z)_DS -> (y, z, x).
 TABLE1_POSITIONS = [[0.080, 0.0, -0.008], [-0.062, 0.0, -0.006]]
@@ -40,13 +42,17 @@ TABLE1_DIRECTIONS = [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
 TABLE1_BASELINE = 0.142
 
 
-def _vectors(name: str, value, count: int | None = None) -> np.ndarray:
+def _vectors(name: str, value, count: int | None = None, nonzero: bool = False) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise ConfigError(f"{name} must be a list of [x, y, z] vectors (m), got {value!r}") from None
     if arr.ndim != 2 or arr.shape[1] != 3 or (count is not None and arr.shape[0] != count):
         raise ConfigError(f"{name} must be a list of {count or 'k'} [x, y, z] vectors, got shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ConfigError(f"{name} must hold finite numbers, got {arr.tolist()}")
+    if nonzero and (np.linalg.norm(arr, axis=1) == 0).any():
+        raise ConfigError(f"{name} must not contain [0, 0, 0]: a direction needs a non-zero vector, got {arr.tolist()}")
     return arr
 
 
@@ -221,16 +227,16 @@ class HeightDistance(KalmanCorrection):
             data = load_calibration(calibration)
             pos, dirs = data["positions"], data["directions"]
         self._r = _vectors("positions", pos)
-        self._n = _vectors("directions", dirs, self._r.shape[0])
+        self._n = _vectors("directions", dirs, self._r.shape[0], nonzero=True)
         self._n = self._n / np.linalg.norm(self._n, axis=1, keepdims=True)
-        self.baseline = check_positive("baseline", baseline)
-        self.range_std = check_positive("range_std", range_std)
-        self.max_range = check_positive("max_range", max_range)
-        self.calibrate = bool(calibrate)
-        self.position_std = check_positive("position_std", position_std)
-        self.direction_std = check_positive("direction_std", direction_std)
-        self.constraint_std = check_positive("constraint_std", constraint_std)
-        self.baseline_std = check_positive("baseline_std", baseline_std)
+        self.baseline = check_range("baseline", baseline, 0.0, 1.0, "m", lo_open=True)
+        self.range_std = check_range("range_std", range_std, 1e-9, 1.0, "m")
+        self.max_range = check_range("max_range", max_range, 0.0, 10.0, "m", lo_open=True)
+        self.calibrate = check_bool("calibrate", calibrate)
+        self.position_std = check_range("position_std", position_std, 1e-9, 1.0, "m")
+        self.direction_std = check_range("direction_std", direction_std, 1e-9, 1.0, "1")
+        self.constraint_std = check_range("constraint_std", constraint_std, 1e-9, 1.0, "1")
+        self.baseline_std = check_range("baseline_std", baseline_std, 1e-9, 1.0, "m")
 
     @property
     def k(self) -> int:
@@ -296,9 +302,9 @@ def save_calibration(calibration: dict, path: str | Path) -> Path:
 def load_calibration(path: str | Path) -> dict:
     """Read a calibration written by :func:`save_calibration`."""
     p = Path(path)
-    if not p.exists():
-        raise ConfigError(f"calibration file {str(p)!r} does not exist")
-    data = yaml.safe_load(p.read_text()) or {}
+    data = load_file(p, ConfigError, "calibration file") or {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{p}: a calibration file is a mapping with positions and directions, got {data!r:.80}")
     missing = [k for k in ("positions", "directions") if k not in data]
     if missing:
         raise ConfigError(f"{p}: calibration file lacks {missing}")
@@ -337,7 +343,7 @@ class HeightFlatFloor(KalmanCorrection):
     units = {"height_std": "m"}
 
     def __init__(self, height_std: float = 0.001):
-        self.height_std = check_positive("height_std", height_std)
+        self.height_std = check_range("height_std", height_std, 1e-9, 1.0, "m")
 
     def model(self, samples: Samples) -> MeasurementModel:
         """One height row in every stance sample."""

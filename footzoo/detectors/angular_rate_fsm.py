@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
+from ..checks import check_range
 from ..plugin import Detector
-from ..registry import check_positive, register
+from ..registry import register
 from .runs import dated_and_online_states
 
 
@@ -48,8 +49,8 @@ class AngularRateFSM(Detector):
     units = {"threshold": "rad/s", "min_duration": "s"}
 
     def __init__(self, threshold: float = 0.6, min_duration: float = 0.1):
-        self.threshold = check_positive("threshold", threshold)
-        self.min_duration = check_positive("min_duration", min_duration, allow_zero=True)
+        self.threshold = check_range("threshold", threshold, 0.0, 50.0, "rad/s", lo_open=True)
+        self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> AngularRateFSM:
         """Detect stance over a whole recording (vectorised).

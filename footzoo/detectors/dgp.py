@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..checks import check_range
 from ..conventions import GRAVITY
 from ..plugin import Detector
 from ..registry import check_positive, register
@@ -227,12 +228,12 @@ class DGP(Detector):
         reference_rate: float = 100.0,
         min_swing: float = 0.0,
     ):
-        self.window = check_positive("window", window)
-        self.condition_window = check_positive("condition_window", condition_window)
+        self.window = check_range("window", window, 0.0, 10.0, "s", lo_open=True)
+        self.condition_window = check_range("condition_window", condition_window, 0.0, 10.0, "s", lo_open=True)
         self.initial_delay = check_positive("initial_delay", initial_delay, allow_zero=True)
         self.initial_threshold = check_positive("initial_threshold", initial_threshold)
-        self.reference_rate = check_positive("reference_rate", reference_rate)
-        self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
+        self.reference_rate = check_range("reference_rate", reference_rate, 0.0, 100000.0, "Hz", lo_open=True)
+        self.min_swing = check_range("min_swing", min_swing, 0.0, 10.0, "s")
 
     def begin(self, rate: float) -> None:
         """Fresh state for a recording sampled at ``rate`` (Hz)."""

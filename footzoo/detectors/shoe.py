@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..checks import check_range
 from ..conventions import GRAVITY
 from ..plugin import Detector
 from ..registry import check_positive, register
@@ -80,9 +81,9 @@ class SHOE(Detector):
     def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
         self.threshold = check_positive("threshold", threshold)
-        self.window = check_positive("window", window)
-        self.sigma_a = check_positive("sigma_a", sigma_a)
-        self.sigma_g = check_positive("sigma_g", sigma_g)
+        self.window = check_range("window", window, 0.0, 10.0, "s", lo_open=True)
+        self.sigma_a = check_range("sigma_a", sigma_a, 1e-9, 100.0, "m/s^2")
+        self.sigma_g = check_range("sigma_g", sigma_g, 1e-9, 50.0, "rad/s")
 
     def _statistic(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
         rate = 1.0 / float(np.median(np.diff(t)))
@@ -131,7 +132,7 @@ class HuangStance(SHOE):
     def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1)), min_duration: float = 0.05):
         super().__init__(threshold, window, sigma_a, sigma_g)
-        self.min_duration = check_positive("min_duration", min_duration, allow_zero=True)
+        self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> HuangStance:
         """SHOE, then the state machine (dated back)."""

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import check_range
 from ..plugin import Detector
-from ..registry import check_positive, register
+from ..registry import register
 from .windows import row_norms, window_max
 
 
@@ -55,10 +56,11 @@ class Windowed(Detector):
         gyro_window: float = 0.1,
         acc_window: float = 0.1,
     ):
-        self.gyro_threshold = check_positive("gyro_threshold", gyro_threshold)
-        self.acc_diff_threshold = check_positive("acc_diff_threshold", acc_diff_threshold)
-        self.gyro_window = check_positive("gyro_window", gyro_window, allow_zero=True)
-        self.acc_window = check_positive("acc_window", acc_window, allow_zero=True)
+        self.gyro_threshold = check_range("gyro_threshold", gyro_threshold, 0.0, 50.0, "rad/s", lo_open=True)
+        self.acc_diff_threshold = check_range("acc_diff_threshold", acc_diff_threshold, 0.0, 2000.0, "m/s^2",
+                                              lo_open=True)
+        self.gyro_window = check_range("gyro_window", gyro_window, 0.0, 10.0, "s")
+        self.acc_window = check_range("acc_window", acc_window, 0.0, 10.0, "s")
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Windowed:
         """Evaluate eq. 21 over the whole recording (vectorised)."""

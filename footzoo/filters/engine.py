@@ -10,12 +10,14 @@ loop, ``"reference"`` the filterpy loop, ``"auto"`` the compiled one when every 
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
 
+from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock
@@ -61,17 +63,16 @@ class NavigationNoise:
 
     units = {"attitude_noise": "rad^2/s", "velocity_noise": "(m/s)^2/s", "position_noise": "m^2/s",
              "initial_attitude_std": "rad", "initial_velocity_std": "m/s", "initial_position_std": "m"}
+    #: Accepted range of each value (physically plausible for a foot-mounted IMU).
+    ranges = {"attitude_noise": (0.0, 1.0), "velocity_noise": (0.0, 100.0), "position_noise": (0.0, 100.0),
+              "initial_attitude_std": (0.0, math.pi), "initial_velocity_std": (0.0, 10.0),
+              "initial_position_std": (0.0, 100.0)}
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ConfigError(f"navigation.{f.name} must be a number in {self.units[f.name]}, got {value!r}")
-            value = float(value)
-            if not np.isfinite(value) or value < 0:
-                raise ConfigError(
-                    f"navigation.{f.name} must be finite and >= 0 ({self.units[f.name]}), got {value!r}")
-            setattr(self, f.name, value)
+            lo, hi = self.ranges[f.name]
+            setattr(self, f.name, check_range(f"navigation.{f.name}", getattr(self, f.name), lo, hi,
+                                              self.units[f.name]))
 
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> NavigationNoise:

@@ -20,12 +20,13 @@ sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from ..data import Recording
-from ..errors import FormatError, did_you_mean
+from ..errors import FootzooError, FormatError, did_you_mean
 from . import canonical, gaitmap, pyshoe, sensorconnect, xio
 
 READERS: dict[str, Callable[..., Recording]] = {
@@ -47,6 +48,33 @@ EXPECTED_HEADERS: dict[str, str] = {
 }
 
 
+#: Longest header line read when detecting a format (characters).
+HEADER_MAX_CHARS = 64 * 1024
+
+
+def check_input_file(path: str | Path, what: str = "recording") -> Path:
+    """The path of an existing, readable, non-empty regular file, or a :class:`FormatError` saying why not."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise FormatError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
+    p = Path(path)
+    try:
+        if not p.exists():
+            raise FormatError(f"{what} {str(p)!r}: no such file; check the path")
+        if p.is_dir():
+            raise FormatError(f"{what} {str(p)!r} is a directory; give the path of a recording file inside it")
+        if not p.is_file():
+            raise FormatError(f"{what} {str(p)!r} is not a regular file (a device or pipe?); save the data to a file")
+        if p.stat().st_size == 0:
+            raise FormatError(f"{what} {str(p)!r}: the file is empty (0 bytes)")
+        with open(p, "rb") as fh:
+            fh.read(1)
+    except PermissionError:
+        raise FormatError(f"{what} {str(p)!r} is not readable (permission denied); fix its permissions") from None
+    except OSError as err:
+        raise FormatError(f"{what} {str(p)!r} cannot be read: {err.strerror or err}") from None
+    return p
+
+
 def detect_format(path: str | Path) -> str:
     """Guess a file's format from its extension and first line."""
     p = Path(path)
@@ -57,7 +85,7 @@ def detect_format(path: str | Path) -> str:
         return "canonical"
     if suffix in (".csv", ".txt"):
         with open(p, encoding="utf-8", errors="replace") as fh:
-            head = fh.readline()
+            head = fh.readline(HEADER_MAX_CHARS)
         if not head.strip():
             raise FormatError(f"{p}: the file is empty (no header line)")
         if xio.matches(head):
@@ -93,11 +121,11 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         and ``gyr_unit="deg/s"`` for canonical files (the other formats fix
         their units), ``duplicates="drop"``.
     """
-    p = Path(path)
-    if not p.exists():
-        raise FormatError(f"{p}: no such file")
-    if p.stat().st_size == 0:
-        raise FormatError(f"{p}: the file is empty")
+    p = check_input_file(path)
+    if format is not None and format not in READERS:
+        raise FormatError(
+            f"unknown format {format!r}{did_you_mean(str(format), list(READERS))}; valid: {sorted(READERS)}"
+        )
     fmt = format or detect_format(p)
     if fmt not in READERS:
         raise FormatError(f"unknown format {fmt!r}{did_you_mean(fmt, list(READERS))}; valid: {sorted(READERS)}")
@@ -111,7 +139,23 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     foot = options.pop("foot", None) if fmt != "gaitmap" else None
     if foot is not None and foot not in ("left", "right"):
         raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
-    rec = READERS[fmt](p, **options)
+    try:
+        rec = READERS[fmt](p, **options)
+    except FootzooError:
+        raise
+    except TypeError as err:
+        if "unexpected keyword argument" in str(err):
+            raise FormatError(f"{fmt} reader: {err}; see help(footzoo.io.{fmt}.read) for its options") from err
+        raise FormatError(f"{p}: cannot read as {fmt}: {type(err).__name__}: {err}") from err
+    except UnicodeDecodeError as err:
+        raise FormatError(
+            f"{p}: not UTF-8 text (byte offset {err.start}); is it really a {fmt} file? Pass format= if not"
+        ) from err
+    except Exception as err:  # parsing untrusted bytes: any library error means "not this format"
+        raise FormatError(
+            f"{p}: cannot read as {fmt}: {type(err).__name__}: {str(err)[:300]}; check the file, or pass the "
+            f"right format= (one of {sorted(READERS)})"
+        ) from err
     if foot is not None:
         known = rec.meta.get("foot")
         if known is not None and known != foot:
@@ -130,7 +174,7 @@ FIXED_UNITS: dict[str, dict[str, str]] = {
 }
 
 
-__all__ = ["READERS", "builtin_sample", "detect_format", "load"]
+__all__ = ["READERS", "builtin_sample", "check_input_file", "detect_format", "load"]
 
 
 def builtin_sample() -> Recording:

@@ -15,8 +15,15 @@ from typing import Any
 import pandas as pd
 import yaml
 
+from ..checks import check_bool
 from ..data import Recording
 from ..errors import FormatError
+from ..yamlsafe import load_file
+
+#: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
+FLOAT_FORMAT = "%.17g"
+#: ``pd.read_csv`` options that parse those digits back exactly (pandas 3 does by default).
+EXACT_CSV: dict[str, Any] = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 
 
 def matches(header: str) -> bool:
@@ -31,19 +38,33 @@ def read(path: Path, **options: Any) -> Recording:
         if path.suffix.lower() in (".parquet", ".pq"):
             df = pd.read_parquet(path)
         else:
-            df = pd.read_csv(path, comment="#")
+            df = pd.read_csv(path, comment="#", **EXACT_CSV)
+    except UnicodeDecodeError as err:
+        raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "canonical"}
     sidecar = path.with_name(path.name + ".meta.yaml")
-    extra = yaml.safe_load(sidecar.read_text()) if sidecar.exists() else {}
-    meta.update(extra.get("meta", {}) if isinstance(extra, dict) else {})
+    extra = load_file(sidecar, FormatError, "metadata sidecar") if sidecar.exists() else {}
+    extra = {} if extra is None else extra
+    fix = f"fix or delete {sidecar.name} (footzoo simulate writes it: meta: {{...}}, closed_loop: true|false)"
+    if not isinstance(extra, dict):
+        raise FormatError(f"{sidecar}: expected a mapping with 'meta' and 'closed_loop', got {extra!r:.80}; {fix}")
+    if not isinstance(extra.get("meta", {}) or {}, dict):
+        raise FormatError(f"{sidecar}: 'meta' must be a mapping, got {extra['meta']!r:.80}; {fix}")
+    closed_loop = extra.get("closed_loop", False)
+    if not isinstance(closed_loop, bool):
+        raise FormatError(f"{sidecar}: closed_loop must be true or false, got {closed_loop!r}; {fix}")
+    meta.update(extra.get("meta") or {})
     rec = Recording.from_dataframe(df, meta=meta, **options)
-    if rec.truth is not None and isinstance(extra, dict):
-        rec.truth.closed_loop = bool(extra.get("closed_loop", False))
+    if rec.truth is not None:
+        rec.truth.closed_loop = closed_loop
         steps = path.with_name(path.name + ".steps.csv")
         if steps.exists():
-            rec.truth.steps = pd.read_csv(steps)
+            try:
+                rec.truth.steps = pd.read_csv(steps, **EXACT_CSV)
+            except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
+                raise FormatError(f"{steps}: cannot read the true steps: {err}; fix or delete the file") from None
             rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
         if meta.get("source") == "footzoo.sim":
             rec.truth.source = "simulator"
@@ -53,14 +74,15 @@ def read(path: Path, **options: Any) -> Recording:
 def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     """Write a recording (with truth columns) as canonical CSV or Parquet plus a sidecar."""
     p = Path(path)
+    closed_loop = check_bool("closed_loop", closed_loop)
     df = rec.to_dataframe()
     if p.suffix.lower() in (".parquet", ".pq"):
         df.to_parquet(p, index=False)
     else:
-        df.to_csv(p, index=False, float_format="%.9g")
+        df.to_csv(p, index=False, float_format=FLOAT_FORMAT)
     meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
     side = {"meta": meta, "closed_loop": bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))}
     p.with_name(p.name + ".meta.yaml").write_text(yaml.safe_dump(side))
     if rec.truth is not None and rec.truth.steps is not None:
-        rec.truth.steps.to_csv(p.with_name(p.name + ".steps.csv"), index=False, float_format="%.9g")
+        rec.truth.steps.to_csv(p.with_name(p.name + ".steps.csv"), index=False, float_format=FLOAT_FORMAT)
     return p

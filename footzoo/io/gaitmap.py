@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..checks import check_range
 from ..data import Recording, Truth
 from ..errors import FormatError
 from .gaitmap_reference import has_reference, reference_stride_positions, reference_strides
@@ -71,6 +72,7 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
             f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right', "
             "or read both with footzoo.Session.load(path) (command line: both feet unless --foot left|right)"
         )
+    rate = check_range("rate", rate, 0.0, 100_000.0, "Hz", lo_open=True)
     df = pd.read_csv(path, header=[0, 1], index_col=0)
     sensor = f"{foot}_sensor"
     if sensor not in df.columns.get_level_values(0):

@@ -37,8 +37,14 @@ def read(path: Path, **options: Any) -> Recording:
     missing = [k for k in ("imu", "ts") if k not in d]
     if missing:
         raise FormatError(f"{path}: not a PyShoe trial, missing variable(s) {missing}")
-    imu = np.asarray(d["imu"], dtype=float)
-    t = np.asarray(d["ts"], dtype=float).ravel()
+    try:
+        imu = np.asarray(d["imu"], dtype=float)
+        t = np.asarray(d["ts"], dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise FormatError(f"{path}: 'imu' and 'ts' must be numeric arrays") from None
+    if imu.ndim != 2 or imu.shape[1] < 6 or imu.shape[0] != t.shape[0]:
+        raise FormatError(f"{path}: 'imu' must be N x 6 (acc m/s², gyro rad/s) with N = len(ts) = {t.shape[0]}, "
+                          f"got shape {imu.shape}")
     truth = None
     if "gt" in d:
         stance = np.asarray(d["zv_vicon_opt"]).ravel().astype(bool) if "zv_vicon_opt" in d else None

@@ -19,6 +19,7 @@ from typing import Any
 
 import pandas as pd
 
+from ..checks import check_bool
 from ..data import Recording, Truth
 from ..errors import FormatError
 
@@ -52,6 +53,7 @@ def read(
     closed_loop : bool
         Whether the walk ends where it started (true for ``short_walk.csv``).
     """
+    closed_loop = check_bool("closed_loop", closed_loop)
     df = pd.read_csv(path)
     missing = [c for c in COLUMNS if c not in df.columns]
     if missing:

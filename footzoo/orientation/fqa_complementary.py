@@ -7,8 +7,9 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..checks import check_bool, check_range
 from ..plugin import Orientation
-from ..registry import check_positive, register
+from ..registry import register
 from .fqa import fqa_sample
 
 
@@ -162,9 +163,9 @@ class FQAComplementary(Orientation):
     needs_stance = True
 
     def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True):
-        self.static_gain = check_positive("static_gain", static_gain, allow_zero=True)
-        self.dynamic_gain = check_positive("dynamic_gain", dynamic_gain, allow_zero=True)
-        self.use_magnetometer = bool(use_magnetometer)
+        self.static_gain = check_range("static_gain", static_gain, 0.0, 100.0, "1/s")
+        self.dynamic_gain = check_range("dynamic_gain", dynamic_gain, 0.0, 100.0, "1/s")
+        self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
 
     def estimate(
         self,

@@ -7,8 +7,9 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..checks import check_bool, check_range
 from ..plugin import Orientation
-from ..registry import check_positive, register
+from ..registry import register
 
 
 @njit
@@ -125,8 +126,8 @@ class Madgwick(Orientation):
     units = {"gyro_error": "rad/s"}
 
     def __init__(self, gyro_error: float = float(np.radians(5.0)), use_magnetometer: bool = True):
-        self.gyro_error = check_positive("gyro_error", gyro_error, allow_zero=True)
-        self.use_magnetometer = bool(use_magnetometer)
+        self.gyro_error = check_range("gyro_error", gyro_error, 0.0, 50.0, "rad/s")
+        self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
         """Run the filter over a recording (``stance`` is not used)."""

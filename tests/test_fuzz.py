@@ -1,0 +1,257 @@
+"""Property-based fuzzing: readers, YAML, configs, studies and live samples raise only footzoo's documented errors.
+
+Documented errors: :class:`~footzoo.errors.FootzooError` and its subclasses
+(``ConfigError``, ``RecordingError``, ``FormatError``). Anything else escaping
+is a bug. Parsing is bounded by the loader's limits (size, depth, aliases), so
+every example finishes quickly with bounded memory.
+
+Each property runs twice: a small CI profile (the whole file in well under a
+minute) and a ``nightly`` profile with many more examples, skipped unless
+``-m nightly`` is given or ``FOOTZOO_NIGHTLY=1`` is set.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from footzoo import Pipeline
+from footzoo.ablation.study import STUDY_KEYS, Study
+from footzoo.checks import validate_sample
+from footzoo.config import TOP_LEVEL_KEYS
+from footzoo.errors import FootzooError
+from footzoo.io import READERS, load
+from footzoo.registry import available
+from footzoo.yamlsafe import load_text
+
+CI_EXAMPLES = int(os.environ.get("FOOTZOO_FUZZ_EXAMPLES", "25"))
+NIGHTLY_EXAMPLES = 2000
+
+
+def _settings(examples: int) -> settings:
+    return settings(max_examples=examples, deadline=None, database=None, derandomize=examples == CI_EXAMPLES,
+                    suppress_health_check=list(HealthCheck))
+
+
+def _only_footzoo_errors(action: Callable[[], object]) -> object:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            return action()
+        except FootzooError:
+            return None
+
+
+# --------------------------------------------------------------------------- strategies
+CELL = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-10**6, 10**6).map(str),
+    st.sampled_from(["", "nan", "inf", "-inf", "1e400", "1e30", "-0", "abc", '"', "1,2", "0x10", "\t", "é"]),
+    st.text(alphabet="0123456789.-+eE ", max_size=8),
+)
+HEADERS = [
+    "t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z",
+    "t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,dist_a,true_pos_n,true_pos_e,true_pos_d,true_stance",
+    "Time (s),Gyroscope X (deg/s),Gyroscope Y (deg/s),Gyroscope Z (deg/s),Accelerometer X (g),"
+    "Accelerometer Y (g),Accelerometer Z (g)",
+    "Time,d:scaledAccelX,d:scaledAccelY,d:scaledAccelZ,d:scaledGyroX,d:scaledGyroY,d:scaledGyroZ",
+    "sensor,left_sensor,left_sensor,left_sensor,left_sensor,left_sensor,left_sensor\n"
+    "axis,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z",
+]
+HEADER = st.one_of(st.sampled_from(HEADERS), st.text(max_size=60).filter(lambda s: "\n" not in s and "\r" not in s))
+ROWS = st.lists(st.lists(CELL, min_size=0, max_size=16).map(",".join), max_size=40)
+SCALAR = st.one_of(
+    st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(0.0, 2.0), st.text(max_size=8), st.sampled_from(["no", "yes", "half", ".inf", "1:30", "0.5", "off"]),
+)
+VALUE = st.recursive(SCALAR, lambda c: st.lists(c, max_size=3) | st.dictionaries(st.text(max_size=6), c, max_size=3),
+                     max_leaves=8)
+YAMLISH = st.lists(st.sampled_from(list(":-[]{}&*!|>'\"#,?% \n\t<=@`~abcxyz019.") + ["<<", "!!", "&a", "*a", "\u00e9",
+                                                                                  "\n  ", ": ", "- "]),
+                   max_size=120).map("".join)
+
+
+def _spec(kind: str) -> st.SearchStrategy:
+    plugins = available(kind)
+
+    @st.composite
+    def spec(draw):
+        name = draw(st.sampled_from(sorted(plugins)))
+        params = plugins[name].param_names()
+        keys = draw(st.lists(st.sampled_from(params), unique=True, max_size=len(params))) if params else []
+        out = {"type": name, **{k: draw(VALUE) for k in keys}}
+        if draw(st.booleans()):
+            out[draw(st.text(max_size=6))] = draw(VALUE)
+        return out
+
+    return spec()
+
+
+@st.composite
+def configs(draw):
+    cfg = {"orientation": draw(_spec("orientation")), "detector": draw(_spec("detector"))}
+    if draw(st.booleans()):
+        cfg["corrections"] = draw(st.lists(_spec("correction"), max_size=3))
+    if draw(st.booleans()):
+        cfg["analysis"] = draw(st.lists(_spec("analysis"), max_size=1))
+    if draw(st.booleans()):
+        cfg["gravity"] = draw(st.one_of(VALUE, st.floats(9.6, 10.0)))
+    if draw(st.booleans()):
+        cfg["init"] = draw(st.one_of(VALUE, st.fixed_dictionaries({}, optional={"duration": VALUE, "max_gyr": VALUE})))
+    for key in draw(st.lists(st.sampled_from([*TOP_LEVEL_KEYS, "gravty", "extra"]), max_size=2)):
+        cfg[key] = draw(VALUE)
+    return cfg
+
+
+@st.composite
+def studies(draw):
+    rec = st.one_of(
+        st.fixed_dictionaries({"simulate": VALUE}, optional={"seeds": VALUE, "repeats": VALUE, "label": VALUE}),
+        st.fixed_dictionaries({"path": st.one_of(VALUE, st.text(alphabet="abc_", max_size=5))},
+                              optional={"format": VALUE}),
+        VALUE,
+    )
+    d = {"base": draw(st.one_of(VALUE, configs(), st.lists(configs(), max_size=2))),
+         "recordings": draw(st.one_of(VALUE, st.lists(rec, max_size=3)))}
+    for key in draw(st.lists(st.sampled_from([*STUDY_KEYS, "factor"]), max_size=3)):
+        d[key] = draw(VALUE)
+    return d
+
+
+@st.composite
+def near_valid_recordings(draw):
+    """A still-then-moving 2 s canonical recording at 100 Hz with a few cells damaged."""
+    n = 200
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    t = np.arange(n) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (n, 1)) + rng.normal(0, 0.05, (n, 3))
+    gyr = rng.normal(0, 0.01, (n, 3))
+    gyr[100:] += np.sin(np.arange(n - 100) / 10.0)[:, None]
+    df = pd.DataFrame(np.column_stack([t, acc, gyr]), columns=HEADERS[0].split(",")).astype(object)
+    for _ in range(draw(st.integers(0, 4))):
+        row, col = draw(st.integers(0, n - 1)), draw(st.integers(0, 6))
+        df.iat[row, col] = draw(st.one_of(st.floats(allow_nan=True, allow_infinity=True), CELL))
+    return df.to_csv(index=False)
+
+
+# --------------------------------------------------------------------------- properties
+def _load_every_way(path: Path) -> None:
+    _only_footzoo_errors(lambda: load(path))
+    for fmt in READERS:
+        options = {"foot": "left"} if fmt == "gaitmap" else {}
+        _only_footzoo_errors(lambda fmt=fmt, options=options: load(path, format=fmt, **options))
+
+
+def readers_on_random_bytes(data: bytes, suffix: str) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / f"r{suffix}"
+        p.write_bytes(data)
+        _load_every_way(p)
+
+
+def readers_on_csvish_text(header: str, rows: list[str], encoding: str) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "r.csv"
+        p.write_bytes(("\n".join([header, *rows]) + "\n").encode(encoding, errors="replace"))
+        _load_every_way(p)
+
+
+def reader_on_near_valid_recording(text: str) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "r.csv"
+        p.write_text(text)
+        rec = _only_footzoo_errors(lambda: load(p))
+        if rec is not None:  # accepted: then it is finite and plausible
+            assert np.isfinite(rec.t).all() and np.isfinite(rec.acc).all() and np.isfinite(rec.gyr).all()
+            assert np.all(np.diff(rec.t) > 0)
+
+
+def yaml_text(text: str) -> None:
+    _only_footzoo_errors(lambda: load_text(text, "fuzz.yaml"))
+
+
+def config_files(cfg: dict) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "c.yaml"
+        p.write_text(yaml.safe_dump(cfg, allow_unicode=True))
+        pipeline = _only_footzoo_errors(lambda: Pipeline.from_yaml(p))
+    if pipeline is not None:  # accepted: every number in the resolved config is finite
+        def numbers(x):
+            if isinstance(x, dict):
+                return [v for y in x.values() for v in numbers(y)]
+            if isinstance(x, (list, tuple)):
+                return [v for y in x for v in numbers(y)]
+            return [x] if isinstance(x, float) else []
+
+        assert all(math.isfinite(v) for v in numbers(pipeline.to_dict()))
+        assert 9.7 <= pipeline.gravity <= 9.9
+
+
+def study_mappings(d: dict) -> None:
+    with tempfile.TemporaryDirectory() as root:
+        _only_footzoo_errors(lambda: Study.from_dict(d, root=root))
+
+
+def live_samples(t, acc, gyr, previous) -> None:
+    _only_footzoo_errors(lambda: validate_sample(t, acc, gyr, None, None, previous, None))
+
+
+_STREAM_PIPELINE = Path(__file__).resolve().parents[1] / "configs" / "nguyen2016.yaml"
+SAMPLE = st.tuples(st.floats(0.002, 0.05), st.lists(st.floats(-60.0, 60.0), min_size=3, max_size=3),
+                   st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))
+
+
+def stream_pushes(samples: list, use_mag: bool, offset: float) -> None:
+    """A live stream fed odd but well-formed samples: only footzoo errors, finite estimates."""
+    from footzoo.stream import Stream
+
+    stream = Stream(Pipeline.from_yaml(_STREAM_PIPELINE))
+    t = offset
+    for k, (dt, acc, gyr) in enumerate(samples):
+        t += dt
+        acc = [acc[0] * 0.01, acc[1] * 0.01, -9.81 + acc[2] * 0.01] if k < 60 else acc  # a still start
+        gyr = [g * 0.001 for g in gyr] if k < 60 else gyr
+        est = _only_footzoo_errors(lambda t=t, acc=acc, gyr=gyr: stream.push(t, acc, gyr, [0.2, 0.0, 0.4] if use_mag
+                                                                             else None))
+        if est is not None:
+            assert np.isfinite(est["pos"]).all() and np.isfinite(est["quat"]).all()
+
+
+NUM = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(), st.text(max_size=3), st.none())
+PROPERTIES = {
+    "readers_on_random_bytes": (readers_on_random_bytes, (st.binary(max_size=2048),
+                                                          st.sampled_from([".csv", ".txt", ".mat", ".parquet"]))),
+    "readers_on_csvish_text": (readers_on_csvish_text, (HEADER, ROWS, st.sampled_from(["utf-8", "latin-1"]))),
+    "reader_on_near_valid_recording": (reader_on_near_valid_recording, (near_valid_recordings(),)),
+    "yaml_text": (yaml_text, (st.one_of(YAMLISH, st.text(max_size=200)),)),
+    "config_files": (config_files, (configs(),)),
+    "study_mappings": (study_mappings, (studies(),)),
+    "stream_pushes": (stream_pushes, (st.lists(SAMPLE, min_size=0, max_size=120), st.booleans(),
+                                      st.sampled_from([0.0, 1.7e9]))),
+    "live_samples": (live_samples, (NUM, st.one_of(NUM, st.lists(NUM, max_size=4), st.lists(st.lists(NUM))),
+                                    st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=4),
+                                    st.one_of(st.none(), st.floats(allow_nan=False)))),
+}
+
+
+def _make(name: str, examples: int):
+    body, strategies = PROPERTIES[name]
+    test = _settings(examples)(given(*strategies)(body))
+    test.__name__ = f"test_{name}"
+    return test
+
+
+for _name in PROPERTIES:
+    globals()[f"test_{_name}"] = _make(_name, CI_EXAMPLES)
+    globals()[f"test_{_name}_nightly"] = pytest.mark.nightly(_make(_name, NIGHTLY_EXAMPLES))
