@@ -142,7 +142,7 @@ def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
 
 
 def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
-    """samples.csv, steps.csv (units in the column names), metrics.json and optionally trajectory.png."""
+    """samples.csv, steps.csv (units in the column names), metrics.json and optionally the run's figures."""
     out.mkdir(parents=True, exist_ok=True)
     result.samples.to_csv(out / "samples.csv", index=False, float_format=FLOAT_FORMAT)
     result.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
@@ -151,10 +151,9 @@ def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
     (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
     written = ["samples.csv", "steps.csv", "metrics.json"]
     if plot:
-        from .plots import plot_trajectory
+        from .plots import plot_run
 
-        plot_trajectory(result, out / "trajectory.png", rec)
-        written.append("trajectory.png")
+        written += [p.name for p in plot_run(result, out, rec)]
     return written
 
 
@@ -165,7 +164,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     pipeline = Pipeline.from_yaml(args.config)
     out = _writable_dir(args.out) if args.out else None
     if args.plot and not args.out:
-        print("--plot needs --out DIR (where trajectory.png is written)", file=sys.stderr)
+        print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
         return 2
     if _two_feet(args):
         return _run_session(args, pipeline)
@@ -334,7 +333,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
     run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
     run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
-    run.add_argument("--plot", action="store_true", help="also write trajectory.png (needs --out)")
+    run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
+                     "errors (with a reference), strides, fpa (.png, needs --out)")
     run.set_defaults(func=cmd_run)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")

@@ -77,6 +77,8 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
         out["metrics"] = _metrics(rec, res, metric_names)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
         out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
+        if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
+            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4).tolist()
         if sweep_points:
             out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
     except Exception as err:  # one failing run is reported, not fatal
@@ -118,8 +120,11 @@ def run_study(
     max_runs : int, optional
         Stop after this many new runs (what an interruption leaves behind).
 
-    The table's ``attrs`` hold ``computed`` and ``cached`` run counts and the
-    per-run records (``runs``) with trajectories and threshold sweeps.
+    Returns
+    -------
+    DataFrame
+        The tidy table. Its ``attrs`` hold ``computed`` and ``cached`` run counts and the
+        per-run records (``runs``) with trajectories and threshold sweeps.
     """
     if not isinstance(study, Study):
         study = Study.from_yaml(study)

@@ -1,0 +1,356 @@
+"""MkDocs hooks: pages generated at build time from the code, so they cannot go stale.
+
+* ``zoo/``: one page per registered plug-in (summary, paper, parameters with
+  defaults, units and meaning, YAML snippet, full docstring) and an index table;
+  a plug-in registered tomorrow gets its page without any edit here.
+* ``readers/<format>.md``: one page per reader in ``footzoo.io.READERS`` (and per
+  other module of ``footzoo/io``, e.g. reference-data loaders), from the module
+  docstring and the reader's options.
+* ``gallery/``: every ``docs/gallery/*.py`` script is run; the figures it saves
+  into ``$FOOTZOO_GALLERY_OUT`` are shown with its docstring and source.
+
+The ``nav`` entries ``zoo/index.md``, ``readers/index.md`` and
+``gallery/index.md`` in ``mkdocs.yml`` are expanded into sections here.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import logging
+import os
+import pkgutil
+import re
+import runpy
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def use_checkout() -> None:
+    """Document the checkout being built, not another installed copy of footzoo.
+
+    Called from the events (mkdocs removes the first ``sys.path`` entry after loading a hook file).
+    """
+    if not sys.path or sys.path[0] != str(ROOT):
+        sys.path.insert(0, str(ROOT))
+    mod = sys.modules.get("footzoo")
+    if mod is not None and not str(getattr(mod, "__file__", "")).startswith(str(ROOT)):
+        raise RuntimeError(f"footzoo was imported from {mod.__file__} before the docs hook could use {ROOT}")
+
+log = logging.getLogger("mkdocs.hooks.footzoo")
+
+KIND_TITLES = {"orientation": "Orientation", "detector": "Stance detectors", "correction": "Corrections",
+               "analysis": "Analysis"}
+#: Class attributes of a plug-in that are not capabilities.
+NOT_CAPABILITIES = {"kind", "name", "paper", "units"}
+
+_gallery_dir: Path | None = None
+
+
+# --------------------------------------------------------------------------- docstring helpers
+
+
+def numpy_section(doc: str, name: str) -> dict[str, str]:
+    """``{parameter: description}`` of a numpy-style docstring section (``a, b : type`` lines share one)."""
+    lines = doc.splitlines()
+    out: dict[str, str] = {}
+    for i in range(len(lines) - 1):
+        if lines[i].strip() == name and set(lines[i + 1].strip()) == {"-"}:
+            j, current = i + 2, []
+            while j < len(lines):
+                line = lines[j]
+                underlined = j + 1 < len(lines) and set(lines[j + 1].strip()) == {"-"}
+                if underlined and line.strip() and not line.startswith(" "):
+                    break  # next section
+                if line and not line.startswith(" "):
+                    current = [p.strip() for p in line.split(":")[0].split(",")]
+                    for p in current:
+                        out[p] = ""
+                elif line.strip():
+                    for p in current:
+                        out[p] = (out[p] + " " + line.strip()).strip()
+                j += 1
+            break
+    return out
+
+
+def capabilities(cls: type) -> dict[str, str]:
+    """The declared class attributes (``causal``, ``needs_magnetometer``, ``observes`` ...) of a plug-in class.
+
+    Every annotated class attribute of its bases that holds a flag, a name or a tuple of names,
+    so a capability added to the base classes appears without an edit here.
+    """
+    names: list[str] = []
+    for base in reversed(cls.__mro__):
+        for n in vars(base).get("__annotations__", {}):
+            if n not in names and n not in NOT_CAPABILITIES and not n.startswith("_"):
+                names.append(n)
+    out = {}
+    for n in names:
+        v = getattr(cls, n, None)
+        if isinstance(v, bool):
+            out[n] = "yes" if v else "no"
+        elif isinstance(v, str) and v:
+            out[n] = f"`{v}`"
+        elif isinstance(v, tuple) and v and all(isinstance(x, str) for x in v):
+            out[n] = ", ".join(f"`{x}`" for x in v)
+    return out
+
+
+def first_line(doc: str) -> str:
+    return doc.strip().splitlines()[0] if doc.strip() else ""
+
+
+def md_cell(text: Any) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def yaml_value(v: Any) -> Any:
+    """A default as YAML would write it (tuples and arrays as lists), or None when it has no YAML form."""
+    import numpy as np
+
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, tuple):
+        return [yaml_value(x) for x in v]
+    if isinstance(v, (str, int, float, bool, list, dict)) or v is None:
+        return v
+    return None
+
+
+# --------------------------------------------------------------------------- plug-in pages
+
+
+def plugin_pages() -> dict[str, str]:
+    """``{src_uri: markdown}`` of the plug-in zoo."""
+    import yaml
+
+    from footzoo import registry
+
+    pages: dict[str, str] = {}
+    rows = []
+    for kind in registry.KINDS:
+        for name, cls in sorted(registry.available(kind).items()):
+            uri = f"zoo/{kind}/{name}.md"
+            doc = inspect.getdoc(cls) or ""
+            params = numpy_section(doc, "Parameters")
+            sig = inspect.signature(cls.__init__)
+            units = getattr(cls, "units", {}) or {}
+            lines = [f"# `{name}` ({kind})", "", first_line(doc), ""]
+            paper = getattr(cls, "paper", "")
+            if paper:
+                lines += [f"**Paper:** {paper}", ""]
+            lines += [f"**Class:** `{cls.__module__}.{cls.__qualname__}`", ""]
+            caps = capabilities(cls)
+            if caps:
+                lines += ["**Capabilities:** " + ", ".join(f"`{c}`: {v}" for c, v in caps.items()), ""]
+            names = [p for p in sig.parameters if p != "self" and sig.parameters[p].kind not in
+                     (inspect.Parameter.VAR_KEYWORD, inspect.Parameter.VAR_POSITIONAL)]
+            spec: dict[str, Any] = {"type": name}
+            if names:
+                lines += ["## Parameters", "", "| parameter | default | unit | meaning |", "|---|---|---|---|"]
+                for p in names:
+                    default = sig.parameters[p].default
+                    shown = "required" if default is inspect.Parameter.empty else f"`{default!r}`"
+                    lines.append(f"| `{p}` | {md_cell(shown)} | {md_cell(units.get(p, ''))} | "
+                                 f"{md_cell(params.get(p, ''))} |")
+                    if default is not inspect.Parameter.empty and yaml_value(default) is not None:
+                        spec[p] = yaml_value(default)
+                lines.append("")
+            slot = {"orientation": "orientation", "detector": "detector"}.get(kind)
+            snippet = {slot: spec} if slot else {"corrections" if kind == "correction" else kind: [spec]}
+            lines += ["## In a config", "", "With every default written out:", "", "```yaml",
+                      yaml.safe_dump(snippet, sort_keys=False, default_flow_style=None, width=100).strip(), "```", "",
+                      "## Description", "", f"::: {cls.__module__}.{cls.__qualname__}",
+                      "    options:", "      show_root_heading: false", "      show_root_toc_entry: false",
+                      "      members: false", "      show_docstring_parameters: false", ""]
+            pages[uri] = "\n".join(lines)
+            rows.append(f"| {kind} | [`{name}`]({kind}/{name}.md) | {md_cell(first_line(doc))} | "
+                        f"{md_cell(paper)} |")
+    index = ["# Plug-in zoo", "",
+             "Every plug-in footzoo knows, generated from the registry and the plug-ins' docstrings when the "
+             "documentation is built. `footzoo list` prints the same information in a terminal; "
+             "[the plug-in guide](../plugins.md) shows how to add your own.", "",
+             "| kind | name | what it does | paper |", "|---|---|---|---|", *rows, ""]
+    pages["zoo/index.md"] = "\n".join(index)
+    return pages
+
+
+def plugin_nav() -> list[Any]:
+    from footzoo import registry
+
+    nav: list[Any] = ["zoo/index.md"]
+    for kind in registry.KINDS:
+        names = sorted(registry.available(kind))
+        if names:
+            nav.append({KIND_TITLES.get(kind, kind): [{n: f"zoo/{kind}/{n}.md"} for n in names]})
+    return nav
+
+
+# --------------------------------------------------------------------------- reader pages
+
+
+def reader_modules() -> tuple[dict[str, str], list[str]]:
+    """``({format: module name}, [other io module names])``."""
+    import footzoo.io as fio
+
+    readers = {fmt: fn.__module__ for fmt, fn in fio.READERS.items()}
+    used = set(readers.values())
+    others = [f"footzoo.io.{m.name}" for m in pkgutil.iter_modules(fio.__path__)
+              if f"footzoo.io.{m.name}" not in used and not m.name.startswith("_")]
+    return readers, sorted(others)
+
+
+def reader_pages() -> dict[str, str]:
+    import footzoo.io as fio
+
+    readers, others = reader_modules()
+    pages = {}
+    for fmt, modname in readers.items():
+        mod = importlib.import_module(modname)
+        fn = fio.READERS[fmt]
+        sig = inspect.signature(fn)
+        params = numpy_section(inspect.getdoc(fn) or "", "Parameters")
+        lines = [f"# `{fmt}`: {first_line(inspect.getdoc(mod) or '')}", "",
+                 "```bash", f"footzoo run configs/yun2012.yaml --data FILE --format {fmt}", "```", "",
+                 "```python", "import footzoo", "", f'rec = footzoo.load("FILE", format="{fmt}")', "```", "",
+                 "The format is also detected from the file's extension and header when `format` is left out."]
+        opts = [p for p in sig.parameters.values() if p.name != "path" and p.kind is not p.VAR_KEYWORD]
+        if opts:
+            lines += ["", "## Options", "", "Keyword arguments of `footzoo.load` for this format:", "",
+                      "| option | default | meaning |", "|---|---|---|"]
+            for p in opts:
+                d = "required" if p.default is p.empty else f"`{p.default!r}`"
+                lines.append(f"| `{p.name}` | {md_cell(d)} | {md_cell(params.get(p.name, ''))} |")
+            if any(p.kind is p.VAR_KEYWORD for p in sig.parameters.values()):
+                lines.append("")
+                lines.append("Other keywords (units, `duplicates`, `nan_policy`, `max_gap`) go to "
+                             "[`Recording.from_dataframe`](../api.md#footzoo.data.Recording.from_dataframe).")
+        lines += ["", "## Format, units, axis map and reference data", "",
+                  f"::: {modname}", "    options:", "      show_root_heading: false",
+                  "      show_root_toc_entry: false", "      members: false", ""]
+        pages[f"readers/{fmt}.md"] = "\n".join(lines)
+    for modname in others:
+        mod = importlib.import_module(modname)
+        short = modname.rsplit(".", 1)[-1]
+        pages[f"readers/{short}.md"] = "\n".join([
+            f"# `{short}`: {first_line(inspect.getdoc(mod) or '')}", "",
+            f"::: {modname}", "    options:", "      show_root_heading: false", "      show_root_toc_entry: false",
+            "      heading_level: 2", ""])
+    return pages
+
+
+def reader_nav() -> list[Any]:
+    readers, others = reader_modules()
+    nav: list[Any] = ["readers/index.md"] + [{fmt: f"readers/{fmt}.md"} for fmt in readers]
+    nav += [{m.rsplit(".", 1)[-1]: f"readers/{m.rsplit('.', 1)[-1]}.md"} for m in others]
+    return nav
+
+
+# --------------------------------------------------------------------------- gallery
+
+
+def gallery_scripts() -> list[Path]:
+    return sorted((ROOT / "docs" / "gallery").glob("*.py"))
+
+
+def run_gallery(out: Path) -> dict[str, str]:
+    """Run every gallery script; ``{src_uri: markdown}`` of the gallery page, figures left in ``out``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sections = ["# Gallery", "",
+                "Figures rendered from the scripts in `docs/gallery/` each time the documentation is built "
+                "(so they always show what the current code does). Each script is short and runs as it is: "
+                "`python docs/gallery/NAME.py OUTDIR`.", ""]
+    for script in gallery_scripts():
+        target = out / script.stem
+        target.mkdir(parents=True, exist_ok=True)
+        source = script.read_text()
+        mod_doc = ""
+        m = re.match(r'\s*"""(.*?)"""\s*\n', source, re.S)
+        if m:
+            mod_doc, body = m.group(1).strip(), source[m.end():]
+        else:
+            body = source
+        t0 = time.perf_counter()
+        old_argv, old_cwd = sys.argv, os.getcwd()
+        sys.argv = [str(script), str(target)]
+        try:
+            os.chdir(ROOT)
+            runpy.run_path(str(script), run_name="__main__")
+        finally:
+            sys.argv = old_argv
+            os.chdir(old_cwd)
+            plt.close("all")
+        log.info("gallery: %s ran in %.1f s", script.name, time.perf_counter() - t0)
+        title, _, text = mod_doc.partition("\n")
+        sections += [f"## {title.strip() or script.stem}", "", text.strip(), ""]
+        for png in sorted(target.glob("*.png"), key=lambda f: (f.stat().st_mtime_ns, f.name)):  # as drawn
+            sections += [f"![{script.stem}: {png.stem}]({script.stem}/{png.name})", ""]
+        sections += [f'??? example "Source: docs/gallery/{script.name}"', "", "    ```python"]
+        sections += [("    " + line).rstrip() for line in body.strip("\n").splitlines()]
+        sections += ["    ```", ""]
+    return {"gallery/index.md": "\n".join(sections)}
+
+
+# --------------------------------------------------------------------------- mkdocs events
+
+
+def _expand(nav: list[Any], table: dict[str, list[Any]]) -> list[Any]:
+    out = []
+    for item in nav:
+        if isinstance(item, dict):
+            (title, value), = item.items()
+            if isinstance(value, str) and value in table:
+                out.append({title: table[value]})
+            elif isinstance(value, list):
+                out.append({title: _expand(value, table)})
+            else:
+                out.append(item)
+        else:
+            out.append(item)
+    return out
+
+
+def on_config(config, **_):
+    use_checkout()
+    config["nav"] = _expand(config["nav"], {"zoo/index.md": plugin_nav(), "readers/index.md": reader_nav()})
+    return config
+
+
+def on_files(files, config, **_):
+    from mkdocs.structure.files import File
+
+    global _gallery_dir
+    use_checkout()
+    pages = {**plugin_pages(), **reader_pages()}
+    if os.environ.get("FOOTZOO_DOCS_NO_GALLERY"):
+        pages["gallery/index.md"] = "# Gallery\n\nNot rendered in this build (`FOOTZOO_DOCS_NO_GALLERY` is set).\n"
+    else:
+        _gallery_dir = Path(tempfile.mkdtemp(prefix="footzoo-gallery-"))
+        pages.update(run_gallery(_gallery_dir))
+        for png in sorted(_gallery_dir.rglob("*.png")):
+            files.append(File.generated(config, f"gallery/{png.relative_to(_gallery_dir).as_posix()}",
+                                        abs_src_path=str(png)))
+    for uri, text in pages.items():
+        existing = files.get_file_from_path(uri)
+        if existing is not None:
+            files.remove(existing)
+        files.append(File.generated(config, uri, content=text))
+    return files
+
+
+_ROLE = re.compile(r":(?:func|class|mod|meth|attr|data|obj):(<code>)~?")
+
+
+def on_page_content(html, **_):
+    """Docstrings use Sphinx roles (``:func:`name```), which Markdown renders as text: keep the code only."""
+    return _ROLE.sub(r"\1", html)

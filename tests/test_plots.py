@@ -1,0 +1,342 @@
+"""Figures: produced for typical and edge cases, human labels, references drawn, files written."""
+
+from __future__ import annotations
+
+import json
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import footzoo
+from footzoo.ablation.report import level_labels, metric_figure, metric_label, plot_study, roc_figure, run_labels
+from footzoo.ablation.report import trajectories_figure as study_trajectories
+from footzoo.plots import (
+    aligned_reference,
+    errors_figure,
+    fpa_figure,
+    plot_run,
+    robust_limits,
+    states_figure,
+    step_column,
+    strides_figure,
+    trajectory_figure,
+)
+from footzoo.sim import NoiseModel, simulate
+
+
+@pytest.fixture(scope="module")
+def walk():
+    """A short simulated walk with truth and the yun2012 pipeline's result on it."""
+    rec = simulate(n_strides=8, rate=100.0, profile="physical", noise=NoiseModel(seed=0), seed=0,
+                   fpa=np.radians(8.0))
+    res = footzoo.Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
+    return rec, res
+
+
+def legend_texts(fig) -> list[str]:
+    texts = [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+    for ax in fig.axes:
+        if ax.get_legend() is not None:
+            texts += [t.get_text() for t in ax.get_legend().get_texts()]
+    return texts
+
+
+def close(fig) -> None:
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+# --------------------------------------------------------------------------- one run
+
+
+def test_plot_run_writes_every_figure_with_truth(walk, tmp_path):
+    rec, res = walk
+    files = plot_run(res, tmp_path, rec, window=(2.0, 5.0))
+    assert {f.name for f in files} == {"trajectory.png", "states.png", "errors.png", "strides.png"}
+    for f in files:
+        assert f.stat().st_size > 10_000
+        assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_reference_is_aligned_onto_the_estimate(walk):
+    rec, res = walk
+    # an "estimate" that is the truth turned by 30° about the vertical and shifted: the aligned
+    # reference must land exactly on it (hand-derived case, independent of any estimator)
+    psi = np.radians(30.0)
+    c, s = np.cos(psi), np.sin(psi)
+    truth = rec.truth.pos
+    turned = np.column_stack([c * truth[:, 0] - s * truth[:, 1], s * truth[:, 0] + c * truth[:, 1], truth[:, 2]])
+    samples = res.samples.copy()
+    samples[["pos_n", "pos_e", "pos_d"]] = turned + [5.0, -2.0, 0.3]
+    fake = footzoo.data.Result(samples=samples, steps=res.steps, config=res.config, versions=res.versions)
+    assert np.allclose(aligned_reference(fake, rec), fake.pos, atol=1e-9)
+    fig = trajectory_figure(res, rec)
+    assert "reference (yaw-aligned)" in legend_texts(fig)
+    assert f"stride ends, numbered ({len(res.steps)} strides)" in legend_texts(fig)
+    close(fig)
+
+
+def test_errors_figure_reports_the_rms_of_the_plotted_error(walk):
+    rec, res = walk
+    fig = errors_figure(res, rec)
+    err = res.pos - aligned_reference(res, rec)
+    rms = np.sqrt(np.mean(np.sum(err**2, axis=1)))
+    assert f"3-D RMS {rms:.3f} m" in fig._suptitle.get_text()
+    close(fig)
+
+
+def test_no_truth_gives_no_error_figure_and_no_reference(walk, tmp_path):
+    rec, res = walk
+    bare = footzoo.data.Recording(t=rec.t, acc=rec.acc, gyr=rec.gyr, meta={"name": "bare"})
+    assert errors_figure(res, bare) is None
+    assert aligned_reference(res, bare) is None
+    fig = trajectory_figure(res, bare)
+    assert not any("reference" in t for t in legend_texts(fig))
+    close(fig)
+    files = plot_run(res, tmp_path, None)
+    assert {f.name for f in files} == {"trajectory.png", "states.png", "strides.png"}
+
+
+def test_states_window_outside_the_recording_is_a_clear_error(walk):
+    rec, res = walk
+    with pytest.raises(footzoo.ConfigError, match="outside the recording"):
+        states_figure(res, rec, window=(1e4, 2e4))
+
+
+def test_a_recording_that_does_not_match_the_result_is_refused(walk):
+    rec, res = walk
+    other = simulate(n_strides=4, rate=100.0)
+    for figure in (trajectory_figure, errors_figure, states_figure, strides_figure):
+        with pytest.raises(footzoo.RecordingError, match="pass the recording the result was computed from"):
+            figure(res, other)
+
+
+def test_strides_figure_uses_gait_event_columns_and_reference(walk):
+    rec, res = walk
+    steps = res.steps.copy()
+    steps["fpa_deg"] = 8.0  # as the huang_fpa analysis adds it
+    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
+                               diagnostics=res.diagnostics)
+    fig = strides_figure(res2, rec)
+    titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_visible()]
+    assert any(t.startswith("stance time") for t in titles)
+    assert any(t.startswith("swing time") for t in titles)
+    assert any(t.startswith("foot progression angle: median 8 deg") for t in titles)
+    assert "reference" in legend_texts(fig)  # the simulator's true strides, matched by time
+    close(fig)
+    fig = fpa_figure(res2, rec)
+    assert "reference" in legend_texts(fig)
+    ax = fig.axes[0]
+    ref_y = next(line.get_ydata() for line in ax.lines if line.get_label() == "reference")
+    assert np.allclose(ref_y, 8.0, atol=0.5)  # the simulator's true FPA (deg)
+    lo, hi = ax.get_ylim()
+    assert lo <= ref_y.min() and ref_y.max() <= hi  # kept in view
+    close(fig)
+    fig = states_figure(res2, rec, window=(2.0, 6.0))
+    events = [t for ax in fig.axes if ax.get_legend() for t in [x.get_text() for x in ax.get_legend().get_texts()]]
+    assert "initial contact" in events and "toe-off" in events
+    close(fig)
+
+
+def test_stride_table_without_units_in_its_names(walk):
+    """An older stride table (``start``, ``end``, ``stride_length`` ..., angles in rad) draws the same panels."""
+    rec, res = walk
+    st = res.steps
+    legacy = pd.DataFrame({"start": st["start_s"], "end": st["end_s"], "stride_time": st["stride_time_s"],
+                           "stride_length": st["stride_length_m"], "speed": st["speed_m_s"],
+                           "heading": st["heading_rad"], "max_clearance": st["max_clearance_m"], "fpa": 0.1})
+    res2 = footzoo.data.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
+                               diagnostics=res.diagnostics)
+    fig = strides_figure(res2, rec)
+    titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
+    assert titles == {"stride length", "stride time", "speed", "max. foot clearance", "foot progression angle"}
+    fpa_title = [ax.get_title(loc="left") for ax in fig.axes if ax.get_title(loc="left").startswith("foot")]
+    assert fpa_title == [f"foot progression angle: median {np.degrees(0.1):.3g} deg"]
+    close(fig)
+    fig = trajectory_figure(res2, rec)
+    assert f"stride ends, numbered ({len(legacy)} strides)" in legend_texts(fig)
+    close(fig)
+
+
+def test_step_column_units():
+    steps = pd.DataFrame({"fpa": [np.radians(10.0)], "heading_deg": [5.0], "stride_length_m": [1.2],
+                          "stride_time": [1.1]})
+    v, unit = step_column(steps, "fpa")
+    assert unit == "deg" and v[0] == pytest.approx(10.0)
+    assert step_column(steps, "heading") == (pytest.approx([5.0]), "deg")
+    assert step_column(steps, "stride_length")[1] == "m"
+    assert step_column(steps, "stride_time")[1] == "s"
+    assert step_column(steps, "swing_time") is None
+    assert step_column(pd.DataFrame({"speed_m_s": [1.0]}), "speed")[1] == "m/s"
+
+
+def test_robust_limits_keep_a_precise_series_and_drop_a_standing_stride():
+    precise = 1.2 + 1e-4 * np.sin(np.arange(50))
+    assert robust_limits(precise) is None
+    times = np.array([16.4, 1.13, 1.07, 1.06, 1.13, 1.22, 1.2, 1.25, 1.31])
+    lo, hi = robust_limits(times)
+    assert hi < 16.4 and lo <= 1.06 and hi >= 1.31
+
+
+def test_no_strides(walk):
+    rec, res = walk
+    empty = footzoo.data.Result(samples=res.samples, steps=res.steps.iloc[:0], config=res.config,
+                                versions=res.versions)
+    assert strides_figure(empty, rec) is None
+    assert fpa_figure(empty, rec) is None
+    close(trajectory_figure(empty, rec))
+
+
+# --------------------------------------------------------------------------- studies
+
+
+def test_level_labels_are_human():
+    labels = level_labels("corrections", [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]])
+    assert labels == {"[{'type': 'zvu_dedrift'}]": "zvu_dedrift", "[{'type': 'zupt'}]": "zupt"}
+    labels = level_labels("corrections", [json.dumps([{"type": "ekf_zupt", "gyro_bias": False}]),
+                                          json.dumps([{"type": "ekf_zupt", "gyro_bias": True}, {"type": "hdr"}])])
+    assert sorted(labels.values()) == ["ekf_zupt (gyro_bias=off)", "ekf_zupt (gyro_bias=on) + hdr"]
+    gains = level_labels("orientation.static_gain", [0.5, 1.05])
+    assert gains == {"0.5": "static_gain=0.5", "1.05": "static_gain=1.05"}
+    assert level_labels("detector.type", ["shoe"]) == {"shoe": "shoe"}
+    assert metric_label("loop_closure_xy_pct") == "loop closure xy (%)"
+    assert metric_label("armse_3d_m") == "armse 3d (m)"
+
+
+def fake_runs(n_configs: int, n_recordings: int = 2, with_reference: bool = True, outlier: bool = False):
+    """Study records as the runner stores them: a circle walked with a per-config heading error."""
+    rng = np.random.default_rng(1)
+    s = np.linspace(0, 2 * np.pi, 200)
+    t = np.linspace(0, 60, 200)
+    ref = np.column_stack([t, 10 * np.sin(s), 10 * (1 - np.cos(s)), 0 * s])
+    runs = []
+    for c in range(n_configs):
+        for k in range(n_recordings):
+            drift = 0.01 * (c + 1) * s
+            est = np.column_stack([t, 10 * np.sin(s + drift), 10 * (1 - np.cos(s + drift)), 0.01 * s])
+            fpr = np.linspace(0, 1, 11)
+            roc = np.column_stack([np.linspace(0, 1, 11), fpr ** (0.1 + 0.05 * c), fpr])
+            runs.append({"key": f"c{c}r{k}", "base": "yun2012.yaml", "recording": f"walk_{k}",
+                         "levels": {"detector.threshold": 0.1 * (c + 1), "corrections": [{"type": "zupt"}]},
+                         "error": None, "metrics": {"armse_3d_m": float(rng.uniform(0.1, 0.3))},
+                         "trajectory": est.tolist(), "roc": roc.tolist(),
+                         **({"reference": ref.tolist()} if with_reference else {})})
+    if outlier:
+        runs[0]["metrics"]["armse_3d_m"] = 55.0
+    return runs
+
+
+def table_of(runs, factors):
+    rows = [{"run": r["key"], "base": r["base"], **{f: (json.dumps(r["levels"][f]) if not
+             isinstance(r["levels"][f], (int, float, str)) else r["levels"][f]) for f in factors},
+             "recording": r["recording"], "metric": m, "value": v, "error": None}
+            for r in runs for m, v in r["metrics"].items()]
+    return pd.DataFrame(rows)
+
+
+FACTORS = ["detector.threshold", "corrections"]
+
+
+def test_eight_configs_share_one_axis_with_the_legend_outside(tmp_path):
+    runs = fake_runs(8)
+    labels = run_labels(runs, FACTORS)
+    assert labels["c0r0"] == "threshold=0.1, zupt"
+    fig = study_trajectories([r for r in runs if r["recording"] == "walk_0"], labels, "walk_0")
+    assert len(fig.axes) == 1
+    texts = legend_texts(fig)
+    assert texts[0] == "reference" and "threshold=0.8, zupt" in texts
+    assert not any("type" in t or "{" in t for t in texts)
+    # the legend is a figure legend outside the axes: it does not overlap the plotted area
+    fig.canvas.draw()
+    leg = fig.legends[0].get_window_extent()
+    assert leg.y1 <= fig.axes[0].get_window_extent().y0
+    close(fig)
+    roc = roc_figure(runs, run_labels(runs, FACTORS, only=["detector.threshold"]))
+    texts = legend_texts(roc)
+    assert len(texts) == 8 and texts[0].startswith("threshold=0.1 (AUC ")
+    fpr = np.linspace(0, 1, 11)  # the fake sweep of configuration 0: tpr = fpr^0.1, trapezoid rule
+    assert texts[0] == f"threshold=0.1 (AUC {np.trapezoid(fpr ** 0.1, fpr):.3f})"
+    assert roc.axes[0].get_xscale() == "linear"  # some AUCs are below 0.9
+    close(roc)
+    steep = fake_runs(1, n_recordings=1)
+    steep[0]["roc"] = np.column_stack([fpr, fpr ** 0.02, fpr]).tolist()  # AUC 0.93: crowded top-left corner
+    roc = roc_figure(steep, run_labels(steep, FACTORS))
+    assert roc.axes[0].get_xscale() == "log"
+    close(roc)
+
+
+
+def test_many_configs_get_small_multiples(tmp_path):
+    runs = fake_runs(110, n_recordings=1)
+    fig = roc_figure(runs, run_labels(runs, FACTORS, only=["detector.threshold"]))
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(visible) == 110
+    assert all(len(ax.lines) <= 3 for ax in visible)  # one recording, its mean, the diagonal
+    assert visible[0].get_title().startswith("threshold=0.1\nAUC ")
+    close(fig)
+    fig = study_trajectories(runs, run_labels(runs, FACTORS), "walk_0")
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(visible) == 110
+    assert all(len(ax.lines) == 2 for ax in visible)  # the reference and one estimate per panel
+    assert len({ax.get_xlim() for ax in visible}) == 1  # one scale for all
+    close(fig)
+    fig = metric_figure(table_of(runs, FACTORS), "detector.threshold", "armse_3d_m")
+    assert len(fig.axes[0].get_yticklabels()) == 110  # one row per level
+    close(fig)
+
+
+def test_plot_study_writes_its_files(tmp_path):
+    runs = fake_runs(9, n_recordings=2)
+    written = plot_study(table_of(runs, FACTORS), runs, FACTORS, tmp_path)
+    names = {p.name for p in written}
+    assert names == {"trajectories_walk_0.png", "trajectories_walk_1.png", "roc.png",
+                     "metric_armse_3d_m_by_detector_threshold.png", "metric_armse_3d_m_by_corrections.png"}
+    for p in written:
+        assert p.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_diverging_run_does_not_shrink_the_other_panels():
+    runs = fake_runs(10, n_recordings=1)
+    tr = np.asarray(runs[3]["trajectory"])
+    tr[:, 1:3] *= 50.0  # one configuration diverges to 1 km
+    runs[3]["trajectory"] = tr.tolist()
+    for with_reference in (True, False):
+        rs = [dict(r) for r in runs]
+        if not with_reference:
+            for r in rs:
+                r.pop("reference")
+        fig = study_trajectories(rs, run_labels(rs, FACTORS), "walk_0")
+        panels = [ax for ax in fig.axes if ax.get_visible()]
+        lo, hi = panels[0].get_xlim()
+        assert 20 < hi - lo < 40  # the 20 m circle fills the frame
+        notes = [[t.get_text() for t in ax.texts] for ax in panels]
+        assert notes[3] == ["leaves the frame"] and notes[0] == []
+        close(fig)
+
+
+def test_outlier_puts_the_box_plot_on_a_log_scale():
+    runs = fake_runs(4, n_recordings=3, outlier=True)
+    table = table_of(runs, FACTORS)
+    fig = metric_figure(table, "detector.threshold", "armse_3d_m")
+    assert fig.axes[0].get_yscale() == "log"
+    assert [t.get_text() for t in fig.axes[0].get_xticklabels()][:2] == ["0.1", "0.2"]
+    close(fig)
+    fig = metric_figure(table_of(fake_runs(4, n_recordings=3), FACTORS), "detector.threshold", "armse_3d_m")
+    assert fig.axes[0].get_yscale() == "linear"
+    close(fig)
+
+
+def test_one_config_without_reference(tmp_path):
+    runs = fake_runs(1, n_recordings=1, with_reference=False)
+    written = plot_study(table_of(runs, FACTORS), runs, FACTORS, tmp_path)
+    assert (tmp_path / "trajectories_walk_0.png") in written
+    labels = run_labels(runs, FACTORS)
+    fig = study_trajectories(runs, labels, "walk_0")
+    assert legend_texts(fig) == ["threshold=0.1, zupt"]
+    close(fig)
