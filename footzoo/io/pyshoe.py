@@ -6,6 +6,9 @@ reference is mirrored with respect to the IMU frame: a right-handed NED
 estimate matches ``gt · [1, 1, −1]`` (negate z only), which is what the
 :class:`~footzoo.data.Truth` holds (z down, horizontal axes VICON's, so compare
 after a rotation about the vertical). ``zv_vicon_opt`` becomes the stance truth.
+
+The dataset documents the sensor on the right shoe's instep: ``meta["foot"]`` is
+``"right"`` (what foot-dependent analyses such as ``huang_fpa`` with ``foot: auto`` read).
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ def read(path: Path, **options: Any) -> Recording:
         mirror = np.array([1.0, 1.0, -1.0])  # VICON z up and mirrored: negate z only
         truth = Truth(pos=np.asarray(d["gt"], dtype=float) * mirror, stance=stance)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe",
-                            "placement": "right shoe instep (LORD MicroStrain)"}
+                            "placement": "right shoe instep (LORD MicroStrain)", "foot": "right"}
     if "trial_error" in d:
         errors = np.ravel(d["trial_error"]).astype(float)
         meta["pyshoe_trial_error"] = {k: float(e) for k, e in zip(TRIAL_ERROR_DETECTORS, errors, strict=True)}
