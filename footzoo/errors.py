@@ -15,3 +15,7 @@ class ConfigError(FootzooError, ValueError):
 
 class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
+
+
+class FootzooWarning(UserWarning):
+    """Something footzoo repaired or bridged that the user should know about (e.g. a short logger gap)."""

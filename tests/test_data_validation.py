@@ -65,7 +65,7 @@ def test_duplicate_time_stamps_are_an_error_unless_dropped_with_a_count():
 
 def test_gaps_are_reported_with_their_length_and_place():
     df = frame().drop(index=range(100, 120)).reset_index(drop=True)
-    with pytest.raises(RecordingError, match=r"gap\(s\) longer than 50.0 ms, the first 210.0 ms at t = 0.990 s"):
+    with pytest.raises(RecordingError, match=r"gap\(s\) longer than 100.0 ms, the first 210.0 ms at t = 0.990 s"):
         Recording.from_dataframe(df)
     assert Recording.from_dataframe(df, max_gap=0.3).n == 380
 

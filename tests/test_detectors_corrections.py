@@ -10,9 +10,10 @@ from footzoo.detectors import AngularRateFSM, dated_and_online_states
 def test_state_machine_ignores_short_runs_and_dates_switches_back():
     c = np.array([1, 1, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 1, 1, 1, 1], bool)
     dated, online = dated_and_online_states(c, 3)
-    # the 1-sample dip at 2 is ignored; the 4-sample swing run at 5..8 switches, dated back to 5;
-    # the 2-sample blip at 9 is ignored; stance run at 12..15 switches back, dated to 12
-    np.testing.assert_array_equal(dated, [1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1])
+    # the 4-sample swing run at 5..8 switches; the 2-sample still run at 3..4 is too short to be stance, so
+    # the swing is dated back across it to the motion at 2 (a toe roll before the toe-off dip);
+    # the 1-sample blip at 9 is ignored; stance run at 12..15 switches back, dated to 12
+    np.testing.assert_array_equal(dated, [1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1])
     # the live machine learns each switch Γ_th - 1 samples later
     np.testing.assert_array_equal(online, [1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 1])
 

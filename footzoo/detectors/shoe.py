@@ -6,50 +6,20 @@ import math
 
 import numpy as np
 
-from .._jit import njit
 from ..conventions import GRAVITY
-from ..registry import Plugin, check_positive, register
+from ..registry import check_positive, register
 from .runs import dated_and_online_states
-
-
-@njit
-def shoe_statistic(acc: np.ndarray, gyr: np.ndarray, window: int, sigma_a: float, sigma_g: float,
-                   g: float = GRAVITY) -> np.ndarray:
-    """SHOE test statistic per sample (centred window of ``window`` samples, edges replicated).
-
-    ``T_k = (1/W) Σ_l [ ‖y_a,l − g ȳ_a/‖ȳ_a‖‖² / σ_a² + ‖y_ω,l‖² / σ_ω² ]`` with ``ȳ_a``
-    the window's mean specific force (Skog et al. 2010, the GLRT's SHOE statistic).
-    """
-    n = acc.shape[0]
-    out = np.empty(n)
-    start = -(window // 2)
-    for k in range(n):
-        mx = my = mz = 0.0
-        for j in range(k + start, k + start + window):
-            i = min(max(j, 0), n - 1)
-            mx += acc[i, 0]
-            my += acc[i, 1]
-            mz += acc[i, 2]
-        norm = math.sqrt(mx * mx + my * my + mz * mz)
-        ux, uy, uz = g * mx / norm, g * my / norm, g * mz / norm
-        total = 0.0
-        for j in range(k + start, k + start + window):
-            i = min(max(j, 0), n - 1)
-            dx, dy, dz = acc[i, 0] - ux, acc[i, 1] - uy, acc[i, 2] - uz
-            total += (dx * dx + dy * dy + dz * dz) / sigma_a**2
-            total += (gyr[i, 0] ** 2 + gyr[i, 1] ** 2 + gyr[i, 2] ** 2) / sigma_g**2
-        out[k] = total / window
-    return out
+from .skog import SkogTest
 
 
 @register
-class SHOE(Plugin):
+class SHOE(SkogTest):
     """Stance hypothesis optimal detector (generalised likelihood ratio test).
 
     Skog, Händel, Nilsson & Rantakokko, "Zero-velocity detection — an algorithm
     evaluation", IEEE TBME 57(11), 2010 (cited by Yun 2012 and Huang 2016): stance
-    where the windowed statistic of :func:`shoe_statistic` (a sliding, centred
-    window) is below γ. Defaults from Skog's OpenShoe: σ_a = 0.01 m/s²,
+    where the windowed statistic (see :class:`~footzoo.detectors.skog.SkogTest`;
+    a sliding, centred window) is below γ. Defaults from Skog's OpenShoe: σ_a = 0.01 m/s²,
     σ_ω = 0.1 °/s, γ = 3e4, and a window of 0.025 s (5 samples at 200 Hz). PyShoe's
     thresholds are not comparable: it sums over non-overlapping blocks.
 
@@ -72,30 +42,20 @@ class SHOE(Plugin):
         Stance flag (the centred window makes it W/2 samples late when live).
     """
 
-    kind = "detector"
     name = "shoe"
-    paper = "Skog et al. 2010, IEEE TBME 57(11) (cited by Yun 2012 and Huang 2016)"
-    units = {"threshold": "1", "window": "s", "sigma_a": "m/s^2", "sigma_g": "rad/s"}
+    paper = "Skog et al. 2010, IEEE TBME 57(11), Sec. III (cited by Yun 2012 and Huang 2016)"
 
     def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
-        self.threshold = check_positive("threshold", threshold)
-        self.window = check_positive("window", window)
-        self.sigma_a = check_positive("sigma_a", sigma_a)
-        self.sigma_g = check_positive("sigma_g", sigma_g)
+        super().__init__(threshold, window, sigma_a, sigma_g)
 
-    def _statistic(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
-        rate = 1.0 / float(np.median(np.diff(t)))
-        w = max(int(round(self.window * rate)), 1)
-        return shoe_statistic(np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(gyr, dtype=float), w,
-                              self.sigma_a, self.sigma_g, GRAVITY)
+    def test(self, m: np.ndarray) -> np.ndarray:
+        """``T_k = (1/W) Σ ‖y_a − g ȳ_a/‖ȳ_a‖‖²/σ_a² + ‖y_ω‖²/σ_ω²``, expanded in the window moments.
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> SHOE:
-        """Evaluate the test over the whole recording (vectorised)."""
-        self.statistic_ = self._statistic(t, acc, gyr)
-        self.stance_ = self.statistic_ < self.threshold
-        self.stance_online_ = self.stance_.copy()
-        return self
+        ``(1/W) Σ ‖y_a − g u‖² = mean ‖y_a‖² − 2 g ‖ȳ_a‖ + g²`` for the unit vector ``u = ȳ_a/‖ȳ_a‖``.
+        """
+        acc_term = m[:, 3] - 2.0 * GRAVITY * np.linalg.norm(m[:, :3], axis=1) + GRAVITY**2
+        return np.maximum(acc_term, 0.0) / self.sigma_a**2 + m[:, 4] / self.sigma_g**2
 
 
 @register

@@ -8,8 +8,8 @@ sensor's x axis is taken as the foot's forward axis; it is tilted on the foot
 
 The file has exact duplicate rows (time stamp repeated) and short gaps (up to
 17 ms at 400 Hz). Duplicates are dropped with a warning that gives the count;
-gaps up to ``max_gap`` (default 25 ms) are bridged by the filters, which use
-each sample's own interval. The walk is a closed loop: ``truth.closed_loop``.
+gaps up to ``max_gap`` (default: the library's, 0.1 s) are bridged by the filters, which use
+each sample's own interval, with a warning. The walk is a closed loop: ``truth.closed_loop``.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def matches(header: str) -> bool:
 
 
 def read(
-    path: Path, duplicates: str = "drop", max_gap: float = 0.025, closed_loop: bool = True, **options: Any
+    path: Path, duplicates: str = "drop", max_gap: float | None = None, closed_loop: bool = True, **options: Any
 ) -> Recording:
     """Read an x-io CSV and convert to FRD/SI.
 
@@ -47,8 +47,8 @@ def read(
     ----------
     duplicates : {"drop", "error"}
         Repeated time stamps (the file has about 1 % exact duplicates).
-    max_gap : float
-        Largest gap bridged (s).
+    max_gap : float, optional
+        Largest gap bridged (s); default :data:`footzoo.data.DEFAULT_MAX_GAP`.
     closed_loop : bool
         Whether the walk ends where it started (true for ``short_walk.csv``).
     """

@@ -9,6 +9,7 @@ import numpy as np
 from .._jit import njit
 from ..registry import Plugin, check_positive, register
 from .fqa import fqa_sample
+from .magnetic import magnetometer_valid
 
 
 @njit
@@ -18,7 +19,7 @@ def complementary_kernel(
     dt: np.ndarray,
     q_static: np.ndarray,
     gain: np.ndarray,
-    keep_yaw: bool,
+    keep_yaw: np.ndarray,
     static_yaw: np.ndarray,
 ) -> np.ndarray:
     """Per-sample core of the complementary filter (plain arrays, no objects).
@@ -29,10 +30,11 @@ def complementary_kernel(
     that is constant over the sample interval; the feedback ``k e(t)`` with
     ``e = ±q_s − q̂`` (the sign of ``q_s`` chosen to match ``q̂``) is evaluated at
     ``t[k]``, with the static quaternion and the gyro-propagated estimate of
-    the same instant, and added with the same step. With ``keep_yaw`` (no magnetometer) ``q_s`` is the tilt-only
-    FQA quaternion given the current estimate's heading, so the static branch
-    corrects roll and pitch only: ``q_static`` then holds the tilt quaternion and
-    ``static_yaw`` its heading, which is replaced by the estimate's.
+    the same instant, and added with the same step. Where ``keep_yaw[k]`` (no
+    magnetometer, or a rejected sample) ``q_s`` is the tilt-only FQA quaternion
+    given the current estimate's heading, so the static branch corrects roll and
+    pitch only: ``q_static`` then holds the tilt quaternion and ``static_yaw`` its
+    heading, which is replaced by the estimate's.
     """
     n = gyr.shape[0]
     out = np.empty((n, 4))
@@ -54,7 +56,7 @@ def complementary_kernel(
         kk = gain[k] * h
         if kk != 0.0:
             sw, sx, sy, sz = q_static[k, 0], q_static[k, 1], q_static[k, 2], q_static[k, 3]
-            if keep_yaw:
+            if keep_yaw[k]:
                 # give q_s the current estimate's heading: q_z(ψ̂ − ψ_s) ⊗ q_s
                 psi = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) - static_yaw[k]
                 cw, cz = math.cos(0.5 * psi), math.sin(0.5 * psi)
@@ -138,6 +140,14 @@ class FQAComplementary(Plugin):
 
     Without a magnetometer the static branch corrects roll and pitch only.
 
+    Magnetic disturbance rejection (footzoo's, not the paper's; see
+    :mod:`footzoo.orientation.magnetic`): a magnetometer sample whose magnitude
+    or dip departs from the values learned at the still start by more than
+    ``mag_norm_tolerance`` or ``mag_dip_tolerance`` is not used: the static
+    branch then corrects roll and pitch only, and the heading follows the gyro.
+    Undisturbed recordings are unaffected; near steel or a motor the paper's
+    filter pulls the heading toward the disturbed field.
+
     Parameters
     ----------
     static_gain : float
@@ -146,6 +156,12 @@ class FQAComplementary(Plugin):
         k_d (1/s), gain in swing; paper: 0.0 (Table II).
     use_magnetometer : bool
         Use the magnetometer for heading when the recording has one.
+    mag_rejection : bool
+        Reject disturbed magnetometer samples (False: the paper's filter).
+    mag_norm_tolerance : float
+        Accepted relative deviation of the field magnitude (1).
+    mag_dip_tolerance : float
+        Accepted deviation of the dip angle (rad); default 5°.
 
     Attributes
     ----------
@@ -153,18 +169,25 @@ class FQAComplementary(Plugin):
         Estimated attitude, body -> NED.
     gain_ : (N,) ndarray
         Gain used at each sample (1/s).
+    mag_valid_ : (N,) bool ndarray or None
+        Magnetometer samples used for heading (None without a magnetometer).
     """
 
     kind = "orientation"
     name = "fqa_complementary"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
-    units = {"static_gain": "1/s", "dynamic_gain": "1/s"}
+    units = {"static_gain": "1/s", "dynamic_gain": "1/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
     needs_stance = True
 
-    def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True):
+    def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True,
+                 mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
+                 mag_dip_tolerance: float = float(np.radians(5.0))):
         self.static_gain = check_positive("static_gain", static_gain, allow_zero=True)
         self.dynamic_gain = check_positive("dynamic_gain", dynamic_gain, allow_zero=True)
         self.use_magnetometer = bool(use_magnetometer)
+        self.mag_rejection = bool(mag_rejection)
+        self.mag_norm_tolerance = check_positive("mag_norm_tolerance", mag_norm_tolerance)
+        self.mag_dip_tolerance = check_positive("mag_dip_tolerance", mag_dip_tolerance)
 
     def estimate(
         self,
@@ -195,8 +218,20 @@ class FQAComplementary(Plugin):
         dt[0] = 0.0
         use_mag = self.use_magnetometer and mag is not None
         q_static, static_yaw = static_quaternion(acc, gyr, dt, mag if use_mag else None)
+        keep_yaw = np.full(t.shape[0], not use_mag)
+        self.mag_valid_ = None
+        if use_mag:
+            self.mag_valid_ = np.ones(t.shape[0], dtype=bool)
+            if self.mag_rejection:
+                self.mag_valid_ = magnetometer_valid(t, acc, mag, stance, self.mag_norm_tolerance,
+                                                     self.mag_dip_tolerance)[0]
+                if not self.mag_valid_.all():
+                    q_tilt, tilt_yaw = static_quaternion(acc, gyr, dt, None)
+                    bad = ~self.mag_valid_
+                    q_static[bad], static_yaw[bad] = q_tilt[bad], tilt_yaw[bad]
+                    keep_yaw = bad
         self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
         self.quat_ = complementary_kernel(
-            np.asarray(q0, dtype=float), gyr, dt, q_static, self.gain_, not use_mag, static_yaw
+            np.asarray(q0, dtype=float), gyr, dt, q_static, self.gain_, keep_yaw, static_yaw
         )
         return self

@@ -8,11 +8,13 @@ import numpy as np
 
 from .._jit import njit
 from ..registry import Plugin, check_positive, register
+from .magnetic import magnetometer_valid
 
 
 @njit
 def madgwick_kernel(
-    q0: np.ndarray, gyr: np.ndarray, acc: np.ndarray, mag: np.ndarray | None, dt: np.ndarray, beta: float
+    q0: np.ndarray, gyr: np.ndarray, acc: np.ndarray, mag: np.ndarray | None, dt: np.ndarray, beta: float,
+    mag_valid: np.ndarray | None = None,
 ) -> np.ndarray:
     """Per-sample core (plain arrays): gyro rate minus β times the normalised gradient.
 
@@ -22,7 +24,8 @@ def madgwick_kernel(
     the current estimate of the measured field, ``h = q ⊗ m ⊗ q*``,
     ``b_x = |h_xy|``, ``b_z = h_z`` (Madgwick's distortion compensation). The
     objective ``f = q* ⊗ d ⊗ q − s`` (eq. 6) and its Jacobian are written out for
-    a general ``d`` (eqs. 7–9).
+    a general ``d`` (eqs. 7–9). Where ``mag_valid[k]`` is False the sample is
+    treated as IMU-only (eq. 10, first case).
     """
     n = gyr.shape[0]
     out = np.empty((n, 4))
@@ -42,7 +45,7 @@ def madgwick_kernel(
             ax, ay, az = ax / an, ay / an, az / an
             # gravity part: d = (0, 0, -1), s = â
             s0, s1, s2, s3 = _grad(w, x, y, z, 0.0, 0.0, -1.0, ax, ay, az)
-            if mag is not None:
+            if mag is not None and (mag_valid is None or mag_valid[k]):
                 mx, my, mz = mag[k, 0], mag[k, 1], mag[k, 2]
                 mn = math.sqrt(mx * mx + my * my + mz * mz)
                 if mn > 0.0:
@@ -110,6 +113,14 @@ class Madgwick(Plugin):
         which gives Madgwick's β = 0.076 (Huang does not give a number).
     use_magnetometer : bool
         MARG (accelerometer + magnetometer) or IMU-only (eq. 10, first case).
+    mag_rejection : bool
+        Treat magnetometer samples whose magnitude or dip departs from the
+        still start's as IMU-only (footzoo's, see
+        :mod:`footzoo.orientation.magnetic`; False: the paper's filter).
+    mag_norm_tolerance : float
+        Accepted relative deviation of the field magnitude (1).
+    mag_dip_tolerance : float
+        Accepted deviation of the dip angle (rad); default 5°.
 
     Attributes
     ----------
@@ -117,16 +128,23 @@ class Madgwick(Plugin):
         Attitude, body -> NED.
     beta_ : float
         β (rad/s).
+    mag_valid_ : (N,) bool ndarray or None
+        Magnetometer samples used (None without a magnetometer).
     """
 
     kind = "orientation"
     name = "madgwick"
     paper = "Huang et al. 2016, IEEE TBME, eqs. 1-10 (Madgwick 2011)"
-    units = {"gyro_error": "rad/s"}
+    units = {"gyro_error": "rad/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
 
-    def __init__(self, gyro_error: float = float(np.radians(5.0)), use_magnetometer: bool = True):
+    def __init__(self, gyro_error: float = float(np.radians(5.0)), use_magnetometer: bool = True,
+                 mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
+                 mag_dip_tolerance: float = float(np.radians(5.0))):
         self.gyro_error = check_positive("gyro_error", gyro_error, allow_zero=True)
         self.use_magnetometer = bool(use_magnetometer)
+        self.mag_rejection = bool(mag_rejection)
+        self.mag_norm_tolerance = check_positive("mag_norm_tolerance", mag_norm_tolerance)
+        self.mag_dip_tolerance = check_positive("mag_dip_tolerance", mag_dip_tolerance)
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
         """Run the filter over a recording (``stance`` is not used)."""
@@ -135,5 +153,12 @@ class Madgwick(Plugin):
         dt[0] = 0.0
         self.beta_ = math.sqrt(3.0 / 4.0) * self.gyro_error  # eq. 3
         use_mag = self.use_magnetometer and mag is not None
-        self.quat_ = madgwick_kernel(np.asarray(q0, float), gyr, acc, mag if use_mag else None, dt, self.beta_)
+        self.mag_valid_ = None
+        if use_mag:
+            self.mag_valid_ = np.ones(t.shape[0], dtype=bool)
+            if self.mag_rejection:
+                self.mag_valid_ = magnetometer_valid(t, acc, mag, stance, self.mag_norm_tolerance,
+                                                     self.mag_dip_tolerance)[0]
+        self.quat_ = madgwick_kernel(np.asarray(q0, float), gyr, acc, mag if use_mag else None, dt, self.beta_,
+                                     self.mag_valid_)
         return self

@@ -60,6 +60,7 @@ def simulate(
     cycle: float = 1.0,
     stance_fraction: float = 0.6,
     clearance: float = 0.25,
+    flat_fraction: float = 2.0 / 3.0,
     rate: float = 50.0,
     profile: str = "paper",
     sampling: str = "interval",
@@ -95,6 +96,8 @@ def simulate(
         Stride length (m); Table II: 1.2.
     cycle, stance_fraction, clearance : float
         Gait cycle (s), stance share, swing clearance (m); Table I/II: 1.0, 0.6, 0.25.
+    flat_fraction : float
+        Foot-flat share of the stance (Table I: 2/3; running about 1/3).
     rate : float
         Sampling rate (Hz); Table II: 50.
     profile : {"paper", "physical"}
@@ -147,7 +150,7 @@ def simulate(
         steps, closed = paths.straight(len(lengths), lengths), False
     else:
         steps, closed = _footsteps(path, n_strides, stride_length, **path_options)
-        specs = [StrideSpec(cycle, stance_fraction, clearance)] * (len(steps) - 1)
+        specs = [StrideSpec(cycle, stance_fraction, clearance, flat_fraction)] * (len(steps) - 1)
     fpas = np.broadcast_to(np.asarray(fpa, float), (len(steps),))
     for s, a in zip(steps, fpas, strict=True):
         s.fpa = float(a)

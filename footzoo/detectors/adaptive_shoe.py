@@ -1,0 +1,96 @@
+"""SHOE with a Bayesian threshold growing with the time since the last zero-velocity update (Wahlström 2019)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import njit
+from ..registry import check_positive, register
+from .shoe import SHOE
+
+
+@njit
+def adaptive_threshold_kernel(t: np.ndarray, statistic: np.ndarray, gamma0: float, tau: float,
+                              gamma_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """Causal test ``T_k < γ_k`` with ``γ_k = min(γ_0 exp((t_k − t_last)/τ), γ_max)``.
+
+    ``t_last`` is the time of the last sample declared stationary (the start of
+    the recording before the first). Returns the stance flag and γ_k.
+    """
+    n = t.shape[0]
+    stance = np.empty(n, dtype=np.bool_)
+    gamma = np.empty(n)
+    log_max = math.log(gamma_max)
+    t_last = t[0]
+    for k in range(n):
+        g = math.exp(min(math.log(gamma0) + (t[k] - t_last) / tau, log_max))
+        gamma[k] = g
+        s = statistic[k] < g
+        stance[k] = s
+        if s:
+            t_last = t[k]
+    return stance, gamma
+
+
+@register
+class AdaptiveSHOE(SHOE):
+    """Zero-velocity detection with a threshold that adapts to the gait (Bayesian thresholding).
+
+    Wahlström, Skog, Gustafsson, Markham & Trigoni, "Zero-velocity detection —
+    a Bayesian approach to adaptive thresholding", IEEE Sensors Letters 3(6),
+    2019: the likelihood-ratio test of Skog et al. 2010 (here SHOE, see
+    ``shoe``) compared with a Bayes threshold, the ratio of the hypotheses'
+    prior probabilities times the ratio of the costs of a false alarm and a
+    missed detection. The cost of a missed detection grows exponentially with
+    the time Δt since the last zero-velocity update (the longer without an
+    update, the more an update is worth), so the threshold is
+    ``γ_k = γ_0 exp(Δt_k / τ)``: in a long walking stance it stays at γ_0, while a
+    brief, shaky running stance, which comes after a swing of about the same
+    duration, meets a threshold that has grown meanwhile. The paper also
+    derives a prior from the navigation filter's velocity estimate; footzoo's
+    detectors run before the filter, so that prior is flat here (documented
+    simplification). ``γ_max`` caps the growth (footzoo's guard: without it, any
+    long motion would end in a false stance).
+
+    Parameters
+    ----------
+    threshold : float
+        γ_0, the threshold right after an update (dimensionless, as for ``shoe``).
+    window, sigma_a, sigma_g : float
+        As for ``shoe`` (s, m/s², rad/s).
+    time_constant : float
+        τ (s): the threshold grows by e every τ without an update.
+    max_threshold : float
+        γ_max (dimensionless).
+
+    Attributes
+    ----------
+    statistic_ : (N,) ndarray
+        SHOE's T_k.
+    threshold_ : (N,) ndarray
+        γ_k in force at each sample.
+    stance_, stance_online_ : (N,) bool ndarray
+        Stance flag (the decision is causal; the centred window makes it W/2
+        samples late when live).
+    """
+
+    name = "adaptive_shoe"
+    paper = "Wahlström et al. 2019, IEEE Sensors Letters 3(6) (Bayesian adaptive threshold) on SHOE (Skog et al. 2010)"
+    units = {**SHOE.units, "time_constant": "s", "max_threshold": "1"}
+
+    def __init__(self, threshold: float = 1e4, window: float = 0.025, sigma_a: float = 0.01,
+                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.15, max_threshold: float = 1e6):
+        super().__init__(threshold, window, sigma_a, sigma_g)
+        self.time_constant = check_positive("time_constant", time_constant)
+        self.max_threshold = check_positive("max_threshold", max_threshold)
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> AdaptiveSHOE:
+        """Evaluate SHOE, then the adaptive test sample by sample."""
+        self.statistic_ = self._statistic(t, acc, gyr)
+        self.stance_, self.threshold_ = adaptive_threshold_kernel(
+            np.ascontiguousarray(t, dtype=float), self.statistic_, self.threshold, self.time_constant,
+            max(self.max_threshold, self.threshold))
+        self.stance_online_ = self.stance_.copy()
+        return self
