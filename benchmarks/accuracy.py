@@ -41,7 +41,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from footzoo.ablation import Study, run_study  # noqa: E402
+from footzoo.ablation import Study, run_cell, run_study, tidy  # noqa: E402
 from footzoo.ablation.report import to_markdown  # noqa: E402
 
 DEFAULT_DATA = ROOT.parent / "shared" / "data"
@@ -59,21 +59,23 @@ MOTION_CLASSES = {
 CLASS_ORDER = ["walking", "running/fast", "slow unusual", "inverted"]
 QUICK_PYSHOE = ["2017-11-22-11-22-03", "2017-11-27-11-12-18", "2018-02-22-10-09-36"]
 
-_NOISE = {"scale": 1}
-#: Simulator scenarios: name -> simulate() arguments (physical foot model, Table II noise).
+
+def _sim(**spec: Any) -> dict[str, Any]:
+    """A simulator scenario: physical foot model, Table II noise and biases, VL6180-like distance sensors
+    (Duong & Suh 2015, so that ``duong2015`` runs too), 0.15 m swing clearance, unless ``spec`` says otherwise."""
+    return {"profile": "physical", "clearance": 0.15, "noise": {"scale": 1}, "distance_sensors": True, **spec}
+
+
+#: Simulator scenarios: name -> simulate() arguments.
 SIM_SCENARIOS: dict[str, dict[str, Any]] = {
-    "walk": {"path": "rectangle", "rate": 100, "profile": "physical", "clearance": 0.15, "noise": _NOISE},
-    "run": {"path": "run", "n_strides": 40, "rate": 200, "profile": "physical", "clearance": 0.15, "noise": _NOISE},
-    "stairs": {"path": "stairs", "n_strides": 6, "landing_strides": 3, "cycle": 1.2, "clearance": 0.1, "rate": 100,
-               "profile": "physical", "noise": _NOISE},
-    "mixed_speed_100hz": {"path": "mixed_speed", "rate": 100, "profile": "physical", "clearance": 0.15,
-                          "noise": _NOISE},
-    "mixed_speed_200hz": {"path": "mixed_speed", "rate": 200, "profile": "physical", "clearance": 0.15,
-                          "noise": _NOISE},
-    "walk_1h": {"path": "track", "laps": 10, "rate": 100, "profile": "physical", "clearance": 0.15, "noise": _NOISE},
+    "walk": _sim(path="rectangle", rate=100),
+    "run": _sim(path="run", n_strides=40, rate=200),
+    "stairs": _sim(path="stairs", n_strides=6, landing_strides=3, cycle=1.2, clearance=0.1, rate=100),
+    "mixed_speed_100hz": _sim(path="mixed_speed", rate=100),
+    "mixed_speed_200hz": _sim(path="mixed_speed", rate=200),
+    "walk_1h": _sim(path="track", laps=10, rate=100),
 }
-QUICK_SIM = {"walk_short": {"path": "rectangle", "length": 10.0, "width": 5.0, "rate": 100, "profile": "physical",
-                            "clearance": 0.15, "noise": _NOISE}}
+QUICK_SIM = {"walk_short": _sim(path="rectangle", length=10.0, width=5.0, rate=100)}
 
 #: Targets of the issue (recommended config unless said otherwise).
 TARGETS = {
@@ -142,11 +144,32 @@ def recordings(data: Path, quick: bool, sim: dict[str, dict[str, Any]]) -> dict[
     return {k: v for k, v in out.items() if v}
 
 
+def run_cached(study: Study, folder: Path, jobs: int = 1, plots: bool = False, progress: bool = False) -> pd.DataFrame:
+    """A study's tidy table through the ablation runner, cached in ``folder/cache``.
+
+    ``plots`` also writes the runner's report (tables and one plot per recording, slow for
+    thousands of runs); without it the cells go through :func:`footzoo.ablation.run_cell`
+    with the same cache, so a rerun only computes what changed.
+    """
+    if plots:
+        return run_study(study, jobs=jobs, out=folder, progress=progress)
+    cache = folder / "cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    cells = study.cells()
+    if jobs == 1:
+        runs = [run_cell(c, str(cache), study.metrics) for c in cells]
+    else:
+        from joblib import Parallel, delayed
+
+        runs = Parallel(n_jobs=jobs)(delayed(run_cell)(c, str(cache), study.metrics) for c in cells)
+    return tidy(runs, list(study.factors))
+
+
 def run_dataset(name: str, recs: list[dict[str, Any]], configs: list[Path], results: Path, jobs: int,
-                progress: bool) -> pd.DataFrame:
+                progress: bool, plots: bool = False) -> pd.DataFrame:
     """Every config on one dataset's recordings, through the ablation runner (cached)."""
     study = Study.from_dict({"name": name, "base": [str(c) for c in configs], "recordings": recs})
-    table = run_study(study, jobs=jobs, out=results / name, progress=progress)
+    table = run_cached(study, results / name, jobs, plots, progress)
     table = table.rename(columns={"base": "config"})
     table.insert(0, "dataset", name)
     return table[["dataset", "recording", "config", "metric", "value", "error"]]
@@ -466,7 +489,7 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
 
 
 def run(data: Path, results: Path, configs: list[Path], jobs: int = 1, quick: bool = False,
-        progress: bool = False, sim: dict[str, dict[str, Any]] | None = None) -> pd.DataFrame:
+        progress: bool = False, sim: dict[str, dict[str, Any]] | None = None, plots: bool = False) -> pd.DataFrame:
     """Run the benchmark and return the tidy table (also written to ``results``)."""
     results.mkdir(parents=True, exist_ok=True)
     sim = (QUICK_SIM if quick else SIM_SCENARIOS) if sim is None else sim
@@ -474,7 +497,7 @@ def run(data: Path, results: Path, configs: list[Path], jobs: int = 1, quick: bo
     tables = []
     for name, recs in datasets.items():
         t0 = time.time()
-        tables.append(run_dataset(name, recs, configs, results, jobs, progress))
+        tables.append(run_dataset(name, recs, configs, results, jobs, progress, plots))
         print(f"{name}: {len(recs)} recording(s) x {len(configs)} config(s) in {time.time() - t0:.0f} s", flush=True)
     tables.append(run_stride_references(datasets, configs, jobs))
     table = pd.concat([t for t in tables if not t.empty], ignore_index=True)
@@ -499,13 +522,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="Markdown summary (default benchmarks/accuracy.md; with --quick RESULTS/accuracy_quick.md)")
     ap.add_argument("--recommended", default="recommended", help="config the targets are checked for")
     ap.add_argument("--progress", action="store_true", help="progress bars")
+    ap.add_argument("--plots", action="store_true", help="also the ablation runner's report per dataset (slow)")
     args = ap.parse_args(argv)
     # readers warn about what they repair (x-io's duplicate rows): expected here, and workers inherit this
     os.environ.setdefault("PYTHONWARNINGS", "ignore::UserWarning")
     warnings.simplefilter("ignore", UserWarning)
     configs = shipped_configs([c for c in args.configs.split(",") if c] or None)
     t0 = time.time()
-    table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress)
+    table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
     ref = pyshoe_reference(args.data / "pyshoe_vicon") if (args.data / "pyshoe_vicon").is_dir() else \
         pd.DataFrame(columns=["best_error_m", "best_detector", "n_strides_manual_koroglu"])
     summary = args.summary or (args.results / "accuracy_quick.md" if args.quick else DEFAULT_SUMMARY)

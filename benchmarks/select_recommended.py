@@ -3,8 +3,8 @@
 Usage: python benchmarks/select_recommended.py [--jobs 2] [--results benchmarks/results/]
                                                [--data ../shared/data] [--write]
 
-A small grid of settings (stance detector type and threshold × zero-velocity Kalman filter
-noise, see :data:`GRID`) runs on the 36 PyShoe VICON trials through footzoo's ablation runner
+A small grid of settings (stance detector type and threshold, :data:`THRESHOLDS`, × zero-velocity
+Kalman filter noise, :data:`NOISE_GRID`) runs on the 36 PyShoe VICON trials through footzoo's ablation runner
 (cached). The score of a setting on a set of trials is the mean, over the motion classes in the
 set, of the geometric mean over the class's trials of ``error / PyShoe's per-trial best``
 (PyShoe's 2-D metric): every motion class weighs the same whatever its number of trials, and a
@@ -38,9 +38,16 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from accuracy import CLASS_ORDER, DEFAULT_DATA, DEFAULT_RESULTS, motion_class, pyshoe_reference  # noqa: E402
+from accuracy import (  # noqa: E402
+    CLASS_ORDER,
+    DEFAULT_DATA,
+    DEFAULT_RESULTS,
+    motion_class,
+    pyshoe_reference,
+    run_cached,
+)
 
-from footzoo.ablation import Study, run_study  # noqa: E402
+from footzoo.ablation import Study  # noqa: E402
 from footzoo.ablation.report import to_markdown  # noqa: E402
 from footzoo.registry import available  # noqa: E402
 
@@ -56,29 +63,34 @@ BASE = {
 
 
 def detector_grid() -> list[dict[str, Any]]:
-    """Detector settings: type and threshold (only detectors this footzoo has)."""
+    """Detector settings: type and threshold around each detector's default (only detectors this footzoo has)."""
     have = set(available("detector"))
     grid: list[dict[str, Any]] = []
-    for th in (3e4, 1e5, 3e5, 1e6, 3e6):
-        grid.append({"type": "shoe", "threshold": th})
-    for th in (0.6, 1.0, 1.5):
-        grid.append({"type": "angular_rate_fsm", "threshold": th})
-    for th in (0.4, 0.6, 1.0):
-        grid.append({"type": "windowed", "gyro_threshold": th})
-    if "ared" in have:
-        for th in (0.1, 0.3, 1.0):
-            grid.append({"type": "ared", "threshold": th})
-    for name, params in ADAPTIVE.items():
+    for name, values in THRESHOLDS.items():
         if name in have:
-            grid += [{"type": name, **p} for p in params]
+            key, settings = values
+            grid += [{"type": name, **({key: v} if isinstance(v, float) else v)} for v in settings]
     return grid
 
 
-#: Adaptive detectors added by other work, with the settings tried when they are registered.
-ADAPTIVE: dict[str, list[dict[str, Any]]] = {"adaptive_shoe": [{}], "dgp": [{"min_swing": 0.2}]}
+#: Detector type -> (threshold parameter, values tried); adaptive_shoe also varies its time constant.
+THRESHOLDS: dict[str, tuple[str, list[Any]]] = {
+    "shoe": ("threshold", [1e4, 3e4, 1e5, 3e5, 1e6]),
+    "adaptive_shoe": ("threshold", [{"threshold": th, "time_constant": tau} for th in (3e3, 1e4, 3e4)
+                                    for tau in (0.15, 0.3)]),
+    "ared": ("threshold", [3e3, 1e4, 3e4]),
+    "amvd": ("threshold", [3e2, 1e3, 3e3]),
+    "mbgtd": ("threshold", [1e2, 3e2, 1e3]),
+    "angular_rate_fsm": ("threshold", [0.6, 1.0, 1.5]),
+    "windowed": ("gyro_threshold", [0.6, 1.0]),
+    "dgp": ("min_swing", [0.2]),
+}
 
-#: Kalman noise settings: (attitude_noise rad²/s, velocity_noise (m/s)²/s, zupt velocity_std m/s).
-NOISE_GRID = [(1.7e-6, 8.3e-5, 0.01), (1e-5, 1e-3, 0.01), (1.7e-6, 8.3e-5, 0.05)]
+
+#: Kalman noise settings: (attitude_noise rad²/s, velocity_noise (m/s)²/s, zupt velocity_std m/s): Duong & Suh's
+#: Table 1 values, and larger ones (gyro 0.5 °/s and accelerometer 0.5 m/s² white noise at 200 Hz give
+#: 4e-7 rad²/s and 1.25e-3 (m/s)²/s), each with a tight and a loose zero-velocity measurement.
+NOISE_GRID = [(a, v, z) for a, v in ((1.7e-6, 8.3e-5), (1e-5, 1e-3), (4e-7, 1.25e-3)) for z in (0.01, 0.05)]
 
 
 def candidates() -> list[dict[str, Any]]:
@@ -151,7 +163,7 @@ def main(argv: list[str] | None = None) -> int:
     study = Study.from_dict({"name": "select_recommended", "base": cands,
                              "recordings": [{"path": str(folder / "*.mat"), "format": "pyshoe"}],
                              "metrics": ["pyshoe_error_m", "armse_3d_m"]})
-    table = run_study(study, jobs=args.jobs, out=args.results / "select_recommended", progress=args.progress)
+    table = run_cached(study, args.results / "select_recommended", args.jobs)
     t = table[table["metric"] == "pyshoe_error_m"]
     err = t.pivot_table(index="recording", columns="base", values="value", aggfunc="first")
     err = err.reindex(columns=[c["name"] for c in cands])
