@@ -11,7 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 import footzoo
-from footzoo.detectors import DGP, AngularRateFSM
+from footzoo.detectors import DGP, AdaptiveSHOE, AngularRateFSM
 from footzoo.metrics import loop_closure, pyshoe_error, step_detection
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
@@ -19,12 +19,12 @@ CONFIGS = ("nguyen2016_ins_zvu", "nguyen2016_ins_zvu_hdr", "nguyen2016")
 
 
 def detection_table(seeds: int) -> pd.DataFrame:
-    """Gait-phase error rate of DGP and the angular-rate FSM on slow/normal/fast walking and running."""
+    """Gait-phase error rate of DGP, the adaptive SHOE and the angular-rate FSM on walking and running."""
     rows = []
     for rate in (100.0, 200.0):
         for seed in range(seeds):
             rec = simulate(path="mixed_speed", profile="physical", rate=rate, noise=NoiseModel(seed=seed), seed=seed)
-            for det in (DGP(min_swing=0.2), AngularRateFSM()):
+            for det in (DGP(min_swing=0.2), AdaptiveSHOE(), AngularRateFSM()):
                 d = det.detect(rec.t, rec.acc, rec.gyr)
                 r = step_detection(d.stance_, rec.truth.stance, rec.t)
                 rows.append({"rate_hz": rate, "seed": seed, "detector": det.name, **r})

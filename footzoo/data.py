@@ -383,7 +383,7 @@ def _report_gaps(rec: Recording) -> None:
             "the filters integrate over each sample's real interval. The list is in meta['diagnostics']['gaps']; "
             "pass a smaller max_gap to refuse them"
         ),
-        stacklevel=3,
+        stacklevel=4,
     )
 
 

@@ -1,5 +1,6 @@
 """Config errors name the problem, list the valid choices and suggest the closest one."""
 
+import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline
@@ -22,7 +23,8 @@ def with_(**changes):
 def test_good_config_resolves_every_parameter():
     p = Pipeline.from_dict(GOOD)
     assert p.to_dict()["orientation"] == {"type": "fqa_complementary", "static_gain": 1.05, "dynamic_gain": 0.0,
-                                          "use_magnetometer": True}
+                                          "use_magnetometer": True, "mag_rejection": True,
+                                          "mag_norm_tolerance": 0.1, "mag_dip_tolerance": float(np.radians(5.0))}
 
 
 def test_unknown_top_level_key_suggests_the_closest():
@@ -32,13 +34,14 @@ def test_unknown_top_level_key_suggests_the_closest():
 
 def test_unknown_type_lists_valid_types():
     with pytest.raises(ConfigError, match=r"unknown detector type 'angular_rate' \(did you mean 'angular_rate_fsm'\?\)"
-                                          r"; valid types: \['angular_rate_fsm'"):
+                                          r"; valid types: \['adaptive_shoe', 'amvd', 'angular_rate_fsm'"):
         Pipeline.from_dict(with_(detector={"type": "angular_rate"}))
 
 
 def test_unknown_parameter_lists_valid_parameters():
     with pytest.raises(ConfigError, match=r"unknown parameter 'static_gian'.*did you mean 'static_gain'.*"
-                                          r"valid parameters: \['static_gain', 'dynamic_gain', 'use_magnetometer'\]"):
+                                          r"valid parameters: \['static_gain', 'dynamic_gain', 'use_magnetometer', "
+                                          r"'mag_rejection'"):
         Pipeline.from_dict(with_(orientation={"type": "fqa_complementary", "static_gian": 1}))
 
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from .._jit import njit
 from ..registry import check_positive, register
+from .runs import close_short_swings
 from .shoe import SHOE
 
 
@@ -54,6 +55,14 @@ class AdaptiveSHOE(SHOE):
     simplification). ``γ_max`` caps the growth (footzoo's guard: without it, any
     long motion would end in a false stance).
 
+    Defaults (footzoo's): γ_0 = 1e4, τ = 0.5 s, γ_max = 5e5, min_swing = 0.15 s,
+    chosen on PyShoe's 36 VICON trials (PyShoe's 2-D error, pipelines
+    ``yun2012`` and ``duong2015_zupt`` with this detector) by the mean over the
+    motion classes (walking, running, slow, inverted) of the log median ratio to
+    PyShoe's per-trial best, never per trial; leaving any one class out picks
+    a setting of the same family (τ 0.5–1 s, γ_max 2e5–5e5). On the simulator
+    they give 0 % gait-phase error on the mixed-speed walk at 100 and 200 Hz.
+
     Parameters
     ----------
     threshold : float
@@ -64,6 +73,11 @@ class AdaptiveSHOE(SHOE):
         τ (s): the threshold grows by e every τ without an update.
     max_threshold : float
         γ_max (dimensionless).
+    min_swing : float
+        Shortest swing (s): a shorter run of "moving" between two stationary
+        samples is a momentary spike of the test and counts as stance
+        (footzoo's, against split stances). Stances are kept however short: a
+        running stance can last a few samples.
 
     Attributes
     ----------
@@ -72,25 +86,28 @@ class AdaptiveSHOE(SHOE):
     threshold_ : (N,) ndarray
         γ_k in force at each sample.
     stance_, stance_online_ : (N,) bool ndarray
-        Stance flag (the decision is causal; the centred window makes it W/2
-        samples late when live).
+        Stance flag (a live system knows it ``min_swing`` + W/2 late).
     """
 
     name = "adaptive_shoe"
     paper = "Wahlström et al. 2019, IEEE Sensors Letters 3(6) (Bayesian adaptive threshold) on SHOE (Skog et al. 2010)"
-    units = {**SHOE.units, "time_constant": "s", "max_threshold": "1"}
+    units = {**SHOE.units, "time_constant": "s", "max_threshold": "1", "min_swing": "s"}
 
     def __init__(self, threshold: float = 1e4, window: float = 0.025, sigma_a: float = 0.01,
-                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.15, max_threshold: float = 1e6):
+                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.5, max_threshold: float = 5e5,
+                 min_swing: float = 0.15):
         super().__init__(threshold, window, sigma_a, sigma_g)
         self.time_constant = check_positive("time_constant", time_constant)
         self.max_threshold = check_positive("max_threshold", max_threshold)
+        self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> AdaptiveSHOE:
         """Evaluate SHOE, then the adaptive test sample by sample."""
         self.statistic_ = self._statistic(t, acc, gyr)
-        self.stance_, self.threshold_ = adaptive_threshold_kernel(
+        test, self.threshold_ = adaptive_threshold_kernel(
             np.ascontiguousarray(t, dtype=float), self.statistic_, self.threshold, self.time_constant,
             max(self.max_threshold, self.threshold))
+        rate = 1.0 / float(np.median(np.diff(t)))
+        self.stance_ = close_short_swings(test, int(math.floor(self.min_swing * rate + 0.5)))
         self.stance_online_ = self.stance_.copy()
         return self

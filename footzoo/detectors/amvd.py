@@ -16,10 +16,11 @@ class AMVD(SkogTest):
     AMVD in PyShoe, Wagstaff et al. 2017):
     T_k = (1/σ_a²) · (1/W) Σ ‖y_a,l − ȳ_a‖²: the specific force does not vary
     over the window. It ignores the gyro. Window and σ defaults as for ``shoe``
-    (0.025 s, σ_a = 0.01 m/s², σ_ω = 0.1 °/s, unused); the default γ is footzoo's, between
-    the best thresholds for PyShoe's walking and running trials (the paper tunes γ per
-    data set). T is in units of σ_a²: γ = 1e3 is an RMS
-    deviation from the window's mean of about 0.3 m/s².
+    (0.025 s, σ_a = 0.01 m/s², σ_ω = 0.1 °/s, unused); the default γ is footzoo's,
+    chosen by cross-validation over PyShoe's motion classes (walking, running, slow, inverted; PyShoe's
+    2-D error with the ``yun2012`` and ``duong2015_zupt`` pipelines), never per trial
+    (the paper tunes γ per data set). T is in units of σ_a²: γ = 1e2 is an RMS
+    deviation from the window's mean of about 0.1 m/s².
 
     Parameters
     ----------
@@ -36,7 +37,7 @@ class AMVD(SkogTest):
     name = "amvd"
     paper = "Skog et al. 2010, IEEE TBME 57(11), Sec. III (acceleration moving variance detector (MV))"
 
-    def __init__(self, threshold: float = 1e3, window: float = 0.025, sigma_a: float = 0.01,
+    def __init__(self, threshold: float = 1e2, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
         super().__init__(threshold, window, sigma_a, sigma_g)
 

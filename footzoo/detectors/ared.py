@@ -17,8 +17,9 @@ class ARED(SkogTest):
     T_k = (1/σ_ω²) · (1/W) Σ ‖y_ω,l‖²: the foot is still when it does not
     rotate; it is blind to translation without rotation. Window and σ defaults
     as for ``shoe`` (0.025 s, σ_ω = 0.1 °/s; σ_a unused); the default γ is
-    footzoo's, between the best thresholds for PyShoe's walking and running trials. T is in units of σ_ω²: γ = 1e4
-    is an RMS rate of about 0.17 rad/s.
+    footzoo's, chosen by cross-validation over PyShoe's motion classes (walking, running, slow, inverted; PyShoe's
+    2-D error with the ``yun2012`` and ``duong2015_zupt`` pipelines), never per
+    trial. T is in units of σ_ω²: γ = 3e4 is an RMS rate of about 0.3 rad/s.
 
     Parameters
     ----------
@@ -35,7 +36,7 @@ class ARED(SkogTest):
     name = "ared"
     paper = "Skog et al. 2010, IEEE TBME 57(11), Sec. III (angular rate energy detector (ARE))"
 
-    def __init__(self, threshold: float = 1e4, window: float = 0.025, sigma_a: float = 0.01,
+    def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
         super().__init__(threshold, window, sigma_a, sigma_g)
 

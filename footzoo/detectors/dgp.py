@@ -11,6 +11,11 @@ from ..conventions import GRAVITY
 from ..registry import Plugin, check_positive, register
 
 
+def _count(x: float) -> int:
+    """Nearest whole number of samples, halves rounded up, immune to the last bits of a median rate."""
+    return int(math.floor(x + 0.5 + 1e-6))
+
+
 def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
     """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and of the last ``lag`` samples."""
     w = 2 * f + 1
@@ -139,7 +144,7 @@ def dgp_initial_state(s_d0: float, th0: float, delay: int = 2) -> np.ndarray:
 
 @njit
 def dgp_kernel(
-    s_c: np.ndarray, state: np.ndarray, min_swing: int = 0
+    s_c: np.ndarray, state: np.ndarray, min_swing: int = 0, max_swing: int = 0
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Delayed condition, max changing speed, dynamic threshold and stance (eqs. 10–15).
 
@@ -176,6 +181,8 @@ def dgp_kernel(
                 swing_len = 0
             in_swing = True
             swing_len += 1
+            if max_swing > 0 and swing_len % max_swing == 0:
+                threshold *= 2.0  # no stance for longer than any swing: the gait has changed
             mc = max(mc, s_c[k])  # eq. 12
             md = max(md, sd)  # eq. 13
         elif in_swing:
@@ -234,9 +241,17 @@ class DGP(Plugin):
         Shortest swing (s) from which the threshold is re-learned; 0 (paper):
         every swing. On real recordings a momentary crossing in stance makes a
         "swing" of a few samples whose Mc − Md is tiny; the threshold then
-        collapses and the detector never returns to stance. A value of 0.2 s
-        (shorter than any real swing) prevents that; footzoo's Nguyen & La
-        configs set it and say so.
+        collapses and the detector never returns to stance (on PyShoe's 36
+        trials with 0: 24 trials have a "swing" longer than 3 s, thresholds down
+        to 0.004). Default 0.2 s (shorter than any real swing); footzoo's.
+    max_swing : float
+        Longest swing (s): after every ``max_swing`` of one swing without a
+        stance the threshold is doubled; 0 (paper): never. A threshold learned
+        on walking is too low for a run that follows (its stances have
+        ``max_cd`` of 0.4–0.8), the swing then never ends and eq. 14 never
+        runs again (5 of PyShoe's running trials stuck in one "swing" of
+        7–34 s with ``min_swing`` alone). Default 2 s, longer than any swing;
+        footzoo's. With both guards at 0 the detector is the paper's.
 
     Attributes
     ----------
@@ -252,7 +267,7 @@ class DGP(Plugin):
     name = "dgp"
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-A, eqs. 3-15, Algorithm 1"
     units = {"window": "s", "condition_window": "s", "initial_delay": "1", "initial_threshold": "1",
-             "reference_rate": "Hz", "min_swing": "s"}
+             "reference_rate": "Hz", "min_swing": "s", "max_swing": "s"}
 
     def __init__(
         self,
@@ -261,7 +276,8 @@ class DGP(Plugin):
         initial_delay: float = 0.8,
         initial_threshold: float = 0.8,
         reference_rate: float = 100.0,
-        min_swing: float = 0.0,
+        min_swing: float = 0.2,
+        max_swing: float = 2.0,
     ):
         self.window = check_positive("window", window)
         self.condition_window = check_positive("condition_window", condition_window)
@@ -269,23 +285,25 @@ class DGP(Plugin):
         self.initial_threshold = check_positive("initial_threshold", initial_threshold)
         self.reference_rate = check_positive("reference_rate", reference_rate)
         self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
+        self.max_swing = check_positive("max_swing", max_swing, allow_zero=True)
 
     def begin(self, rate: float) -> None:
         """Fresh state for a recording sampled at ``rate`` (Hz)."""
-        f = max(int(round((self.window * rate - 1) / 2)), 1)
-        self._n_c = max(int(round(self.condition_window * rate)), 1)
+        f = max(_count((self.window * rate - 1) / 2), 1)
+        self._n_c = max(_count(self.condition_window * rate), 1)
         self._w = 2 * f + 1
-        self._lag = max(int(round(rate / self.reference_rate)), 1)
+        self._lag = max(_count(rate / self.reference_rate), 1)
         self._scale = rate / (self.reference_rate * self._lag)
-        self._min_swing = int(round(self.min_swing * rate))
+        self._min_swing = _count(self.min_swing * rate)
+        self._max_swing = _count(self.max_swing * rate)
         self._stat_state = dgp_statistic_state(f, self._n_c, self._lag)
-        delay = max(int(round(2 * rate / self.reference_rate)), 1)
+        delay = max(_count(2 * rate / self.reference_rate), 1)
         self._state = dgp_initial_state(self.initial_delay, self.initial_threshold, delay)
 
     def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
         """Process the next samples (a whole recording, or one live sample) from the carried state."""
         s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
-        s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing)
+        s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing, self._max_swing)
         return s_c, d_g, s_d, max_cd, th, stance
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> DGP:

@@ -63,3 +63,20 @@ def dated_and_online_states(
     long_starts = starts[lengths >= g]
     dated = fill(still, long_starts, long_starts)
     return dated, online
+
+
+def close_short_swings(stance: np.ndarray, min_samples: int) -> np.ndarray:
+    """Stance mask with every swing run shorter than ``min_samples`` between two stance runs filled in.
+
+    Stance runs are kept whatever their length (a running stance can be a few
+    samples long); only momentary spikes of the test inside a stance go.
+    """
+    s = np.asarray(stance, dtype=bool)
+    n = s.shape[0]
+    if n == 0 or min_samples <= 1:
+        return s.copy()
+    change = np.flatnonzero(s[1:] != s[:-1]) + 1
+    starts = np.concatenate([[0], change]).astype(np.int64)
+    lengths = np.diff(np.concatenate([starts, [n]]))
+    short_gap = ~s[starts] & (lengths < min_samples) & (starts > 0) & (starts + lengths < n)
+    return s | np.repeat(short_gap, lengths)
