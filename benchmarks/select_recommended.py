@@ -77,10 +77,10 @@ def detector_grid() -> list[dict[str, Any]]:
 THRESHOLDS: dict[str, tuple[str, list[Any]]] = {
     "shoe": ("threshold", [1e4, 3e4, 1e5, 3e5, 1e6]),
     "adaptive_shoe": ("threshold", [{"threshold": th, "time_constant": tau} for th in (3e3, 1e4, 3e4)
-                                    for tau in (0.15, 0.3)]),
-    "ared": ("threshold", [3e3, 1e4, 3e4]),
-    "amvd": ("threshold", [3e2, 1e3, 3e3]),
-    "mbgtd": ("threshold", [1e2, 3e2, 1e3]),
+                                    for tau in (0.3, 0.5)]),
+    "ared": ("threshold", [1e4, 3e4, 1e5]),
+    "amvd": ("threshold", [3e1, 1e2, 3e2]),
+    "mbgtd": ("threshold", [3e1, 1e2, 3e2]),
     "angular_rate_fsm": ("threshold", [0.6, 1.0, 1.5]),
     "windowed": ("gyro_threshold", [0.6, 1.0]),
     "dgp": ("min_swing", [0.2]),
@@ -88,9 +88,8 @@ THRESHOLDS: dict[str, tuple[str, list[Any]]] = {
 
 
 #: Kalman noise settings: (attitude_noise rad²/s, velocity_noise (m/s)²/s, zupt velocity_std m/s): Duong & Suh's
-#: Table 1 values, and larger ones (gyro 0.5 °/s and accelerometer 0.5 m/s² white noise at 200 Hz give
-#: 4e-7 rad²/s and 1.25e-3 (m/s)²/s), each with a tight and a loose zero-velocity measurement.
-NOISE_GRID = [(a, v, z) for a, v in ((1.7e-6, 8.3e-5), (1e-5, 1e-3), (4e-7, 1.25e-3)) for z in (0.01, 0.05)]
+#: Table 1 values and larger ones, each with a tight and a loose zero-velocity measurement.
+NOISE_GRID = [(a, v, z) for a, v in ((1.7e-6, 8.3e-5), (1e-5, 1e-3)) for z in (0.01, 0.05)]
 
 
 def candidates() -> list[dict[str, Any]]:
