@@ -59,9 +59,13 @@ class AdaptiveSHOE(SHOE):
     chosen on PyShoe's 36 VICON trials (PyShoe's 2-D error, pipelines
     ``yun2012`` and ``duong2015_zupt`` with this detector) by the mean over the
     motion classes (walking, running, slow, inverted) of the log median ratio to
-    PyShoe's per-trial best, never per trial; leaving any one class out picks
-    a setting of the same family (τ 0.5–1 s, γ_max 2e5–5e5). On the simulator
-    they give 0 % gait-phase error on the mixed-speed walk at 100 and 200 Hz.
+    PyShoe's per-trial best, never per trial. Leaving one class out, the
+    adaptive settings chosen on the rest stay in the same family (τ 0.5–1 s,
+    γ_max 1e5–5e5); but over all detectors, leaving running out picks a fixed
+    SHOE (γ = 1e4) that fails on running (median 3.9–7.6 m): the setting needs
+    running data to be chosen (``examples/detectors_pyshoe.py --grid``). On
+    the simulator the defaults give 0 % gait-phase error on the mixed-speed
+    walk at 100 and 200 Hz.
 
     Parameters
     ----------

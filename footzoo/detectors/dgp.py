@@ -225,6 +225,13 @@ class DGP(Plugin):
     (see :func:`dgp_statistic_kernel`), taken from the gyro whatever the
     orientation source.
 
+    Known limitation on real recordings (measured, not fixed): ``d_g`` sums
+    *changes*, so a steady mid-swing rotation (|ω| ≈ 6 rad/s on PyShoe's
+    walking trials) gives ``s_c`` ≈ 0.3, below the learned ``Mc − Md`` ≈ 0.5
+    (half the heel-strike peak): DGP marks parts of the swing as stance, and
+    the pipelines built on it end near 1 m of PyShoe's error on walking where
+    SHOE-type detectors reach 0.05 m.
+
     Parameters
     ----------
     window : float
