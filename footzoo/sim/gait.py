@@ -321,8 +321,13 @@ class GaitTimeline:
         out = {"p": np.zeros((n, 3)), "v": np.zeros((n, 3)), "a": np.zeros((n, 3)),
                "psi": np.zeros(n), "psi_dot": np.zeros(n), "theta": np.zeros(n), "theta_dot": np.zeros(n),
                "still": np.zeros(n, bool)}
-        for j in np.unique(idx):
-            m = idx == j
+        # group the samples by segment in one sort (a mask per segment costs N × segments: hours for a
+        # one-hour walk evaluated at sub-sample times)
+        order = np.argsort(idx, kind="stable")
+        segs, first = np.unique(idx[order], return_index=True)
+        bounds = np.append(first, n)
+        for j, a, b in zip(segs, bounds[:-1], bounds[1:], strict=True):
+            m = order[a:b]
             res = self.segments[j].evaluate(t[m])
             for k, v in res.items():
                 out[k][m] = v

@@ -20,6 +20,41 @@ def straight(n_strides: int, stride_length: float | list[float] = 1.2, heading: 
     return [Footstep(pos=d * u, heading=heading) for d in dist]
 
 
+def stairs(
+    n_strides: int = 6, rise: float = 0.17, going: float = 0.28, landing_strides: int = 2,
+    landing_stride: float = 1.2, heading: float = 0.0,
+) -> list[Footstep]:
+    """Up a straight flight of stairs, across a landing and down an equal flight (a footbridge).
+
+    One foot's stride on stairs climbs two steps (step-over-step gait): each of the
+    ``n_strides`` strides up moves ``2 · going`` forward and ``2 · rise`` up, the
+    landing strides are ``landing_stride`` long and flat, and the same flight is
+    walked down. Default steps are 0.17 m risers and 0.28 m treads (a typical
+    public stair). Returns ``2 · n_strides + landing_strides + 1`` footsteps (NED,
+    so up is −z).
+    """
+    u = np.array([np.cos(heading), np.sin(heading), 0.0])
+    up = np.array([0.0, 0.0, -2.0 * rise])
+    pos = [np.zeros(3)]
+    for _ in range(n_strides):
+        pos.append(pos[-1] + 2.0 * going * u + up)
+    for _ in range(landing_strides):
+        pos.append(pos[-1] + landing_stride * u)
+    for _ in range(n_strides):
+        pos.append(pos[-1] + 2.0 * going * u - up)
+    return [Footstep(pos=p, heading=heading) for p in pos]
+
+
+def repeat_laps(steps: list[Footstep], laps: int) -> list[Footstep]:
+    """A closed path walked ``laps`` times: the footsteps repeated, the shared start/end kept once."""
+    if laps < 1:
+        raise ValueError(f"laps must be a positive integer, got {laps}")
+    out = list(steps)
+    for _ in range(laps - 1):
+        out += [Footstep(pos=s.pos.copy(), heading=s.heading, fpa=s.fpa) for s in steps[1:]]
+    return out
+
+
 def _closed_curve(points: np.ndarray, stride_length: float) -> list[Footstep]:
     """Footsteps at equal arc length along a dense closed polyline (N, 2), starting at its first point."""
     pts = np.vstack([points, points[:1]])

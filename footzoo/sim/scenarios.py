@@ -30,19 +30,27 @@ SPEEDS = {
     "run": (2.4, 0.75, 0.40, 1 / 3),  # 3.2 m/s: 0.3 s contact, 0.1 s still (PyShoe fast trials: 0.10-0.15 s)
 }
 
-PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed")
+PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed", "run", "stairs")
 
 
 def _footsteps(path: str, n_strides: int, stride_length: float, **kw) -> tuple[list[Footstep], bool]:
+    laps = int(kw.get("laps", 1))
+    if laps != 1 and path not in ("rectangle", "track", "figure_eight"):
+        raise ValueError(f"laps applies to closed paths (rectangle, track, figure_eight), not {path!r}")
     if path == "straight":
         return paths.straight(n_strides, stride_length, kw.get("heading", 0.0)), False
+    if path == "stairs":
+        return paths.stairs(n_strides, kw.get("rise", 0.17), kw.get("going", 0.28), kw.get("landing_strides", 2),
+                            stride_length, kw.get("heading", 0.0)), False
     if path == "rectangle":
-        return paths.rectangle(kw.get("length", 40.0), kw.get("width", 20.0), stride_length), True
-    if path == "track":
-        return paths.track(stride_length=stride_length), True
-    if path == "figure_eight":
-        return paths.figure_eight(kw.get("radius", 5.0), stride_length), True
-    raise ValueError(f"unknown path {path!r}; known: {list(PATHS)}")
+        steps = paths.rectangle(kw.get("length", 40.0), kw.get("width", 20.0), stride_length)
+    elif path == "track":
+        steps = paths.track(stride_length=stride_length)
+    elif path == "figure_eight":
+        steps = paths.figure_eight(kw.get("radius", 5.0), stride_length)
+    else:
+        raise ValueError(f"unknown path {path!r}; known: {list(PATHS)}")
+    return paths.repeat_laps(steps, laps), True
 
 
 def simulate(
@@ -76,8 +84,12 @@ def simulate(
 
     Parameters
     ----------
-    path : {"straight", "rectangle", "track", "figure_eight", "mixed_speed"}
-        Footstep layout; ``mixed_speed`` walks straight through ``speeds``.
+    path : {"straight", "rectangle", "track", "figure_eight", "mixed_speed", "run", "stairs"}
+        Footstep layout; ``mixed_speed`` walks straight through ``speeds``; ``run``
+        runs ``n_strides`` straight strides at :data:`SPEEDS` ``["run"]`` (3.2 m/s);
+        ``stairs`` climbs ``n_strides`` strides of two steps, crosses a landing of
+        ``landing_strides`` strides of ``stride_length`` and descends as many (options
+        ``rise`` = 0.17 m and ``going`` = 0.28 m per step; see :func:`footzoo.sim.paths.stairs`).
     n_strides : int
         Strides of a straight walk (closed paths take as many as they need).
     stride_length : float
@@ -115,9 +127,17 @@ def simulate(
         Standing still before and after (s).
     seed : int
         Seed of the noise (reproducible).
+    **path_options
+        Path shape: ``length``/``width`` (rectangle, m), ``radius`` (figure eight, m),
+        ``heading`` (straight and stairs, rad), ``rise``/``going``/``landing_strides``
+        (stairs), ``laps`` (closed paths walked that many times: ``track`` with
+        ``laps=10`` is a 4.4 km, one-hour walk at 1.2 m/s).
     """
     if foot not in ("right", "left"):
         raise ValueError(f"foot must be 'right' or 'left', got {foot!r}")
+    rec_name = f"sim_{path}"
+    if path == "run":
+        path, speeds = "mixed_speed", [("run", n_strides)]
     if path == "mixed_speed":
         speeds = speeds or [("slow", 9), ("normal", 9), ("fast", 9), ("run", 9)]
         specs, lengths = [], []
@@ -161,7 +181,7 @@ def simulate(
     truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=stance, steps=step_table,
                   closed_loop=closed, dist=true_dist, stride_count=len(step_table), source="simulator")
     meta = {
-        "name": f"sim_{path}", "source": "footzoo.sim", "format": "simulated", "profile": profile,
+        "name": rec_name, "source": "footzoo.sim", "format": "simulated", "profile": profile,
         "sampling": sampling, "foot": foot, "seed": seed,
         "noise": asdict(noise) if isinstance(noise, NoiseModel) else "none",
     }
