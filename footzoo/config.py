@@ -30,6 +30,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
+    "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")

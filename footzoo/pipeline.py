@@ -16,6 +16,7 @@ from .config import INIT_KEYS, check_top_level, load_yaml
 from .conventions import GRAVITY, quat_to_euler
 from .data import Recording, Result
 from .errors import ConfigError
+from .extensions import load_plugins
 from .filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from .registry import Plugin, build, check_positive
 
@@ -44,6 +45,9 @@ class Pipeline:
         g (m/s²).
     init : dict
         ``duration`` (s) and ``max_gyr`` (rad/s) of the still start used for alignment.
+    plugins : list of str, optional
+        External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
+        :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.extensions`).
     """
 
     def __init__(
@@ -55,6 +59,7 @@ class Pipeline:
         gravity: float = GRAVITY,
         init: dict[str, float] | None = None,
         analysis: list[Plugin] | None = None,
+        plugins: list[str] | None = None,
     ):
         self.orientation = orientation
         self.detector = detector
@@ -63,13 +68,19 @@ class Pipeline:
         self.name = name
         self.gravity = check_positive("gravity", gravity)
         self.init = {**INIT_KEYS, **(init or {})}
+        self.plugins = list(plugins or [])
         check_compatibility(orientation, detector, self.corrections)
 
     # ----------------------------------------------------------------- build
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Pipeline:
-        """Build and validate a pipeline from a config mapping (see :mod:`footzoo.config`)."""
+    def from_dict(cls, d: dict[str, Any], base_dir: str | Path | None = None) -> Pipeline:
+        """Build and validate a pipeline from a config mapping (see :mod:`footzoo.config`).
+
+        A ``plugins:`` list (module names or ``.py`` paths, relative to ``base_dir``, default the
+        working directory) is loaded first, so the config can use the plug-ins it registers.
+        """
         check_top_level(d)
+        plugins = [p["spec"] for p in load_plugins(d.get("plugins"), base_dir)]
         orientation = build("orientation", d["orientation"], "orientation")
         detector = build("detector", d["detector"], "detector")
         corrections = [
@@ -84,6 +95,7 @@ class Pipeline:
             gravity=d.get("gravity", GRAVITY),
             init=d.get("init") or {},
             analysis=analysis,
+            plugins=plugins,
         )
 
     @classmethod
@@ -91,7 +103,7 @@ class Pipeline:
         """Build a pipeline from a YAML file."""
         d = load_yaml(path)
         try:
-            return cls.from_dict(d)
+            return cls.from_dict(d, base_dir=Path(path).parent)
         except ConfigError as err:
             raise ConfigError(f"{path}: {err}") from None
 
@@ -100,7 +112,7 @@ class Pipeline:
         def spec(p: Plugin) -> dict[str, Any]:
             return {"type": p.name, **p.get_params()}
 
-        return {
+        out = {
             "name": self.name,
             "gravity": self.gravity,
             "init": dict(self.init),
@@ -109,6 +121,9 @@ class Pipeline:
             "corrections": [spec(c) for c in self.corrections],
             "analysis": [spec(a) for a in self.analysis],
         }
+        if self.plugins:
+            out["plugins"] = list(self.plugins)
+        return out
 
     # ------------------------------------------------------------------- run
     def run(self, rec: Recording, engine: str = "auto") -> Result:

@@ -47,8 +47,11 @@ def register(cls: type[Plugin]) -> type[Plugin]:
     """Class decorator: make a plug-in available under ``cls.kind`` / ``cls.name``."""
     if cls.kind not in _REGISTRY:
         raise ValueError(f"unknown plug-in kind {cls.kind!r}; kinds are {list(KINDS)}")
-    if cls.name in _REGISTRY[cls.kind]:
-        raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered")
+    old = _REGISTRY[cls.kind].get(cls.name)
+    # the same class executed again (an edited plug-in file loaded again) replaces the old one
+    if old is not None and (old.__module__, old.__qualname__) != (cls.__module__, cls.__qualname__):
+        raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered by "
+                         f"{old.__module__}.{old.__qualname__}; choose another name")
     _REGISTRY[cls.kind][cls.name] = cls
     return cls
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -45,14 +46,23 @@ def _fmt(v: Any, digits: int) -> str:
     return str(v)
 
 
-def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> None:
-    """Write the tidy table, summaries and plots into ``out``."""
+def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                  step: Callable[[int], Any] | None = None) -> None:
+    """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
+
+    ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
+    """
+    step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
+    table = table.copy()
+    table.attrs = {}  # counts and cache notes describe this execution, not the results
     table.to_csv(out / "results.csv", index=False)
-    try:
-        table.to_parquet(out / "results.parquet", index=False)
-    except ImportError:  # pyarrow not installed: CSV only
-        pass
+    _to_parquet(table, out / "results.parquet")
+    step(1)
+    trajectories, roc = run_frames(runs)
+    _to_parquet(trajectories, out / "trajectories.parquet")
+    _to_parquet(roc, out / "roc.parquet")
+    step(1)
     md, tex = [], []
     for f in ["base", *factors]:
         s = summarise(table, f)
@@ -63,7 +73,41 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
         md.append("## failed runs\n\n" + to_markdown(errors))
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.tex").write_text("\n".join(tex))
+    step(1)
     plot_study(table, runs, factors, out)
+    step(1)
+
+
+def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The runs' stored trajectories and threshold sweeps as two tidy tables, apart from the results table.
+
+    Returns
+    -------
+    trajectories : DataFrame
+        ``run``, ``recording``, ``t_s``, ``north_m``, ``east_m``, ``down_m`` (one row per stored point).
+    roc : DataFrame
+        ``run``, ``recording``, ``threshold``, ``true_stance_rate``, ``false_stance_rate``.
+    """
+    def frame(field: str, cols: list[str]) -> pd.DataFrame:
+        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if r.get(field)]
+        if not parts:
+            return pd.DataFrame({c: pd.Series(dtype=float if i > 1 else object) for i, c in enumerate(cols)})
+        values = np.concatenate([a for _, _, a in parts])
+        return pd.DataFrame({
+            cols[0]: np.repeat([k for k, _, _ in parts], [len(a) for _, _, a in parts]),
+            cols[1]: np.repeat([rec for _, rec, _ in parts], [len(a) for _, _, a in parts]),
+            **{c: values[:, j] for j, c in enumerate(cols[2:])},
+        })
+
+    return (frame("trajectory", ["run", "recording", "t_s", "north_m", "east_m", "down_m"]),
+            frame("roc", ["run", "recording", "threshold", "true_stance_rate", "false_stance_rate"]))
+
+
+def _to_parquet(df: pd.DataFrame, path: Path) -> None:
+    try:
+        df.to_parquet(path, index=False)
+    except ImportError:  # pyarrow not installed: CSV only (the README's install has it)
+        pass
 
 
 def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> None:
