@@ -229,7 +229,8 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
     if cache_dir is not None and (Path(cache_dir) / f"{key}.json").exists():
         record, problem = read_entry(Path(cache_dir) / f"{key}.json", key)
         if record is not None:
-            return {**record, "cached": True}
+            return {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                    "cached": True}
         warnings.warn(f"cache entry {key} {problem}; running it again", CacheWarning, stacklevel=2)
     plugins = [p for p in cell.config.get("plugins") or []]
     return run_chunk([cell], [key], identity, plugins, cache_dir, metric_names, sweep_points)[0]
@@ -323,9 +324,10 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
         elif record.get("error") and record.get("code_fingerprint") != code_fingerprint():
             retried.append(key)
             todo.append(i)
-        else:
-            record["cached"] = True
-            results[i] = record
+        else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
+            cell = cells[i]
+            results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                          "cached": True}
             bar.update(1)
     if recomputed:
         warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
