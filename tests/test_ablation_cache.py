@@ -4,6 +4,7 @@ import json
 import shutil
 
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 
@@ -246,3 +247,20 @@ def test_the_progress_bar_covers_loading_runs_and_report(tmp_path, monkeypatch):
     assert seen[-1] == ("closed", seen[-1][2], seen[-1][2])  # 100 % exactly at the end
     assert all(n < total for d, n, total in seen[:-2])  # not full before the last report step
     assert sum(1 for p in phases if p == "report") == 4
+
+
+def test_outputs_are_rewritten_only_when_something_they_show_changed(tmp_path):
+    study = Study.from_dict(SMALL)
+    run_study(study, out=tmp_path)
+    png = sorted(tmp_path.glob("trajectories_*.png"))[0]
+    stamps = {f.name: f.stat().st_mtime_ns for f in tmp_path.iterdir() if f.is_file()}
+    again = run_study(study, out=tmp_path)  # everything cached, outputs current: kept as they are
+    assert again.attrs["cached"] == 4
+    assert {f.name: f.stat().st_mtime_ns for f in tmp_path.iterdir() if f.is_file()} == stamps
+    png.unlink()  # a missing output brings the report back
+    run_study(study, out=tmp_path)
+    assert png.exists()
+    more = Study.from_dict({**SMALL, "recordings": [{**SIM, "seeds": [0, 1, 2]}]})
+    table = run_study(more, out=tmp_path)  # a new result: the tables are written again
+    assert len(pd.read_csv(tmp_path / "results.csv")) == len(table) > 0
+    assert (tmp_path / "results.csv").stat().st_mtime_ns > stamps["results.csv"]

@@ -356,8 +356,40 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
         if recomputed:
             _log_damaged(Path(out), recomputed)
         bar.phase("report")
-        write_outputs(table, runs, list(study.factors), Path(out), step=bar.update)
+        digest = _outputs_digest(table, runs, list(study.factors))
+        if _outputs_current(Path(out), digest):
+            bar.update(report_steps)  # nothing changed since the outputs were written: keep them
+        else:
+            write_outputs(table, runs, list(study.factors), Path(out), step=bar.update)
+            _write_manifest(Path(out), digest)
     return table
+
+
+MANIFEST = "outputs.json"
+
+
+def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> str:
+    """What the report depends on: the table, the runs (keys and labels), the factors and footzoo's source."""
+    h = hashlib.sha256(json.dumps([[r["key"], r["base"], r["recording"]] for r in runs]).encode())
+    h.update(json.dumps([factors, code_fingerprint()]).encode())
+    h.update(pd.util.hash_pandas_object(table.astype(str), index=True).to_numpy().tobytes())
+    return h.hexdigest()
+
+
+def _outputs_current(out: Path, digest: str) -> bool:
+    """True when ``out`` holds every output of a report with this digest, unchanged in size."""
+    try:
+        manifest = json.loads((out / MANIFEST).read_text())
+        return manifest["digest"] == digest and all(
+            (out / name).is_file() and (out / name).stat().st_size == size for name, size in manifest["files"].items())
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return False
+
+
+def _write_manifest(out: Path, digest: str) -> None:
+    skip = {MANIFEST, "cache_report.log"}
+    files = {f.name: f.stat().st_size for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
+    (out / MANIFEST).write_text(json.dumps({"digest": digest, "files": files}, indent=1))
 
 
 def _chunks(todo: list[int], cells: list[Cell], identity: dict[int, str], workers: int) -> list[list[int]]:

@@ -1,0 +1,86 @@
+"""Speed-up of an ablation study from two local workers (joblib) and from a local Dask cluster.
+
+Usage: python benchmarks/study_scaling.py [--repeat 2] [--strides 0] [--no-report]
+
+The study: 4 configs (angular-rate FSM or SHOE detector x ZVU dedrift or ZUPT, on yun2012.yaml)
+x 8 simulated recordings (the hallway rectangle at 100 Hz, physical foot model, seeds 0-7), with
+a threshold sweep. Each back end runs the whole study from an empty output folder (runs, cache
+writes, tables, summaries and plots; ``--no-report`` leaves out the output folder). Runs are
+interleaved (serial, joblib, Dask, serial, ...) and the minimum and median wall times are printed
+with the speed-ups against serial, and whether the three tables are identical. Worker processes
+are started and warmed (compiled kernels loaded from the cache) before timing, as a user's second
+study would find them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from footzoo.ablation import Study, run_study  # noqa: E402
+from footzoo.config import load_yaml  # noqa: E402
+
+
+def study(strides: int) -> Study:
+    sim = {"path": "rectangle", "rate": 100, "profile": "physical", "clearance": 0.15, "noise": {"scale": 1}}
+    if strides:
+        sim = {"path": "straight", "n_strides": strides, "rate": 100, "profile": "physical", "noise": {"scale": 1}}
+    return Study.from_dict({
+        "name": "scaling",
+        "base": {**load_yaml(ROOT / "configs" / "yun2012.yaml"), "name": "yun2012"},
+        "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
+                    "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
+        "recordings": [{"simulate": sim, "seeds": list(range(8))}],
+        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "steps"],
+        "sweep": {"points": 25},
+    })
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=2, help="interleaved repetitions per back end")
+    ap.add_argument("--strides", type=int, default=0, help="a straight walk of this many strides instead of "
+                                                           "the rectangle (0: rectangle)")
+    ap.add_argument("--no-report", action="store_true", help="no output folder: runs only")
+    args = ap.parse_args()
+    from dask.distributed import LocalCluster
+
+    s = study(args.strides)
+    print(f"{len(s.cells())} cells ({len(s.cells()) // len(s.recordings)} configs x {len(s.recordings)} recordings), "
+          f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start")
+    tmp = Path(tempfile.mkdtemp(prefix="footzoo_scaling_"))
+    times: dict[str, list[float]] = {"serial": [], "joblib, 2 jobs": [], "dask, 2 processes": []}
+    tables = {}
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        warm = study(3)  # load the compiled kernels in every process before timing
+        run_study(warm)
+        run_study(warm, jobs=2)
+        run_study(warm, scheduler=cluster.scheduler_address)
+        for r in range(args.repeat):
+            for name, kw in (("serial", {}), ("joblib, 2 jobs", {"jobs": 2}),
+                             ("dask, 2 processes", {"scheduler": cluster.scheduler_address})):
+                out = None if args.no_report else tmp / f"{r}_{name.split(',')[0]}"
+                t0 = time.perf_counter()
+                tables[name] = run_study(s, out=out, **kw)
+                times[name].append(time.perf_counter() - t0)
+                print(f"  {name:18s} run {r + 1}: {times[name][-1]:6.2f} s", flush=True)
+    shutil.rmtree(tmp, ignore_errors=True)
+    base = min(times["serial"])
+    print(f"\n{'back end':18s} {'min (s)':>8s} {'median (s)':>10s} {'speed-up (min)':>15s} {'same table':>11s}")
+    for name, ts in times.items():
+        same = tables[name].equals(tables["serial"])
+        print(f"{name:18s} {min(ts):8.2f} {statistics.median(ts):10.2f} {base / min(ts):15.2f} {str(same):>11s}")
+    print(f"load average {os.getloadavg()[0]:.1f} at the end")
+
+
+if __name__ == "__main__":
+    main()
