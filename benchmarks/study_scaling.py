@@ -15,6 +15,7 @@ study would find them.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import shutil
 import statistics
@@ -60,7 +61,8 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="footzoo_scaling_"))
     times: dict[str, list[float]] = {"serial": [], "joblib, 2 jobs": [], "dask, 2 processes": []}
     tables = {}
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.CRITICAL) as cluster:
         warm = study(3)  # load the compiled kernels in every process before timing
         run_study(warm)
         run_study(warm, jobs=2)

@@ -264,3 +264,34 @@ def test_outputs_are_rewritten_only_when_something_they_show_changed(tmp_path):
     table = run_study(more, out=tmp_path)  # a new result: the tables are written again
     assert len(pd.read_csv(tmp_path / "results.csv")) == len(table) > 0
     assert (tmp_path / "results.csv").stat().st_mtime_ns > stamps["results.csv"]
+
+
+def test_a_truncated_parquet_output_is_rebuilt(tmp_path):
+    study = Study.from_dict(SMALL)
+    first = run_study(study, out=tmp_path)
+    parquet = tmp_path / "results.parquet"
+    parquet.write_bytes(parquet.read_bytes()[:100])
+    second = run_study(study, out=tmp_path)
+    assert second.attrs["cached"] == 4
+    back = pd.read_parquet(parquet)
+    assert back.drop(columns="value").equals(first.drop(columns="value"))
+    np.testing.assert_array_equal(back["value"].to_numpy(), first["value"].to_numpy())
+    assert not list(tmp_path.glob(".staging-*"))
+
+
+def test_two_studies_on_one_output_folder_at_once(tmp_path):
+    import subprocess
+    import sys
+
+    study = tmp_path / "study.yaml"
+    study.write_text(yaml.safe_dump({**SMALL, "recordings": [{**SIM, "seeds": [0, 1, 2]}]}))
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "footzoo", "ablate", str(study), "--out", str(out), "--quiet"]
+    procs = [subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE) for _ in range(2)]
+    for p in procs:
+        _, err = p.communicate(timeout=600)
+        assert p.returncode == 0, err.decode()
+    assert all(read_entry(f, f.stem)[1] is None for f in entries(out)) and len(entries(out)) == 6
+    table = run_study(Study.from_yaml(study), out=out)
+    assert table.attrs["cached"] == 6 and table.attrs["recomputed"] == {}
+    assert pd.read_csv(out / "results.csv").shape == table.shape

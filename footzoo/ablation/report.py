@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -51,9 +54,24 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
+    Everything is written into a staging folder first and then moved into ``out`` file by file
+    (atomic renames): an interrupted report or two studies writing into one folder never leave a
+    half-written file.
     """
     step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
+    try:
+        _write_outputs(table, runs, factors, staging, step)
+        for f in sorted(staging.iterdir()):
+            if f.is_file():
+                os.replace(f, out / f.name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                   step: Callable[[int], Any]) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
     table.to_csv(out / "results.csv", index=False)
