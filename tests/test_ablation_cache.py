@@ -92,6 +92,7 @@ def folder_of_recordings(tmp_path):
     write(rec, data / "a_good.parquet")
     (data / "b_dangling.parquet").symlink_to(data / "nowhere.parquet")
     (data / "c_folder.parquet").mkdir()
+    (data / "d_garbage.parquet").write_bytes(bytes(range(256)) * 4)
     return data
 
 
@@ -100,16 +101,17 @@ def test_a_dangling_link_or_a_directory_fails_its_cells_not_the_study(tmp_path, 
     out = tmp_path / "out"
     table = run_study(Study.from_dict(d), out=out, jobs=2)
     by_rec = {rec: g for rec, g in table.groupby("recording")}
-    assert set(by_rec) == {"a_good", "b_dangling", "c_folder"}
+    assert set(by_rec) == {"a_good", "b_dangling", "c_folder", "d_garbage"}
     assert by_rec["a_good"]["error"].isna().all() and by_rec["a_good"]["metric"].notna().all()
     assert by_rec["b_dangling"]["error"].str.contains("dangling link").all()
     assert by_rec["c_folder"]["error"].str.contains("is a directory").all()
-    assert table.attrs["failed"] == 4 and "failed runs" in (out / "summary.md").read_text()
+    assert by_rec["d_garbage"]["error"].str.startswith("FormatError: ").all()
+    assert table.attrs["failed"] == 6 and "failed runs" in (out / "summary.md").read_text()
     # the data changes: the link's target appears; its cells run again (new key), the others stay cached
     write(simulate(n_strides=5, rate=50.0, noise=NoiseModel(seed=1)), folder_of_recordings / "nowhere.parquet")
     again = run_study(Study.from_dict(d), out=out)
     assert again.attrs["computed"] == 2 + 2  # b_dangling now readable, and the new file nowhere.parquet
-    assert again.attrs["cached"] == 2 + 2  # a_good, and c_folder's failures (nothing changed there)
+    assert again.attrs["cached"] == 2 + 2 + 2  # a_good, and the failures of c_folder and d_garbage (unchanged)
     good = again[again["recording"].isin(["a_good", "b_dangling", "nowhere"])]
     assert good["error"].isna().all()
     values = {rec: g["value"].to_numpy() for rec, g in good.groupby("recording")}
