@@ -246,3 +246,20 @@ def test_the_version_is_part_of_the_code_identity(tmp_path, monkeypatch):
     keys = [c.key() for c in study.cells()]
     monkeypatch.setattr(footzoo, "__version__", "99.0")
     assert not set(keys) & {c.key() for c in study.cells()}
+
+
+def test_a_plugin_that_writes_into_its_input_fails_its_cells_not_the_others(tmp_path):
+    name = det_name(tmp_path)
+    (tmp_path / "vandal.py").write_text(PLUGIN.format(threshold=0.6, name=name) + '''
+    def detect(self, t, acc, gyr):
+        acc *= 2.0  # a bug: changes the caller's recording
+        return super().detect(t, acc, gyr)
+''')
+    d = study_dict("vandal.py", name)
+    d["factors"] = {"detector.type": [name, "angular_rate_fsm"]}  # the vandal runs first on each recording
+    table = run_study(Study.from_dict(d, root=tmp_path))
+    mine = table[table["detector.type"] == name]
+    assert mine["error"].str.contains("a plug-in wrote into the recording's arrays").all()
+    clean = run_study(Study.from_dict({**d, "factors": {"detector.type": ["angular_rate_fsm"]}}, root=tmp_path))
+    builtin = table[table["detector.type"] == "angular_rate_fsm"]
+    np.testing.assert_array_equal(builtin["value"].to_numpy(), clean["value"].to_numpy())

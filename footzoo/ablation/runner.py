@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+import threading
 import time
 import traceback
 import warnings
@@ -145,17 +146,31 @@ def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]
 # --------------------------------------------------------------------------- one cell, one chunk
 
 _RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
+_RECORDINGS_LOCK = threading.Lock()
 
 
 def _recording(cell: Cell, identity: str):
     """The cell's recording, loaded or simulated once per process and shared by the configs that use it."""
-    if identity in _RECORDINGS:
-        _RECORDINGS.move_to_end(identity)
-        return _RECORDINGS[identity]
-    rec = cell.recording.load()
-    _RECORDINGS[identity] = rec
-    while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
-        _RECORDINGS.popitem(last=False)
+    with _RECORDINGS_LOCK:  # Dask workers may run several chunks in threads of one process
+        rec = _RECORDINGS.get(identity)
+        if rec is not None:
+            _RECORDINGS.move_to_end(identity)
+            return rec
+    rec = _read_only(cell.recording.load())
+    with _RECORDINGS_LOCK:
+        _RECORDINGS[identity] = rec
+        while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
+            _RECORDINGS.popitem(last=False)
+    return rec
+
+
+def _read_only(rec):
+    """Freeze a shared recording's arrays: a plug-in writing into its input fails loudly instead of
+    silently changing the input of the configs that run after it."""
+    for obj in (rec, rec.truth):
+        for value in vars(obj).values() if obj is not None else ():
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
     return rec
 
 
@@ -166,6 +181,9 @@ def _new_record(cell: Cell, key: str) -> dict[str, Any]:
 
 def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
     out["error"] = f"{type(err).__name__}: {err}"
+    if isinstance(err, ValueError) and "read-only" in str(err):
+        out["error"] += ("; a plug-in wrote into the recording's arrays, which a study shares between configs: "
+                         "the plug-in must copy its input before changing it")
     out["traceback"] = "".join(traceback.format_exception(type(err), err, err.__traceback__, limit=3))
     return out
 
