@@ -216,6 +216,7 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
 
     setup_error: BaseException | None = None
     rec = None
+    start = time.process_time()
     try:
         load_plugins(plugins)
         rec = _recording(cells[0], identity)
@@ -227,6 +228,9 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
             record = _fail(_new_record(cell, key), setup_error)
         else:
             record = _compute(cell, key, rec, metric_names, sweep_points)
+        # CPU seconds of this run in its worker (the first run of a chunk includes loading the recording)
+        record["cpu_s"] = round(time.process_time() - start, 6)
+        start = time.process_time()
         if cache_dir is not None:
             try:
                 write_entry(Path(cache_dir) / f"{key}.json", key, record)
