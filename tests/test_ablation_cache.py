@@ -262,6 +262,10 @@ def test_outputs_are_rewritten_only_when_something_they_show_changed(tmp_path):
     png.unlink()  # a missing output brings the report back
     run_study(study, out=tmp_path)
     assert png.exists()
+    summary = (tmp_path / "summary.md").read_text()
+    (tmp_path / "summary.md").write_text(summary.replace("|", "!"))  # an edited output, same size
+    run_study(study, out=tmp_path)
+    assert (tmp_path / "summary.md").read_text() == summary
     more = Study.from_dict({**SMALL, "recordings": [{**SIM, "seeds": [0, 1, 2]}]})
     table = run_study(more, out=tmp_path)  # a new result: the tables are written again
     assert len(pd.read_csv(tmp_path / "results.csv")) == len(table) > 0

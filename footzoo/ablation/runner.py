@@ -284,7 +284,9 @@ def run_study(
         Output folder: ``cache/`` (one checked file per run, keyed by the hash of the
         resolved config, the data, footzoo's version and the plug-ins' source, so a rerun
         resumes), ``results.parquet``, ``results.csv``, ``trajectories.parquet``,
-        ``roc.parquet``, ``summary.md``, ``summary.tex`` and plots.
+        ``roc.parquet``, ``summary.md``, ``summary.tex`` and plots. A rerun whose table,
+        runs and footzoo source are unchanged, and whose outputs are all present and
+        intact (``outputs.json`` records their checksums), leaves them as they are.
     progress : bool
         Show one progress bar over the whole command (loading, runs, report).
     max_runs : int, optional
@@ -399,19 +401,25 @@ def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: li
 
 
 def _outputs_current(out: Path, digest: str) -> bool:
-    """True when ``out`` holds every output of a report with this digest, unchanged in size."""
+    """True when ``out`` holds every output of a report with this digest, each with its recorded content."""
     try:
         manifest = json.loads((out / MANIFEST).read_text())
         return manifest["digest"] == digest and all(
-            (out / name).is_file() and (out / name).stat().st_size == size for name, size in manifest["files"].items())
+            _file_sha256(out / name) == sha for name, sha in manifest["files"].items())
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return False
 
 
 def _write_manifest(out: Path, digest: str) -> None:
     skip = {MANIFEST, "cache_report.log"}
-    files = {f.name: f.stat().st_size for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
-    (out / MANIFEST).write_text(json.dumps({"digest": digest, "files": files}, indent=1))
+    files = {f.name: _file_sha256(f) for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
+    tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps({"digest": digest, "files": files}, indent=1))
+    tmp.replace(out / MANIFEST)
+
+
+def _file_sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def _chunks(todo: list[int], cells: list[Cell], identity: dict[int, str], workers: int) -> list[list[int]]:
