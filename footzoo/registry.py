@@ -48,8 +48,8 @@ def register(cls: type[Plugin]) -> type[Plugin]:
     if cls.kind not in _REGISTRY:
         raise ValueError(f"unknown plug-in kind {cls.kind!r}; kinds are {list(KINDS)}")
     old = _REGISTRY[cls.kind].get(cls.name)
-    # the same class executed again (an edited plug-in file loaded again) replaces the old one
-    if old is not None and (old.__module__, old.__qualname__) != (cls.__module__, cls.__qualname__):
+    # a module executed again (an edited plug-in file loaded again) replaces its own registrations
+    if old is not None and old.__module__ != cls.__module__:
         raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered by "
                          f"{old.__module__}.{old.__qualname__}; choose another name")
     _REGISTRY[cls.kind][cls.name] = cls

@@ -158,10 +158,12 @@ def test_a_one_off_run_cell_checks_the_cache_too(tmp_path):
 # --------------------------------------------------------------------------- metric names
 
 
-def test_unknown_metric_names_are_a_config_error_listing_the_valid_ones(tmp_path, capsys):
+def test_unknown_metric_names_and_bad_job_counts_are_config_errors(tmp_path, capsys):
     with pytest.raises(ConfigError, match=r"unknown metric 'armse_3d' \(did you mean 'armse_3d_m'\?\); "
                                           r"valid metrics: \['path_length_m'"):
         Study.from_dict({**SMALL, "metrics": ["steps", "armse_3d"]})
+    with pytest.raises(ConfigError, match=r"jobs must be a number of worker processes .* got 0"):
+        run_study(Study.from_dict(SMALL), jobs=0)
     study = tmp_path / "study.yaml"
     study.write_text(yaml.safe_dump({**SMALL, "metrics": ["stride_count"]}))
     assert main(["ablate", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 2

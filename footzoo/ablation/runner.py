@@ -301,6 +301,10 @@ def run_study(
         cells run again because footzoo's source changed: keys). Trajectories and
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
+        from ..errors import ConfigError
+
+        raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
     bar = _Progress(progress, "study")
     try:
         return _run_study(study, jobs, scheduler, out, max_runs, bar)
