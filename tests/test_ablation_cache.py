@@ -303,3 +303,15 @@ def test_two_studies_on_one_output_folder_at_once(tmp_path):
     table = run_study(Study.from_yaml(study), out=out)
     assert table.attrs["cached"] == 6 and table.attrs["recomputed"] == {}
     assert pd.read_csv(out / "results.csv").shape == table.shape
+
+
+def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path):
+    study = Study.from_dict({**SMALL, "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]},
+                             "sweep": {"points": 5}})
+    run_study(study, out=tmp_path / "serial")
+    run_study(study, out=tmp_path / "parallel", jobs=2)
+    serial = {f.name: f.read_bytes() for f in (tmp_path / "serial").glob("*.png")}
+    parallel = {f.name: f.read_bytes() for f in (tmp_path / "parallel").glob("*.png")}
+    assert len(serial) > 5 and "roc.png" in serial
+    assert serial.keys() == parallel.keys()
+    assert all(serial[name] == parallel[name] for name in serial)

@@ -50,19 +50,20 @@ def _fmt(v: Any, digits: int) -> str:
 
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                  step: Callable[[int], Any] | None = None) -> None:
+                  step: Callable[[int], Any] | None = None, jobs: int = 1) -> None:
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
     Everything is written into a staging folder first and then moved into ``out`` file by file
     (atomic renames): an interrupted report or two studies writing into one folder never leave a
-    half-written file.
+    half-written file. With ``jobs`` other than 1 the figures are drawn by that many local worker
+    processes (see :func:`figure_tasks`) while this process writes the tables.
     """
     step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
-        _write_outputs(table, runs, factors, staging, step)
+        _write_outputs(table, runs, factors, staging, step, jobs)
         for f in sorted(staging.iterdir()):
             if f.is_file():
                 os.replace(f, out / f.name)
@@ -70,10 +71,25 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
         shutil.rmtree(staging, ignore_errors=True)
 
 
+def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> list[tuple]:
+    """:func:`plot_study` split into independent calls whose figures together are the whole call's.
+
+    The trajectories and the threshold sweep need the runs but no metric rows (an empty table);
+    the metric plots of one factor need the table but no runs.
+    """
+    return [(table.iloc[:0], runs, factors)] + [(table, [], [f]) for f in factors]
+
+
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                   step: Callable[[int], Any]) -> None:
+                   step: Callable[[int], Any], jobs: int = 1) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
+    figures = None
+    if jobs != 1:  # started first: the workers draw while this process writes the tables
+        from joblib import Parallel, delayed
+
+        figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
+            delayed(plot_study)(t, r, f, out) for t, r, f in figure_tasks(table, runs, factors))
     table.to_csv(out / "results.csv", index=False)
     _to_parquet(table, out / "results.parquet")
     step(1)
@@ -92,7 +108,11 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.tex").write_text("\n".join(tex))
     step(1)
-    plot_study(table, runs, factors, out)
+    if figures is None:
+        plot_study(table, runs, factors, out)
+    else:
+        for _ in figures:
+            pass
     step(1)
 
 
