@@ -15,7 +15,9 @@ On a machine shared with other work, wall times say little about scaling, so the
 measured too: the main process's (``time.process_time``) and each run's in its worker (``cpu_s``
 in the cache entries, loading the recording included). From them, the time the same work would
 take on two otherwise idle cores: the main process's CPU plus the makespan of the chunks
-dispatched to two workers in order (each to the first free worker, as joblib and Dask do).
+dispatched to two workers in order (each to the first free worker, as joblib and Dask do); with
+joblib the figures are drawn by the workers while the main process writes the tables, so the
+figure tasks are timed again one by one afterwards and scheduled the same way.
 """
 
 from __future__ import annotations
@@ -86,7 +88,11 @@ def main() -> None:
                 main_cpu = time.process_time() - c0
                 if out is not None:
                     workers = 1 if name == "serial" else 2
-                    est = main_cpu if workers == 1 else main_cpu + makespan(s, out, workers)
+                    est = main_cpu
+                    if workers > 1:
+                        est += makespan(s, out, workers)
+                        if name.startswith("joblib"):  # the figures are drawn by the workers meanwhile
+                            est += max(0.0, lpt(figure_cpu(s, out, tables[name]), workers) - REPORT_CPU[-1])
                     idle[name].append(est)
                     runs_only[name].append(est - REPORT_CPU[-1])
                 print(f"  {name:18s} run {r + 1}: {times[name][-1]:6.2f} s wall, main process {main_cpu:6.2f} s CPU"
@@ -124,18 +130,41 @@ def _timed_report(write_outputs):
 
 
 def makespan(s: Study, out: Path, workers: int) -> float:
-    """CPU seconds until the last of two workers is done, the chunks handed out in order to the first free one."""
+    """CPU seconds until the last worker is done, the chunks handed out in order to the first free one."""
     from footzoo.ablation import runner
 
     cells = s.cells()
     identity = {id(r): r.identity() for r in s.recordings}
     keys = [c.key(identity[id(c.recording)]) for c in cells]
     cpu = {k: runner.read_entry(out / "cache" / f"{k}.json", k)[0]["cpu_s"] for k in set(keys)}
+    chunks = runner._chunks(list(range(len(cells))), cells, identity, workers)
+    return lpt([sum(cpu[keys[i]] for i in chunk) for chunk in chunks], workers)
+
+
+def lpt(costs: list[float], workers: int) -> float:
+    """Finish time of tasks handed out in order, each to the first free worker."""
     free = [0.0] * workers
-    for chunk in runner._chunks(list(range(len(cells))), cells, identity, workers):
-        w = free.index(min(free))
-        free[w] += sum(cpu[keys[i]] for i in chunk)
+    for c in costs:
+        free[free.index(min(free))] += c
     return max(free)
+
+
+def figure_cpu(s: Study, out: Path, table) -> list[float]:
+    """CPU seconds of each figure task the workers drew, measured again here one after the other."""
+    from footzoo.ablation import report, runner
+
+    runs = []
+    for key, (_, row) in zip(table["run"], table.iterrows(), strict=True):
+        if not runs or runs[-1]["key"] != key:
+            rec = runner.read_entry(out / "cache" / f"{key}.json", key)[0]
+            runs.append({**rec, "recording": row["recording"], "base": row["base"]})
+    costs = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for t, r, f in report.figure_tasks(table, runs, list(s.factors)):
+            c0 = time.process_time()
+            report.plot_study(t, r, f, Path(tmp))
+            costs.append(time.process_time() - c0)
+    return costs
 
 
 if __name__ == "__main__":
