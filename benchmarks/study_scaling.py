@@ -88,13 +88,12 @@ def main() -> None:
                 main_cpu = time.process_time() - c0
                 if out is not None:
                     workers = 1 if name == "serial" else 2
-                    est = main_cpu
-                    if workers > 1:
-                        est += makespan(s, out, workers)
-                        if name.startswith("joblib"):  # the figures are drawn by the workers meanwhile
-                            est += max(0.0, lpt(figure_cpu(s, out, tables[name]), workers) - REPORT_CPU[-1])
-                    idle[name].append(est)
-                    runs_only[name].append(est - REPORT_CPU[-1])
+                    runs = main_cpu - REPORT_CPU[-1] + (makespan(s, out, workers) if workers > 1 else 0.0)
+                    report_time = REPORT_CPU[-1]
+                    if name.startswith("joblib"):  # the workers draw the figures while the main writes tables
+                        report_time = max(report_time, lpt(figure_cpu(s, out, tables[name]), workers))
+                    idle[name].append(runs + report_time)
+                    runs_only[name].append(runs)
                 print(f"  {name:18s} run {r + 1}: {times[name][-1]:6.2f} s wall, main process {main_cpu:6.2f} s CPU"
                       + (f" (report {REPORT_CPU[-1]:.2f} s)" if out is not None else ""), flush=True)
     shutil.rmtree(tmp, ignore_errors=True)
@@ -108,7 +107,7 @@ def main() -> None:
             line += f" {min(idle[name]):26.2f} {min(idle['serial']) / min(idle[name]):9.2f}"
         print(line)
     if any(runs_only.values()):
-        print("\nidle-machine estimate without the report (drawn by the main process after the runs):")
+        print("\nidle-machine estimate without the report (tables and figures, after the runs):")
         for name, ts in runs_only.items():
             print(f"{name:18s} {min(ts):8.2f} s, speed-up {min(runs_only['serial']) / min(ts):5.2f}")
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
