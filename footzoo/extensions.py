@@ -1,7 +1,7 @@
 """External plug-ins: modules or ``.py`` files named in a config's or a study's ``plugins:`` list, and
 installed packages that declare the entry-point group ``footzoo.plugins``.
 
-Importing a plug-in module registers its plug-ins (they use ``footzoo.register``). A ``.py`` file is
+Importing a plug-in module registers its plug-ins (they use ``footzoo.registry.register``). A ``.py`` file is
 imported under a stable module name derived from its resolved path and kept in ``sys.modules``, so
 objects defined in it pickle by reference and every worker process that loads the same file gets the
 same module name. Loading is idempotent: a file or module already loaded with the same source is not
