@@ -290,10 +290,12 @@ def cmd_ablate(args: argparse.Namespace) -> int:
 
     out = args.out or f"ablation_{Path(args.study).stem}"
     table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
-    runs = table.attrs["runs"]
-    failed = sum(1 for r in runs if r["error"])
-    print(f"{len(runs)} runs ({table.attrs['computed']} computed, {table.attrs['cached']} from the cache, "
-          f"{failed} failed); results in {out}/")
+    a = table.attrs
+    notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
+             if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
+    notes = "".join(f", {n}" for n in notes if n)
+    print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
+          f"{a['failed']} failed{notes}); results in {out}/")
     factors = [c for c in table.columns if c not in ("run", "base", "recording", "metric", "value", "error")]
     for f in factors[:3]:
         s = summarise(table, f)

@@ -33,6 +33,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
                   "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
                   "initial_position_std: m}",
+    "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")

@@ -23,6 +23,7 @@ from .config import check_init, check_top_level, load_yaml
 from .conventions import GRAVITY, quat_to_euler
 from .data import Recording, Result
 from .errors import ConfigError, RecordingError
+from .extensions import load_plugins
 from .filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from .filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from .plugin import (
@@ -63,6 +64,9 @@ class Pipeline:
         ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
         (:mod:`footzoo.filters.smoother`; offline only). The forward trajectory stays in
         ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
+    plugins : list of str, optional
+        External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
+        :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.extensions`).
     """
 
     SMOOTHERS = ("none", "rts")
@@ -78,6 +82,7 @@ class Pipeline:
         analysis: list[Analysis] | None = None,
         navigation: NavigationNoise | dict[str, Any] | None = None,
         smoother: str = "none",
+        plugins: list[str] | None = None,
     ):
         self.orientation = orientation
         self.detector = detector
@@ -88,6 +93,7 @@ class Pipeline:
         self.init = check_init(init or {})
         self.navigation = (navigation if isinstance(navigation, NavigationNoise)
                            else NavigationNoise.from_dict(navigation))
+        self.plugins = list(plugins or [])
         check_compatibility(orientation, detector, self.corrections)
         if smoother not in self.SMOOTHERS:
             raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
@@ -98,9 +104,14 @@ class Pipeline:
 
     # ----------------------------------------------------------------- build
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Pipeline:
-        """Build and validate a pipeline from a config mapping (see :mod:`footzoo.config`)."""
+    def from_dict(cls, d: dict[str, Any], base_dir: str | Path | None = None) -> Pipeline:
+        """Build and validate a pipeline from a config mapping (see :mod:`footzoo.config`).
+
+        A ``plugins:`` list (module names or ``.py`` paths, relative to ``base_dir``, default the
+        working directory) is loaded first, so the config can use the plug-ins it registers.
+        """
         check_top_level(d)
+        plugins = [p["spec"] for p in load_plugins(d.get("plugins"), base_dir)]
         orientation = build("orientation", d["orientation"], "orientation")
         detector = build("detector", d["detector"], "detector")
         corrections = [
@@ -117,6 +128,7 @@ class Pipeline:
             analysis=analysis,
             navigation=d.get("navigation"),
             smoother=d.get("smoother", "none"),
+            plugins=plugins,
         )
 
     @classmethod
@@ -124,13 +136,13 @@ class Pipeline:
         """Build a pipeline from a YAML file."""
         d = load_yaml(path)
         try:
-            return cls.from_dict(d)
+            return cls.from_dict(d, base_dir=Path(path).parent)
         except ConfigError as err:
             raise ConfigError(f"{path}: {err}") from None
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved configuration, every parameter explicit."""
-        return {
+        out = {
             "name": self.name,
             "gravity": self.gravity,
             "init": dict(self.init),
@@ -141,6 +153,9 @@ class Pipeline:
             "corrections": [c.spec() for c in self.corrections],
             "analysis": [a.spec() for a in self.analysis],
         }
+        if self.plugins:
+            out["plugins"] = list(self.plugins)
+        return out
 
     # ------------------------------------------------------------ structure
     @property

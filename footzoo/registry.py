@@ -47,11 +47,10 @@ def register(cls: type[Plugin]) -> type[Plugin]:
     if not cls.name or not isinstance(cls.name, str):
         raise ValueError(f"{cls.__name__}: set the class attribute name = '...' (the YAML type)")
     old = _REGISTRY[cls.kind].get(cls.name)
-    if old is not None and old is not cls:
-        same = f"{old.__module__}.{old.__qualname__}" == f"{cls.__module__}.{cls.__qualname__}"
-        if not same:
-            raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered "
-                             f"({old.__module__}.{old.__qualname__}); choose another name")
+    # a module executed again (an edited plug-in file loaded again) replaces its own registrations
+    if old is not None and old.__module__ != cls.__module__:
+        raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered by "
+                         f"{old.__module__}.{old.__qualname__}; choose another name")
     _REGISTRY[cls.kind][cls.name] = cls
     return cls
 

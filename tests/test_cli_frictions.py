@@ -84,7 +84,7 @@ def test_missing_pyarrow_warns_instead_of_silently_skipping_parquet(tmp_path, mo
     monkeypatch.setattr(pd.DataFrame, "to_parquet", no_pyarrow)
     table = pd.DataFrame({"run": ["a"], "base": ["yun2012"], "recording": ["r"], "metric": ["m"], "value": [1.0],
                           "error": [None]})
-    with pytest.warns(UserWarning, match="not results.parquet"):
+    with pytest.warns(UserWarning, match="results.parquet was not written"):
         write_outputs(table, [], [], tmp_path)
     assert (tmp_path / "results.csv").exists() and not (tmp_path / "results.parquet").exists()
 

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import json
+import os
+import shutil
+import tempfile
 import textwrap
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -48,15 +52,54 @@ def _fmt(v: Any, digits: int) -> str:
     return str(v)
 
 
-def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> None:
-    """Write the tidy table, summaries and plots into ``out``."""
+def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                  step: Callable[[int], Any] | None = None, jobs: int = 1) -> None:
+    """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
+
+    ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
+    Everything is written into a staging folder first and then moved into ``out`` file by file
+    (atomic renames): an interrupted report or two studies writing into one folder never leave a
+    half-written file. With ``jobs`` other than 1 the figures are drawn by that many local worker
+    processes (see :func:`figure_tasks`) while this process writes the tables.
+    """
+    step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out / "results.csv", index=False)
+    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
-        table.to_parquet(out / "results.parquet", index=False)
-    except ImportError:  # pyarrow not installed: CSV only, and say so
-        warnings.warn("pyarrow is not installed: wrote results.csv but not results.parquet "
-                      "(pip install 'footzoo[parquet]' or pyarrow to get it)", stacklevel=2)
+        _write_outputs(table, runs, factors, staging, step, jobs)
+        for f in sorted(staging.iterdir()):
+            if f.is_file():
+                os.replace(f, out / f.name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> list[tuple]:
+    """:func:`plot_study` split into independent calls whose figures together are the whole call's.
+
+    The trajectories and the threshold sweep need the runs but no metric rows (an empty table);
+    the metric plots of one factor need the table but no runs.
+    """
+    return [(table.iloc[:0], runs, factors)] + [(table, [], [f]) for f in factors]
+
+
+def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                   step: Callable[[int], Any], jobs: int = 1) -> None:
+    table = table.copy()
+    table.attrs = {}  # counts and cache notes describe this execution, not the results
+    figures = None
+    if jobs != 1:  # started first: the workers draw while this process writes the tables
+        from joblib import Parallel, delayed
+
+        figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
+            delayed(plot_study)(t, r, f, out) for t, r, f in figure_tasks(table, runs, factors))
+    table.to_csv(out / "results.csv", index=False)
+    _to_parquet(table, out / "results.parquet")
+    step(1)
+    trajectories, roc = run_frames(runs)
+    _to_parquet(trajectories, out / "trajectories.parquet")
+    _to_parquet(roc, out / "roc.parquet")
+    step(1)
     md, tex = [], []
     for f in ["base", *factors]:
         s = summarise(table, f)
@@ -67,7 +110,46 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
         md.append("## failed runs\n\n" + to_markdown(errors))
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.tex").write_text("\n".join(tex))
-    plot_study(table, runs, factors, out)
+    step(1)
+    if figures is None:
+        plot_study(table, runs, factors, out)
+    else:
+        for _ in figures:
+            pass
+    step(1)
+
+
+def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The runs' stored trajectories and threshold sweeps as two tidy tables, apart from the results table.
+
+    Returns
+    -------
+    trajectories : DataFrame
+        ``run``, ``recording``, ``t_s``, ``north_m``, ``east_m``, ``down_m`` (one row per stored point).
+    roc : DataFrame
+        ``run``, ``recording``, ``threshold``, ``true_stance_rate``, ``false_stance_rate``.
+    """
+    def frame(field: str, cols: list[str]) -> pd.DataFrame:
+        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if r.get(field)]
+        if not parts:
+            return pd.DataFrame({c: pd.Series(dtype=float if i > 1 else object) for i, c in enumerate(cols)})
+        values = np.concatenate([a for _, _, a in parts])
+        return pd.DataFrame({
+            cols[0]: np.repeat([k for k, _, _ in parts], [len(a) for _, _, a in parts]),
+            cols[1]: np.repeat([rec for _, rec, _ in parts], [len(a) for _, _, a in parts]),
+            **{c: values[:, j] for j, c in enumerate(cols[2:])},
+        })
+
+    return (frame("trajectory", ["run", "recording", "t_s", "north_m", "east_m", "down_m"]),
+            frame("roc", ["run", "recording", "threshold", "true_stance_rate", "false_stance_rate"]))
+
+
+def _to_parquet(df: pd.DataFrame, path: Path) -> None:
+    try:
+        df.to_parquet(path, index=False)
+    except ImportError:  # pyarrow not installed: CSV only, and say so
+        warnings.warn(f"pyarrow is not installed: {path.name} was not written (results.csv has the table; "
+                      "pip install 'footzoo[parquet]' or pyarrow to get it)", stacklevel=2)
 
 
 # --------------------------------------------------------------------------- human labels

@@ -1,10 +1,34 @@
-"""Run a study's cells serially, on local cores (joblib) or on a Dask cluster, with a resumable cache."""
+"""Run a study's cells serially, on local cores (joblib) or on a Dask cluster, with a checked, resumable cache.
+
+How a study runs:
+
+1. the study is parsed, its plug-ins loaded, each recording identified once (content hash of a file,
+   or the simulator spec and seed) and every cell keyed by the hash of its resolved config, the data's
+   identity, footzoo's version and the plug-ins' source hash;
+2. cached cells are read back after checking their checksum; a damaged, truncated, edited or foreign
+   entry is reported (warning, ``table.attrs["recomputed"]``, ``cache_report.log``) and run again; a
+   cell that failed is run again once footzoo's source changed (a changed config, plug-in, version or
+   recording changes its key anyway);
+3. the remaining cells are grouped by recording and sent in chunks to the workers: each worker loads
+   the study's plug-ins, then loads or simulates each recording once and runs every config of the chunk
+   on it (a small per-process cache shares a recording between chunks);
+4. the tidy table is built from the run records; trajectories and threshold sweeps stay in the run
+   records and in ``trajectories.parquet`` / ``roc.parquet``, never in ``table.attrs``.
+"""
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import json
+import math
 import os
+import threading
+import time
 import traceback
+import warnings
+from collections import OrderedDict
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +38,16 @@ import pandas as pd
 from .study import Cell, Study
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
+CACHE_FORMAT = "footzoo-ablation-cache/2"
+RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
+CHUNKS_PER_WORKER = 4  # aim for this many chunks per worker (load balance vs. loading a recording again)
+
+
+class CacheWarning(UserWarning):
+    """A cache entry was damaged, truncated, edited or foreign; its cell was run again."""
+
+
+# --------------------------------------------------------------------------- metrics of one run
 
 
 def _metrics(rec, res, metric_names: list[str] | None) -> dict[str, float]:
@@ -57,23 +91,109 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     return out
 
 
-def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] | None = None,
-             sweep_points: int = 0) -> dict[str, Any]:
-    """Run one cell (or read it from the cache); never raises: errors are recorded."""
-    key = cell.key()
-    path = Path(cache_dir) / f"{key}.json" if cache_dir else None
-    if path is not None and path.exists():
-        out = json.loads(path.read_text())
-        out["cached"] = True
-        return out
-    out: dict[str, Any] = {"key": key, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
-                           "error": None, "metrics": {}, "trajectory": [], "roc": []}
+# --------------------------------------------------------------------------- cache entries
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """SHA-256 over footzoo's own source files: a failed cell is retried once it changes."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:
+    """Write one cache entry atomically: a header line (format, key, checksum, size) then the JSON record."""
+    payload = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
+    header = {"format": CACHE_FORMAT, "key": key, "sha256": hashlib.sha256(payload).hexdigest(),
+              "bytes": len(payload)}
+    tmp = path.with_suffix(f".{os.getpid()}.{time.monotonic_ns()}.tmp")
+    tmp.write_bytes(json.dumps(header).encode() + b"\n" + payload)
+    tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
+
+
+def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]:
+    """``(record, None)`` for a sound entry of this cell, ``(None, problem)`` otherwise; never raises."""
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        return None, f"unreadable ({err.strerror or err})"
+    line, _, payload = raw.partition(b"\n")
+    try:
+        header = json.loads(line)
+    except ValueError:
+        header = None
+    if not isinstance(header, dict) or header.get("format") != CACHE_FORMAT:
+        return None, "not a footzoo cache entry of this version (foreign file or older format)"
+    if header.get("key") != key:
+        return None, f"belongs to another cell (key {str(header.get('key'))[:24]!r})"
+    if len(payload) != header.get("bytes"):
+        return None, f"truncated or extended ({len(payload)} of {header.get('bytes')} bytes)"
+    if hashlib.sha256(payload).hexdigest() != header.get("sha256"):
+        return None, "checksum mismatch (edited or damaged)"
+    try:
+        record = json.loads(payload)
+    except ValueError:
+        return None, "checksum matches but the content is not JSON"
+    if not isinstance(record, dict) or record.get("key") != key:
+        return None, "checksum matches but the record is not this cell's"
+    return record, None
+
+
+# --------------------------------------------------------------------------- one cell, one chunk
+
+_RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
+_RECORDINGS_LOCK = threading.Lock()
+
+
+def _recording(cell: Cell, identity: str):
+    """The cell's recording, loaded or simulated once per process and shared by the configs that use it."""
+    with _RECORDINGS_LOCK:  # Dask workers may run several chunks in threads of one process
+        rec = _RECORDINGS.get(identity)
+        if rec is not None:
+            _RECORDINGS.move_to_end(identity)
+            return rec
+    rec = _read_only(cell.recording.load())
+    with _RECORDINGS_LOCK:
+        _RECORDINGS[identity] = rec
+        while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
+            _RECORDINGS.popitem(last=False)
+    return rec
+
+
+def _read_only(rec):
+    """Freeze a shared recording's arrays: a plug-in writing into its input fails loudly instead of
+    silently changing the input of the configs that run after it."""
+    for obj in (rec, rec.truth):
+        for value in vars(obj).values() if obj is not None else ():
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+    return rec
+
+
+def _new_record(cell: Cell, key: str) -> dict[str, Any]:
+    return {"key": key, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+            "error": None, "metrics": {}, "trajectory": [], "roc": [], "code_fingerprint": code_fingerprint()}
+
+
+def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
+    out["error"] = f"{type(err).__name__}: {err}"
+    if isinstance(err, ValueError) and "read-only" in str(err):
+        out["error"] += ("; a plug-in wrote into the recording's arrays, which a study shares between configs: "
+                         "the plug-in must copy its input before changing it")
+    out["traceback"] = "".join(traceback.format_exception(type(err), err, err.__traceback__, limit=3))
+    return out
+
+
+def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_points: int) -> dict[str, Any]:
+    out = _new_record(cell, key)
     try:
         from ..pipeline import Pipeline
 
-        pipeline = Pipeline.from_dict(cell.config)
-        rec = cell.recording.load()
-        res = pipeline.run(rec)
+        res = Pipeline.from_dict(cell.config).run(rec)
         out["metrics"] = _metrics(rec, res, metric_names)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
         out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
@@ -82,14 +202,65 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
         if sweep_points:
             out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
     except Exception as err:  # one failing run is reported, not fatal
-        out["error"] = f"{type(err).__name__}: {err}"
-        out["traceback"] = traceback.format_exc(limit=3)
-    if path is not None:
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(out))
-        tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
-    out["cached"] = False
+        _fail(out, err)
     return out
+
+
+def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[str], cache_dir: str | None,
+              metric_names: list[str] | None = None, sweep_points: int = 0,
+              on_cell: Callable[[], None] | None = None) -> list[dict[str, Any]]:
+    """Run cells that share one recording (in a worker): load the plug-ins, the recording once, run each config.
+
+    Never raises: a plug-in, recording or run failure is recorded in the cells it concerns. Each
+    finished cell is written to the cache at once, so an interrupted study keeps it.
+    """
+    from ..extensions import load_plugins
+
+    setup_error: BaseException | None = None
+    rec = None
+    start = time.process_time()
+    try:
+        load_plugins(plugins)
+        rec = _recording(cells[0], identity)
+    except Exception as err:  # a plug-in, reader or simulator failure fails this recording's cells only
+        setup_error = err
+    out = []
+    for cell, key in zip(cells, keys, strict=True):
+        if setup_error is not None:
+            record = _fail(_new_record(cell, key), setup_error)
+        else:
+            record = _compute(cell, key, rec, metric_names, sweep_points)
+        # CPU seconds of this run in its worker (the first run of a chunk includes loading the recording)
+        record["cpu_s"] = round(time.process_time() - start, 6)
+        start = time.process_time()
+        if cache_dir is not None:
+            try:
+                write_entry(Path(cache_dir) / f"{key}.json", key, record)
+            except OSError as err:  # a full or read-only cache costs the resume, not the result
+                warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning, stacklevel=2)
+        record["cached"] = False
+        out.append(record)
+        if on_cell is not None:
+            on_cell()
+    return out
+
+
+def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] | None = None,
+             sweep_points: int = 0) -> dict[str, Any]:
+    """Run one cell, or read it from the cache when a sound entry exists; never raises: errors are recorded."""
+    identity = cell.recording.identity()
+    key = cell.key(identity)
+    if cache_dir is not None and (Path(cache_dir) / f"{key}.json").exists():
+        record, problem = read_entry(Path(cache_dir) / f"{key}.json", key)
+        if record is not None:
+            return {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                    "cached": True}
+        warnings.warn(f"cache entry {key} {problem}; running it again", CacheWarning, stacklevel=2)
+    plugins = [p for p in cell.config.get("plugins") or []]
+    return run_chunk([cell], [key], identity, plugins, cache_dir, metric_names, sweep_points)[0]
+
+
+# --------------------------------------------------------------------------- the study
 
 
 def run_study(
@@ -107,78 +278,217 @@ def run_study(
     study : Study or path
         The study (or its YAML file).
     jobs : int
-        Local worker processes (joblib); 1 runs serially.
+        Local worker processes (joblib); 1 runs serially, -1 uses every core.
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``); the runs go
         to its workers through ``dask.distributed``.
     out : path, optional
-        Output folder: ``cache/`` (one file per run, keyed by the hash of the
-        resolved config and the data, so a rerun resumes), ``results.parquet``,
-        ``results.csv``, ``summary.md``, ``summary.tex`` and plots.
+        Output folder: ``cache/`` (one checked file per run, keyed by the hash of the
+        resolved config, the data, footzoo's version and the plug-ins' source, so a rerun
+        resumes), ``results.parquet``, ``results.csv``, ``trajectories.parquet``,
+        ``roc.parquet``, ``summary.md``, ``summary.tex`` and plots. A rerun whose table,
+        runs and footzoo source are unchanged, and whose outputs are all present and
+        intact (``outputs.json`` records their checksums), leaves them as they are.
     progress : bool
-        Show a progress bar.
+        Show one progress bar over the whole command (loading, runs, report).
     max_runs : int, optional
         Stop after this many new runs (what an interruption leaves behind).
 
     Returns
     -------
-    DataFrame
-        The tidy table. Its ``attrs`` hold ``computed`` and ``cached`` run counts and the
-        per-run records (``runs``) with trajectories and threshold sweeps.
+    pandas.DataFrame
+        Columns ``run``, ``base``, one per factor, ``recording``, ``metric``, ``value``,
+        ``error``. ``attrs`` holds counts only: ``computed``, ``cached``, ``failed``, and
+        ``recomputed`` (damaged cache entries: key -> problem) and ``retried`` (failed
+        cells run again because footzoo's source changed: keys). Trajectories and
+        threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
+        from ..errors import ConfigError
+
+        raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+    bar = _Progress(progress, "study")
+    try:
+        return _run_study(study, jobs, scheduler, out, max_runs, bar)
+    finally:
+        bar.close()
+
+
+def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.DataFrame:
+    bar.phase("loading")
     if not isinstance(study, Study):
         study = Study.from_yaml(study)
+    bar.set_description(study.name)
     cells = study.cells()
+    report_steps = 4 if out is not None else 0
+    bar.add(len(study.recordings) + len(cells) + report_steps)
+    bar.update(1)
+
+    bar.phase("hashing data")
+    identity: dict[int, str] = {}
+    for rec in study.recordings:
+        identity[id(rec)] = rec.identity()
+        bar.update(1)
+    keys = [c.key(identity[id(c.recording)]) for c in cells]
+
     cache_dir = None
     if out is not None:
         cache = Path(out) / "cache"
         cache.mkdir(parents=True, exist_ok=True)
         cache_dir = str(cache)
-    keys = [c.key() for c in cells]
-    missing = _all_missing(keys, cache_dir)
-    new = set(missing if max_runs is None else missing[:max_runs])
-    # cached cells are read back, missing ones run (all of them unless max_runs stops early)
-    work = [i for i in range(len(cells)) if i in new or i not in set(missing)]
-    args = (cache_dir, study.metrics, study.sweep_points)
+
+    bar.phase("reading cache")
     results: dict[int, dict[str, Any]] = {}
-    bar = _progress(len(work), progress, study.name)
-    if scheduler is not None:
-        from dask.distributed import Client, as_completed
+    todo: list[int] = []
+    recomputed: dict[str, str] = {}
+    retried: list[str] = []
+    for i, key in enumerate(keys):
+        path = Path(cache_dir) / f"{key}.json" if cache_dir else None
+        if path is None or not (path.exists() or path.is_symlink()):
+            todo.append(i)
+            continue
+        record, problem = read_entry(path, key)
+        if record is None:
+            recomputed[key] = problem
+            todo.append(i)
+        elif record.get("error") and record.get("code_fingerprint") != code_fingerprint():
+            retried.append(key)
+            todo.append(i)
+        else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
+            cell = cells[i]
+            results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                          "cached": True}
+            bar.update(1)
+    if recomputed:
+        warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
+                      f"(e.g. {next(iter(recomputed))}: {next(iter(recomputed.values()))}) will be run again"
+                      + (f"; see {Path(out) / 'cache_report.log'}" if out is not None else ""),
+                      CacheWarning, stacklevel=3)
+    if max_runs is not None:
+        bar.add(-(len(todo) - min(len(todo), max_runs)))
+        todo = todo[:max_runs]
 
-        with Client(scheduler) as client:
-            futures = {client.submit(run_cell, cells[i], *args, pure=False): i for i in work}
-            for fut in as_completed(futures):
-                results[futures[fut]] = fut.result()
-                bar.update(1)
-    elif jobs != 1:
-        from joblib import Parallel, delayed
-
-        gen = Parallel(n_jobs=jobs, return_as="generator")(delayed(run_cell)(cells[i], *args) for i in work)
-        for i, r in zip(work, gen, strict=True):
+    bar.phase("running")
+    args = (study.plugins, cache_dir, study.metrics, study.sweep_points)
+    for idx, records in _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
+        for i, r in zip(idx, records, strict=True):
             results[i] = r
-            bar.update(1)
-    else:
-        for i in work:
-            results[i] = run_cell(cells[i], *args)
-            bar.update(1)
-    bar.close()
     runs = [results[i] for i in sorted(results)]
     table = tidy(runs, list(study.factors))
     table.attrs["computed"] = sum(1 for r in runs if not r.get("cached"))
     table.attrs["cached"] = sum(1 for r in runs if r.get("cached"))
-    table.attrs["runs"] = runs
+    table.attrs["failed"] = sum(1 for r in runs if r.get("error"))
+    table.attrs["recomputed"] = dict(recomputed)
+    table.attrs["retried"] = list(retried)
     if out is not None:
         from .report import write_outputs
 
-        write_outputs(table, runs, list(study.factors), Path(out))
+        if recomputed:
+            _log_damaged(Path(out), recomputed)
+        bar.phase("report")
+        digest = _outputs_digest(table, runs, list(study.factors))
+        if _outputs_current(Path(out), digest):
+            bar.update(report_steps)  # nothing changed since the outputs were written: keep them
+        else:
+            # figures on the local workers with jobs: N; with a Dask scheduler the workers may not see `out`
+            write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
+                          jobs=jobs if scheduler is None else 1)
+            _write_manifest(Path(out), digest)
     return table
 
 
-def _all_missing(keys: list[str], cache_dir: str | None) -> list[int]:
-    """Indices not in the cache (all when there is no cache)."""
-    if cache_dir is None:
-        return list(range(len(keys)))
-    return [i for i, k in enumerate(keys) if not (Path(cache_dir) / f"{k}.json").exists()]
+MANIFEST = "outputs.json"
+
+
+def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> str:
+    """What the report depends on: the table, the runs (keys and labels), the factors and footzoo's source."""
+    h = hashlib.sha256(json.dumps([[r["key"], r["base"], r["recording"]] for r in runs]).encode())
+    h.update(json.dumps([factors, code_fingerprint()]).encode())
+    h.update(pd.util.hash_pandas_object(table.astype(str), index=True).to_numpy().tobytes())
+    return h.hexdigest()
+
+
+def _outputs_current(out: Path, digest: str) -> bool:
+    """True when ``out`` holds every output of a report with this digest, each with its recorded content."""
+    try:
+        manifest = json.loads((out / MANIFEST).read_text())
+        return manifest["digest"] == digest and all(
+            _file_sha256(out / name) == sha for name, sha in manifest["files"].items())
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return False
+
+
+def _write_manifest(out: Path, digest: str) -> None:
+    skip = {MANIFEST, "cache_report.log"}
+    files = {f.name: _file_sha256(f) for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
+    tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps({"digest": digest, "files": files}, indent=1))
+    tmp.replace(out / MANIFEST)
+
+
+def _file_sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _chunks(todo: list[int], cells: list[Cell], identity: dict[int, str], workers: int) -> list[list[int]]:
+    """Group the cells to run by recording, then split each group so every worker gets several chunks."""
+    groups: dict[str, list[int]] = {}
+    for i in todo:
+        groups.setdefault(identity[id(cells[i].recording)], []).append(i)
+    if workers <= 1:
+        return list(groups.values())
+    want = CHUNKS_PER_WORKER * workers
+    per_group = max(1, math.ceil(want / max(len(groups), 1)))
+    chunks = []
+    for idx in groups.values():
+        n = min(per_group, len(idx))
+        size = math.ceil(len(idx) / n)
+        chunks += [idx[k:k + size] for k in range(0, len(idx), size)]
+    return chunks
+
+
+def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
+    """Yield ``(indices, records)`` per finished chunk, from the chosen back end."""
+    def task(idx):
+        first = cells[idx[0]]
+        return ([cells[i] for i in idx], [keys[i] for i in idx], identity[id(first.recording)], *args)
+
+    if not todo:
+        return
+    if scheduler is not None:
+        from dask.distributed import Client, as_completed
+
+        with Client(scheduler) as client:
+            workers = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+            chunks = _chunks(todo, cells, identity, max(workers, 1))
+            futures = {client.submit(run_chunk, *task(idx), pure=False): idx for idx in chunks}
+            for fut in as_completed(futures):
+                records = fut.result()
+                bar.update(len(records))
+                yield futures[fut], records
+    elif jobs != 1:
+        from joblib import Parallel, delayed
+
+        chunks = _chunks(todo, cells, identity, (os.cpu_count() or 1) if jobs < 0 else int(jobs))
+        gen = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
+            delayed(_indexed)(k, *task(idx)) for k, idx in enumerate(chunks))
+        for k, records in gen:
+            bar.update(len(records))
+            yield chunks[k], records
+    else:
+        for idx in _chunks(todo, cells, identity, 1):
+            yield idx, run_chunk(*task(idx), on_cell=lambda: bar.update(1))
+
+
+def _indexed(k: int, *args: Any) -> tuple[int, list[dict[str, Any]]]:
+    return k, run_chunk(*args)
+
+
+def _log_damaged(out: Path, recomputed: dict[str, str]) -> None:
+    stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
+    with open(out / "cache_report.log", "a") as f:
+        for key, problem in recomputed.items():
+            f.write(f"{stamp} cache entry {key}.json {problem}: run again\n")
 
 
 def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
@@ -195,23 +505,44 @@ def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=cols)
 
 
+def read_trajectories(out: str | Path) -> pd.DataFrame:
+    """The stored trajectories of a study's runs (``out/trajectories.parquet``): one row per stored point."""
+    return pd.read_parquet(Path(out) / "trajectories.parquet")
+
+
 def _cell_value(v: Any) -> Any:
     return v if isinstance(v, (str, int, float, bool)) or v is None else json.dumps(v, sort_keys=True)
 
 
-class _NoBar:
-    def update(self, n: int) -> None:
-        pass
+class _Progress:
+    """One tqdm bar over the whole command; its total grows as the work becomes known."""
+
+    def __init__(self, show: bool, name: str):
+        self.bar = None
+        if show:
+            try:
+                from tqdm import tqdm
+            except ImportError:  # tqdm is a dependency, but a bar is not worth failing for
+                return
+            self.bar = tqdm(total=1, desc=name, unit="step")
+        self.name = name
+
+    def set_description(self, name: str) -> None:
+        self.name = name
+
+    def phase(self, what: str) -> None:
+        if self.bar is not None:
+            self.bar.set_description(f"{self.name}: {what}")
+
+    def add(self, n: int) -> None:
+        if self.bar is not None:
+            self.bar.total += n
+            self.bar.refresh()
+
+    def update(self, n: int = 1) -> None:
+        if self.bar is not None:
+            self.bar.update(n)
 
     def close(self) -> None:
-        pass
-
-
-def _progress(total: int, show: bool, name: str):
-    if not show:
-        return _NoBar()
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return _NoBar()
-    return tqdm(total=total, desc=name, unit="run")
+        if self.bar is not None:
+            self.bar.close()

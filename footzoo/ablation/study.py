@@ -7,12 +7,15 @@ import glob
 import hashlib
 import itertools
 import json
+import os
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..config import load_yaml
 from ..errors import ConfigError, did_you_mean
+from ..extensions import load_plugins, resolve_specs, source_hash
 from ..yamlsafe import load_file
 
 STUDY_KEYS = {
@@ -23,7 +26,29 @@ STUDY_KEYS = {
     "recordings": "list of {path: glob, format: ...} or {simulate: {...}, seeds: [...]}",
     "metrics": "list of metric names to keep (default: all)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
+    "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
 }
+
+# what a run can measure (footzoo.ablation.runner computes them); a study's ``metrics`` picks among them
+METRICS: dict[str, str] = {
+    "path_length_m": "horizontal path length (m)",
+    "loop_closure_xy_m": "horizontal end-to-start distance of a closed walk (m)",
+    "loop_closure_3d_m": "3-D end-to-start distance of a closed walk (m)",
+    "loop_closure_xy_pct": "horizontal end-to-start distance, % of the path length",
+    "loop_closure_3d_pct": "3-D end-to-start distance, % of the path length",
+    "armse_3d_m": "RMS position error after yaw alignment, against the reference (m)",
+    "pyshoe_error_m": "PyShoe's position error against the reference (m)",
+    "steps": "number of detected steps",
+    "stance_precision": "per-sample stance precision against the true stance",
+    "stance_recall": "per-sample stance recall against the true stance",
+    "stance_f1": "per-sample stance F1 against the true stance",
+    "stance_accuracy": "per-sample stance accuracy against the true stance",
+    "gait_phase_error_rate": "wrong or missed steps per true step",
+    "step_count_error": "detected minus true steps",
+    "fpa_mean_deg": "mean foot progression angle (deg)",
+}
+
+_FILE_DIGESTS: dict[tuple[str, int, int], str] = {}  # (path, size, mtime_ns) -> sha256 of the content
 
 
 @dataclass
@@ -38,18 +63,50 @@ class RecordingSpec:
     seed: int | None = None
 
     def identity(self) -> str:
-        """What the cache key depends on: the file's content hash, or the simulator spec and seed."""
+        """What the cache key depends on: the file's content hash, or the simulator spec and seed.
+
+        A path that is not a readable file (a dangling link, a directory, a vanished or unreadable
+        file) gets an identity describing the problem, so its cells fail on their own and are run
+        again once the file changes.
+        """
         if self.path is not None:
-            digest = hashlib.sha256(Path(self.path).read_bytes()).hexdigest()
-            return json.dumps({"file": digest, "format": self.format, "options": self.options}, sort_keys=True)
+            problem = self.problem()
+            data = {"problem": problem, "path": self.path} if problem else {"file": _file_digest(self.path)}
+            return json.dumps({**data, "format": self.format, "options": self.options}, sort_keys=True, default=str)
         from .._version import __version__
 
         return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": __version__}, sort_keys=True,
                           default=str)
 
+    def problem(self) -> str | None:
+        """Why the recording's file cannot be read (None for a simulated recording or a readable file)."""
+        if self.path is None:
+            return None
+        p = Path(self.path)
+        try:
+            st = p.stat()
+        except FileNotFoundError:
+            if p.is_symlink():
+                return f"{self.path!r} is a dangling link (its target {os.readlink(p)!r} does not exist)"
+            return f"{self.path!r} does not exist (any more)"
+        except OSError as err:
+            return f"{self.path!r} cannot be accessed: {err.strerror or err}"
+        if stat.S_ISDIR(st.st_mode):
+            return f"{self.path!r} is a directory, not a recording file; narrow the study's glob"
+        if not stat.S_ISREG(st.st_mode):
+            return f"{self.path!r} is not a regular file"
+        if not os.access(p, os.R_OK):
+            return f"{self.path!r} is not readable (permission denied)"
+        return None
+
     def load(self):
         """The recording."""
         if self.path is not None:
+            problem = self.problem()
+            if problem:
+                from ..errors import RecordingError
+
+                raise RecordingError(f"recording {problem}")
             from ..io import load
 
             return load(self.path, format=self.format, **self.options)
@@ -70,10 +127,12 @@ class Cell:
     recording: RecordingSpec
     levels: dict[str, Any]
     base: str
+    code: str = ""  # footzoo's version and the plug-ins' source hash (Study.code_identity)
 
-    def key(self) -> str:
-        """Cache key: hash of the resolved config and the data's identity."""
-        payload = json.dumps({"config": self.config, "data": self.recording.identity()}, sort_keys=True, default=str)
+    def key(self, data: str | None = None) -> str:
+        """Cache key: hash of the resolved config, the code identity and the data's identity."""
+        data = self.recording.identity() if data is None else data
+        payload = json.dumps({"config": self.config, "data": data, "code": self.code}, sort_keys=True, default=str)
         return hashlib.sha256(payload.encode()).hexdigest()[:24]
 
 
@@ -87,6 +146,7 @@ class Study:
     recordings: list[RecordingSpec]
     metrics: list[str] | None = None
     sweep_points: int = 0
+    plugins: list[str] = field(default_factory=list)
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> Study:
@@ -100,6 +160,12 @@ class Study:
         except ConfigError as err:
             raise ConfigError(f"{p}: {err}") from None
 
+    def code_identity(self) -> str:
+        """footzoo's version and the SHA-256 of every plug-in's source: part of every cache key."""
+        from .._version import __version__
+
+        return json.dumps({"footzoo": __version__, "plugins": source_hash(self.plugins)}, sort_keys=True)
+
     @classmethod
     def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
         """Build from a mapping (see :data:`STUDY_KEYS`)."""
@@ -110,15 +176,23 @@ class Study:
                                   f"valid keys: {list(STUDY_KEYS)}")
         if "base" not in d or "recordings" not in d:
             raise ConfigError("a study needs 'base' (config path(s)) and 'recordings'")
+        plugins = resolve_specs(d.get("plugins"), root, "plugins")
         bases = []
         for b in d["base"] if isinstance(d["base"], list) else [d["base"]]:
             if isinstance(b, str):
                 path = _resolve(root, b)
-                bases.append((Path(path).stem, load_yaml(path)))
+                cfg, folder = load_yaml(path), Path(path).parent
+                name = Path(path).stem
             elif isinstance(b, dict):
-                bases.append((str(b.get("name", f"base{len(bases)}")), copy.deepcopy(b)))
+                cfg, folder = copy.deepcopy(b), root
+                name = str(b.get("name", f"base{len(bases)}"))
             else:
                 raise ConfigError(f"base entries must be config paths or mappings, got {b!r}")
+            if cfg.get("plugins"):  # the base's own plug-ins, made absolute so any worker finds them
+                cfg["plugins"] = resolve_specs(cfg["plugins"], folder, f"base {name}: plugins")
+                plugins += [p for p in cfg["plugins"] if p not in plugins]
+            bases.append((name, cfg))
+        load_plugins(plugins)  # here too: errors surface before any run, and factors may name the plug-ins
         factors = d.get("factors") or {}
         if not isinstance(factors, dict):
             raise ConfigError("factors must map dotted paths to lists of values, e.g. {detector.type: [dgp, shoe]}")
@@ -134,20 +208,28 @@ class Study:
         if not recordings:
             raise ConfigError("the study has no recordings (check the globs)")
         metrics = d.get("metrics")
-        if metrics is not None and (not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics)):
-            raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}")
+        if metrics is not None:
+            if isinstance(metrics, str):
+                metrics = [metrics]
+            if not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics):
+                raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}; valid: {list(METRICS)}")
+            for m in metrics:
+                if m not in METRICS:
+                    raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}; "
+                                      f"valid metrics: {list(METRICS)}")
         sweep = d.get("sweep") or {}
         if not isinstance(sweep, dict) or set(sweep) - {"points"}:
             raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
         points = sweep.get("points", 0)
         if isinstance(points, bool) or not isinstance(points, int) or points < 0:
             raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
-        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points)
+        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins)
 
     def cells(self) -> list[Cell]:
         """Every base × factor combination × recording."""
         # type changes first: they reset the plug-in's parameters, which other factors may then set
         names = sorted(self.factors, key=lambda n: not n.endswith(".type"))
+        code = self.code_identity()
         out = []
         for base_name, base in self.bases:
             for values in itertools.product(*(self.factors[n] for n in names)):
@@ -156,7 +238,7 @@ class Study:
                     set_dotted(cfg, n, v)
                 levels = {"base": base_name, **dict(zip(names, values, strict=True))}
                 for rec in self.recordings:
-                    out.append(Cell(cfg, rec, levels, base_name))
+                    out.append(Cell(cfg, rec, levels, base_name, code))
         return out
 
 
@@ -217,3 +299,16 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
         node["type"] = value
     else:
         node[last] = value
+
+
+def _file_digest(path: str) -> str:
+    """SHA-256 of a file's content, remembered per (path, size, modification time) within the process."""
+    st = os.stat(path)
+    memo = (os.path.realpath(path), st.st_size, st.st_mtime_ns)
+    if memo not in _FILE_DIGESTS:
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        _FILE_DIGESTS[memo] = h.hexdigest()
+    return _FILE_DIGESTS[memo]

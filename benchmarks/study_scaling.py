@@ -1,0 +1,192 @@
+"""Speed-up of an ablation study from two local workers (joblib) and from a local Dask cluster.
+
+Usage: python benchmarks/study_scaling.py [--repeat 2] [--strides 0] [--no-report]
+
+The study: 4 configs (angular-rate FSM or SHOE detector x ZVU dedrift or ZUPT, on yun2012.yaml)
+x 8 simulated recordings (the hallway rectangle at 100 Hz, physical foot model, seeds 0-7), with
+a threshold sweep. Each back end runs the whole study from an empty output folder (runs, cache
+writes, tables, summaries and plots; ``--no-report`` leaves out the output folder). Runs are
+interleaved (serial, joblib, Dask, serial, ...) and the minimum and median wall times are printed
+with the speed-ups against serial, and whether the three tables are identical. Worker processes
+are started and warmed by one untimed run of the study per back end (imports and compiled kernels
+loaded), as a user's second study in one session would find them.
+
+On a machine shared with other work, wall times say little about scaling, so the CPU time is
+measured too: the main process's (``time.process_time``) and each run's in its worker (``cpu_s``
+in the cache entries, loading the recording included). From them, the time the same work would
+take on two otherwise idle cores: the main process's CPU plus the makespan of the chunks
+dispatched to two workers in order (each to the first free worker, as joblib and Dask do); with
+joblib the figures are drawn by the workers while the main process writes the tables, so the
+figure tasks are timed again one by one afterwards and scheduled the same way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from footzoo.ablation import Study, run_study  # noqa: E402
+from footzoo.config import load_yaml  # noqa: E402
+
+
+def study(strides: int) -> Study:
+    sim = {"path": "rectangle", "rate": 100, "profile": "physical", "clearance": 0.15, "noise": {"scale": 1}}
+    if strides:
+        sim = {"path": "straight", "n_strides": strides, "rate": 100, "profile": "physical", "noise": {"scale": 1}}
+    return Study.from_dict({
+        "name": "scaling",
+        "base": {**load_yaml(ROOT / "configs" / "yun2012.yaml"), "name": "yun2012"},
+        "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
+                    "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
+        "recordings": [{"simulate": sim, "seeds": list(range(8))}],
+        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "steps"],
+        "sweep": {"points": 25},
+    })
+
+
+def _spin(n: int) -> int:
+    total = 0
+    for i in range(n):
+        total += i * i
+    return total
+
+
+def machine_check(n: int = 3_000_000, tasks: int = 8) -> float:
+    """Speed-up two joblib processes give a pure-Python loop right now: what the machine lets scale at all."""
+    from joblib import Parallel, delayed
+
+    Parallel(n_jobs=2)(delayed(_spin)(10) for _ in range(2))
+    t0 = time.perf_counter()
+    for _ in range(tasks):
+        _spin(n)
+    serial = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    Parallel(n_jobs=2, batch_size=1)(delayed(_spin)(n) for _ in range(tasks))
+    return serial / (time.perf_counter() - t0)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=2, help="interleaved repetitions per back end")
+    ap.add_argument("--strides", type=int, default=0, help="a straight walk of this many strides instead of "
+                                                           "the rectangle (0: rectangle)")
+    ap.add_argument("--no-report", action="store_true", help="no output folder: runs only")
+    args = ap.parse_args()
+    from dask.distributed import LocalCluster
+
+    from footzoo.ablation import report
+
+    report.write_outputs = _timed_report(report.write_outputs)
+    s = study(args.strides)
+    print(f"{len(s.cells())} cells ({len(s.cells()) // len(s.recordings)} configs x {len(s.recordings)} recordings), "
+          f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start")
+    tmp = Path(tempfile.mkdtemp(prefix="footzoo_scaling_"))
+    times: dict[str, list[float]] = {"serial": [], "joblib, 2 jobs": [], "dask, 2 processes": []}
+    tables = {}
+    idle: dict[str, list[float]] = {name: [] for name in times}
+    runs_only: dict[str, list[float]] = {name: [] for name in times}
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.CRITICAL) as cluster:
+        for kw in ({}, {"jobs": 2}, {"scheduler": cluster.scheduler_address}):
+            run_study(s, **kw)  # untimed: imports and compiled kernels loaded in every process
+        for r in range(args.repeat):
+            for name, kw in (("serial", {}), ("joblib, 2 jobs", {"jobs": 2}),
+                             ("dask, 2 processes", {"scheduler": cluster.scheduler_address})):
+                out = None if args.no_report else tmp / f"{r}_{name.split(',')[0]}"
+                t0, c0 = time.perf_counter(), time.process_time()
+                tables[name] = run_study(s, out=out, **kw)
+                times[name].append(time.perf_counter() - t0)
+                main_cpu = time.process_time() - c0
+                if out is not None:
+                    workers = 1 if name == "serial" else 2
+                    runs = main_cpu - REPORT_CPU[-1] + (makespan(s, out, workers) if workers > 1 else 0.0)
+                    report_time = REPORT_CPU[-1]
+                    if name.startswith("joblib"):  # the workers draw the figures while the main writes tables
+                        report_time = max(report_time, lpt(figure_cpu(s, out, tables[name]), workers))
+                    idle[name].append(runs + report_time)
+                    runs_only[name].append(runs)
+                print(f"  {name:18s} run {r + 1}: {times[name][-1]:6.2f} s wall, main process {main_cpu:6.2f} s CPU"
+                      + (f" (report {REPORT_CPU[-1]:.2f} s)" if out is not None else ""), flush=True)
+    shutil.rmtree(tmp, ignore_errors=True)
+    base = min(times["serial"])
+    print(f"\n{'back end':18s} {'min (s)':>8s} {'median (s)':>10s} {'speed-up (min)':>15s} {'same table':>11s}"
+          + ("" if args.no_report else f" {'idle-machine estimate (s)':>26s} {'speed-up':>9s}"))
+    for name, ts in times.items():
+        same = tables[name].equals(tables["serial"])
+        line = f"{name:18s} {min(ts):8.2f} {statistics.median(ts):10.2f} {base / min(ts):15.2f} {str(same):>11s}"
+        if idle[name]:
+            line += f" {min(idle[name]):26.2f} {min(idle['serial']) / min(idle[name]):9.2f}"
+        print(line)
+    if any(runs_only.values()):
+        print("\nidle-machine estimate without the report (tables and figures, after the runs):")
+        for name, ts in runs_only.items():
+            print(f"{name:18s} {min(ts):8.2f} s, speed-up {min(runs_only['serial']) / min(ts):5.2f}")
+    print(f"load average {os.getloadavg()[0]:.1f} at the end; a pure-Python loop gets {machine_check():.2f}x from "
+          f"two joblib processes on this machine now (about 2 when two cores are free)")
+
+
+REPORT_CPU: list[float] = []
+
+
+def _timed_report(write_outputs):
+    """Wrap the report writer to record its CPU time in the main process."""
+    def timed(*args, **kwargs):
+        c0 = time.process_time()
+        try:
+            return write_outputs(*args, **kwargs)
+        finally:
+            REPORT_CPU.append(time.process_time() - c0)
+
+    return timed
+
+
+def makespan(s: Study, out: Path, workers: int) -> float:
+    """CPU seconds until the last worker is done, the chunks handed out in order to the first free one."""
+    from footzoo.ablation import runner
+
+    cells = s.cells()
+    identity = {id(r): r.identity() for r in s.recordings}
+    keys = [c.key(identity[id(c.recording)]) for c in cells]
+    cpu = {k: runner.read_entry(out / "cache" / f"{k}.json", k)[0]["cpu_s"] for k in set(keys)}
+    chunks = runner._chunks(list(range(len(cells))), cells, identity, workers)
+    return lpt([sum(cpu[keys[i]] for i in chunk) for chunk in chunks], workers)
+
+
+def lpt(costs: list[float], workers: int) -> float:
+    """Finish time of tasks handed out in order, each to the first free worker."""
+    free = [0.0] * workers
+    for c in costs:
+        free[free.index(min(free))] += c
+    return max(free)
+
+
+def figure_cpu(s: Study, out: Path, table) -> list[float]:
+    """CPU seconds of each figure task the workers drew, measured again here one after the other."""
+    from footzoo.ablation import report, runner
+
+    runs = []
+    for key, (_, row) in zip(table["run"], table.iterrows(), strict=True):
+        if not runs or runs[-1]["key"] != key:
+            rec = runner.read_entry(out / "cache" / f"{key}.json", key)[0]
+            runs.append({**rec, "recording": row["recording"], "base": row["base"]})
+    costs = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for t, r, f in report.figure_tasks(table, runs, list(s.factors)):
+            c0 = time.process_time()
+            report.plot_study(t, r, f, Path(tmp))
+            costs.append(time.process_time() - c0)
+    return costs
+
+
+if __name__ == "__main__":
+    main()
