@@ -1,6 +1,5 @@
 """The plug-in guide's two worked examples (docs/plugins.md, examples/plugins/) work as documented."""
 
-import importlib.util
 import sys
 import warnings
 from pathlib import Path
@@ -10,6 +9,7 @@ import pytest
 
 from footzoo import Pipeline
 from footzoo.errors import FootzooWarning
+from footzoo.extensions import load_plugins
 from footzoo.metrics import stance_scores
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 from footzoo.stream import Stream
@@ -19,13 +19,9 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "plugins"
 
 
 def _load(name):
-    if name in sys.modules:
-        return sys.modules[name]
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
+    """The example module, loaded as a config's `plugins:` entry loads it."""
+    info = load_plugins([str(EXAMPLES / f"{name}.py")], None)[0]
+    return sys.modules[info["module"]]
 
 
 @pytest.fixture(scope="module")
@@ -94,3 +90,19 @@ def test_the_magnetometer_update_runs_live_like_the_batch(magu):
         batch = p.run(rec)
     live = Stream(p).run(rec)
     np.testing.assert_allclose(live["pos"], batch.pos, rtol=0, atol=1e-9 * np.abs(batch.pos).max())
+
+
+def test_the_guide_yaml_loads_the_example_files_by_path(tmp_path):
+    """The guide's YAML: `plugins:` lists the .py files (relative to the YAML file, or absolute)."""
+    three, magu = EXAMPLES / "three_condition_detector.py", EXAMPLES / "magnetometer_heading_update.py"
+    (tmp_path / "three.yaml").write_text(
+        f"plugins: [{three}]\norientation: {{type: madgwick}}\n"
+        "detector: {type: three_condition, gyro_max: 0.87}\ncorrections: [{type: zvu_dedrift}]\n")
+    (tmp_path / "magu.yaml").write_text(
+        f"plugins: [{magu}]\norientation: {{type: ins}}\ndetector: {{type: shoe}}\n"
+        "corrections:\n  - {type: zupt}\n  - {type: magnetometer_heading, heading_std: 0.1}\n")
+    rec = simulate(n_strides=6, profile="physical", rate=100.0, noise=NoiseModel(seed=1), clearance=0.1)
+    for name, path in (("three", three), ("magu", magu)):
+        res = Pipeline.from_yaml(tmp_path / f"{name}.yaml").run(rec)
+        assert np.isfinite(res.pos).all()
+        assert res.config["plugins"] == [str(path)]

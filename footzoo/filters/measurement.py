@@ -103,6 +103,10 @@ def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[...,
         fn = fn.py_func
     try:
         return numba.njit(signature, cache=True, nogil=True)(fn)
+    except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
+        pass
+    try:
+        return numba.njit(signature, cache=False, nogil=True)(fn)
     except Exception as err:  # numba raises many types; the message is what matters
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise NotCompilable(f"{role} function {getattr(fn, '__qualname__', fn)!r}: {first}") from None
