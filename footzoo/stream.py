@@ -149,7 +149,7 @@ class Stream:
         self._engine = self.pipeline.kalman_engine(self._corrections, samples, self.engine)
         nav0 = np.zeros(16)
         nav0[:4] = q0
-        self._state = self._engine.start(nav0)
+        self._state = self._engine.live(self._engine.start(nav0))
         self._ready = True
         self._prev = None
         for sample in b[:n]:

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._jit import HAVE_NUMBA, numba
 from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
@@ -140,6 +141,7 @@ class Packed:
     functions: tuple
     arrays: tuple
     data_widths: list[int]
+    bound: Any = None  # the compiled loop with the functions bound in (live use): see KalmanEngine.live
 
 
 class KalmanEngine:
@@ -268,8 +270,8 @@ class KalmanEngine:
         mem_off = np.cumsum([0] + [np.asarray(m.mem).size for m in models]).astype(np.int64)
         widths = [0 if m.data is None else m.data.shape[1] for m in models]
         data_off = np.cumsum([0] + widths).astype(np.int64)
-        functions = (tuple(m.measure for m in models), tuple(m.feedback for m in models),
-                     tuple(m.after for m in models))
+        functions = (tuple(_address(m.measure) for m in models), tuple(_address(m.feedback) for m in models),
+                     tuple(_address(m.after) for m in models))
         arrays = (m_idx, par, par_off, mem_off, data_off)
         return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays, widths)
 
@@ -284,6 +286,17 @@ class KalmanEngine:
         off = packed.arrays[3]
         return [packed.mems[off[j]:off[j + 1]] for j in range(len(self.models))]
 
+    def live(self, state: Any) -> Any:
+        """Prepare a state from :meth:`start` for many short :meth:`advance` calls (a live stream).
+
+        Passing the models' functions to the compiled loop costs about a millisecond per call (numba
+        types them each time); live, they are bound into a small compiled wrapper once (about a
+        second, at the stream's start) and each call passes arrays only.
+        """
+        if self.engine == "fast" and HAVE_NUMBA:
+            state.bound = _bound_loop(state.functions)
+        return state
+
     @staticmethod
     def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
         """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
@@ -291,14 +304,74 @@ class KalmanEngine:
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off = packed.arrays
+        signals = (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
+                   np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext)
+        outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
+                   out["P_diag"], out["gains"], out["dxs"])
+        state = (packed.nav, packed.P, packed.mems)
+        if packed.bound is not None:
+            packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off), outputs, k0)
+            return
         measures, feedbacks, afters = packed.functions
-        eskf_loop(
-            (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
-             np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext),
-            packed.core,
-            (packed.nav, packed.P, packed.mems),
-            (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off),
-            (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"], out["P_diag"],
-             out["gains"], out["dxs"]),
-            k0,
-        )
+        eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
+                                                data_off), outputs, k0)
+
+
+_BOUND: dict[tuple, Any] = {}
+
+
+def _address(fn: Any) -> Any:
+    """A compiled measurement function as a first-class function value with a fixed address.
+
+    numba types a dispatcher passed as an argument, and looks up its machine-code address, at
+    every call of the compiled loop (about 0.2 ms each); a ``WrapperAddressProtocol`` object
+    carries the signature and the address, looked up once. Plain Python functions pass through.
+    """
+    if not HAVE_NUMBA or not isinstance(fn, numba.core.registry.CPUDispatcher) or len(fn.signatures) != 1:
+        return fn
+    cached = _ADDRESSES.get(id(fn))
+    if cached is None or cached.dispatcher is not fn:
+        cached = _ADDRESSES[id(fn)] = _FixedAddress(fn)
+    return cached
+
+
+_ADDRESSES: dict[int, Any] = {}
+
+if HAVE_NUMBA:
+    from numba.core.types.function_type import WrapperAddressProtocol
+    from numba.experimental.function_type import _get_wrapper_address
+
+    class _FixedAddress(WrapperAddressProtocol):
+        """A dispatcher compiled for one signature, seen by numba through its address."""
+
+        def __init__(self, dispatcher: Any):
+            self.dispatcher = dispatcher
+            self._signature = dispatcher.signatures[0]
+            self._sig = dispatcher.nopython_signatures[0]
+            self._address = _get_wrapper_address(dispatcher, self._sig)
+
+        def __wrapper_address__(self) -> int:
+            return self._address
+
+        def signature(self) -> Any:
+            return self._sig
+
+        def __call__(self, *args: Any) -> Any:
+            return self.dispatcher(*args)
+
+
+def _bound_loop(functions: tuple) -> Any:
+    """The compiled loop with these measurement functions as constants (compiled once per process and set)."""
+    key = tuple(id(f) for group in functions for f in group)
+    if key not in _BOUND:
+        from .kalman_fast import eskf_loop
+
+        measures, feedbacks, afters = functions
+
+        def bound(signals, core, state, arrays, out, k0):
+            m_idx, par, par_off, mem_off, data, data_off = arrays
+            eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
+                                             data_off), out, k0)
+
+        _BOUND[key] = numba.njit(nogil=True)(bound)
+    return _BOUND[key]
