@@ -10,10 +10,11 @@ import numpy as np
 import pandas as pd
 
 from . import __version__
+from ._table import samples_frame
 from .alignment import initial_attitude
 from .analysis.strides import segment_steps
 from .config import INIT_KEYS, check_top_level, load_yaml
-from .conventions import GRAVITY, quat_to_euler
+from .conventions import GRAVITY
 from .data import Recording, Result
 from .errors import ConfigError
 from .filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -169,18 +170,7 @@ class Pipeline:
             else:
                 vel = integrate_velocity(acc_nav, dt)
                 pos = integrate_position(vel, dt)
-        euler = quat_to_euler(quat)
-        samples = pd.DataFrame(
-            {
-                "t": t,
-                "qw": quat[:, 0], "qx": quat[:, 1], "qy": quat[:, 2], "qz": quat[:, 3],
-                "roll": euler[:, 0], "pitch": euler[:, 1], "yaw": euler[:, 2],
-                "pos_n": pos[:, 0], "pos_e": pos[:, 1], "pos_d": pos[:, 2],
-                "vel_n": vel[:, 0], "vel_e": vel[:, 1], "vel_d": vel[:, 2],
-                "acc_n": acc_nav[:, 0], "acc_e": acc_nav[:, 1], "acc_d": acc_nav[:, 2],
-                "stance": stance,
-            }
-        )
+        samples = samples_frame(t, quat, pos, vel, acc_nav, stance)
         steps = segment_steps(t, stance, pos)
         for a in self.analysis:
             a = _clone(a).analyze(t, quat, pos, stance, rec.meta)
