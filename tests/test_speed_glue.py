@@ -11,7 +11,7 @@ import pytest
 from footzoo import Pipeline
 from footzoo._table import samples_frame
 from footzoo.analysis.fpa import HuangFPA
-from footzoo.conventions import gravity_ned, quat_normalize, quat_rotate, quat_to_euler, wrap_angle
+from footzoo.conventions import gravity_ned, quat_mul, quat_normalize, quat_rotate, quat_to_euler, wrap_angle
 from footzoo.corrections.zvu_dedrift import swing_segments, zvu_dedrift
 from footzoo.filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from footzoo.metrics import intervals
@@ -154,3 +154,59 @@ def test_sample_table_equals_the_dict_frame(walk):
     for col in ref.columns[:-1]:
         _close(got[col].to_numpy(), ref[col].to_numpy())
     np.testing.assert_array_equal(got["stance"].to_numpy(), ref["stance"].to_numpy())
+
+
+def _reference_complementary(q0, acc, gyr, mag, dt, gain):
+    """The previous two-pass filter: the FQA quaternion of every sample first, then the sample loop."""
+    import math
+
+    from footzoo.orientation.fqa import fqa_sample
+
+    n = len(dt)
+    q_s, yaw = np.empty((n, 4)), np.empty(n)
+    for k in range(n):
+        if mag is not None:
+            w, x, y, z = fqa_sample(*acc[k], *mag[k], True)
+        else:
+            w, x, y, z = fqa_sample(*acc[k], 0.0, 0.0, 0.0, False)
+        r = gyr[k] * 0.5 * dt[k]
+        angle = math.sqrt(float(r @ r))
+        kk = math.sin(0.5 * angle) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
+        d = np.array([math.cos(0.5 * angle), *(kk * r)])
+        q_s[k] = quat_mul(np.array([w, x, y, z]), d)
+        yaw[k] = math.atan2(2.0 * (q_s[k, 0] * q_s[k, 3] + q_s[k, 1] * q_s[k, 2]),
+                            1.0 - 2.0 * (q_s[k, 2] ** 2 + q_s[k, 3] ** 2))
+    out = np.empty((n, 4))
+    q = np.asarray(q0, float)
+    for k in range(n):
+        g = gyr[k] * dt[k]
+        ang = math.sqrt(float(g @ g))
+        d = np.array([math.cos(0.5 * ang), *(g * math.sin(0.5 * ang) / ang)]) if ang > 1e-12 else \
+            np.array([1.0, *(0.5 * g)])
+        p = quat_mul(q, d)
+        kk = gain[k] * dt[k]
+        if kk != 0.0:
+            s = q_s[k].copy()
+            if mag is None:
+                psi = math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] ** 2 + q[3] ** 2)) - yaw[k]
+                s = quat_mul(np.array([math.cos(0.5 * psi), 0.0, 0.0, math.sin(0.5 * psi)]), s)
+            if s @ p < 0.0:
+                s = -s
+            p = p + kk * (s - p)
+        q = p / math.sqrt(float(p @ p))
+        out[k] = q
+    return out
+
+
+@pytest.mark.parametrize("use_mag", [True, False])
+def test_complementary_filter_equals_the_two_pass_loop(walk, use_mag):
+    from footzoo.orientation import FQAComplementary
+
+    n = 1500
+    t, acc, gyr, mag = walk.t[:n], walk.acc[:n], walk.gyr[:n], walk.mag[:n]
+    stance = walk.truth.stance[:n]
+    f = FQAComplementary(static_gain=1.05, dynamic_gain=0.3, use_magnetometer=use_mag)
+    got = f.estimate(t, acc, gyr, mag, stance, walk.truth.quat[0]).quat_
+    ref = _reference_complementary(walk.truth.quat[0], acc, gyr, mag if use_mag else None, sample_intervals(t),
+                                   f.gain_)
+    _close(got, ref)

@@ -67,6 +67,6 @@ class INS(Plugin):
         dt[1:] = np.diff(t)
         dt[0] = 0.0
         n = t.shape[0]
-        self.quat_ = complementary_kernel(np.asarray(q0, float), gyr, dt, np.zeros((n, 4)), np.zeros(n), False,
-                                          np.zeros(n))
+        self.quat_ = complementary_kernel(np.asarray(q0, float), np.ascontiguousarray(gyr, dtype=float), dt,
+                                          np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(n), False)
         return self
