@@ -210,3 +210,36 @@ def test_complementary_filter_equals_the_two_pass_loop(walk, use_mag):
     ref = _reference_complementary(walk.truth.quat[0], acc, gyr, mag if use_mag else None, sample_intervals(t),
                                    f.gain_)
     _close(got, ref)
+
+
+def _reference_first_still_window(t, gyr, duration, max_gyr):
+    still = np.linalg.norm(gyr, axis=1) <= max_gyr
+    edges = np.flatnonzero(still[1:] != still[:-1]) + 1
+    bounds = np.concatenate([[0], edges, [still.shape[0]]])
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        if still[a] and t[b - 1] - t[a] >= duration:
+            stop = int(np.searchsorted(t, t[a] + duration, side="right"))
+            if stop - a >= 2:
+                return int(a), stop
+    return None
+
+
+@pytest.mark.parametrize("still_from", [0, 4090, 5000, 20000, None])
+def test_first_still_window_reads_chunks_but_finds_the_same_window(still_from):
+    from footzoo.alignment import first_still_window
+    from footzoo.errors import RecordingError
+
+    rng = np.random.default_rng(0)
+    n = 30000
+    t = np.arange(n) / 100.0
+    gyr = rng.normal(0.0, 1.0, (n, 3))
+    gyr[::7] = 0.0  # many short still runs that are too short
+    if still_from is not None:
+        gyr[still_from:still_from + 60] = 0.01  # 0.6 s still
+    ref = _reference_first_still_window(t, gyr, 0.5, 0.6)
+    if ref is None:
+        with pytest.raises(RecordingError, match="still period"):
+            first_still_window(t, gyr, 0.5, 0.6)
+    else:
+        assert abs(ref[0] - still_from) <= 1  # a zeroed sample may join the still run
+        assert first_still_window(t, gyr, 0.5, 0.6) == ref
