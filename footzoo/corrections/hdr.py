@@ -71,14 +71,14 @@ class HDR(Plugin):
     # ------------------------------------------------------------- no EKF: eqs. 25-27
     def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:
         """NED motion acceleration with each swing turned by −δψ about the vertical."""
-        yaw = quat_yaw(quat)
         out = acc_nav.copy()
         ends: list[float] = []
         biases = []
         st = intervals(stance)
+        yaw_end = quat_yaw(quat[st[:, 1] - 1]).tolist()  # γ at the end of each stance
         for j, (_start, b) in enumerate(st):
-            d = heading_bias(float(yaw[b - 1]), ends, self.threshold)
-            ends.append(float(yaw[b - 1]))
+            d = heading_bias(yaw_end[j], ends, self.threshold)
+            ends.append(yaw_end[j])
             biases.append(np.nan if d is None else d)
             if d is None:
                 continue
