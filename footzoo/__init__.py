@@ -2,14 +2,30 @@
 
 Conventions: NED navigation frame, FRD body frame, scalar-first body -> NED
 quaternions, SI units (see :mod:`footzoo.conventions`).
+
+The names below are imported at their first use (PEP 562), so ``import footzoo``
+does not load pandas, scipy or numba; ``footzoo.Pipeline`` and
+``from footzoo import Pipeline`` work as usual.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-from .data import Recording, Result, Truth  # noqa: E402
-from .errors import ConfigError, FootzooError, FormatError, RecordingError  # noqa: E402
-from .io import load  # noqa: E402
-from .pipeline import Pipeline  # noqa: E402
+_EXPORTS = {
+    "ConfigError": "errors",
+    "FootzooError": "errors",
+    "FormatError": "errors",
+    "RecordingError": "errors",
+    "Pipeline": "pipeline",
+    "Recording": "data",
+    "Result": "data",
+    "Truth": "data",
+    "load": "io",
+}
 
 __all__ = [
     "ConfigError",
@@ -23,3 +39,26 @@ __all__ = [
     "load",
     "__version__",
 ]
+
+if TYPE_CHECKING:
+    from .data import Recording, Result, Truth
+    from .errors import ConfigError, FootzooError, FormatError, RecordingError
+    from .io import load
+    from .pipeline import Pipeline
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    try:
+        return importlib.import_module(f".{name}", __name__)
+    except ModuleNotFoundError as err:
+        if err.name != f"{__name__}.{name}":
+            raise
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
