@@ -19,6 +19,7 @@ import functools
 import importlib.util
 import os
 import sys
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -27,6 +28,7 @@ HAVE_NUMBA = ENABLED and importlib.util.find_spec("numba") is not None
 
 _pending: list[_Kernel] = []
 _numba: Any = None
+_lock = threading.Lock()
 
 
 class _Kernel:
@@ -58,21 +60,23 @@ def _compile(fn: Callable[..., Any]) -> Any:
 def _materialise() -> None:
     """Import numba, make every pending kernel a dispatcher, rebind the module attributes that named it."""
     global _numba
-    if _numba is None:
+    with _lock:
+        if not _pending:  # another thread did it
+            return
         import numba
 
         _numba = numba
-    kernels = {id(k): k for k in _pending}
-    for k in kernels.values():
-        k.dispatcher = _compile(k.py_func)
-    _pending.clear()
-    for name, module in list(sys.modules.items()):
-        if name != "footzoo" and not name.startswith("footzoo."):
-            continue
-        attrs = getattr(module, "__dict__", {})
-        for attr, value in list(attrs.items()):
-            if id(value) in kernels and isinstance(value, _Kernel):
-                attrs[attr] = value.dispatcher
+        kernels = {id(k): k for k in _pending}
+        for k in kernels.values():
+            k.dispatcher = _compile(k.py_func)
+        _pending.clear()
+        for name, module in list(sys.modules.items()):
+            if name != "footzoo" and not name.startswith("footzoo."):
+                continue
+            attrs = getattr(module, "__dict__", {})
+            for attr, value in list(attrs.items()):
+                if id(value) in kernels and isinstance(value, _Kernel):
+                    attrs[attr] = value.dispatcher
 
 
 def njit(fn: Callable[..., Any]) -> Callable[..., Any]:
