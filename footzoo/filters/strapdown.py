@@ -23,9 +23,10 @@ from ..conventions import GRAVITY
 
 def sample_intervals(t: np.ndarray) -> np.ndarray:
     """``dt[k] = t[k] - t[k-1]`` (s), with ``dt[0] = 0`` (the first sample starts the clock)."""
-    dt = np.empty_like(np.asarray(t, dtype=float))
-    dt[1:] = np.diff(t)
-    dt[0] = 0.0
+    t = np.asarray(t, dtype=float)
+    dt = np.empty_like(t)
+    np.subtract(t[1:], t[:-1], out=dt[1:])  # no temporary
+    dt[:1] = 0.0
     return dt
 
 

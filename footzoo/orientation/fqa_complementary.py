@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..filters.strapdown import sample_intervals
 from ..registry import Plugin, check_positive, register
 from .fqa import fqa_sample
 
@@ -190,9 +191,7 @@ class FQAComplementary(Plugin):
         q0 : (4,) ndarray
             Initial attitude.
         """
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         use_mag = self.use_magnetometer and mag is not None
         self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
         self.quat_ = complementary_kernel(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..filters.strapdown import sample_intervals
 from ..registry import Plugin, check_positive, register
 from .fqa_complementary import complementary_kernel
 
@@ -63,9 +64,7 @@ class INS(Plugin):
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> INS:
         """Gyro integration from ``q0`` (no Kalman filter configured)."""
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         n = t.shape[0]
         self.quat_ = complementary_kernel(np.asarray(q0, float), np.ascontiguousarray(gyr, dtype=float), dt,
                                           np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(n), False)

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from ..filters.strapdown import sample_intervals
 from ..registry import Plugin, check_positive, register
 
 
@@ -130,9 +131,7 @@ class Madgwick(Plugin):
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
         """Run the filter over a recording (``stance`` is not used)."""
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         self.beta_ = math.sqrt(3.0 / 4.0) * self.gyro_error  # eq. 3
         use_mag = self.use_magnetometer and mag is not None
         self.quat_ = madgwick_kernel(np.asarray(q0, float), gyr, acc, mag if use_mag else None, dt, self.beta_)
