@@ -29,6 +29,7 @@ HAVE_NUMBA = ENABLED and importlib.util.find_spec("numba") is not None
 _pending: list[_Kernel] = []
 _numba: Any = None
 _lock = threading.Lock()
+_materialised = False
 
 
 class _Kernel:
@@ -59,17 +60,21 @@ def _compile(fn: Callable[..., Any]) -> Any:
 
 def _materialise() -> None:
     """Import numba, make every pending kernel a dispatcher, rebind the module attributes that named it."""
-    global _numba
+    global _numba, _materialised, HAVE_NUMBA
     with _lock:
         if not _pending:  # another thread did it
             return
-        import numba
-
+        try:
+            import numba
+        except ImportError:  # installed but broken: run the same code as plain Python
+            numba = None
+            HAVE_NUMBA = False
         _numba = numba
         kernels = {id(k): k for k in _pending}
         for k in kernels.values():
-            k.dispatcher = _compile(k.py_func)
+            k.dispatcher = _compile(k.py_func) if numba is not None else k.py_func
         _pending.clear()
+        _materialised = True
         for name, module in list(sys.modules.items()):
             if name != "footzoo" and not name.startswith("footzoo."):
                 continue
@@ -85,6 +90,8 @@ def njit(fn: Callable[..., Any]) -> Callable[..., Any]:
         return fn
     if _numba is not None:  # numba already imported: a module imported after the first kernel call
         return _compile(fn)
+    if _materialised:  # numba failed to import
+        return fn
     kernel = _Kernel(fn)
     _pending.append(kernel)
     return kernel
