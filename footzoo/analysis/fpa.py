@@ -123,7 +123,8 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
                 w0: float, w1: float, stance_fraction: float, side: float) -> np.ndarray:
     """Eqs. 12–16 for every heel strike ``hs[i]`` (sample indices); NaN where undefined."""
     m = hs.shape[0]
-    fpa = np.full(m, np.nan)
+    fpa = np.empty(m)
+    fpa[:] = np.nan
     hx, hy = 0.0, 0.0
     for i in range(1, m):
         rx = pos[hs[i], 0] - pos[hs[i - 1], 0]  # eq. 13
@@ -136,8 +137,8 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
             continue
         stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < m else t[hs[i]] - t[hs[i - 1]]
         stance_time = stance_fraction * stride
-        lo = np.searchsorted(t, t[hs[i]] + w0 * stance_time, side="left")
-        hi = np.searchsorted(t, t[hs[i]] + w1 * stance_time, side="right")
+        lo = _bisect(t, t[hs[i]] + w0 * stance_time, False)
+        hi = _bisect(t, t[hs[i]] + w1 * stance_time, True)
         if hi <= lo:
             continue
         psi_h = math.atan2(hy, hx)
@@ -151,3 +152,16 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
             total += side * -((-d + math.pi) % (2 * math.pi) - math.pi)  # eq. 15, wrapped to (-π, π]
         fpa[i] = total / (hi - lo)  # eq. 16
     return fpa
+
+
+@njit
+def _bisect(t: np.ndarray, v: float, right: bool) -> int:
+    """``np.searchsorted(t, v, side="right" if right else "left")`` for sorted ``t`` (cheaper to compile)."""
+    lo, hi = 0, t.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if t[mid] < v or (right and t[mid] == v):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
