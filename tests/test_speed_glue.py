@@ -243,3 +243,52 @@ def test_first_still_window_reads_chunks_but_finds_the_same_window(still_from):
     else:
         assert abs(ref[0] - still_from) <= 1  # a zeroed sample may join the still run
         assert first_still_window(t, gyr, 0.5, 0.6) == ref
+
+
+def _reference_hdr(quat, acc_nav, stance, threshold):
+    """The previous per-stride loop of HDR without a Kalman filter (eqs. 23–27)."""
+    import math
+
+    from footzoo.conventions import quat_yaw
+
+    yaw = quat_yaw(quat)
+    out = acc_nav.copy()
+    ends, biases = [], []
+    st = intervals(stance)
+    for j, (_start, b) in enumerate(st):
+        d = None
+        if len(ends) >= 2:
+            a0, b0 = ends[-1], ends[-2]
+            mean = math.atan2(math.sin(a0) + math.sin(b0), math.cos(a0) + math.cos(b0))
+            d = float(wrap_angle(yaw[b - 1] - mean))
+            d = d if abs(d) <= threshold else None
+        ends.append(float(yaw[b - 1]))
+        biases.append(np.nan if d is None else d)
+        if d is None:
+            continue
+        stop = st[j + 1, 0] if j + 1 < len(st) else len(stance)
+        c, s = math.cos(-d), math.sin(-d)
+        n, e = out[b:stop, 0].copy(), out[b:stop, 1].copy()
+        out[b:stop, 0] = c * n - s * e
+        out[b:stop, 1] = s * n + c * e
+    return out, np.array(biases)
+
+
+def test_hdr_swing_rotation_equals_the_stride_loop(walk):
+    from footzoo.conventions import quat_from_euler
+    from footzoo.corrections.hdr import HDR
+
+    rng = np.random.default_rng(4)
+    stance = walk.truth.stance
+    # the true attitude with a heading that wanders by up to ±0.6 rad between strides: some δψ kept, some rejected
+    steps = np.cumsum(~stance[1:] & stance[:-1])
+    wander = np.concatenate([[0.0], rng.uniform(-0.6, 0.6, steps[-1] + 1)[steps]])
+    quat = quat_mul(quat_from_euler(np.zeros_like(wander), np.zeros_like(wander), wander), walk.truth.quat)
+    acc = motion_acceleration(quat, walk.acc)
+    h = HDR(threshold=0.3)
+    got = h.apply_acceleration(quat, acc, stance)
+    ref, ref_bias = _reference_hdr(quat, acc, stance, 0.3)
+    assert np.isfinite(ref_bias).sum() >= 3 and np.isnan(ref_bias[2:]).sum() >= 3
+    np.testing.assert_array_equal(np.isnan(h.bias_), np.isnan(ref_bias))
+    _close(h.bias_[np.isfinite(ref_bias)], ref_bias[np.isfinite(ref_bias)])
+    _close(got, ref)
