@@ -1,13 +1,32 @@
-"""Throughput, cold start, peak memory and linearity of footzoo's pipelines and plug-ins.
+"""footzoo's speed against the hardware limit and other libraries, side by side in one run.
 
-Usage: python benchmarks/throughput.py [--samples 1000000] [--quick]
+Usage: python benchmarks/throughput.py [--samples 1e6] [--repeat 5] [--slow-samples 20000]
+                                        [--scaling] [--cold] [--import-time] [--out FILE.md]
 
-Prints, for every config in configs/ and for each plug-in alone, samples per second on one
-core for a simulated 100 Hz walk (reading excluded, all outputs produced), next to the
-reference path measured in the same run (the filterpy loop for Kalman pipelines, the
-uncompiled Python kernels otherwise), as ratios; the cold start of a new process (import +
-first run on 10 k samples, compilation cache warm); the peak memory beyond the input; and the
-cost at 10 k, 100 k and 1 M samples.
+Every item runs on the same simulated 100 Hz walk (distance sensors included), interleaved:
+each repetition runs every item once, in the same order, so load on the machine hits all of
+them alike; the table gives the minimum and the median over the repetitions, in samples per
+second of wall-clock time, and each item's speed as a fraction of (a) measured in the same
+run (from the minima; also from CPU time, which other processes on a shared machine disturb
+less). Items:
+
+* (a) the hardware limit: a minimal compiled strapdown loop that stores attitude, velocity
+  and position for every sample (benchmarks/hardware_limit.py);
+* every config in configs/ end to end (``Pipeline.run``: detector, alignment, orientation,
+  corrections, the sample table and the step table);
+* each orientation filter and each detector alone;
+* (b) plain filterpy loops: a 9-state (position, velocity, attitude) and a 15-state (plus gyro
+  and accelerometer biases) zero-velocity-aided error-state filter written directly on
+  ``filterpy.kalman.KalmanFilter``;
+* (c) gaitmap's ``RtsKalman``, ahrs' Madgwick and Mahony filters and imufusion's AHRS, when
+  installed (never dependencies of footzoo).
+
+The pure-Python baselines (b, c) run on the first ``--slow-samples`` samples of the same walk
+(their cost per sample does not depend on the length). Optional sections: ``--scaling`` (µs per
+sample and peak memory beyond the input, 1e5 to 1e7 samples, one new process per size),
+``--cold`` (a new process with an empty numba cache: import and first run of a config on a
+simulated 80-stride walk), ``--import-time``. The ``met`` column judges the CPU-time fraction
+("wall-clock only": met by the wall-clock minima alone).
 """
 
 from __future__ import annotations
@@ -15,10 +34,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
+import tempfile
 import time
-import tracemalloc
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +51,9 @@ import footzoo  # noqa: E402
 from footzoo.sim import NoiseModel, simulate  # noqa: E402
 
 CONFIGS = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml") if not p.stem.startswith("study"))
+#: Targets of issue 16 as the fraction of (a)'s speed, by kind of item.
+TARGETS = {"no Kalman filter": 1 / 8, "9-state Kalman": 1 / 10, "15-state Kalman": 1 / 20,
+           "21-state Kalman": 1 / 50, "orientation filter": 1 / 3, "detector": 1 / 2}
 
 
 def walk(samples: int) -> footzoo.Recording:
@@ -43,133 +67,359 @@ def walk(samples: int) -> footzoo.Recording:
                              dist=tile(r.dist), meta={"foot": "right", "name": "bench"})
 
 
-def rate_of(fn, n: int, repeat: int = 1) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return n / best
+# ------------------------------------------------------------------------------------------ items
+class Item:
+    """One thing to time: ``fn()`` processes ``n`` samples."""
+
+    def __init__(self, name: str, kind: str, fn: Callable[[], object], n: int, note: str = ""):
+        self.name, self.kind, self.fn, self.n, self.note = name, kind, fn, n, note
+        self.wall: list[float] = []
+        self.cpu: list[float] = []
+
+    def run(self) -> None:
+        c0, w0 = time.process_time(), time.perf_counter()
+        self.fn()
+        self.wall.append(time.perf_counter() - w0)
+        self.cpu.append(time.process_time() - c0)
 
 
-def config_rates(rec: footzoo.Recording, ref_rec: footzoo.Recording) -> list[dict]:
-    rows = []
+def hardware_item(rec) -> Item:
+    from benchmarks.hardware_limit import strapdown
+
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    strapdown(rec.t[:100], rec.acc[:100], rec.gyr[:100], q0)  # compile
+    return Item("(a) minimal compiled strapdown loop", "hardware limit",
+                lambda: strapdown(rec.t, rec.acc, rec.gyr, q0), rec.n)
+
+
+def kalman_states(p) -> int:
+    """Error-state size of a Kalman pipeline (0 without one)."""
+    from footzoo.filters.engine import assemble
+
+    kalman = p.filter_corrections
+    if not kalman:
+        return 0
+    blocks = [b for c in kalman for b in c.state_blocks()]
+    return int(assemble(p.orientation.carried_by_filter, blocks, p.navigation)[0].n)
+
+
+def config_items(rec, warm) -> list[Item]:
+    items = []
     for name in CONFIGS:
         p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
-        p.run(ref_rec)  # compile / warm up
-        fast = rate_of(lambda p=p: p.run(rec), rec.n, repeat=3)
-        kalman = bool(p.filter_corrections)
-        if kalman:
-            ref = rate_of(lambda p=p: p.run(ref_rec, engine="reference"), ref_rec.n)
-            ref_name = "filterpy loop"
-        else:
-            ref = _python_rate(name, ref_rec)
-            ref_name = "uncompiled"
-        rows.append({"config": name, "samples_per_s": fast, "reference": ref_name, "reference_per_s": ref,
-                     "ratio": fast / ref})
-    return rows
+        p.run(warm)  # compile / load the compiled kernels
+        n_states = kalman_states(p)
+        kind = "no Kalman filter" if n_states == 0 else f"{min((9, 15, 21), key=lambda s: abs(s - n_states))}" \
+            "-state Kalman"
+        items.append(Item(f"config {name}" + (f" ({n_states} states)" if n_states else ""), kind,
+                          lambda p=p: p.run(rec), rec.n))
+    return items
 
 
-def _python_rate(name: str, rec: footzoo.Recording) -> float:
-    """The same config with FOOTZOO_DISABLE_JIT=1, in a new process (the no-compiler install)."""
-    config = str(ROOT / "configs" / f"{name}.yaml")
-    code = (
-        f"import time, numpy as np, footzoo, sys; sys.path.insert(0, {str(ROOT)!r});"
-        f"from benchmarks.throughput import walk; rec = walk({rec.n});"
-        f"p = footzoo.Pipeline.from_yaml({config!r}); t0 = time.perf_counter(); p.run(rec);"
-        "print(rec.n / (time.perf_counter() - t0))"
-    )
-    env = {**os.environ, "FOOTZOO_DISABLE_JIT": "1"}
-    out = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True, env=env,
-                         cwd=ROOT)
-    return float(out.stdout.strip().splitlines()[-1]) if out.returncode == 0 else float("nan")
-
-
-def plugin_rates(rec: footzoo.Recording) -> list[dict]:
-    from footzoo.registry import available
+def plugin_items(rec, warm) -> list[Item]:
+    from footzoo.registry import available, build
 
     t, acc, gyr, mag = rec.t, rec.acc, rec.gyr, rec.mag
-    stance = footzoo.registry.build("detector", {"type": "windowed"}).detect(t, acc, gyr).stance_
-    q0 = np.array([1.0, 0, 0, 0])
-    rows = []
+    stance = build("detector", {"type": "windowed"}).detect(t, acc, gyr).stance_
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    items = []
     for name, cls in sorted(available("orientation").items()):
         o = cls()
-        o.estimate(t[:2000], acc[:2000], gyr[:2000], mag[:2000], stance[:2000], q0)
-        rows.append({"plugin": f"orientation/{name}",
-                     "samples_per_s": rate_of(lambda o=o: o.estimate(t, acc, gyr, mag, stance, q0), rec.n, 2)})
+        o.estimate(warm.t, warm.acc, warm.gyr, warm.mag, stance[: warm.n], q0)
+        items.append(Item(f"orientation {name}", "orientation filter",
+                          lambda o=o: o.estimate(t, acc, gyr, mag, stance, q0), rec.n))
     for name, cls in sorted(available("detector").items()):
-        if name == "oracle":
+        if getattr(cls, "needs_truth", False) or name == "oracle":
             continue
         d = cls()
-        d.detect(t[:2000], acc[:2000], gyr[:2000])
-        rows.append({"plugin": f"detector/{name}",
-                     "samples_per_s": rate_of(lambda d=d: d.detect(t, acc, gyr), rec.n, 2)})
-    return rows
+        d.detect(warm.t, warm.acc, warm.gyr)
+        items.append(Item(f"detector {name}", "detector", lambda d=d: d.detect(t, acc, gyr), rec.n))
+    return items
 
 
-def cold_start() -> float:
-    code = ("import time; t0 = time.perf_counter(); import footzoo, numpy as np;"
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def filterpy_zupt(t, acc, gyr, stance, q0, biases: bool, g: float = 9.81) -> np.ndarray:
+    """A plain zero-velocity-aided error-state filter on ``filterpy.kalman.KalmanFilter``.
+
+    Error state ``[δp, δv, δθ]`` (9) or ``[δp, δv, δθ, δb_g, δb_a]`` (15); per sample a
+    strapdown step, ``F``/``Q`` set and ``predict()``, in stance ``update()`` with the velocity
+    as the measurement of ``δv``, then the error fed back into the nominal state. Returns the
+    positions (N, 3).
+    """
+    from filterpy.kalman import KalmanFilter
+
+    from footzoo.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
+
+    n_x = 15 if biases else 9
+    kf = KalmanFilter(dim_x=n_x, dim_z=3)
+    kf.P = np.diag([0.0] * 6 + [1e-4] * 3 + ([1e-6] * 6 if biases else []))
+    kf.R = np.eye(3) * 1e-4
+    h = np.zeros((3, n_x))
+    h[:, 3:6] = np.eye(3)
+    q, v, p = np.asarray(q0, float), np.zeros(3), np.zeros(3)
+    bg, ba = np.zeros(3), np.zeros(3)
+    out = np.empty((len(t), 3))
+    eye = np.eye(n_x)
+    for k in range(len(t)):
+        dt = t[k] - t[k - 1] if k else 0.0
+        q = quat_mul(q, quat_from_rotvec((gyr[k] - bg) * dt))
+        c = quat_to_matrix(q)
+        f_n = c @ (acc[k] - ba)
+        a = f_n + np.array([0.0, 0.0, g])
+        p = p + v * dt + 0.5 * a * dt * dt
+        v = v + a * dt
+        f = eye.copy()
+        f[0:3, 3:6] = np.eye(3) * dt
+        f[3:6, 6:9] = -_skew(f_n) * dt
+        qn = np.zeros(n_x)
+        qn[3:6], qn[6:9] = 1e-4 * dt, 1e-6 * dt
+        if biases:
+            f[6:9, 9:12] = -c * dt
+            f[3:6, 12:15] = -c * dt
+            qn[9:] = 1e-10 * dt
+        kf.F, kf.Q = f, np.diag(qn)
+        kf.predict()
+        if stance[k]:
+            kf.update(v.reshape(3, 1), H=h)
+            x = kf.x.ravel()
+            p, v = p - x[0:3], v - x[3:6]
+            q = quat_mul(quat_from_rotvec(-x[6:9]), q)
+            if biases:
+                bg, ba = bg + x[9:12], ba + x[12:15]
+            kf.x = np.zeros((n_x, 1))
+        out[k] = p
+    return out
+
+
+def baseline_items(rec, slow: int) -> list[Item]:
+    """(b) plain filterpy loops and (c) other libraries, on the first ``slow`` samples."""
+    from footzoo.alignment import initial_attitude
+    from footzoo.registry import build
+
+    s = slice(0, slow)
+    t, acc, gyr, mag = rec.t[s], rec.acc[s], rec.gyr[s], rec.mag[s]
+    stance = build("detector", {"type": "windowed"}).detect(t, acc, gyr).stance_
+    q0 = initial_attitude(t, acc, gyr, None)
+    items = []
+    try:
+        import filterpy  # noqa: F401
+
+        for biases, states in ((False, 9), (True, 15)):
+            items.append(Item(f"(b) filterpy loop, {states} states", f"{states}-state Kalman",
+                              lambda b=biases: filterpy_zupt(t, acc, gyr, stance, q0, b), slow))
+    except ImportError:
+        pass
+    try:
+        from ahrs.filters import Madgwick, Mahony
+
+        items.append(Item("(c) ahrs Madgwick (MARG)", "orientation filter",
+                          lambda: Madgwick(gyr=gyr, acc=acc, mag=mag, frequency=100.0), slow))
+        items.append(Item("(c) ahrs Mahony (IMU)", "orientation filter",
+                          lambda: Mahony(gyr=gyr, acc=acc, frequency=100.0), slow))
+    except ImportError:
+        pass
+    try:
+        import imufusion
+
+        def fusion():
+            ahrs = imufusion.Ahrs()
+            g_deg, a_g = np.degrees(gyr), acc / -9.81
+            for k in range(len(t)):
+                ahrs.update(g_deg[k], a_g[k], mag[k], 0.01)
+
+        items.append(Item("(c) imufusion Ahrs", "orientation filter", fusion, slow))
+    except ImportError:
+        pass
+    try:
+        import pandas as pd
+        from gaitmap.trajectory_reconstruction import RtsKalman
+
+        data = pd.DataFrame(np.column_stack([acc, np.degrees(gyr)]),
+                            columns=["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"])
+        items.append(Item("(c) gaitmap RtsKalman", "9-state Kalman",
+                          lambda: RtsKalman().estimate(data, sampling_rate_hz=100.0), slow))
+    except ImportError:
+        pass
+    return items
+
+
+def main_table(n: int, repeat: int, slow: int) -> tuple[list[str], dict]:
+    rec = walk(n)
+    warm = walk(20_000)
+    hw = hardware_item(rec)
+    items = [hw] + config_items(rec, warm) + plugin_items(rec, warm) + baseline_items(rec, min(slow, n))
+    for it in items[1:]:
+        if it.n < n:
+            it.note = f"first {it.n // 1000} k samples"
+    for _ in range(repeat):
+        for it in items:
+            it.run()
+    lim_wall = hw.n / min(hw.wall)
+    lim_cpu = hw.n / min(hw.cpu)
+    lines = [
+        f"{n} samples of a simulated 100 Hz walk, {repeat} interleaved repetitions, one core; "
+        f"numba {'on' if footzoo._jit.HAVE_NUMBA else 'off'}.",
+        "",
+        "| item | kind | M samples/s (min time) | M samples/s (median) | fraction of (a), wall | "
+        "fraction of (a), CPU | target | met (CPU) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    results = {}
+    for it in items:
+        best, med, cpu = it.n / min(it.wall), it.n / statistics.median(it.wall), it.n / min(it.cpu)
+        frac, frac_cpu = best / lim_wall, cpu / lim_cpu
+        target = TARGETS.get(it.kind)
+        if it is hw or it.name.startswith("("):
+            met = ""
+        else:
+            met = "yes" if frac_cpu >= target else ("wall-clock only" if frac >= target else "no")
+        tgt = f"1/{round(1 / target)}" if target and not it.name.startswith("(") else ""
+        label = it.name + (f" ({it.note})" if it.note else "")
+        lines.append(f"| {label} | {it.kind} | {best / 1e6:.3g} | {med / 1e6:.3g} | {_frac(frac)} | "
+                     f"{_frac(frac_cpu)} | {tgt} | {met} |")
+        results[it.name] = {"per_s_min": best, "per_s_median": med, "per_s_cpu": cpu, "fraction": frac,
+                            "fraction_cpu": frac_cpu}
+    return lines, results
+
+
+def _frac(x: float) -> str:
+    return "1" if x >= 0.95 else f"1/{1 / x:.3g}" if x > 0 else "-"
+
+
+# --------------------------------------------------------------------------- scaling and memory
+_SCALING_CHILD = """
+import gc, json, resource, sys, time
+sys.path.insert(0, {root!r})
+from benchmarks.throughput import walk
+import footzoo
+n, name, repeat = {n}, {name!r}, {repeat}
+if name == "(a)":
+    import numpy as np
+    from benchmarks.hardware_limit import strapdown
+    class p:
+        run = staticmethod(lambda r: strapdown(r.t, r.acc, r.gyr, np.array([1.0, 0.0, 0.0, 0.0])))
+else:
+    p = footzoo.Pipeline.from_yaml({root!r} + f"/configs/{{name}}.yaml")
+p.run(walk(3000))  # load the compiled kernels, on little memory
+rec = walk(n)
+gc.collect()
+with open("/proc/self/statm") as f:
+    base = int(f.read().split()[1]) * resource.getpagesize()
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")  # reset the peak resident set size to the current one
+res = p.run(rec)  # the first run on this input: its memory is new to the process
+with open("/proc/self/status") as f:
+    peak = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmHWM"))
+del res
+gc.collect()
+best = []
+for _ in range(repeat):
+    t0 = time.process_time(); p.run(rec); best.append(time.process_time() - t0)
+print(json.dumps({{"us_per_sample": min(best) / n * 1e6, "bytes_per_sample": (peak - base) / n}}))
+"""
+
+
+def scaling(names: list[str], sizes=(100_000, 1_000_000, 10_000_000), repeat: int = 5) -> list[str]:
+    """µs per sample (CPU time, min over runs) and peak RSS beyond the input; a new process per config and size."""
+    rows: dict[str, list[tuple[float, float]]] = {c: [] for c in names}
+    for n in sizes:
+        for c in names:
+            code = _SCALING_CHILD.format(root=str(ROOT), n=n, name=c, repeat=repeat if n < 10**7 else 3)
+            proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True,
+                                  cwd=ROOT)
+            if proc.returncode != 0:
+                raise RuntimeError(proc.stderr[-2000:])
+            res = json.loads(proc.stdout.strip().splitlines()[-1])
+            rows[c].append((res["us_per_sample"], res["bytes_per_sample"]))
+    head = " / ".join(f"{n:.0e}" for n in sizes)
+    lines = [f"| config ((a): the strapdown loop) | µs/sample at {head} | max / min | "
+             f"peak memory beyond the input (B/sample) at {head} |",
+             "|---|---|---|---|"]
+    for c, r in rows.items():
+        us = [x[0] for x in r]
+        lines.append(f"| {c} | " + " / ".join(f"{x:.3f}" for x in us) + f" | {max(us) / min(us):.2f} | "
+                     + " / ".join(f"{x[1]:.0f}" for x in r) + " |")
+    return lines
+
+
+# ------------------------------------------------------------------------------ cold start, import
+def cold_start(names: list[str]) -> list[str]:
+    """A new process, an empty numba cache: import, and the first run of one config on a simulated 80-stride walk.
+
+    Wall-clock and CPU seconds (the CPU time of the process, which load from other processes
+    on a shared machine does not inflate).
+    """
+    lines = ["| config | import footzoo, wall / CPU (s) | first run, empty cache, wall / CPU (s) | "
+             "first run, a second process with the cache filled, wall / CPU (s) |", "|---|---|---|---|"]
+    code = ("import time; c0, w0 = time.process_time(), time.perf_counter(); import footzoo;"
+            "c1, w1 = time.process_time(), time.perf_counter();"
             "from footzoo.sim import simulate; rec = simulate(n_strides=80, rate=100.0, profile='physical');"
-            "t1 = time.perf_counter(); [footzoo.Pipeline.from_yaml(f'configs/{c}.yaml').run(rec) for c in "
-            "('yun2012', 'nguyen2016', 'duong2015_zupt', 'huang2016')]; print(time.perf_counter() - t0 - 0*(t1))")
-    out = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True, cwd=ROOT)
-    return float(out.stdout.strip().splitlines()[-1])
+            "p = footzoo.Pipeline.from_yaml('configs/{c}.yaml'); c2, w2 = time.process_time(), time.perf_counter();"
+            "p.run(rec); print(w1 - w0, c1 - c0, time.perf_counter() - w2, time.process_time() - c2)")
+    for c in names:
+        with tempfile.TemporaryDirectory() as cache:
+            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            out = []
+            for _ in range(2):
+                proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code.format(c=c)], capture_output=True,
+                                      text=True, cwd=ROOT, env=env)
+                if proc.returncode != 0:
+                    raise RuntimeError(proc.stderr[-2000:])
+                out.append([float(x) for x in proc.stdout.split()])
+        lines.append(f"| {c} | {out[0][0]:.2f} / {out[0][1]:.2f} | {out[0][2]:.2f} / {out[0][3]:.2f} | "
+                     f"{out[1][2]:.2f} / {out[1][3]:.2f} |")
+    return lines
 
 
-def peak_memory(rec: footzoo.Recording, name: str) -> float:
-    p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
-    tracemalloc.start()
-    p.run(rec)
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    return peak / rec.n
-
-
-def stream_latency(rec: footzoo.Recording, n: int = 20_000) -> tuple[float, float]:
-    """Mean and 99th-percentile time (s) of one ``Stream.push`` with the nguyen2016 config."""
-    from footzoo.stream import Stream
-
-    stream = Stream(footzoo.Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml"))
-    times = []
-    for k in range(min(n, rec.n)):
-        t0 = time.perf_counter()
-        stream.push(rec.t[k], rec.acc[k], rec.gyr[k], rec.mag[k])
-        times.append(time.perf_counter() - t0)
-    lat = np.array(times[200:])  # after the still start has been collected
-    return float(lat.mean()), float(np.percentile(lat, 99))
+def import_time(repeat: int = 5) -> list[str]:
+    lines = ["| statement | wall (s), min | CPU (s), min |", "|---|---|---|"]
+    for stmt in ("import footzoo", "from footzoo import Pipeline", "from footzoo import Pipeline, load"):
+        code = (f"import time; c = time.process_time(); w = time.perf_counter(); {stmt};"
+                "print(time.perf_counter() - w, time.process_time() - c)")
+        res = [[float(x) for x in subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                                 cwd=ROOT).stdout.split()] for _ in range(repeat)]
+        lines.append(f"| `{stmt}` | {min(r[0] for r in res):.3f} | {min(r[1] for r in res):.3f} |")
+    return lines
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=float, default=1e6)
-    parser.add_argument("--quick", action="store_true", help="100 k samples, no linearity check")
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--slow-samples", type=int, default=20_000, help="samples for the pure-Python baselines")
+    parser.add_argument("--scaling", action="store_true", help="1e5..1e7 samples: µs/sample and memory")
+    parser.add_argument("--cold", action="store_true", help="first run with an empty numba cache")
+    parser.add_argument("--import-time", action="store_true")
+    parser.add_argument("--out", type=Path, help="also write the Markdown here")
+    parser.add_argument("--json", type=Path, help="write the main table's numbers here")
     args = parser.parse_args()
-    n = int(1e5 if args.quick else args.samples)
-    rec = walk(n)
-    ref_rec = walk(min(n, 50_000))
-    print(f"footzoo {footzoo.__version__}, numba: {footzoo._jit.HAVE_NUMBA}, {n} samples at 100 Hz, one core\n")
-    print("== configs (end to end) ==")
-    for r in config_rates(rec, ref_rec):
-        print(f"{r['config']:26s} {r['samples_per_s'] / 1e3:9.1f} k/s   {r['reference']:14s} "
-              f"{r['reference_per_s'] / 1e3:8.1f} k/s   ratio {r['ratio']:7.1f}")
-    print("\n== plug-ins alone ==")
-    for r in plugin_rates(rec):
-        print(f"{r['plugin']:32s} {r['samples_per_s'] / 1e6:8.2f} M/s")
-    mean, p99 = stream_latency(rec)
-    print(f"\n== streaming (nguyen2016, push one sample) == mean {mean * 1e6:.0f} us, p99 {p99 * 1e6:.0f} us")
-    print(f"\n== cold start (new process: import + 4 configs on 8 k samples, cache warm) == {cold_start():.2f} s")
-    print("\n== peak memory beyond the input (bytes per sample) ==")
-    for name in ("yun2012", "nguyen2016", "duong2015"):
-        print(f"{name:26s} {peak_memory(rec, name):8.0f}")
-    if not args.quick:
-        print("\n== linearity (seconds for 10 k, 100 k, 1 M samples) ==")
-        sizes = (10_000, 100_000, 1_000_000)
-        recs = {m: walk(m) for m in sizes}
-        for name in ("yun2012", "nguyen2016"):
-            p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
-            times = [m / rate_of(lambda p=p, m=m: p.run(recs[m]), m) for m in sizes]
-            per = [round(x / m * 1e6, 2) for x, m in zip(times, sizes, strict=True)]
-            print(f"{name:26s} " + "  ".join(f"{x:7.3f}" for x in times) + f"   per sample: {json.dumps(per)} us")
+    sections = []
+    lines, results = main_table(int(args.samples), args.repeat, args.slow_samples)
+    sections.append(("Throughput", lines))
+    _emit(sections[-1])
+    if args.json:
+        args.json.write_text(json.dumps(results, indent=1))
+    if args.scaling:
+        sections.append(("Scaling and memory (CPU time, min of runs; peak RSS beyond the input)",
+                         scaling(["(a)", "yun2012", "huang2016", "nguyen2016_ins_zvu"])))
+        _emit(sections[-1])
+    if args.cold:
+        sections.append(("Cold start (new process, empty numba cache)",
+                         cold_start(["yun2012", "huang2016", "duong2015_zupt", "nguyen2016"])))
+        _emit(sections[-1])
+    if args.import_time:
+        sections.append(("Import time (new process, min of 5)", import_time()))
+        _emit(sections[-1])
+    if args.out:
+        args.out.write_text("\n\n".join(f"### {title}\n\n" + "\n".join(lines) for title, lines in sections) + "\n")
+
+
+def _emit(section: tuple[str, list[str]]) -> None:
+    print(f"\n### {section[0]}\n")
+    print("\n".join(section[1]), flush=True)
 
 
 if __name__ == "__main__":

@@ -1,33 +1,110 @@
-"""Optional compilation of the per-sample kernels with numba.
+"""Optional compilation of the per-sample kernels with numba, imported and compiled lazily.
 
-``njit`` compiles a plain-array function with numba when numba is installed
-(cached on disk next to the module, so a new process loads the machine code
-instead of compiling again) and returns it unchanged otherwise, or when the
-environment variable ``FOOTZOO_DISABLE_JIT=1`` is set. Both paths run the same
-source, so they give the same numbers; the tests run both.
+``njit`` marks a plain-array function for compilation with numba when numba is
+installed and returns it unchanged otherwise, or when the environment variable
+``FOOTZOO_DISABLE_JIT=1`` is set. Both paths run the same source, so they give
+the same numbers; the tests run both.
+
+Nothing is imported or compiled when footzoo is imported: numba itself is
+imported at the first call of any kernel (which keeps ``import footzoo`` fast),
+and each kernel is compiled at its first call, only for the argument types it
+gets (so a pipeline compiles only the kernels it uses). The machine code is
+cached on disk next to the module (or in ``NUMBA_CACHE_DIR``), so a new process
+loads it instead of compiling again.
 """
 
 from __future__ import annotations
 
+import functools
+import importlib.util
 import os
+import sys
+import threading
 from collections.abc import Callable
 from typing import Any
 
 ENABLED = os.environ.get("FOOTZOO_DISABLE_JIT", "").strip() not in ("1", "true", "yes")
+HAVE_NUMBA = ENABLED and importlib.util.find_spec("numba") is not None
 
-try:
-    if not ENABLED:
-        raise ImportError("disabled by FOOTZOO_DISABLE_JIT")
-    import numba
+_pending: list[_Kernel] = []
+_numba: Any = None
+_lock = threading.Lock()
+_materialised = False
 
-    HAVE_NUMBA = True
-except ImportError:  # no compiler: the same code runs as plain Python
-    numba = None
-    HAVE_NUMBA = False
+
+class _Kernel:
+    """A kernel whose numba dispatcher is created at the first call of any kernel.
+
+    numba resolves the kernels a kernel calls from its module's globals when it
+    compiles, so at that moment every pending kernel is turned into its dispatcher
+    and every footzoo module attribute that named it is rebound to the dispatcher.
+    """
+
+    def __init__(self, fn: Callable[..., Any]):
+        functools.update_wrapper(self, fn)
+        self.py_func = fn
+        self.dispatcher: Any = None
+
+    def __call__(self, *args: Any) -> Any:
+        if self.dispatcher is None:
+            _materialise()
+        return self.dispatcher(*args)
+
+    def __repr__(self) -> str:
+        return f"<footzoo kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
+
+
+def _compile(fn: Callable[..., Any]) -> Any:
+    return _numba.njit(cache=True, nogil=True)(fn)
+
+
+def _materialise() -> None:
+    """Import numba, make every pending kernel a dispatcher, rebind the module attributes that named it."""
+    global _numba, _materialised, HAVE_NUMBA
+    with _lock:
+        if not _pending:  # another thread did it
+            return
+        try:
+            import numba
+        except ImportError:  # installed but broken: run the same code as plain Python
+            numba = None
+            HAVE_NUMBA = False
+        _numba = numba
+        kernels = {id(k): k for k in _pending}
+        for k in kernels.values():
+            k.dispatcher = _compile(k.py_func) if numba is not None else k.py_func
+        _pending.clear()
+        _materialised = True
+        for name, module in list(sys.modules.items()):
+            if name != "footzoo" and not name.startswith("footzoo."):
+                continue
+            attrs = getattr(module, "__dict__", {})
+            for attr, value in list(attrs.items()):
+                if id(value) in kernels and isinstance(value, _Kernel):
+                    attrs[attr] = value.dispatcher
 
 
 def njit(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``numba.njit(cache=True)`` when available, else the function itself."""
+    """``numba.njit(cache=True, nogil=True)`` when available (created lazily), else the function itself."""
     if not HAVE_NUMBA:
         return fn
-    return numba.njit(cache=True, nogil=True)(fn)
+    if _numba is not None:  # numba already imported: a module imported after the first kernel call
+        return _compile(fn)
+    if _materialised:  # numba failed to import
+        return fn
+    kernel = _Kernel(fn)
+    _pending.append(kernel)
+    return kernel
+
+
+def compiled(fn: Any) -> Any:
+    """The numba dispatcher behind a kernel (creating the pending ones), or ``fn`` itself.
+
+    For compiled code that refers to a kernel it was not compiled next to (e.g. a wrapper built at
+    run time), which must see the dispatcher, not the lazy wrapper.
+    """
+    if isinstance(fn, _Kernel):
+        if fn.dispatcher is None:
+            _materialise()
+        return fn.dispatcher
+    return fn

@@ -54,15 +54,26 @@ def initial_attitude(
 
 
 def first_still_window(t: np.ndarray, gyr: np.ndarray, duration: float, max_gyr: float) -> tuple[int, int]:
-    """Sample range ``[start, stop)`` of the first ``duration`` s with |ω| ≤ ``max_gyr`` throughout."""
-    still = np.linalg.norm(gyr, axis=1) <= max_gyr
-    edges = np.flatnonzero(still[1:] != still[:-1]) + 1
-    bounds = np.concatenate([[0], edges, [still.shape[0]]])
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-        if still[a] and t[b - 1] - t[a] >= duration:
-            stop = int(np.searchsorted(t, t[a] + duration, side="right"))
-            if stop - a >= 2:
-                return int(a), stop
+    """Sample range ``[start, stop)`` of the first ``duration`` s with |ω| ≤ ``max_gyr`` throughout.
+
+    Reads the recording from the start in growing chunks and stops at the first such window, so a
+    long recording that starts still costs almost nothing.
+    """
+    n = len(t)
+    m = min(n, 4096)
+    while True:
+        still = np.linalg.norm(gyr[:m], axis=1) <= max_gyr
+        edges = np.flatnonzero(still[1:] != still[:-1]) + 1
+        bounds = np.concatenate([[0], edges, [m]])
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            # a run cut by the end of the chunk (b == m < n) may still grow: decided only if already long enough
+            if still[a] and t[b - 1] - t[a] >= duration:
+                stop = int(np.searchsorted(t, t[a] + duration, side="right"))
+                if stop - a >= 2:
+                    return int(a), stop
+        if m == n:
+            break
+        m = min(n, 4 * m)
     raise RecordingError(
         f"the recording has no still period of {duration} s (|ω| ≤ init.max_gyr = {max_gyr} rad/s) "
         "to align the initial attitude; record a moment of rest, shorten init.duration or raise init.max_gyr"

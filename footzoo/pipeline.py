@@ -15,12 +15,13 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ._table import samples_frame
 from ._version import __version__
 from .alignment import initial_attitude
 from .analysis.strides import segment_steps
 from .checks import GRAVITY_RANGE, check_range
 from .config import check_init, check_top_level, load_yaml
-from .conventions import GRAVITY, quat_to_euler
+from .conventions import GRAVITY
 from .data import Recording, Result
 from .errors import ConfigError, RecordingError
 from .extensions import load_plugins
@@ -200,7 +201,8 @@ class Pipeline:
         diagnostics = {"detector_statistic": detector.statistic_, **nav["diagnostics"]}
         config = self.to_dict()
         config["engine"] = nav["engine"]
-        return Result(samples=_samples_table(rec.t, stance, nav), steps=steps, config=config, versions=versions(),
+        samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
+        return Result(samples=samples, steps=steps, config=config, versions=versions(),
                       recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
 
     def _use_mag(self, rec: Recording) -> bool:
@@ -271,20 +273,6 @@ class Pipeline:
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps
-
-
-def _samples_table(t: np.ndarray, stance: np.ndarray, nav: dict[str, Any]) -> pd.DataFrame:
-    quat, pos, vel, acc_nav = nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"]
-    euler = quat_to_euler(quat)
-    return pd.DataFrame({
-        "t": t,
-        "qw": quat[:, 0], "qx": quat[:, 1], "qy": quat[:, 2], "qz": quat[:, 3],
-        "roll": euler[:, 0], "pitch": euler[:, 1], "yaw": euler[:, 2],
-        "pos_n": pos[:, 0], "pos_e": pos[:, 1], "pos_d": pos[:, 2],
-        "vel_n": vel[:, 0], "vel_e": vel[:, 1], "vel_d": vel[:, 2],
-        "acc_n": acc_nav[:, 0], "acc_e": acc_nav[:, 1], "acc_d": acc_nav[:, 2],
-        "stance": stance,
-    })
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

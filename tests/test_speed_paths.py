@@ -65,3 +65,38 @@ def test_without_a_compiler_the_same_code_gives_the_same_numbers(tmp_path):
     assert results[1]["jit"] is False
     for name in ("yun2012", "huang2016", "nguyen2016", "duong2015_zupt"):
         np.testing.assert_allclose(results[0][name], results[1][name], rtol=1e-9, atol=1e-12)
+
+
+def test_import_footzoo_loads_no_heavy_dependency():
+    """``import footzoo`` defers pandas, scipy and numba to their first use; the names still resolve."""
+    script = (
+        "import sys, json, footzoo; before = {m: m in sys.modules for m in ('pandas', 'scipy', 'numba')};"
+        "p = footzoo.Pipeline; from footzoo import Recording, load, ConfigError;"
+        "print(json.dumps({'before': before, 'pipeline': p.__module__, 'all': sorted(footzoo.__all__)}))"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["before"] == {"pandas": False, "scipy": False, "numba": False}
+    assert out["pipeline"] == "footzoo.pipeline"
+    assert "Pipeline" in out["all"] and "load" in out["all"]
+
+
+def test_kernels_are_compiled_at_first_call_and_callers_see_the_compiled_callees():
+    """After the first kernel call every footzoo module attribute naming a kernel is numba's dispatcher."""
+    script = (
+        "import sys, json, numpy as np, footzoo, footzoo._jit as j;"
+        "from footzoo.orientation import fqa_complementary as fc; fqa = sys.modules['footzoo.orientation.fqa'];"
+        "lazy = type(fc.complementary_kernel).__name__;"
+        "q = fc.complementary_kernel(np.array([1.0, 0, 0, 0]), np.zeros((3, 3)), np.full(3, 0.01),"
+        " np.tile([0.0, 0.0, -9.81], (3, 1)), np.zeros((1, 3)), np.ones(3), np.zeros(3, dtype=bool));"
+        "print(json.dumps({'numba': j.HAVE_NUMBA, 'lazy': lazy, 'after': [type(fc.complementary_kernel).__name__,"
+        " type(fc.fqa_sample).__name__, type(fqa.fqa_sample).__name__], 'q': q[-1].tolist()}))"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    np.testing.assert_allclose(out["q"], [1.0, 0.0, 0.0, 0.0], atol=1e-12)  # level, still: no rotation
+    if out["numba"]:
+        assert out["lazy"] == "_Kernel"
+        assert out["after"] == ["CPUDispatcher"] * 3

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 
+from .._jit import njit
 from ..checks import check_range, check_vector
-from ..conventions import quat_rotate, wrap_angle
 from ..errors import ConfigError
 from ..metrics import intervals, nearest_index
 from ..plugin import Analysis
@@ -102,27 +104,11 @@ class HuangFPA(Analysis):
         side = self._side(meta)
         f_s = FootVector.load(self.calibration).vector if self.calibration else np.asarray(self.foot_vector, float)
         f_s = f_s / np.linalg.norm(f_s)
-        f_e = quat_rotate(quat, f_s)  # eq. 12
-        psi_f = np.arctan2(f_e[:, 1], f_e[:, 0])
-        st = intervals(stance)
-        hs = st[:, 0]
-        self.heel_strikes_ = hs
-        fpa = np.full(len(hs), np.nan)
-        h = None
-        for i in range(1, len(hs)):
-            r = pos[hs[i], :2] - pos[hs[i - 1], :2]  # eq. 13
-            h = r if h is None else self.alpha * r + (1 - self.alpha) * h  # eq. 14
-            if np.linalg.norm(h) == 0:
-                continue
-            stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < len(hs) else t[hs[i]] - t[hs[i - 1]]
-            stance_time = self.stance_fraction * stride
-            lo = np.searchsorted(t, t[hs[i]] + self.window[0] * stance_time, side="left")
-            hi = np.searchsorted(t, t[hs[i]] + self.window[1] * stance_time, side="right")
-            if hi <= lo:
-                continue
-            theta = side * wrap_angle(psi_f[lo:hi] - np.arctan2(h[1], h[0]))  # eq. 15
-            fpa[i] = float(np.mean(theta))  # eq. 16
-        self.fpa_ = fpa
+        self.heel_strikes_ = intervals(stance)[:, 0]
+        self.fpa_ = _fpa_kernel(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(quat, dtype=float),
+                                np.ascontiguousarray(pos, dtype=float), self.heel_strikes_.astype(np.int64),
+                                f_s, float(self.alpha), self.window[0], self.window[1], float(self.stance_fraction),
+                                float(side))
         return self
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
@@ -139,3 +125,52 @@ class HuangFPA(Analysis):
             return out
         out["fpa_rad"] = self.fpa_[nearest_index(onsets, out["end_s"].to_numpy(dtype=float))]
         return out
+
+
+@njit
+def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray, f_s: np.ndarray, alpha: float,
+                w0: float, w1: float, stance_fraction: float, side: float) -> np.ndarray:
+    """Eqs. 12–16 for every heel strike ``hs[i]`` (sample indices); NaN where undefined."""
+    m = hs.shape[0]
+    fpa = np.empty(m)
+    fpa[:] = np.nan
+    hx, hy = 0.0, 0.0
+    for i in range(1, m):
+        rx = pos[hs[i], 0] - pos[hs[i - 1], 0]  # eq. 13
+        ry = pos[hs[i], 1] - pos[hs[i - 1], 1]
+        if i == 1:
+            hx, hy = rx, ry
+        else:  # eq. 14
+            hx, hy = alpha * rx + (1 - alpha) * hx, alpha * ry + (1 - alpha) * hy
+        if hx == 0.0 and hy == 0.0:
+            continue
+        stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < m else t[hs[i]] - t[hs[i - 1]]
+        stance_time = stance_fraction * stride
+        lo = _bisect(t, t[hs[i]] + w0 * stance_time, False)
+        hi = _bisect(t, t[hs[i]] + w1 * stance_time, True)
+        if hi <= lo:
+            continue
+        psi_h = math.atan2(hy, hx)
+        total = 0.0
+        for k in range(lo, hi):
+            w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
+            # eq. 12: the first two rows of R(q) applied to f_s
+            fx = (1 - 2 * (y * y + z * z)) * f_s[0] + 2 * (x * y - w * z) * f_s[1] + 2 * (x * z + w * y) * f_s[2]
+            fy = 2 * (x * y + w * z) * f_s[0] + (1 - 2 * (x * x + z * z)) * f_s[1] + 2 * (y * z - w * x) * f_s[2]
+            d = math.atan2(fy, fx) - psi_h
+            total += side * -((-d + math.pi) % (2 * math.pi) - math.pi)  # eq. 15, wrapped to (-π, π]
+        fpa[i] = total / (hi - lo)  # eq. 16
+    return fpa
+
+
+@njit
+def _bisect(t: np.ndarray, v: float, right: bool) -> int:
+    """``np.searchsorted(t, v, side="right" if right else "left")`` for sorted ``t`` (cheaper to compile)."""
+    lo, hi = 0, t.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if t[mid] < v or (right and t[mid] == v):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo

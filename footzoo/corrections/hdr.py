@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
+from .._jit import njit
 from ..checks import check_range
-from ..conventions import quat_yaw, wrap_angle
+from ..conventions import quat_yaw
 from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
 from ..metrics import intervals
 from ..plugin import AccelerationCorrection, KalmanCorrection, Samples
@@ -21,10 +22,35 @@ def heading_bias(yaw: float, previous: list[float], threshold: float) -> float |
     """
     if len(previous) < 2:
         return None
-    a, b = previous[-1], previous[-2]
+    d = _bias(float(yaw), float(previous[-1]), float(previous[-2]), float(threshold))
+    return None if math.isnan(d) else d
+
+
+@njit
+def _bias(yaw: float, a: float, b: float, threshold: float) -> float:
+    """Eqs. 23–24 for the current yaw and the two previous ones (rad); NaN when rejected."""
     mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
-    d = float(wrap_angle(yaw - mean))
-    return d if abs(d) <= threshold else None
+    d = -((-(yaw - mean) + math.pi) % (2 * math.pi) - math.pi)  # wrapped to (-π, π]
+    return d if abs(d) <= threshold else math.nan
+
+
+@njit
+def _turn_swings(out: np.ndarray, onsets: np.ndarray, ends: np.ndarray, yaw_end: np.ndarray,
+                 threshold: float) -> np.ndarray:
+    """Eqs. 25–27 in place on ``out`` (N, 3): the samples after stance j turned by −δψ_j; returns δψ (NaN: none)."""
+    m = onsets.shape[0]
+    bias = np.empty(m)
+    for j in range(m):
+        bias[j] = _bias(yaw_end[j], yaw_end[j - 1], yaw_end[j - 2], threshold) if j >= 2 else math.nan
+        if math.isnan(bias[j]):
+            continue
+        stop = onsets[j + 1] if j + 1 < m else out.shape[0]
+        c, s = math.cos(-bias[j]), math.sin(-bias[j])
+        for k in range(ends[j], stop):
+            n, e = out[k, 0], out[k, 1]
+            out[k, 0] = c * n - s * e
+            out[k, 1] = s * n + c * e
+    return bias
 
 
 @measurement_function
@@ -103,23 +129,11 @@ class HDR(AccelerationCorrection, KalmanCorrection):
     # ------------------------------------------------------------- no EKF: eqs. 25-27
     def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:
         """NED motion acceleration with each swing turned by −δψ about the vertical."""
-        yaw = quat_yaw(quat)
-        out = acc_nav.copy()
-        ends: list[float] = []
-        biases = []
+        out = np.array(acc_nav, dtype=float)
         st = intervals(stance)
-        for j, (_start, b) in enumerate(st):
-            d = heading_bias(float(yaw[b - 1]), ends, self.threshold)
-            ends.append(float(yaw[b - 1]))
-            biases.append(np.nan if d is None else d)
-            if d is None:
-                continue
-            stop = st[j + 1, 0] if j + 1 < len(st) else len(stance)
-            c, s = math.cos(-d), math.sin(-d)
-            n, e = out[b:stop, 0].copy(), out[b:stop, 1].copy()
-            out[b:stop, 0] = c * n - s * e
-            out[b:stop, 1] = s * n + c * e
-        self.bias_ = np.array(biases)
+        yaw_end = np.ascontiguousarray(quat_yaw(quat[st[:, 1] - 1]))  # γ at the end of each stance
+        self.bias_ = _turn_swings(out, np.ascontiguousarray(st[:, 0], dtype=np.int64),
+                                  np.ascontiguousarray(st[:, 1], dtype=np.int64), yaw_end, float(self.threshold))
         return out
 
     # ------------------------------------------------------------- with the EKF: eq. 28

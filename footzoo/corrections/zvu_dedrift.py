@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.strapdown import integrate_position
+from .._jit import njit
+from ..filters.strapdown import integrate_position, sample_intervals
 from ..plugin import VelocityCorrection
 from ..registry import register
 
@@ -49,23 +50,59 @@ def zvu_dedrift(t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> tuple
     bias : (M, 3) ndarray
         ε of each closed swing (m/s²).
     """
-    n = t.shape[0]
-    vel = np.zeros((n, 3))
-    dt = np.empty(n)
-    dt[1:] = np.diff(t)
-    dt[0] = 0.0
-    biases = []
-    for i0, stop in swing_segments(stance):
-        end = min(stop + 1, n)  # include the first stance sample, where v(T) is known to be 0
-        v = np.cumsum(acc_nav[i0:end] * dt[i0:end, None], axis=0)
-        if stop < n:
-            elapsed = t[i0:end] - t[i0 - 1]
-            eps = v[-1] / elapsed[-1]
-            v = v - eps[None, :] * elapsed[:, None]
-            biases.append(eps)
-        vel[i0:stop] = v[: stop - i0]
+    t = np.ascontiguousarray(t, dtype=float)
+    a = np.ascontiguousarray(acc_nav, dtype=float)
+    s = np.ascontiguousarray(stance, dtype=np.bool_)
+    dt = sample_intervals(t)
+    vel = np.empty((t.shape[0], 3))
+    bias = np.empty((int(np.count_nonzero(s[1:] & ~s[:-1])) + 1, 3))
+    m = _dedrift_kernel(t, dt, a, s, vel, bias)
     pos = integrate_position(vel, dt)
-    return vel, pos, np.array(biases).reshape(-1, 3)
+    return vel, pos, bias[:m].copy()
+
+
+@njit
+def _dedrift_kernel(t: np.ndarray, dt: np.ndarray, a: np.ndarray, stance: np.ndarray, vel: np.ndarray,
+                    bias: np.ndarray) -> int:
+    """One pass: zero in stance, eqs. 9–10 over each swing; ``bias[:m]`` gets the ε of the m closed swings."""
+    n = t.shape[0]
+    m = 0
+    k = 0
+    while k < n:
+        if stance[k] or k == 0:  # stance, or a swing with no stance before it: not a swing of eq. 9
+            if stance[k]:
+                vel[k, 0], vel[k, 1], vel[k, 2] = 0.0, 0.0, 0.0
+                k += 1
+                continue
+            while k < n and not stance[k]:
+                vel[k, 0], vel[k, 1], vel[k, 2] = 0.0, 0.0, 0.0
+                k += 1
+            continue
+        i0 = k
+        stop = i0
+        while stop < n and not stance[stop]:
+            stop += 1
+        vx, vy, vz = 0.0, 0.0, 0.0  # eq. 9: v(t) = ∫ a_m dt from the last stance sample
+        for j in range(i0, stop):
+            vx += a[j, 0] * dt[j]
+            vy += a[j, 1] * dt[j]
+            vz += a[j, 2] * dt[j]
+            vel[j, 0], vel[j, 1], vel[j, 2] = vx, vy, vz
+        if stop < n:  # closed by stance sample `stop`, where the true velocity is 0
+            vx += a[stop, 0] * dt[stop]
+            vy += a[stop, 1] * dt[stop]
+            vz += a[stop, 2] * dt[stop]
+            span = t[stop] - t[i0 - 1]
+            ex, ey, ez = vx / span, vy / span, vz / span  # eq. 10: ε = v(T) / T
+            for j in range(i0, stop):
+                e = t[j] - t[i0 - 1]
+                vel[j, 0] -= ex * e
+                vel[j, 1] -= ey * e
+                vel[j, 2] -= ez * e
+            bias[m, 0], bias[m, 1], bias[m, 2] = ex, ey, ez
+            m += 1
+        k = stop
+    return m
 
 
 @register

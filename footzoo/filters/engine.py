@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import HAVE_NUMBA, numba
+from .. import _jit
 from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
@@ -293,7 +293,7 @@ class KalmanEngine:
         types them each time); live, they are bound into a small compiled wrapper once (about a
         second, at the stream's start) and each call passes arrays only.
         """
-        if self.engine == "fast" and HAVE_NUMBA:
+        if self.engine == "fast" and _jit.HAVE_NUMBA:
             state.bound = _bound_loop(state.functions)
         return state
 
@@ -327,7 +327,7 @@ def _address(fn: Any) -> Any:
     every call of the compiled loop (about 0.2 ms each); a ``WrapperAddressProtocol`` object
     carries the signature and the address, looked up once. Plain Python functions pass through.
     """
-    if not HAVE_NUMBA or not isinstance(fn, numba.core.registry.CPUDispatcher) or len(fn.signatures) != 1:
+    if not _jit.HAVE_NUMBA or type(fn).__name__ != "CPUDispatcher" or len(fn.signatures) != 1:
         return fn
     cached = _ADDRESSES.get(id(fn))
     if cached is None or cached.dispatcher is not fn:
@@ -337,7 +337,7 @@ def _address(fn: Any) -> Any:
 
 _ADDRESSES: dict[int, Any] = {}
 
-if HAVE_NUMBA:
+if _jit.HAVE_NUMBA:
     from numba.core.types.function_type import WrapperAddressProtocol
     from numba.experimental.function_type import _get_wrapper_address
 
@@ -364,14 +364,17 @@ def _bound_loop(functions: tuple) -> Any:
     """The compiled loop with these measurement functions as constants (compiled once per process and set)."""
     key = tuple(id(f) for group in functions for f in group)
     if key not in _BOUND:
-        from .kalman_fast import eskf_loop
+        from .kalman_fast import eskf_loop as lazy_loop
 
+        eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
 
         def bound(signals, core, state, arrays, out, k0):
             m_idx, par, par_off, mem_off, data, data_off = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
                                              data_off), out, k0)
+
+        import numba
 
         _BOUND[key] = numba.njit(nogil=True)(bound)
     return _BOUND[key]

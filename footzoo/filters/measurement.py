@@ -67,7 +67,10 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import HAVE_NUMBA, numba
+from .._jit import HAVE_NUMBA
+
+if HAVE_NUMBA:  # measurement functions are compiled eagerly, with the engine's fixed signature
+    import numba
 
 #: Offsets in ``nav``: quaternion, position, velocity, gyro bias, accelerometer bias.
 Q, P, V, BG, BA = 0, 4, 7, 10, 13

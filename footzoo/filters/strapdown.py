@@ -6,21 +6,47 @@ attitude at ``t[k]`` is ``q[k]``; the acceleration of interval ``k`` is rotated
 with the attitude at the interval's middle (the normalised mean of ``q[k-1]``
 and ``q[k]``), velocity is summed per interval and position integrated with the
 trapezoidal rule (exact for constant acceleration within an interval).
+
+Each function is one compiled pass over the samples (no temporaries beyond its
+output), so its cost per sample does not grow with the recording's length.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..conventions import GRAVITY, gravity_ned, quat_normalize, quat_rotate
+from .._jit import njit
+from ..conventions import GRAVITY
 
 
 def sample_intervals(t: np.ndarray) -> np.ndarray:
     """``dt[k] = t[k] - t[k-1]`` (s), with ``dt[0] = 0`` (the first sample starts the clock)."""
-    dt = np.empty_like(np.asarray(t, dtype=float))
-    dt[1:] = np.diff(t)
-    dt[0] = 0.0
+    t = np.asarray(t, dtype=float)
+    dt = np.empty_like(t)
+    np.subtract(t[1:], t[:-1], out=dt[1:])  # no temporary
+    dt[:1] = 0.0
     return dt
+
+
+@njit
+def _motion_acceleration_kernel(q: np.ndarray, acc: np.ndarray, g: float, out: np.ndarray) -> None:
+    """``out[k] = R(q̄_k) f_k + [0, 0, g]`` with ``q̄_k = normalise(±q_{k-1} + q_k)`` (eqs. 5–6)."""
+    n = q.shape[0]
+    for k in range(n):
+        w, x, y, z = q[k, 0], q[k, 1], q[k, 2], q[k, 3]
+        j = k - 1 if k > 0 else 0
+        pw, px, py, pz = q[j, 0], q[j, 1], q[j, 2], q[j, 3]
+        if pw * w + px * x + py * y + pz * z < 0.0:  # same hemisphere before averaging
+            pw, px, py, pz = -pw, -px, -py, -pz
+        w, x, y, z = pw + w, px + x, py + y, pz + z
+        nrm = math.sqrt(w * w + x * x + y * y + z * z)
+        w, x, y, z = w / nrm, x / nrm, y / nrm, z / nrm
+        fx, fy, fz = acc[k, 0], acc[k, 1], acc[k, 2]
+        out[k, 0] = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
+        out[k, 1] = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
+        out[k, 2] = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz + g
 
 
 def motion_acceleration(quat: np.ndarray, acc: np.ndarray, g: float = GRAVITY) -> np.ndarray:
@@ -30,28 +56,72 @@ def motion_acceleration(quat: np.ndarray, acc: np.ndarray, g: float = GRAVITY) -
     which in NED is ``[0, 0, -g]`` (their eq. 17 adds it to the motion): so the
     gravity vector ``[0, 0, +g]`` is added to the rotated specific force.
     Interval ``k`` is rotated with the mid-interval attitude.
+
+    Parameters
+    ----------
+    quat : (N, 4) ndarray
+        Attitude at each sample time, body -> NED.
+    acc : (N, 3) ndarray
+        Specific force in FRD (m/s²).
+    g : float
+        Gravity (m/s²).
     """
-    q = np.asarray(quat, dtype=float)
-    prev = np.concatenate([q[:1], q[:-1]])
-    # same hemisphere before averaging
-    prev = np.where(np.sum(prev * q, axis=1, keepdims=True) < 0, -prev, prev)
-    q_mid = quat_normalize(prev + q)
-    return quat_rotate(q_mid, acc) + gravity_ned(g)
+    q = np.ascontiguousarray(quat, dtype=float)
+    f = np.ascontiguousarray(acc, dtype=float)
+    if q.ndim != 2 or q.shape[1] != 4 or f.shape != (q.shape[0], 3):
+        raise ValueError(f"motion_acceleration needs quat (N, 4) and acc (N, 3), got {q.shape} and {f.shape}")
+    out = np.empty((q.shape[0], 3))
+    try:
+        _motion_acceleration_kernel(q, f, float(g), out)
+    except ZeroDivisionError:
+        raise ValueError("motion_acceleration: a zero quaternion (or two opposite ones in a row) in quat; "
+                         "pass unit quaternions") from None
+    return out
+
+
+@njit
+def _integrate_velocity_kernel(a: np.ndarray, dt: np.ndarray, v0: np.ndarray, out: np.ndarray) -> None:
+    sx, sy, sz = 0.0, 0.0, 0.0
+    for k in range(a.shape[0]):
+        sx += a[k, 0] * dt[k]
+        sy += a[k, 1] * dt[k]
+        sz += a[k, 2] * dt[k]
+        out[k, 0], out[k, 1], out[k, 2] = sx + v0[0], sy + v0[1], sz + v0[2]
+
+
+@njit
+def _integrate_position_kernel(v: np.ndarray, dt: np.ndarray, p0: np.ndarray, out: np.ndarray) -> None:
+    sx, sy, sz = 0.0, 0.0, 0.0
+    for k in range(v.shape[0]):
+        if k > 0:
+            h = dt[k]
+            sx += 0.5 * (v[k, 0] + v[k - 1, 0]) * h
+            sy += 0.5 * (v[k, 1] + v[k - 1, 1]) * h
+            sz += 0.5 * (v[k, 2] + v[k - 1, 2]) * h
+        out[k, 0], out[k, 1], out[k, 2] = sx + p0[0], sy + p0[1], sz + p0[2]
 
 
 def integrate_velocity(acc_nav: np.ndarray, dt: np.ndarray, v0: np.ndarray | None = None) -> np.ndarray:
-    """Velocity (m/s, (N, 3)) from motion acceleration: ``v[k] = v[k-1] + a[k] dt[k]`` (eq. 7)."""
-    v = np.cumsum(acc_nav * dt[:, None], axis=0)
-    if v0 is not None:
-        v = v + v0
-    return v
+    """Velocity (m/s, (N, 3)) from motion acceleration: ``v[k] = v[k-1] + a[k] dt[k]`` (eq. 7).
+
+    ``acc_nav`` (m/s², (N, 3)), ``dt`` (s, (N,)) as from :func:`sample_intervals`, ``v0`` (m/s, (3,)).
+    """
+    a = np.ascontiguousarray(acc_nav, dtype=float)
+    out = np.empty(a.shape)
+    _integrate_velocity_kernel(a, np.ascontiguousarray(dt, dtype=float), _start(v0), out)
+    return out
 
 
 def integrate_position(vel: np.ndarray, dt: np.ndarray, p0: np.ndarray | None = None) -> np.ndarray:
-    """Position (m, (N, 3)) by the trapezoidal rule: ``p[k] = p[k-1] + (v[k-1] + v[k]) dt[k] / 2``."""
-    steps = np.zeros_like(vel)
-    steps[1:] = 0.5 * (vel[1:] + vel[:-1]) * dt[1:, None]
-    p = np.cumsum(steps, axis=0)
-    if p0 is not None:
-        p = p + p0
-    return p
+    """Position (m, (N, 3)) by the trapezoidal rule: ``p[k] = p[k-1] + (v[k-1] + v[k]) dt[k] / 2``.
+
+    ``vel`` (m/s, (N, 3)), ``dt`` (s, (N,)), ``p0`` (m, (3,)).
+    """
+    v = np.ascontiguousarray(vel, dtype=float)
+    out = np.empty(v.shape)
+    _integrate_position_kernel(v, np.ascontiguousarray(dt, dtype=float), _start(p0), out)
+    return out
+
+
+def _start(x0: np.ndarray | None) -> np.ndarray:
+    return np.zeros(3) if x0 is None else np.asarray(x0, dtype=float).reshape(3)

@@ -8,10 +8,13 @@ import numpy as np
 
 from .._jit import njit
 from ..checks import check_bool, check_range
+from ..filters.strapdown import sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .fqa import fqa_sample
 from .magnetic import magnetometer_valid
+
+_NO_MAG = np.zeros((1, 3))
 
 
 @njit
@@ -19,10 +22,10 @@ def complementary_kernel(
     q0: np.ndarray,
     gyr: np.ndarray,
     dt: np.ndarray,
-    q_static: np.ndarray,
+    acc: np.ndarray,
+    mag: np.ndarray,
     gain: np.ndarray,
-    keep_yaw: np.ndarray,
-    static_yaw: np.ndarray,
+    mag_ok: np.ndarray,
 ) -> np.ndarray:
     """Per-sample core of the complementary filter (plain arrays, no objects).
 
@@ -31,12 +34,28 @@ def complementary_kernel(
     The gyro branch ``q̇_d = ½ q̂ ⊗ ω`` (eq. 2) is integrated exactly for a rate
     that is constant over the sample interval; the feedback ``k e(t)`` with
     ``e = ±q_s − q̂`` (the sign of ``q_s`` chosen to match ``q̂``) is evaluated at
-    ``t[k]``, with the static quaternion and the gyro-propagated estimate of
-    the same instant, and added with the same step. Where ``keep_yaw[k]`` (no
-    magnetometer, or a rejected sample) ``q_s`` is the tilt-only FQA quaternion
-    given the current estimate's heading, so the static branch corrects roll and
-    pitch only: ``q_static`` then holds the tilt quaternion and ``static_yaw`` its
-    heading, which is replaced by the estimate's.
+    ``t[k]``, with the static quaternion (:func:`static_sample`) and the
+    gyro-propagated estimate of the same instant, and added with the same step.
+    ``q_s`` is computed only where the gain is not zero. Where ``mag_ok[k]`` is false (no
+    magnetometer, or a rejected sample) the static branch corrects roll and pitch only: ``q_s`` is the tilt-only FQA
+    quaternion given the current estimate's heading.
+
+    Parameters
+    ----------
+    q0 : (4,) ndarray
+        Initial attitude.
+    gyr : (N, 3) ndarray
+        Angular rate (rad/s).
+    dt : (N,) ndarray
+        Sample intervals (s).
+    acc : (N, 3) ndarray
+        Specific force (m/s²).
+    mag : (N, 3) ndarray
+        Magnetic field (any unit); read only where ``mag_ok``.
+    gain : (N,) ndarray
+        k at each sample (1/s).
+    mag_ok : (N,) bool ndarray
+        Heading from the magnetometer at this sample.
     """
     n = gyr.shape[0]
     out = np.empty((n, 4))
@@ -57,10 +76,15 @@ def complementary_kernel(
         pz = w * dz + x * dy - y * dx + z * dw
         kk = gain[k] * h
         if kk != 0.0:
-            sw, sx, sy, sz = q_static[k, 0], q_static[k, 1], q_static[k, 2], q_static[k, 3]
-            if keep_yaw[k]:
+            if mag_ok[k]:
+                sw, sx, sy, sz = static_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2],
+                                               True, gyr[k, 0], gyr[k, 1], gyr[k, 2], h)
+            else:
+                sw, sx, sy, sz = static_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0,
+                                               False, gyr[k, 0], gyr[k, 1], gyr[k, 2], h)
                 # give q_s the current estimate's heading: q_z(ψ̂ − ψ_s) ⊗ q_s
-                psi = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) - static_yaw[k]
+                psi = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) - math.atan2(
+                    2.0 * (sw * sz + sx * sy), 1.0 - 2.0 * (sy * sy + sz * sz))
                 cw, cz = math.cos(0.5 * psi), math.sin(0.5 * psi)
                 sw, sx, sy, sz = cw * sw - cz * sz, cw * sx - cz * sy, cw * sy + cz * sx, cw * sz + cz * sw
             if sw * pw + sx * px + sy * py + sz * pz < 0.0:  # ±q_s: same sign as q̂
@@ -77,49 +101,25 @@ def complementary_kernel(
 
 
 @njit
-def _static_kernel(acc, gyr, dt, mag, use_mag):
-    n = acc.shape[0]
-    q_s = np.empty((n, 4))
-    yaw = np.empty(n)
-    for k in range(n):
-        if use_mag:
-            w, x, y, z = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2], True)
-        else:
-            w, x, y, z = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0, False)
-        # ⊗ exp(ω dt / 4): rotation by half the interval
-        rx, ry, rz = gyr[k, 0] * 0.5 * dt[k], gyr[k, 1] * 0.5 * dt[k], gyr[k, 2] * 0.5 * dt[k]
-        angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-        half = 0.5 * angle
-        kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-        dw, dx, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
-        qw = w * dw - x * dx - y * dy - z * dz
-        qx = w * dx + x * dw + y * dz - z * dy
-        qy = w * dy - x * dz + y * dw + z * dx
-        qz = w * dz + x * dy - y * dx + z * dw
-        q_s[k, 0], q_s[k, 1], q_s[k, 2], q_s[k, 3] = qw, qx, qy, qz
-        yaw[k] = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
-    return q_s, yaw
-
-
-def static_quaternion(acc: np.ndarray, gyr: np.ndarray, dt: np.ndarray, mag: np.ndarray | None):
-    """FQA quaternion of each sample, carried to the sample's time stamp, and its heading.
+def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
+    """FQA quaternion of one sample, carried to the sample's time stamp.
 
     An interval-average sample describes the middle of its interval
     ``(t[k-1], t[k]]``, so the FQA attitude is rotated on by half the
     interval's gyro rotation, ``q_s ⊗ exp(ω_k dt_k / 4)``, before it is
     compared with the estimate at ``t[k]``. Without this, a foot rotating at
     7.5 rad/s sampled at 50 Hz would see a 4° lag in ``q_s``.
-
-    Returns
-    -------
-    q_s : (N, 4) ndarray
-    yaw : (N,) ndarray
-        Z-Y-X heading of ``q_s`` (rad).
+    Specific force (m/s²), field (any unit), rate (rad/s), interval ``h`` (s).
     """
-    use_mag = mag is not None
-    m = np.ascontiguousarray(mag, dtype=float) if use_mag else np.zeros((1, 3))
-    return _static_kernel(np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(gyr, dtype=float),
-                          np.ascontiguousarray(dt, dtype=float), m, use_mag)
+    w, x, y, z = fqa_sample(ax, ay, az, mx, my, mz, use_mag)
+    # ⊗ exp(ω dt / 4): rotation by half the interval
+    rx, ry, rz = wx * 0.5 * h, wy * 0.5 * h, wz * 0.5 * h
+    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
+    half = 0.5 * angle
+    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
+    dw, dx, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
+    return (w * dw - x * dx - y * dy - z * dz, w * dx + x * dw + y * dz - z * dy,
+            w * dy - x * dz + y * dw + z * dx, w * dz + x * dy - y * dx + z * dw)
 
 
 @register
@@ -215,25 +215,20 @@ class FQAComplementary(Orientation):
         q0 : (4,) ndarray
             Initial attitude.
         """
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         use_mag = self.use_magnetometer and mag is not None
-        q_static, static_yaw = static_quaternion(acc, gyr, dt, mag if use_mag else None)
-        keep_yaw = np.full(t.shape[0], not use_mag)
+        self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
         self.mag_valid_ = None
+        mag_ok = np.zeros(t.shape[0], dtype=bool)
         if use_mag:
             self.mag_valid_ = np.ones(t.shape[0], dtype=bool)
             if self.mag_rejection:
                 self.mag_valid_ = magnetometer_valid(t, acc, mag, stance, self.mag_norm_tolerance,
                                                      self.mag_dip_tolerance)[0]
-                if not self.mag_valid_.all():
-                    q_tilt, tilt_yaw = static_quaternion(acc, gyr, dt, None)
-                    bad = ~self.mag_valid_
-                    q_static[bad], static_yaw[bad] = q_tilt[bad], tilt_yaw[bad]
-                    keep_yaw = bad
-        self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
+            mag_ok = self.mag_valid_
         self.quat_ = complementary_kernel(
-            np.asarray(q0, dtype=float), gyr, dt, q_static, self.gain_, keep_yaw, static_yaw
+            np.asarray(q0, dtype=float), np.ascontiguousarray(gyr, dtype=float), dt,
+            np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(mag, dtype=float) if use_mag else _NO_MAG,
+            self.gain_, np.ascontiguousarray(mag_ok),
         )
         return self

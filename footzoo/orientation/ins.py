@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..filters.strapdown import sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .fqa_complementary import complementary_kernel
@@ -47,10 +48,8 @@ class INS(Orientation):
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> INS:
         """Gyro integration from ``q0`` (no Kalman filter configured)."""
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         n = t.shape[0]
-        self.quat_ = complementary_kernel(np.asarray(q0, float), gyr, dt, np.zeros((n, 4)), np.zeros(n),
-                                          np.zeros(n, dtype=bool), np.zeros(n))
+        self.quat_ = complementary_kernel(np.asarray(q0, float), np.ascontiguousarray(gyr, dtype=float), dt,
+                                          np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(n), np.zeros(n, dtype=bool))
         return self

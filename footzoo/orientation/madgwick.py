@@ -8,6 +8,7 @@ import numpy as np
 
 from .._jit import njit
 from ..checks import check_bool, check_range
+from ..filters.strapdown import sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .magnetic import magnetometer_valid
@@ -150,9 +151,7 @@ class Madgwick(Orientation):
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
         """Run the filter over a recording (``stance`` is not used)."""
-        dt = np.empty_like(t)
-        dt[1:] = np.diff(t)
-        dt[0] = 0.0
+        dt = sample_intervals(t)
         self.beta_ = math.sqrt(3.0 / 4.0) * self.gyro_error  # eq. 3
         use_mag = self.use_magnetometer and mag is not None
         self.mag_valid_ = None
