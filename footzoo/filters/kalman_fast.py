@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from .._jit import njit
-from .smoother import smoother_gain, spd_inverse
+from .smoother import feed_back_attitude, smoother_gain, spd_inverse
 
 
 @njit
@@ -275,18 +275,7 @@ def eskf_loop(signals, core, state, models, out, k0):
                     H[a, nzc[a, e]] = 0.0
             # feedback, eqs. 49-52: q <- exp(−δφ) ⊗ q, p <- p − δp, v <- v − δv, b <- b + δb
             if att >= 0 and not use_ext:
-                rx, ry, rz = -dx[att], -dx[att + 1], -dx[att + 2]
-                angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-                half = 0.5 * angle
-                kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-                aw, ax, ay, az = math.cos(half), kk * rx, kk * ry, kk * rz
-                bw, bx, by, bz = nav[0], nav[1], nav[2], nav[3]
-                qw = aw * bw - ax * bx - ay * by - az * bz
-                qx = aw * bx + ax * bw + ay * bz - az * by
-                qy = aw * by - ax * bz + ay * bw + az * bx
-                qz = aw * bz + ax * by - ay * bx + az * bw
-                nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-                nav[0], nav[1], nav[2], nav[3] = qw / nq, qx / nq, qy / nq, qz / nq
+                feed_back_attitude(nav[0:4], dx[att], dx[att + 1], dx[att + 2])
             for i in range(3):
                 nav[4 + i] -= dx[pos_i + i]
                 nav[7 + i] -= dx[vel_i + i]

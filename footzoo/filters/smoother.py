@@ -83,6 +83,23 @@ def smoother_gain(M, P_pred, A, sub, L, inv, keep):
 
 
 @njit
+def feed_back_attitude(q, ex, ey, ez):
+    """``q ← exp(−e) ⊗ q``, normalised, in place (the attitude feedback of Nguyen & La eqs. 51–52)."""
+    rx, ry, rz = -ex, -ey, -ez
+    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
+    half = 0.5 * angle
+    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
+    aw, ax, ay, az = math.cos(half), kk * rx, kk * ry, kk * rz
+    bw, bx, by, bz = q[0], q[1], q[2], q[3]
+    qw = aw * bw - ax * bx - ay * by - az * bz
+    qx = aw * bx + ax * bw + ay * bz - az * by
+    qy = aw * by - ax * bz + ay * bw + az * bx
+    qz = aw * bz + ax * by - ay * bx + az * bw
+    nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    q[0], q[1], q[2], q[3] = qw / nq, qx / nq, qy / nq, qz / nq
+
+
+@njit
 def rts_backward(A, dxs, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Backward pass: correct the forward trajectories in place (see the module docstring)."""
     N, n = dxs.shape
@@ -105,15 +122,4 @@ def rts_backward(A, dxs, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
             if ab_i >= 0:
                 acc_bias[k, i] += e[ab_i + i]
         if att >= 0 and not use_ext:
-            rx, ry, rz = -e[att], -e[att + 1], -e[att + 2]
-            angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-            half = 0.5 * angle
-            kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-            aw, ax, ay, az = math.cos(half), kk * rx, kk * ry, kk * rz
-            bw, bx, by, bz = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
-            qw = aw * bw - ax * bx - ay * by - az * bz
-            qx = aw * bx + ax * bw + ay * bz - az * by
-            qy = aw * by - ax * bz + ay * bw + az * bx
-            qz = aw * bz + ax * by - ay * bx + az * bw
-            nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-            quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = qw / nq, qx / nq, qy / nq, qz / nq
+            feed_back_attitude(quat[k], e[att], e[att + 1], e[att + 2])

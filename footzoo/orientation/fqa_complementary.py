@@ -12,7 +12,7 @@ from ..filters.strapdown import sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .fqa import fqa_sample
-from .magnetic import magnetometer_valid
+from .magnetic import magnetometer_valid, rejection_parameters
 
 _NO_MAG = np.zeros((1, 3))
 
@@ -186,10 +186,8 @@ class FQAComplementary(Orientation):
         self.static_gain = check_range("static_gain", static_gain, 0.0, 100.0, "1/s")
         self.dynamic_gain = check_range("dynamic_gain", dynamic_gain, 0.0, 100.0, "1/s")
         self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
-        self.mag_rejection = check_bool("mag_rejection", mag_rejection)
-        self.mag_norm_tolerance = check_range("mag_norm_tolerance", mag_norm_tolerance, 0.0, 1.0, "1", lo_open=True)
-        self.mag_dip_tolerance = check_range("mag_dip_tolerance", mag_dip_tolerance, 0.0, float(np.pi), "rad",
-                                             lo_open=True)
+        self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
+            mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
 
     def estimate(
         self,

@@ -11,7 +11,7 @@ from ..checks import check_bool, check_range
 from ..filters.strapdown import sample_intervals
 from ..plugin import Orientation
 from ..registry import register
-from .magnetic import magnetometer_valid
+from .magnetic import magnetometer_valid, rejection_parameters
 
 
 @njit
@@ -144,10 +144,8 @@ class Madgwick(Orientation):
                  mag_dip_tolerance: float = float(np.radians(5.0))):
         self.gyro_error = check_range("gyro_error", gyro_error, 0.0, 50.0, "rad/s")
         self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
-        self.mag_rejection = check_bool("mag_rejection", mag_rejection)
-        self.mag_norm_tolerance = check_range("mag_norm_tolerance", mag_norm_tolerance, 0.0, 1.0, "1", lo_open=True)
-        self.mag_dip_tolerance = check_range("mag_dip_tolerance", mag_dip_tolerance, 0.0, float(np.pi), "rad",
-                                             lo_open=True)
+        self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
+            mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
 
     def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
         """Run the filter over a recording (``stance`` is not used)."""

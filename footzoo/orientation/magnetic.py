@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import check_bool, check_range
 from ..conventions import GRAVITY
 
 #: Longest stretch of the still start used to learn the reference (s).
@@ -75,3 +76,10 @@ def magnetometer_valid(
     valid = np.abs(mn - norm_ref) <= norm_tolerance * norm_ref
     valid &= ~quiet | (np.abs(dip - dip_ref) <= dip_tolerance)
     return valid, norm_ref, dip_ref
+
+
+def rejection_parameters(rejection: bool, norm_tolerance: float, dip_tolerance: float) -> tuple[bool, float, float]:
+    """Validated ``mag_rejection``, ``mag_norm_tolerance`` (fraction) and ``mag_dip_tolerance`` (rad)."""
+    return (check_bool("mag_rejection", rejection),
+            check_range("mag_norm_tolerance", norm_tolerance, 0.0, 1.0, "1", lo_open=True),
+            check_range("mag_dip_tolerance", dip_tolerance, 0.0, float(np.pi), "rad", lo_open=True))
