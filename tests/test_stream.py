@@ -72,3 +72,30 @@ def test_distance_readings_missing_on_some_samples_count_as_no_reading(walk):
     late.push(walk.t[0], walk.acc[0], walk.gyr[0])
     with pytest.raises(RecordingError, match="distance readings started after the first sample"):
         late.push(walk.t[1], walk.acc[1], walk.gyr[1], dist=walk.dist[1])
+
+
+@pytest.mark.parametrize("trial", ["2017-11-22-11-22-03", "2017-11-22-11-38-45"])
+def test_stream_equals_batch_on_real_walking_trials(trial):
+    """Every shipped causal config, live on a PyShoe walking trial, gives the batch result (1e-9)."""
+    import glob
+
+    from footzoo import load
+    from tests.conftest import data_file
+
+    rec = load(data_file("pyshoe_vicon", f"{trial}.mat"), format="pyshoe")
+    causal = []
+    for path in sorted(glob.glob("configs/*.yaml")):
+        if "study" in path:
+            continue
+        p = Pipeline.from_yaml(path)
+        try:
+            Stream(p)
+        except ConfigError:
+            continue
+        causal.append(p)
+    assert causal
+    for p in causal:
+        batch = p.run(rec)
+        live = Stream(p).run(rec)
+        np.testing.assert_array_equal(live["stance"], batch.stance)
+        assert np.abs(live["pos"] - batch.pos).max() <= 1e-9 * max(np.abs(batch.pos).max(), 1.0), p.name
