@@ -7,8 +7,10 @@ on the whole recording. It holds the filter's state between samples and advances
 engine (compiled, or the reference for a correction that does not compile) two samples at a
 time, with the same measurement models, built by the same :meth:`Pipeline.kalman_engine`.
 
-The stream needs the foot still for ``init.duration`` seconds at the start (the batch run can
-also look later and carry the attitude back; a live system cannot). A detector's windows in
+The filter starts from the batch run's alignment: the first still period of ``init.duration``
+seconds, the attitude carried back to the first sample. Until that period has been seen (at most
+``max_wait`` seconds), :meth:`Stream.push` buffers the samples and returns None; then it runs
+through the buffer and answers for the newest sample. A detector's windows in
 seconds become samples at the sampling ``rate``: give the sensor's nominal rate (the batch run
 uses the recording's median rate, :attr:`Recording.rate`; :meth:`Stream.run` passes it), or
 leave it out and the stream measures it over the still start, with a warning.
@@ -21,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from .alignment import first_still_window, initial_attitude
 from .checks import validate_sample
 from .errors import ConfigError, FootzooWarning, RecordingError
-from .orientation.fqa import fqa
 from .plugin import KalmanCorrection, Samples
 
 
@@ -40,6 +42,8 @@ class Stream:
         As :meth:`Pipeline.run`.
     max_gap : float
         Longest accepted time between two pushed samples (s); a longer gap is an error.
+    max_wait : float
+        How long the stream waits for the first still period (s) before it gives up with an error.
 
     Examples
     --------
@@ -47,11 +51,13 @@ class Stream:
     >>> est = s.push(t, acc, gyr)          # None until the still start has been seen
     """
 
-    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1):
+    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
+                 max_wait: float = 10.0):
         self.pipeline = pipeline
         self.rate = rate
         self.engine = engine
         self.max_gap = max_gap
+        self.max_wait = max_wait
         self._dist_width: int | None = None
         reasons = []
         if not pipeline.orientation.carried_by_filter:
@@ -70,8 +76,9 @@ class Stream:
             reasons.append("analysis plug-ins run on whole recordings")
         if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
-        if not (isinstance(max_gap, (int, float)) and not isinstance(max_gap, bool) and 0 < max_gap < np.inf):
-            reasons.append(f"max_gap must be a positive number of seconds, got {max_gap!r}")
+        for label, value in (("max_gap", max_gap), ("max_wait", max_wait)):
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < np.inf):
+                reasons.append(f"{label} must be a positive number of seconds, got {value!r}")
         if reasons:
             raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
         self.init = dict(pipeline.init)
@@ -95,9 +102,8 @@ class Stream:
         dist = self._distance_row(dist)
         self._buffer.append((float(t), acc, gyr, mag, dist))
         if not self._ready:
-            if t - self._buffer[0][0] <= self.init["duration"]:
+            if t - self._buffer[0][0] <= self.init["duration"] or not self._start():
                 return None
-            self._start()
             out = None
             for sample in self._buffer[self._n_init:]:
                 out = self._step(*sample)
@@ -121,21 +127,29 @@ class Stream:
                                  "same sensors every time (NaN where one has no reading)")
         return row
 
-    def _start(self) -> None:
+    def _start(self) -> bool:
+        """Start the filter once the buffer holds the first still period; False while it does not yet."""
         b = self._buffer
         t = np.array([s[0] for s in b])
-        window = t <= t[0] + self.init["duration"]
-        self._n_init = n = int(window.sum())
-        gyr = np.array([s[2] for s in b[:n]])
-        if np.linalg.norm(gyr, axis=1).max() > self.init["max_gyr"]:
+        gyr_all = np.array([s[2] for s in b])
+        duration, max_gyr = self.init["duration"], self.init["max_gyr"]
+        try:  # the batch run's alignment: the first still window, the attitude carried back to sample 0
+            first_still_window(t, gyr_all, duration, max_gyr)
+        except RecordingError:
+            if t[-1] - t[0] <= self.max_wait:
+                return False
             raise RecordingError(
-                f"the stream did not start still: |ω| exceeds init.max_gyr = {self.init['max_gyr']} rad/s within "
-                f"the first {self.init['duration']} s; start it with the foot at rest"
-            )
-        acc = np.array([s[1] for s in b[:n]])
-        mag = np.array([s[3] for s in b[:n]]) if b[0][3] is not None else None
+                f"the stream found no still period: |ω| stayed above init.max_gyr = {max_gyr} rad/s in every "
+                f"{duration} s of the first {self.max_wait} s; start it with the foot at rest (or raise max_wait)"
+            ) from None
+        acc_all = np.array([s[1] for s in b])
+        mag_all = np.array([s[3] for s in b]) if b[0][3] is not None else None
+        use_mag = mag_all is not None and bool(getattr(self.pipeline.orientation, "use_magnetometer", False))
+        q0 = initial_attitude(t, acc_all, gyr_all, mag_all if use_mag else None, duration, max_gyr)
+        self._n_init = n = int(np.sum(t <= t[0] + duration))
+        gyr, acc = gyr_all[:n], acc_all[:n]
+        mag = None if mag_all is None else mag_all[:n]
         dist = np.array([s[4] for s in b[:n]]) if b[0][4] is not None else None
-        q0 = fqa(acc.mean(axis=0)[None, :], None if mag is None else mag.mean(axis=0)[None, :])[0]
         rate = self.rate
         if rate is None:
             rate = 1.0 / float(np.median(np.diff(t[:n])))
@@ -154,6 +168,7 @@ class Stream:
         self._prev = None
         for sample in b[:n]:
             self._step(*sample)
+        return True
 
     def _step(self, t, acc, gyr, mag, dist) -> dict[str, Any]:
         self.k += 1

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from footzoo import ConfigError, Pipeline, RecordingError
+from footzoo import ConfigError, Pipeline, Recording, RecordingError
 from footzoo.sim import NoiseModel, simulate
 from footzoo.stream import Stream
 
@@ -55,11 +55,23 @@ def test_bad_live_input_is_reported(walk):
         s.push(walk.t[0], walk.acc[0], walk.gyr[0])
     with pytest.raises(RecordingError, match="non-finite sample"):
         s.push(walk.t[1], [np.nan, 0, 0], walk.gyr[1])
-    moving = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
-    k0 = int(np.searchsorted(walk.t, 3.0))  # mid-walk
-    with pytest.raises(RecordingError, match="did not start still"):
-        for k in range(k0, k0 + 80):
-            moving.push(walk.t[k], walk.acc[k], walk.gyr[k])
+    spinning = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"), rate=100.0, max_wait=3.0)
+    with pytest.raises(RecordingError, match="found no still period.*first 3.0 s"):
+        for k in range(400):  # turning at 1 rad/s: never still
+            spinning.push(k / 100.0, [0.0, 0.0, -9.81], [0.0, 0.0, 1.0])
+
+
+def test_a_stream_that_starts_moving_waits_for_the_first_still_period_and_equals_the_batch(walk):
+    p = Pipeline.from_yaml("configs/nguyen2016.yaml")
+    k0 = int(np.searchsorted(walk.t, 3.0))  # start mid-walk: the batch carries the attitude back
+    rec = Recording(t=walk.t[k0:] - walk.t[k0], acc=walk.acc[k0:], gyr=walk.gyr[k0:], mag=walk.mag[k0:])
+    batch = p.run(rec)
+    s = Stream(p, rate=rec.rate, max_wait=60.0)  # this walk's only 0.5 s still period is at its end
+    outs = [s.push(rec.t[k], rec.acc[k], rec.gyr[k], rec.mag[k]) for k in range(rec.n)]
+    assert outs[0] is None and outs[-1] is not None
+    first = next(k for k, o in enumerate(outs) if o is not None)
+    np.testing.assert_allclose(outs[-1]["pos"], batch.pos[-1], rtol=0, atol=1e-9 * np.abs(batch.pos).max())
+    assert first > 0.5 * rec.rate  # it waited for the still period
 
 
 def test_distance_readings_missing_on_some_samples_count_as_no_reading(walk):
