@@ -186,7 +186,7 @@ def test_any_stance_mask_and_rate_give_a_consistent_table():
     from hypothesis import given, settings
     from hypothesis import strategies as st
 
-    @settings(max_examples=60, deadline=None)
+    @settings(max_examples=60, deadline=None, derandomize=True, database=None)  # the same cases every CI run
     @given(st.lists(st.booleans(), min_size=3, max_size=400), st.integers(0, 2**32 - 1))
     def check(mask, seed):
         rng = np.random.default_rng(seed)

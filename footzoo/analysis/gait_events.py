@@ -140,6 +140,7 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
     den = w[jl] - 2.0 * w[j] + w[jr]
     shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
+    shift = np.clip(shift, -0.5, 0.5)  # at a segment's edge j need not be a local minimum: stay by the sample
     dt = np.where(shift >= 0, t[jr] - t[j], t[j] - t[jl])
     to = t[j] + shift * dt
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
