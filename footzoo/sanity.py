@@ -55,6 +55,8 @@ _AXES = "xyz"
 def check_impossible(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
     """Raise :class:`RecordingError` for any acc/gyr component no body-worn IMU can measure."""
     for name, arr, bound, unit in (("acc", acc, ACC_MAX, "m/s²"), ("gyr", gyr, GYR_MAX, "rad/s")):
+        if arr.max() <= bound and arr.min() >= -bound:
+            continue
         bad = np.abs(arr) > bound
         if bad.any():
             k, j = (int(v) for v in np.argwhere(bad)[0])
@@ -85,12 +87,13 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
     """
     found = []
     for name, arr in (("acc", acc), ("gyr", gyr)):
-        for j in range(3):
-            x = arr[:, j]
-            for rail in {float(x.max()), float(x.min())}:
+        for j, x in enumerate(np.ascontiguousarray(arr.T)):
+            for rail in {float(x.max()), float(x.min())}:  # a constant axis has one rail
                 if abs(rail) < SATURATION_FLOOR[name]:
                     continue
                 at_rail = x == rail
+                if np.count_nonzero(at_rail) < SATURATION_MIN_RUN:
+                    continue
                 runs = _runs(at_rail, SATURATION_MIN_RUN)
                 away = ~(at_rail[1:] | at_rail[:-1])
                 if runs and away.any() and np.mean((x[1:] == x[:-1])[away]) > PLATEAU_FRACTION:
@@ -106,10 +109,14 @@ def find_glitches(gyr: np.ndarray) -> np.ndarray:
     """Samples whose angular rate spikes alone by more than :data:`GLITCH_JUMP` (indices)."""
     if len(gyr) < 3:
         return np.zeros(0, dtype=int)
-    mid, before, after = gyr[1:-1], gyr[:-2], gyr[2:]
+    step = np.diff(gyr, axis=0)
+    step2 = np.einsum("ij,ij->i", step, step)
+    # a spike jumps by more than GLITCH_JUMP on both sides: only those samples need the full test
+    k = np.flatnonzero((step2[:-1] > GLITCH_JUMP**2) & (step2[1:] > GLITCH_JUMP**2)) + 1
+    mid, before, after = gyr[k], gyr[k - 1], gyr[k + 1]
     jump = np.minimum(np.linalg.norm(mid - before, axis=1), np.linalg.norm(mid - after, axis=1))
     spike = jump - np.linalg.norm(after - before, axis=1)
-    return np.flatnonzero(spike > GLITCH_JUMP) + 1
+    return k[spike > GLITCH_JUMP]
 
 
 def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording") -> dict[str, Any]:
