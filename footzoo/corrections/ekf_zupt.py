@@ -137,6 +137,7 @@ class ZUPT(EKFZUPT):
     """
 
     name = "zupt"
+    observes = ("velocity",)
     paper = "Duong & Suh 2015, Sensors 15, eq. 23, Table 1"
     units = {"velocity_std": "m/s"}
 
