@@ -21,7 +21,7 @@ from .. import _jit
 from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
-from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock
+from .measurement import CORE_BLOCKS, NO_AFTER, NO_FEEDBACK, MeasurementModel, NotCompilable, StateBlock
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -272,7 +272,8 @@ class KalmanEngine:
         data_off = np.cumsum([0] + widths).astype(np.int64)
         functions = (tuple(_address(m.measure) for m in models), tuple(_address(m.feedback) for m in models),
                      tuple(_address(m.after) for m in models))
-        arrays = (m_idx, par, par_off, mem_off, data_off)
+        hooks = np.array([[m.feedback is not NO_FEEDBACK, m.after is not NO_AFTER] for m in models], dtype=np.int64)
+        arrays = (m_idx, par, par_off, mem_off, data_off, hooks)
         return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays, widths)
 
     @staticmethod
@@ -303,18 +304,19 @@ class KalmanEngine:
         from .kalman_fast import eskf_loop
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
-        m_idx, par, par_off, mem_off, data_off = packed.arrays
+        m_idx, par, par_off, mem_off, data_off, hooks = packed.arrays
         signals = (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
                    np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["gains"], out["dxs"])
         state = (packed.nav, packed.P, packed.mems)
         if packed.bound is not None:
-            packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off), outputs, k0)
+            packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
+                         k0)
             return
         measures, feedbacks, afters = packed.functions
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off), outputs, k0)
+                                                data_off, hooks), outputs, k0)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -370,9 +372,9 @@ def _bound_loop(functions: tuple) -> Any:
         measures, feedbacks, afters = functions
 
         def bound(signals, core, state, arrays, out, k0):
-            m_idx, par, par_off, mem_off, data, data_off = arrays
+            m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off), out, k0)
+                                             data_off, hooks), out, k0)
 
         import numba
 

@@ -81,7 +81,8 @@ def eskf_loop(signals, core, state, models, out, k0):
         ``(nav (16,): q, p, v, b_g, b_a; P (n, n) covariance; mems (s,) all models' memory)``.
     models : tuple
         ``(measures, feedbacks, afters, idx (L, w) int, par, par_off (L+1,), mem_off (L+1,),
-        data (N, d), data_off (L+1,))``: the corrections' functions and their arrays, in stacking order.
+        data (N, d), data_off (L+1,), hooks (L, 2) int: model j has a feedback / an after function)``:
+        the corrections' functions and their arrays, in stacking order.
     out : tuple
         ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n),
         gains (N or 0, n, n), dxs (N or 0, n))``; row 0 receives the incoming state. ``P_diag``,
@@ -93,7 +94,7 @@ def eskf_loop(signals, core, state, models, out, k0):
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max = core
     nav, P, mems = state
-    measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off = models
+    measures, feedbacks, afters, m_idx, par, par_off, mem_off, data, data_off, hooks = models
     quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs = out
     N = t.shape[0]
     n = P.shape[0]
@@ -284,12 +285,16 @@ def eskf_loop(signals, core, state, models, out, k0):
                 if ab_i >= 0:
                     nav[13 + i] += dx[ab_i + i]
             for j in range(len(feedbacks)):
-                feedbacks[j](dx, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
+                if hooks[j, 0]:
+                    feedbacks[j](dx, m_idx[j], par[par_off[j]:par_off[j + 1]],
+                                 mems[mem_off[j]:mem_off[j + 1]])
             if smooth:
                 for i in range(n):
                     dxs[k, i] = dx[i]
         for j in range(len(afters)):
-            afters[j](k0 + k, nav, st, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
+            if hooks[j, 1]:
+                afters[j](k0 + k, nav, st, m_idx[j], par[par_off[j]:par_off[j + 1]],
+                          mems[mem_off[j]:mem_off[j + 1]])
         for i in range(4):
             quat[k, i] = nav[i]
         for i in range(3):
