@@ -140,7 +140,6 @@ class Packed:
     mems: np.ndarray
     functions: tuple
     arrays: tuple
-    data_widths: list[int]
     bound: Any = None  # the compiled loop with the functions bound in (live use): see KalmanEngine.live
 
 
@@ -274,7 +273,7 @@ class KalmanEngine:
                      tuple(_address(m.after) for m in models))
         hooks = np.array([[m.feedback is not NO_FEEDBACK, m.after is not NO_AFTER] for m in models], dtype=np.int64)
         arrays = (m_idx, par, par_off, mem_off, data_off, hooks)
-        return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays, widths)
+        return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays)
 
     @staticmethod
     def stack_data(datas: list[np.ndarray | None], n: int) -> np.ndarray:
