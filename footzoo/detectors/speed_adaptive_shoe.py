@@ -1,0 +1,250 @@
+"""SHOE with a threshold that follows the foot's speed in each stride (motion-adaptive thresholding)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import njit
+from ..checks import check_range
+from ..registry import register
+from .adaptive_shoe import AdaptiveSHOE, adaptive_threshold_kernel
+from .runs import close_short_swings
+
+
+@njit
+def swing_speeds(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+                 lead: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The foot's speed in every swing, by a zero-velocity-reset strapdown.
+
+    For each run of ``stance == False`` (a swing, samples ``[s, e)``): the attitude at
+    ``s`` is levelled on the mean specific force of the stance samples in the last
+    ``lead`` seconds before it (yaw zero: a speed does not depend on it), the rate is
+    integrated (``q ← q ⊗ exp(ω Δt)``), the specific force rotated to NED and gravity
+    (the mean ‖f‖ of the same stance samples, so an accelerometer scale error cancels)
+    removed, the velocity integrated from zero and linearly dedrifted to zero at the
+    next stance sample ``e`` (Yun 2012's correction). A swing that starts or ends the
+    recording has no stance on that side and gets no speed.
+
+    Parameters
+    ----------
+    t : (N,) s; acc : (N, 3) m/s²; gyr : (N, 3) rad/s; stance : (N,) bool
+        Body-frame signals and a provisional gait phase.
+    lead : float
+        Stance time used for the levelling (s).
+
+    Returns
+    -------
+    starts, ends : (M,) int
+        Sample ranges ``[s, e)`` of the swings.
+    peaks : (M,) float
+        Peak 3-D speed of each swing (m/s), NaN where it cannot be estimated.
+    speed : (N,) float
+        The dedrifted speed at every swing sample (m/s); zero in stance and in the
+        swings without a speed.
+    """
+    n = t.shape[0]
+    m = 0
+    for k in range(n):
+        if not stance[k] and (k == 0 or stance[k - 1]):
+            m += 1
+    starts = np.empty(m, dtype=np.int64)
+    ends = np.empty(m, dtype=np.int64)
+    peaks = np.full(m, np.nan)
+    speed = np.zeros(n)
+    vel = np.empty((n, 3))
+    j = 0
+    k = 0
+    while k < n:
+        if stance[k]:
+            k += 1
+            continue
+        s = k
+        while k < n and not stance[k]:
+            k += 1
+        e = k
+        starts[j], ends[j] = s, e
+        if s > 0 and e < n:
+            fx = fy = fz = 0.0
+            c = 0
+            i = s - 1
+            while i >= 0 and stance[i] and t[s - 1] - t[i] <= lead:
+                fx += acc[i, 0]
+                fy += acc[i, 1]
+                fz += acc[i, 2]
+                c += 1
+                i -= 1
+            fx, fy, fz = fx / c, fy / c, fz / c
+            g = math.sqrt(fx * fx + fy * fy + fz * fz)
+            # levelled attitude: the shortest rotation taking u = −f/g (down, at rest) to NED's (0, 0, 1)
+            ux, uy, uz = -fx / g, -fy / g, -fz / g
+            qw, qx, qy, qz = 1.0 + uz, uy, -ux, 0.0
+            nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+            if nq < 1e-9:  # u points straight up (sensor upside down): half a turn about x
+                qw, qx, qy, qz = 0.0, 1.0, 0.0, 0.0
+            else:
+                qw, qx, qy, qz = qw / nq, qx / nq, qy / nq, qz / nq
+            vx = vy = vz = 0.0
+            for i in range(s, e + 1):
+                dt = t[i] - t[i - 1]
+                rx, ry, rz = gyr[i, 0] * dt, gyr[i, 1] * dt, gyr[i, 2] * dt
+                ang = math.sqrt(rx * rx + ry * ry + rz * rz)
+                kk = math.sin(0.5 * ang) / ang if ang > 1e-12 else 0.5
+                dw, dx, dy, dz = math.cos(0.5 * ang), kk * rx, kk * ry, kk * rz
+                qw, qx, qy, qz = (qw * dw - qx * dx - qy * dy - qz * dz, qw * dx + qx * dw + qy * dz - qz * dy,
+                                  qw * dy - qx * dz + qy * dw + qz * dx, qw * dz + qx * dy - qy * dx + qz * dw)
+                ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
+                an0 = (1 - 2 * (qy * qy + qz * qz)) * ax + 2 * (qx * qy - qw * qz) * ay + 2 * (qx * qz + qw * qy) * az
+                an1 = 2 * (qx * qy + qw * qz) * ax + (1 - 2 * (qx * qx + qz * qz)) * ay + 2 * (qy * qz - qw * qx) * az
+                an2 = 2 * (qx * qz - qw * qy) * ax + 2 * (qy * qz + qw * qx) * ay + (1 - 2 * (qx * qx + qy * qy)) * az
+                vx += an0 * dt
+                vy += an1 * dt
+                vz += (an2 + g) * dt
+                vel[i, 0], vel[i, 1], vel[i, 2] = vx, vy, vz
+            span = t[e] - t[s - 1]
+            peak = 0.0
+            for i in range(s, e):
+                r = (t[i] - t[s - 1]) / span
+                ex, ey, ez = vel[i, 0] - r * vx, vel[i, 1] - r * vy, vel[i, 2] - r * vz
+                speed[i] = math.sqrt(ex * ex + ey * ey + ez * ez)
+                peak = max(peak, speed[i])
+            peaks[j] = peak
+        j += 1
+    return starts, ends, peaks, speed
+
+
+def speed_per_sample(t: np.ndarray, starts: np.ndarray, ends: np.ndarray, peaks: np.ndarray,
+                     reach: float) -> np.ndarray:
+    """The speed each sample's threshold follows (m/s).
+
+    The largest peak speed of the swings that sample ``k`` lies in or within ``reach``
+    seconds of (zero where there is none: a still period). A stance thus takes the speed
+    of the swings that bound it, and a brief provisional "swing" inside a stance (the
+    heel rocking after a strike) does not lower it. A swing without a speed (at an end
+    of the recording) takes its nearest neighbour's.
+    """
+    out = np.zeros(len(t))
+    known = np.flatnonzero(np.isfinite(peaks))
+    if known.size == 0:
+        return out
+    i = np.arange(len(peaks))
+    pos = np.clip(np.searchsorted(known, i), 0, known.size - 1)
+    before, after = known[np.maximum(pos - 1, 0)], known[pos]
+    nearest = np.where(np.abs(before - i) < np.abs(after - i), before, after)
+    p = np.where(np.isfinite(peaks), peaks, peaks[nearest])
+    lo = np.searchsorted(t, t[starts] - reach, side="left")
+    hi = np.searchsorted(t, t[np.maximum(ends - 1, 0)] + reach, side="right")
+    for j in np.argsort(p, kind="stable"):  # ascending: the larger peak wins where reaches overlap
+        out[lo[j]:hi[j]] = p[j]
+    return out
+
+
+def close_still_gaps(stance: np.ndarray, min_samples: int, speed: np.ndarray, still_speed: float) -> np.ndarray:
+    """Close the swings shorter than ``min_samples`` in which the foot stayed slower than ``still_speed`` (m/s).
+
+    A short gap where the foot moved (the push-off before a pause of the test) is a
+    real swing and stays open.
+    """
+    closed = close_short_swings(stance, min_samples)
+    filled = closed & ~stance
+    edges = np.flatnonzero(np.diff(np.r_[False, filled, False].astype(np.int8)))
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        if speed[a:b].max() > still_speed:
+            closed[a:b] = False
+    return closed
+
+
+@register
+class SpeedAdaptiveSHOE(AdaptiveSHOE):
+    """SHOE whose threshold follows the foot's speed in each stride.
+
+    Motion-adaptive thresholding after Wagstaff, Peretroukhin & Kelly, "Improving
+    foot-mounted inertial navigation through real-time motion classification",
+    IPIN 2017: the zero-velocity threshold that works best grows with the speed of
+    the motion (walking, running, ...). Wagstaff et al. classify the motion and switch
+    between per-class thresholds; footzoo's form is continuous and needs no classifier:
+
+    1. a provisional gait phase from Wahlström et al.'s 2019 adaptive SHOE (see
+       ``adaptive_shoe``; parameters ``threshold``, ``time_constant``, ``min_swing``);
+    2. the peak speed of every provisional swing by a zero-velocity-reset strapdown
+       (:func:`swing_speeds`; yaw-free, levelled on the stance before it);
+    3. the final test ``T_k < γ_k`` with ``γ_k = min(γ_0 exp(v_k / v_s), γ_max)``, where
+       ``v_k`` is the largest peak speed of the swings within ``REACH`` (0.5 s) of
+       sample k (:func:`speed_per_sample`); swings shorter than ``min_swing`` are
+       closed where the foot stayed slower than ``still_speed`` (:func:`close_still_gaps`).
+
+    Why: on PyShoe's 36 VICON trials the SHOE threshold that reproduces PyShoe's
+    per-trial optimal labels grows about exponentially with the foot's speed, from
+    1e3–1e4 for slow motion to 3e5–2e6 for running: a running stance is short and
+    rolling and needs the whole ground contact, while in a walk a high threshold eats
+    into the swing. Defaults chosen on those trials by leave-one-motion-class-out
+    cross-validation (``benchmarks/select_recommended.py``), and checked on the
+    simulator at 50–1000 Hz from 0.3 to 4 m/s.
+
+    The detector looks at the next swing, so it is not causal (offline only).
+
+    Parameters
+    ----------
+    threshold : float
+        γ_0, the threshold at zero speed (dimensionless, as for ``shoe``).
+    window, sigma_a, sigma_g : float
+        As for ``shoe`` (s, m/s², rad/s).
+    time_constant : float
+        τ of the provisional pass (s).
+    max_threshold : float
+        γ_max (dimensionless).
+    speed_scale : float
+        v_s (m/s): the threshold grows by e per v_s of swing speed.
+    still_speed : float
+        A short swing is closed only if the foot stayed slower than this (m/s).
+    min_swing : float
+        Shortest swing (s), as for ``adaptive_shoe``.
+
+    Attributes
+    ----------
+    statistic_ : (N,) ndarray
+        SHOE's T_k.
+    speed_ : (N,) ndarray
+        v_k (m/s).
+    threshold_ : (N,) ndarray
+        γ_k.
+    stance_, stance_online_ : (N,) bool ndarray
+        Stance flag (offline: ``stance_online_`` is the same).
+    """
+
+    name = "speed_adaptive_shoe"
+    paper = ("Wagstaff, Peretroukhin & Kelly 2017, IPIN (motion-adaptive zero-velocity threshold), "
+             "on SHOE (Skog et al. 2010) and Wahlström et al. 2019")
+    causal = False
+    units = {**AdaptiveSHOE.units, "speed_scale": "m/s", "still_speed": "m/s"}
+
+    #: Stance time used to level the attitude at the start of a swing (s).
+    LEVELLING = 0.1
+    #: How far before and after a swing its speed sets the threshold (s): about a stance.
+    REACH = 0.5
+
+    def __init__(self, threshold: float = 3e3, window: float = 0.025, sigma_a: float = 0.01,
+                 sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.2, max_threshold: float = 1e6,
+                 speed_scale: float = 1.0, still_speed: float = 0.5, min_swing: float = 0.15):
+        super().__init__(threshold, window, sigma_a, sigma_g, time_constant, max_threshold, min_swing)
+        self.speed_scale = check_range("speed_scale", speed_scale, 1e-3, 100.0, "m/s")
+        self.still_speed = check_range("still_speed", still_speed, 0.0, 100.0, "m/s")
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> SpeedAdaptiveSHOE:
+        """Provisional adaptive SHOE, swing speeds, then the speed-dependent test."""
+        t = np.ascontiguousarray(t, dtype=float)
+        acc = np.ascontiguousarray(acc, dtype=float)
+        gyr = np.ascontiguousarray(gyr, dtype=float)
+        self.statistic_ = self._statistic(t, acc, gyr)
+        rate = 1.0 / float(np.median(np.diff(t)))
+        min_swing = int(math.floor(self.min_swing * rate + 0.5))
+        g_max = max(self.max_threshold, self.threshold)
+        provisional, _ = adaptive_threshold_kernel(t, self.statistic_, self.threshold, self.time_constant, g_max)
+        provisional = close_short_swings(provisional, min_swing)
+        starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
+        self.speed_ = speed_per_sample(t, starts, ends, peaks, self.REACH)
+        self.threshold_ = np.minimum(self.threshold * np.exp(self.speed_ / self.speed_scale), g_max)
+        self.stance_ = close_still_gaps(self.statistic_ < self.threshold_, min_swing, speed, self.still_speed)
+        self.stance_online_ = self.stance_.copy()
+        return self
