@@ -11,6 +11,7 @@ from footzoo.detectors.shoe import SHOE
 from footzoo.detectors.speed_adaptive_shoe import (
     SpeedAdaptiveSHOE,
     close_still_gaps,
+    drop_pauses,
     speed_per_sample,
     swing_speeds,
 )
@@ -81,6 +82,28 @@ def test_only_still_short_gaps_are_closed():
     speed[6:8] = 2.0  # the foot moved in the second gap
     np.testing.assert_array_equal(close_still_gaps(s, 3, speed, 0.5),
                                   [1, 1, 1, 1, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 1])
+
+
+def test_a_pause_in_the_air_is_not_a_stance():
+    """Stance, 2 moving samples, a 2-sample pause, a long swing, 2-sample landing motion, stance (min 3 samples)."""
+    s = np.array([1, 1, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 1], bool)
+    np.testing.assert_array_equal(drop_pauses(s, 3),
+                                  [1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1])
+    # short stances a full swing apart (running) are kept
+    r = np.array([0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0], bool)
+    np.testing.assert_array_equal(drop_pauses(r, 3), r)
+
+
+def test_the_simulated_foot_pausing_in_the_air_gives_no_extra_stances():
+    """The simulator's physical run stops the foot after the push-off and before the landing (|v| = 0 in the
+    air): raised thresholds see those pauses, :func:`drop_pauses` removes them (every stride found, none extra)."""
+    from footzoo.metrics import step_detection
+    from footzoo.sim import simulate
+
+    rec = simulate(path="run", n_strides=20, rate=200.0, profile="physical", noise={"scale": 1.0, "seed": 0})
+    d = SpeedAdaptiveSHOE().detect(rec.t, rec.acc, rec.gyr)
+    r = step_detection(d.stance_, rec.truth.stance, rec.t)
+    assert r["missed"] == 0 and r["false_steps"] == 0 and r["split"] == 0
 
 
 def test_the_threshold_grows_from_slow_walking_to_running():

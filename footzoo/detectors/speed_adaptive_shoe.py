@@ -155,6 +155,31 @@ def close_still_gaps(stance: np.ndarray, min_samples: int, speed: np.ndarray, st
     return closed
 
 
+def drop_pauses(stance: np.ndarray, min_samples: int) -> np.ndarray:
+    """Of two stance runs less than ``min_samples`` apart, remove the shorter if it is shorter than that.
+
+    What is left of such a pair after :func:`close_still_gaps` is a foot that moved in the
+    gap: a stance and a pause in the air (the end of the push-off, or just before the
+    landing), not two stances, which are a swing apart.
+    """
+    out = np.asarray(stance, dtype=bool).copy()
+    n = out.size
+    if n == 0:
+        return out
+    change = np.flatnonzero(out[1:] != out[:-1]) + 1
+    starts = np.r_[0, change]
+    lengths = np.diff(np.r_[starts, n])
+    is_stance = out[starts]
+    for i in range(1, len(starts) - 1):  # a swing run with a stance run on each side
+        if is_stance[i] or lengths[i] >= min_samples:
+            continue
+        a, b = i - 1, i + 1
+        short = a if lengths[a] <= lengths[b] else b
+        if lengths[short] < min_samples:
+            out[starts[short]:starts[short] + lengths[short]] = False
+    return out
+
+
 @register
 class SpeedAdaptiveSHOE(AdaptiveSHOE):
     """SHOE whose threshold follows the foot's speed in each stride.
@@ -172,7 +197,9 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
     3. the final test ``T_k < γ_k`` with ``γ_k = min(γ_0 exp(v_k / v_s), γ_max)``, where
        ``v_k`` is the largest peak speed of the swings within ``REACH`` (0.5 s) of
        sample k (:func:`speed_per_sample`); swings shorter than ``min_swing`` are
-       closed where the foot stayed slower than ``still_speed`` (:func:`close_still_gaps`).
+       closed where the foot stayed slower than ``still_speed`` (:func:`close_still_gaps`),
+       and of two stances closer than ``min_swing`` the shorter, if shorter than that, is
+       a pause in the air (:func:`drop_pauses`).
 
     Why: on PyShoe's 36 VICON trials the SHOE threshold that reproduces PyShoe's
     per-trial optimal labels grows about exponentially with the foot's speed, from
@@ -245,6 +272,7 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
         self.speed_ = speed_per_sample(t, starts, ends, peaks, self.REACH)
         self.threshold_ = np.minimum(self.threshold * np.exp(self.speed_ / self.speed_scale), g_max)
-        self.stance_ = close_still_gaps(self.statistic_ < self.threshold_, min_swing, speed, self.still_speed)
+        closed = close_still_gaps(self.statistic_ < self.threshold_, min_swing, speed, self.still_speed)
+        self.stance_ = drop_pauses(closed, min_swing)
         self.stance_online_ = self.stance_.copy()
         return self
