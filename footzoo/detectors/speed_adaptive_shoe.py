@@ -205,9 +205,11 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
     per-trial optimal labels grows about exponentially with the foot's speed, from
     1e3–1e4 for slow motion to 3e5–2e6 for running: a running stance is short and
     rolling and needs the whole ground contact, while in a walk a high threshold eats
-    into the swing. Defaults chosen on those trials by leave-one-motion-class-out
-    cross-validation (``benchmarks/select_recommended.py``), and checked on the
-    simulator at 50–1000 Hz from 0.3 to 4 m/s.
+    into the swing. Defaults: the setting ``benchmarks/select_recommended.py`` selects
+    on those trials (scored per motion class, never per trial); leaving one motion class
+    out selects settings from the same neighbourhood (γ_0 2e3–3e3, v_s 0.8–1 m/s; see
+    ``benchmarks/recommended_selection.md``). On the simulator it finds every stride at
+    50–1000 Hz from 0.3 to 4 m/s, and ignores the simulated foot's pauses in the air.
 
     The detector looks at the next swing, so it is not causal (offline only).
 
