@@ -151,3 +151,32 @@ def test_real_running_trial_yun2012_within_a_metre_with_the_guard():
         assert bool(caught) == (key == "on")
     assert err["off"] > 10.0
     assert err["on"] < 0.5
+
+
+def test_bias_estimates_stay_within_the_bias_guard():
+    """A stance that turns at 0.2 rad/s about z for a minute (a foot pivoting in place, or a gyro far off).
+
+    The zero-rate update takes all of it for gyro bias (0.2 rad/s, 11 °/s, 45 times the paper's
+    initial bias specification); with the guard (10 initial σ = 0.044 rad/s) the estimate stays
+    at the bound, the other axes' biases are estimated as without it, and the run reports it.
+    """
+    from footzoo import Recording
+
+    rate, n = 100.0, 6000
+    rng = np.random.default_rng(0)
+    t = np.arange(n) / rate
+    acc = np.tile([0.0, 0.0, -9.81], (n, 1)) + rng.normal(scale=0.01, size=(n, 3))
+    gyr = np.tile([0.01, -0.02, 0.2], (n, 1)) + rng.normal(scale=0.002, size=(n, 3))
+    rec = Recording(t=t, acc=acc, gyr=gyr)
+    out = {}
+    for limit in (0.0, 10.0):
+        cfg = {"orientation": {"type": "ins"}, "detector": {"type": "angular_rate_fsm"},
+               "corrections": [{"type": "ekf_zupt", "bias_limit": limit}]}
+        out[limit] = Pipeline.from_dict(cfg).run(rec).diagnostics
+    bound = 10.0 * np.radians(0.25)
+    assert out[0.0]["gyro_bias"][-1, 2] == pytest.approx(0.2, abs=0.005)
+    assert out[0.0]["bias_guard_rows"] == 0
+    assert bound < out[10.0]["gyro_bias"][-1, 2] < 1.1 * bound
+    np.testing.assert_allclose(out[10.0]["gyro_bias"][-1, :2], [0.01, -0.02], atol=1e-3)
+    assert out[10.0]["bias_guard_rows"] > 0
+    assert np.abs(out[10.0]["gyro_bias"]).max() < 1.1 * bound
