@@ -180,3 +180,18 @@ def test_bias_estimates_stay_within_the_bias_guard():
     np.testing.assert_allclose(out[10.0]["gyro_bias"][-1, :2], [0.01, -0.02], atol=1e-3)
     assert out[10.0]["bias_guard_rows"] > 0
     assert np.abs(out[10.0]["gyro_bias"]).max() < 1.1 * bound
+
+
+def test_a_live_stream_warns_when_its_detector_reaches_max_swing(sprint):
+    """Live, a swing's stillest instants are not known yet: the stream warns instead of adding stances."""
+    from footzoo.stream import Stream
+
+    p = Pipeline.from_yaml("configs/nguyen2016.yaml")
+    batch, _ = _run("configs/nguyen2016.yaml", sprint, {})
+    assert batch.diagnostics["guards"]["stances_added"] > 0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        live = Stream(p).run(sprint)
+    messages = [str(w.message) for w in caught if issubclass(w.category, GuardWarning)]
+    assert messages and "has found no stance for 1.5 s" in messages[0]
+    np.testing.assert_array_equal(live["stance"], batch.diagnostics["detector_stance"])
