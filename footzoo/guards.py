@@ -16,10 +16,12 @@ stance mask, the angular rate and the result):
   the foot as stance: the local minima of the angular-rate magnitude (averaged
   over ``window``) below ``still_rate`` (1 rad/s: a foot turning about a ground contact
   point about 0.1 m away moves at 0.1 m/s), at least ``min_step`` apart (0.4 s,
-  shorter than any stride of one foot), each widened to the neighbouring samples
-  still below ``still_rate``, at most ``half_width`` (0.05 s) either side. A missed
-  stance then degrades the estimate (a short zero-velocity interval where the foot
-  was about still) instead of letting it run away. The guard looks at a whole
+  shorter than any stride of one foot). Each is one sample: the guard knows that the
+  foot came to rest there, not for how long, and one zero-velocity sample per stride
+  is the same information at any sampling rate (``half_width`` widens it to the
+  neighbouring samples still below ``still_rate``; 0.05 s made the Kalman pipelines
+  worse on PyShoe's running trials: ``duong2015_zupt`` median 0.25 m against 0.19 m).
+  A missed stance then degrades the estimate instead of letting it run away. The guard looks at a whole
   swing, so it is a batch step: a live :class:`~footzoo.stream.Stream` cannot apply
   it and warns instead when its detector reaches ``max_swing``.
 * **Speed bound** (:func:`check_speed`) — a foot moves at most about 2.5 times the
@@ -95,7 +97,7 @@ class StanceGuard:
     min_step : float
         Shortest time (s) between two stance instants the guard marks.
     half_width : float
-        Widest extent (s) of a marked stance on either side of its instant.
+        Widest extent (s) of a marked stance on either side of its instant (0: the instant alone).
     window : float
         Duration (s) of the centred average of the angular-rate magnitude.
     max_speed : float
@@ -105,7 +107,7 @@ class StanceGuard:
     max_swing: float = 1.5
     still_rate: float = 1.0
     min_step: float = 0.4
-    half_width: float = 0.05
+    half_width: float = 0.0
     window: float = 0.04
     max_speed: float = 50.0
 

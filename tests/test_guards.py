@@ -34,11 +34,15 @@ def test_an_over_long_swing_gets_a_stance_at_each_still_dip_at_any_rate(rate):
     assert len(runs) == len(centres) == report["stances_added"]
     mid = t[(runs[:, 0] + runs[:, 1] - 1) // 2]
     np.testing.assert_allclose(mid, centres, atol=1.5 / rate + 0.011)
-    # each stance lies where the (0.04 s averaged) rate is below 1 rad/s: within 0.03 s of the dip's bottom
-    assert np.all(np.abs(t[added][:, None] - centres[None, :]).min(axis=1) <= 0.03 + 1.0 / rate)
     assert report["long_swings"] == [[pytest.approx(1.0, abs=1 / rate), pytest.approx(7.0 - 1 / rate, abs=1e-9)]]
     assert report["longest_swing"] == pytest.approx(6.0, abs=1.5 / rate)
     np.testing.assert_array_equal(out[stance], True)  # the detector's stances stay
+    assert report["samples_added"] == len(centres)  # one sample per instant by default
+    wide, _ = StanceGuard(half_width=0.05).apply(t, gyr, stance)
+    wide_added = wide & ~stance
+    assert wide_added.sum() > added.sum() and np.all(wide_added[added])
+    # widened only over samples whose averaged rate stays below 1 rad/s: within 0.03 s of the bottom
+    assert np.all(np.abs(t[wide_added][:, None] - centres[None, :]).min(axis=1) <= 0.03 + 1.5 / rate)
 
 
 def test_a_swing_without_a_still_instant_stays_a_swing_and_short_swings_are_left_alone():
