@@ -33,6 +33,8 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
                   "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
                   "initial_position_std: m}",
+    "guards": "what happens when the detector misses stances: {max_swing: s (default 1.5, 0 = off), still_rate: "
+              "rad/s, min_step: s, half_width: s, window: s, max_speed: m/s (default 50, 0 = off)}",
     "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",
 }
 INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}

@@ -27,6 +27,10 @@ class SensorWarning(FootzooWarning):
     """Suspicious sensor data: saturated (clipped) axes, isolated spikes (glitches)."""
 
 
+class GuardWarning(FootzooWarning):
+    """A pipeline guard fired: the detector missed stances, or the estimate diverged (:mod:`footzoo.guards`)."""
+
+
 def did_you_mean(word: str, options: list[str]) -> str:
     """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
     close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)

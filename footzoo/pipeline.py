@@ -27,6 +27,7 @@ from .errors import ConfigError, RecordingError
 from .extensions import load_plugins
 from .filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from .filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
+from .guards import StanceGuard, check_speed
 from .plugin import (
     AccelerationCorrection,
     Analysis,
@@ -68,6 +69,10 @@ class Pipeline:
     plugins : list of str, optional
         External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
         :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.extensions`).
+    guards : StanceGuard or dict, optional
+        What a run does when the detector misses stances (stance at the stillest instants of a
+        swing longer than ``max_swing``) and the speed bound of the estimate; see
+        :mod:`footzoo.guards`. On by default.
     """
 
     SMOOTHERS = ("none", "rts")
@@ -84,6 +89,7 @@ class Pipeline:
         navigation: NavigationNoise | dict[str, Any] | None = None,
         smoother: str = "none",
         plugins: list[str] | None = None,
+        guards: StanceGuard | dict[str, Any] | None = None,
     ):
         self.orientation = orientation
         self.detector = detector
@@ -95,6 +101,7 @@ class Pipeline:
         self.navigation = (navigation if isinstance(navigation, NavigationNoise)
                            else NavigationNoise.from_dict(navigation))
         self.plugins = list(plugins or [])
+        self.guards = guards if isinstance(guards, StanceGuard) else StanceGuard.from_dict(guards)
         check_compatibility(orientation, detector, self.corrections)
         if smoother not in self.SMOOTHERS:
             raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
@@ -130,6 +137,7 @@ class Pipeline:
             navigation=d.get("navigation"),
             smoother=d.get("smoother", "none"),
             plugins=plugins,
+            guards=d.get("guards"),
         )
 
     @classmethod
@@ -149,6 +157,7 @@ class Pipeline:
             "init": dict(self.init),
             "navigation": self.navigation.to_dict(),
             "smoother": self.smoother,
+            "guards": self.guards.to_dict(),
             "orientation": self.orientation.spec(),
             "detector": self.detector.spec(),
             "corrections": [c.spec() for c in self.corrections],
@@ -193,12 +202,14 @@ class Pipeline:
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
         self._check_inputs(rec)
         detector = self.detect(rec)
-        stance = detector.stance_
+        stance, guard_report = self.guard(rec, detector)
         q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
         quat = self.orient(rec, stance, q0)
         nav = self.navigate(rec, stance, q0, quat, engine, covariance)
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
-        diagnostics = {"detector_statistic": detector.statistic_, **nav["diagnostics"]}
+        guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
+        diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
+                       "guards": guard_report, **nav["diagnostics"]}
         config = self.to_dict()
         config["engine"] = nav["engine"]
         samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
@@ -220,6 +231,12 @@ class Pipeline:
         if detector.needs_truth:
             return detector.detect(rec.t, rec.acc, rec.gyr, rec.truth)
         return detector.detect(rec.t, rec.acc, rec.gyr)
+
+    def guard(self, rec: Recording, detector: Detector) -> tuple[np.ndarray, dict[str, Any]]:
+        """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report."""
+        stance, report = self.guards.apply(rec.t, rec.gyr, detector.stance_)
+        self.guards.warn(report, detector.name, rec.name)
+        return stance, report
 
     def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
         """Stage 2: the attitude (N, 4), or None when the Kalman filter carries it."""

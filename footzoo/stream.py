@@ -14,6 +14,11 @@ through the buffer and answers for the newest sample. A detector's windows in
 seconds become samples at the sampling ``rate``: give the sensor's nominal rate (the batch run
 uses the recording's median rate, :attr:`Recording.rate`; :meth:`Stream.run` passes it), or
 leave it out and the stream measures it over the still start, with a warning.
+
+The maximum-swing guard of a batch run (:mod:`footzoo.guards`) looks at a whole swing once it
+has ended; live, the stream cannot, and warns (:class:`~footzoo.errors.GuardWarning`) when its
+detector has found no stance for ``guards.max_swing`` seconds. Where the guard does not fire in
+the batch run, the stream gives exactly its result.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ import numpy as np
 
 from .alignment import first_still_window, initial_attitude
 from .checks import validate_sample
-from .errors import ConfigError, FootzooWarning, RecordingError
+from .errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from .plugin import KalmanCorrection, Samples
 
 
@@ -158,6 +163,8 @@ class Stream:
                           FootzooWarning, stacklevel=3)
         self._detector = self.pipeline.detector.clone()
         self._detector.begin(rate)
+        self._swing = 0
+        self._max_swing = int(round(self.pipeline.guards.max_swing * rate))
         self._corrections = [c.clone() for c in self.pipeline.filter_corrections]
         samples = Samples(t[:n], acc, gyr, mag, dist, np.ones(n, dtype=bool))
         self._engine = self.pipeline.kalman_engine(self._corrections, samples, self.engine)
@@ -173,6 +180,13 @@ class Stream:
     def _step(self, t, acc, gyr, mag, dist) -> dict[str, Any]:
         self.k += 1
         stance = bool(self._detector.step(np.array([t]), acc[None, :], gyr[None, :])[0])
+        self._swing = 0 if stance else self._swing + 1
+        if self._swing == self._max_swing > 0:
+            warnings.warn(f"Stream: detector {self._detector.name!r} has found no stance for "
+                          f"{self.pipeline.guards.max_swing:g} s (guards.max_swing) at t = {t:.2f} s: it misses the "
+                          "stances of this motion and the estimate drifts until it finds one. A batch run would mark "
+                          "the swing's stillest instants as stance (footzoo.guards); live, they cannot be known yet",
+                          GuardWarning, stacklevel=3)
         in_init = self.k < self._n_init
         sample = (t, acc, gyr, mag, dist, stance, in_init)
         if self._prev is None:

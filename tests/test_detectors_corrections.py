@@ -27,7 +27,9 @@ def test_detector_threshold_and_sample_count_from_seconds():
     det = AngularRateFSM(threshold=0.6, min_duration=0.05).detect(t, np.zeros((100, 3)), w)
     assert det.min_samples_ == 5
     expected = np.ones(100, bool)
-    expected[30:60] = False
+    # the rate steps from 0 to 3 rad/s between samples 29 and 30 (and back between 59 and 60): linearly
+    # interpolated it crosses 0.6 rad/s at 29.2 and 59.8, inside the intervals of samples 29 and 60
+    expected[29:61] = False
     np.testing.assert_array_equal(det.stance_, expected)
     np.testing.assert_allclose(det.statistic_, np.linalg.norm(w, axis=1))
 

@@ -59,7 +59,7 @@ def test_batch_equals_sample_by_sample(rate):
 
 
 def test_no_collapse_on_real_walking_and_running():
-    """PyShoe trials: the paper's recursion (both guards off) loses the gait for good; the guarded one keeps it.
+    """PyShoe trials: the paper's recursion (the guards off) loses the gait for good; the guarded one keeps it.
 
     Walking 2017-11-22-11-38-45 and running 2017-12-15-18-03-05 (running after a
     walking start). Measured on all 36 trials: longest "swing" median 8.0 s,
@@ -76,7 +76,7 @@ def test_no_collapse_on_real_walking_and_running():
         m = scipy.io.loadmat(data_file("pyshoe_vicon", f"{trial}.mat"))
         imu, t = m["imu"], m["ts"].ravel()
         longest = {}
-        for key, det in (("paper", DGP(min_swing=0.0, max_swing=0.0)), ("guarded", DGP())):
+        for key, det in (("paper", DGP(min_swing=0.0, max_swing=0.0, max_stance_rate=0.0)), ("guarded", DGP())):
             swings = intervals(~det.detect(t, imu[:, :3], imu[:, 3:]).stance_)
             longest[key] = float(np.max(t[swings[:, 1] - 1] - t[swings[:, 0]]))
         assert longest["paper"] > 10.0
@@ -92,3 +92,49 @@ def test_a_swing_without_end_doubles_the_threshold():
     assert not stance[:200].any()
     assert th[99] == pytest.approx(1.6) and th[199] == pytest.approx(3.2)
     assert stance[200:].all()  # 3 <= 3.2: stance, and no swing to re-learn from
+
+
+def test_a_steady_spin_is_stance_for_the_paper_and_swing_with_the_rotation_bound():
+    """A level sensor spinning at a constant 5 rad/s about its z axis: every change of eq. 3 is zero.
+
+    The paper's eq. 15 then calls it stance (``max_cd`` = 0 ≤ th); no foot on the ground
+    turns at 5 rad/s, and with ``max_stance_rate`` (1 rad/s) the spin is swing. The
+    still second before it is stance for both.
+    """
+    rate = 200.0
+    t = np.arange(int(4 * rate)) / rate
+    acc = np.tile([0.0, 0.0, -9.81], (t.size, 1))
+    gyr = np.zeros((t.size, 3))
+    gyr[t >= 1.0, 2] = 5.0
+    spin = t >= 1.5  # after the start of the spin has left the windows
+    paper = DGP(min_swing=0.0, max_swing=0.0, max_stance_rate=0.0).detect(t, acc, gyr).stance_
+    guarded = DGP().detect(t, acc, gyr).stance_
+    assert paper[spin].all()
+    assert not guarded[spin].any()
+    assert paper[(t > 0.5) & (t < 1.0)].all() and guarded[(t > 0.5) & (t < 1.0)].all()
+
+
+def test_rotation_bound_against_vicon_labels_on_real_walking():
+    """PyShoe walking trial 2017-11-22-11-39-47 against its VICON zero-velocity labels (gaps < 0.1 s closed).
+
+    Without the bound DGP marks parts of the swings as stance (precision 0.43, 50 stance
+    runs for 25 labelled ones); with it the precision is 0.91 with 34 runs, and the
+    recall drops from 0.96 to 0.90 (the end of the toe roll, where the foot turns).
+    """
+    import scipy.io
+
+    from footzoo.detectors.runs import close_short_swings
+    from footzoo.metrics import intervals
+
+    from .conftest import data_file
+
+    m = scipy.io.loadmat(data_file("pyshoe_vicon", "2017-11-22-11-39-47.mat"))
+    imu, t = m["imu"], m["ts"].ravel()
+    truth = close_short_swings(m["zv_vicon_opt"].ravel().astype(bool), 20)
+    score = {}
+    for key, det in (("paper", DGP(max_stance_rate=0.0)), ("bounded", DGP())):
+        s = det.detect(t, imu[:, :3], imu[:, 3:]).stance_
+        score[key] = (np.sum(s & truth) / np.sum(s), np.sum(s & truth) / np.sum(truth), len(intervals(s)))
+    assert score["paper"][0] < 0.5 and score["bounded"][0] > 0.85
+    assert score["bounded"][1] > score["paper"][1] - 0.1
+    assert score["bounded"][2] < 0.75 * score["paper"][2]

@@ -37,6 +37,34 @@ def test_heel_and_toe_roll_are_not_stance_on_a_noise_free_physical_walk():
         assert w[a:b].max() < 1.0
 
 
+@pytest.mark.parametrize("rate", [50.0, 100.0, 200.0, 1000.0])
+def test_no_stance_sample_while_the_simulated_foot_moves(rate):
+    """The stance's edge samples are tested over their interval: no stance sample while the foot moves fast.
+
+    At 100 Hz the last sample before toe-off has |ω| = 0.48 rad/s (below Ω_th) and rises to 3.2
+    at the next one, while the simulated foot already rises at 0.19 m/s: tested at its instant
+    only, it was stance once per stride, and each swing's dedrift started from a wrong zero.
+    With the interval test the fastest stance sample moves at 0.00, 0.00, 0.05 and 0.07 m/s at
+    50, 100, 200 and 1000 Hz (|ω| below Ω_th as the toe roll starts).
+    """
+    rec = simulate(path="straight", n_strides=10, profile="physical", rate=rate)
+    d = AngularRateFSM().detect(rec.t, rec.acc, rec.gyr)
+    speed = np.linalg.norm(rec.truth.vel, axis=1)
+    inner = np.ones(rec.n, bool)
+    inner[: int(rate)] = inner[-int(rate):] = False  # away from the still start and end
+    assert speed[d.stance_ & inner].max() < 0.1
+    instant, _ = dated_and_online_states(d.statistic_ < 0.6, d.min_samples_)
+    if rate == 100.0:
+        assert speed[instant & inner].max() > 0.15
+
+
+def test_the_interval_test_keeps_a_short_run_stance_at_a_low_rate():
+    """A 4 m/s run at 50 Hz: Γ_th (0.1 s) is counted on the instants, so trimming the edges loses no stance."""
+    rec = walk("run_4.0", 50.0)
+    d = AngularRateFSM().detect(rec.t, rec.acc, rec.gyr)
+    assert len(intervals(d.stance_)) == len(intervals(rec.truth.stance))
+
+
 @pytest.mark.parametrize("gait", list(GAITS))
 def test_stance_against_simulator_truth_at_every_rate(gait):
     f1 = []

@@ -12,6 +12,47 @@ from ..registry import register
 from .runs import dated_and_online_states
 
 
+def below_over_interval(rate: np.ndarray, threshold: float) -> np.ndarray:
+    """Samples whose interval (half a sample either side) has ``rate`` below ``threshold`` throughout.
+
+    With ``rate`` linearly interpolated between samples, its largest value over
+    sample k's interval is at the sample or at a half-way point, so the test is
+    ``max(r_k, (r_{k−1} + r_k)/2, (r_k + r_{k+1})/2) < threshold``. A threshold
+    crossing between two samples then belongs to the sample it is nearer.
+
+    Parameters
+    ----------
+    rate : (N,) ndarray
+        The statistic, e.g. |ω| (rad/s).
+    threshold : float
+        Its threshold (same unit).
+
+    Returns
+    -------
+    (N,) bool ndarray
+    """
+    below = rate < threshold
+    half_way = 0.5 * (rate[1:] + rate[:-1]) < threshold
+    below[1:] &= half_way
+    below[:-1] &= half_way
+    return below
+
+
+def trim_stance_edges(stance: np.ndarray, still: np.ndarray) -> np.ndarray:
+    """``stance`` without the first and last sample of each stance run where ``still`` is False.
+
+    The machine counts Γ_th on the samples' instants; only the edge samples of
+    a stance are then tested over their interval, so a stance is never lost,
+    and a spike inside a stance that the machine ignored stays ignored.
+    """
+    s = np.asarray(stance, dtype=bool)
+    first = s.copy()
+    first[1:] &= ~s[:-1]
+    last = s.copy()
+    last[:-1] &= ~s[1:]
+    return s & ~((first | last) & ~still)
+
+
 @register
 class AngularRateFSM(Detector):
     """Two-state STANCE/SWING machine on the angular-rate magnitude |ω|.
@@ -34,6 +75,19 @@ class AngularRateFSM(Detector):
     Γ_th; the defaults (0.6 rad/s, 0.1 s = 5 samples at the paper's 50 Hz) follow
     footzoo's design notes. Γ_th is given in seconds and converted at the
     recording's median rate.
+
+    Reading of the threshold test at a stance's edges (footzoo's, documented):
+    a sample stands for its interval, half a sample either side; the first and
+    last sample of a stance stay stance only when |ω|, linearly interpolated,
+    stays below Ω_th over that whole interval (:func:`below_over_interval`,
+    :func:`trim_stance_edges`; Γ_th is counted on the instants, so no stance is
+    lost at a low rate). Tested at the sample's instant alone, the
+    last sample before toe-off (|ω| = 0.48 rad/s, rising to 3.2 at the next,
+    on the physical simulator at 100 Hz) counted as stance while the foot was
+    already rising at 0.2 m/s; the dedrift then started every swing from a
+    wrong zero velocity and the one-hour simulated walk of ``yun2012`` ended
+    3.5 % of its distance away (161 m of it in height); with the interval
+    test at the edges, 1.05 %, all of it from the sensor biases (0.00 % without them).
 
     Parameters
     ----------
@@ -78,7 +132,8 @@ class AngularRateFSM(Detector):
         rate = 1.0 / float(np.median(np.diff(t)))
         self.min_samples_ = max(1, int(math.floor(self.min_duration * rate + 0.5)))
         self.statistic_ = np.linalg.norm(gyr, axis=1)
-        self.stance_, self.stance_online_ = dated_and_online_states(
+        dated, self.stance_online_ = dated_and_online_states(
             self.statistic_ < self.threshold, self.min_samples_, initial=True
         )
+        self.stance_ = trim_stance_edges(dated, below_over_interval(self.statistic_, self.threshold))
         return self

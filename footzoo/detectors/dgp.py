@@ -146,7 +146,8 @@ def dgp_initial_state(s_d0: float, th0: float, delay: int = 2) -> np.ndarray:
 
 @njit
 def dgp_kernel(
-    s_c: np.ndarray, state: np.ndarray, min_swing: int = 0, max_swing: int = 0
+    s_c: np.ndarray, state: np.ndarray, min_swing: int = 0, max_swing: int = 0,
+    moving: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Delayed condition, max changing speed, dynamic threshold and stance (eqs. 10–15).
 
@@ -155,7 +156,8 @@ def dgp_kernel(
     ``s_d^{t−1}`` is two samples of the paper's rate back (20 ms): ``delay``
     samples here (the ring at the end of ``state``). The threshold is re-learned (eq. 14)
     only after a swing of at least ``min_swing`` samples (0: after every swing,
-    as in the paper).
+    as in the paper). A sample where ``moving`` is True is swing whatever ``max_cd``
+    (footzoo's rotation bound; None: the paper's eq. 15 alone).
     """
     n = s_c.shape[0]
     s_d = np.empty(n)
@@ -177,6 +179,8 @@ def dgp_kernel(
         s_d[k] = sd
         max_cd[k] = m
         is_stance = m <= threshold  # eq. 15
+        if moving is not None and moving[k]:
+            is_stance = False
         if not is_stance:
             if not in_swing:
                 mc, md = -math.inf, -math.inf
@@ -227,12 +231,8 @@ class DGP(Detector):
     (see :func:`dgp_statistic_kernel`), taken from the gyro whatever the
     orientation source.
 
-    Known limitation on real recordings (measured, not fixed): ``d_g`` sums
-    *changes*, so a steady mid-swing rotation (|ω| ≈ 6 rad/s on PyShoe's
-    walking trials) gives ``s_c`` ≈ 0.3, below the learned ``Mc − Md`` ≈ 0.5
-    (half the heel-strike peak): DGP marks parts of the swing as stance, and
-    the pipelines built on it end near 1 m of PyShoe's error on walking where
-    SHOE-type detectors reach 0.05 m.
+    On real recordings ``d_g`` is small in a steady mid-swing rotation (it sums
+    *changes*): footzoo's ``max_stance_rate`` keeps such samples in the swing.
 
     Parameters
     ----------
@@ -260,7 +260,22 @@ class DGP(Detector):
         ``max_cd`` of 0.4–0.8), the swing then never ends and eq. 14 never
         runs again (5 of PyShoe's running trials stuck in one "swing" of
         7–34 s with ``min_swing`` alone). Default 2 s, longer than any swing;
-        footzoo's. With both guards at 0 the detector is the paper's.
+        footzoo's.
+    max_stance_rate : float
+        Fastest rotation (rad/s) a stance sample may have: a sample with
+        ``|ω|`` above it is swing whatever eq. 15 says, and the swing it belongs
+        to goes on (so eq. 14 learns the threshold from the whole swing); 0
+        (paper): no bound. ``d_g`` sums *changes*, so a steady mid-swing rotation
+        (|ω| ≈ 5–7 rad/s on PyShoe's walking trials) has ``s_c`` ≈ 0.3, below
+        the learned ``Mc − Md`` ≈ 0.3–0.6: without the bound DGP marks parts of
+        every swing as stance (on PyShoe's walking trials the false stance runs
+        have a median |ω| of 2–6 rad/s) and the INS/ZVU pipeline ends near
+        0.9 m of PyShoe's error. A foot turning at |ω| about a ground contact
+        point a distance r away moves at |ω| r; at 1 rad/s and an instep
+        sensor some 0.1 m from the heel or toe, that is 0.1 m/s, ten times a
+        ZUPT's noise (0.01 m/s): no zero-velocity sample rotates faster.
+        Default 1 rad/s; footzoo's. With the three guards at 0 the detector
+        is the paper's.
 
     Attributes
     ----------
@@ -276,7 +291,7 @@ class DGP(Detector):
     causal = True
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-A, eqs. 3-15, Algorithm 1"
     units = {"window": "s", "condition_window": "s", "initial_delay": "1", "initial_threshold": "1",
-             "reference_rate": "Hz", "min_swing": "s", "max_swing": "s"}
+             "reference_rate": "Hz", "min_swing": "s", "max_swing": "s", "max_stance_rate": "rad/s"}
 
     def __init__(
         self,
@@ -287,6 +302,7 @@ class DGP(Detector):
         reference_rate: float = 100.0,
         min_swing: float = 0.2,
         max_swing: float = 2.0,
+        max_stance_rate: float = 1.0,
     ):
         self.window = check_range("window", window, 0.0, 10.0, "s", lo_open=True)
         self.condition_window = check_range("condition_window", condition_window, 0.0, 10.0, "s", lo_open=True)
@@ -295,6 +311,7 @@ class DGP(Detector):
         self.reference_rate = check_range("reference_rate", reference_rate, 0.0, 100000.0, "Hz", lo_open=True)
         self.min_swing = check_range("min_swing", min_swing, 0.0, 10.0, "s")
         self.max_swing = check_range("max_swing", max_swing, 0.0, 100.0, "s")
+        self.max_stance_rate = check_range("max_stance_rate", max_stance_rate, 0.0, 50.0, "rad/s")
 
     def begin(self, rate: float) -> None:
         """Fresh state for a recording sampled at ``rate`` (Hz)."""
@@ -311,7 +328,10 @@ class DGP(Detector):
 
     def _advance(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
         s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
-        s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing, self._max_swing)
+        moving = None
+        if self.max_stance_rate > 0.0:
+            moving = np.einsum("ij,ij->i", gyr, gyr) > self.max_stance_rate**2
+        s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing, self._max_swing, moving)
         return s_c, d_g, s_d, max_cd, th, stance
 
     def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
