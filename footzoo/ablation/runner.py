@@ -18,7 +18,6 @@ How a study runs:
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import math
@@ -35,7 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .study import Cell, Study
+from .study import Cell, Study, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
 CACHE_FORMAT = "footzoo-ablation-cache/2"
@@ -92,17 +91,6 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
 
 
 # --------------------------------------------------------------------------- cache entries
-
-
-@functools.lru_cache(maxsize=1)
-def code_fingerprint() -> str:
-    """SHA-256 over footzoo's own source files: a failed cell is retried once it changes."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for f in sorted(root.rglob("*.py")):
-        h.update(str(f.relative_to(root)).encode())
-        h.update(f.read_bytes())
-    return h.hexdigest()
 
 
 def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:

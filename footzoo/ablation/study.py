@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import functools
 import glob
 import hashlib
 import itertools
@@ -50,6 +51,17 @@ METRICS: dict[str, str] = {
 
 _FILE_DIGESTS: dict[tuple[str, int, int], str] = {}  # (path, size, mtime_ns) -> sha256 of the content
 
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """SHA-256 over footzoo's own source files (part of every cache key)."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
 
 @dataclass
 class RecordingSpec:
@@ -161,10 +173,15 @@ class Study:
             raise ConfigError(f"{p}: {err}") from None
 
     def code_identity(self) -> str:
-        """footzoo's version and the SHA-256 of every plug-in's source: part of every cache key."""
+        """footzoo's version and source, and every plug-in's source (SHA-256): part of every cache key.
+
+        With footzoo's own source in the key, a result computed before an edit of a built-in
+        plug-in (an editable install, a benchmark) is never read back as if it were current.
+        """
         from .._version import __version__
 
-        return json.dumps({"footzoo": __version__, "plugins": source_hash(self.plugins)}, sort_keys=True)
+        return json.dumps({"footzoo": __version__, "source": code_fingerprint(),
+                           "plugins": source_hash(self.plugins)}, sort_keys=True)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
