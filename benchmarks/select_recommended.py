@@ -253,7 +253,7 @@ def write_config(cfg: dict[str, Any], cv: dict[str, Any]) -> None:
     header = [
         "# footzoo's recommended setting for foot-mounted IMUs (not a paper's): one fixed setting for walking,",
         "# running, slow unusual motion and any sensor mounting. Chosen by benchmarks/select_recommended.py:",
-        "# a small grid (stance detector type and threshold x zero-velocity Kalman filter noise x RTS smoothing)",
+        "# a small grid (detector type and threshold x Kalman filter noise x RTS smoothing x swing guard)",
         "# on the 36 PyShoe VICON trials, scored per motion class, selected by leave-one-motion-class-out",
         "# cross-validation (never per trial); see benchmarks/recommended_selection.md.",
         f"# Cross-validated: median ratio to PyShoe's per-trial best {cv['median ratio']:.2f}, "
