@@ -149,3 +149,22 @@ def test_pyshoe_strides_walking_and_running_match_the_hand_counts():
         imu, t = m["imu"], m["ts"].ravel()
         found = len(intervals(SpeedAdaptiveSHOE().detect(t, imu[:, :3], imu[:, 3:]).stance_)) - 1
         assert abs(found - row["n_strides_manual_koroglu"]) <= 0.2 * row["n_strides_manual_koroglu"], trial
+
+
+@pytest.mark.parametrize("experiment", [31, 32, 33])
+def test_koroglu_strides_exact_and_no_stance_in_mid_swing(experiment):
+    """Köroğlu's walks (200 Hz): the hand-counted strides exactly.
+
+    In experiment 33 a dip of SHOE's statistic in mid-swing (10 ms, 0.55 s after the stance
+    before it) passes the raised threshold; the strapdown sees the foot moving there, faster
+    than ``still_speed``, so it is no stance: after the first step no two stances start within
+    0.4 s of each other.
+    """
+    rec = footzoo.load(data_file("koroglu_gcp", f"SensorConnectData_{experiment}.csv"), format="sensorconnect")
+    if experiment == 33:
+        d = SpeedAdaptiveSHOE().detect(rec.t, rec.acc, rec.gyr)
+        onsets = rec.t[intervals(d.stance_)[:, 0]]
+        assert np.diff(onsets)[2:].min() > 0.4
+    cfg = {"name": "x", "orientation": {"type": "ins"}, "detector": {"type": "speed_adaptive_shoe"},
+           "corrections": [{"type": "zupt"}]}
+    assert footzoo.Pipeline.from_dict(cfg).run(rec).metrics["stride_count_error"] == 0

@@ -196,7 +196,8 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
        (:func:`swing_speeds`; yaw-free, levelled on the stance before it);
     3. the final test ``T_k < γ_k`` with ``γ_k = min(γ_0 exp(v_k / v_s), γ_max)``, where
        ``v_k`` is the largest peak speed of the swings within ``REACH`` (0.5 s) of
-       sample k (:func:`speed_per_sample`); swings shorter than ``min_swing`` are
+       sample k (:func:`speed_per_sample`), for samples the strapdown does not see moving
+       faster than ``still_speed`` (a dip of the test in mid-swing is no stance); swings shorter than ``min_swing`` are
        closed where the foot stayed slower than ``still_speed`` (:func:`close_still_gaps`),
        and of two stances closer than ``min_swing`` the shorter, if shorter than that, is
        a pause in the air (:func:`drop_pauses`).
@@ -226,7 +227,9 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
     speed_scale : float
         v_s (m/s): the threshold grows by e per v_s of swing speed.
     still_speed : float
-        A short swing is closed only if the foot stayed slower than this (m/s).
+        Fastest a stance sample can move by the provisional swing's strapdown (m/s); a short
+        swing is closed only if the foot stayed slower. 1 m/s: 0.5 m/s rejected real running
+        stances, where the dedrift of a swing with missed stances leaves that much error.
     min_swing : float
         Shortest swing (s), as for ``adaptive_shoe``.
 
@@ -255,7 +258,7 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
 
     def __init__(self, threshold: float = 3e3, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.2, max_threshold: float = 1e6,
-                 speed_scale: float = 1.0, still_speed: float = 0.5, min_swing: float = 0.15):
+                 speed_scale: float = 1.0, still_speed: float = 1.0, min_swing: float = 0.15):
         super().__init__(threshold, window, sigma_a, sigma_g, time_constant, max_threshold, min_swing)
         self.speed_scale = check_range("speed_scale", speed_scale, 1e-3, 100.0, "m/s")
         self.still_speed = check_range("still_speed", still_speed, 0.0, 100.0, "m/s")
@@ -274,7 +277,9 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
         self.speed_ = speed_per_sample(t, starts, ends, peaks, self.REACH)
         self.threshold_ = np.minimum(self.threshold * np.exp(self.speed_ / self.speed_scale), g_max)
-        closed = close_still_gaps(self.statistic_ < self.threshold_, min_swing, speed, self.still_speed)
+        # a sample the strapdown sees moving faster than still_speed is no stance, whatever the test says
+        candidate = (self.statistic_ < self.threshold_) & (speed <= self.still_speed)
+        closed = close_still_gaps(candidate, min_swing, speed, self.still_speed)
         self.stance_ = drop_pauses(closed, min_swing)
         self.stance_online_ = self.stance_.copy()
         return self
