@@ -1,0 +1,66 @@
+"""Compiled replacements give the numbers of the numpy code they replaced.
+
+Each ``_reference_*`` below is the previous implementation, kept verbatim, run on
+simulated walks (with a magnetic disturbance where it matters) and on random data.
+Speed itself: benchmarks/.
+"""
+
+import numpy as np
+import pytest
+
+from footzoo.conventions import GRAVITY
+from footzoo.orientation.magnetic import REFERENCE_DURATION, field_norm_and_dip, magnetometer_valid
+from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+
+def _reference_magnetometer_valid(t, acc, mag, still, norm_tolerance, dip_tolerance):
+    mn, dip = field_norm_and_dip(acc, mag)
+    still = np.asarray(still, dtype=bool)
+    n_lead = int(np.argmin(still)) if not still.all() else still.size
+    ref = (t - t[0] <= REFERENCE_DURATION) & (np.arange(t.size) < n_lead)
+    if ref.sum() < 2:
+        ref = t - t[0] <= 0.5
+    norm_ref = float(np.median(mn[ref]))
+    dip_ref = float(np.median(dip[ref]))
+    quiet = np.abs(np.linalg.norm(acc, axis=1) - GRAVITY) < 0.1 * GRAVITY
+    valid = np.abs(mn - norm_ref) <= norm_tolerance * norm_ref
+    valid &= ~quiet | (np.abs(dip - dip_ref) <= dip_tolerance)
+    return valid, norm_ref, dip_ref
+
+
+@pytest.fixture(scope="module")
+def disturbed_walk():
+    dist = MagneticDisturbance(field=(0.0, 0.25, 0.0), north=(35.0, 41.0), east=(-1.0, 3.0))
+    return simulate(path="rectangle", profile="physical", rate=100.0, disturbance=dist, noise=NoiseModel(seed=3))
+
+
+@pytest.mark.parametrize("lead", [0, 1, 60, 10_000])
+@pytest.mark.parametrize("tolerances", [(0.1, np.radians(5.0)), (0.02, np.radians(1.0)), (0.3, 0.2)])
+def test_magnetometer_check_equals_the_numpy_code(disturbed_walk, lead, tolerances):
+    r = disturbed_walk
+    from footzoo.registry import build
+
+    still = build("detector", {"type": "windowed"}).detect(r.t, r.acc, r.gyr).stance_.copy()
+    still[:lead] = True  # leading still runs of several lengths, also none and all
+    if lead == 0:
+        still[0] = False
+    got = magnetometer_valid(r.t, r.acc, r.mag, still, *tolerances)
+    want = _reference_magnetometer_valid(r.t, r.acc, r.mag, still, *tolerances)
+    assert 0 < want[0].sum() < len(r.t)  # both outcomes occur
+    np.testing.assert_array_equal(got[0], want[0])
+    assert got[1:] == want[1:]
+
+
+def test_magnetometer_check_equals_the_numpy_code_on_random_fields():
+    rng = np.random.default_rng(7)
+    n = 20_000
+    t = np.cumsum(rng.uniform(0.004, 0.006, n))
+    acc = rng.normal([0.0, 0.0, -GRAVITY], 1.0, (n, 3))
+    mag = rng.normal([0.2, 0.0, 0.4], 0.03, (n, 3))
+    for still in (rng.random(n) < 0.5, np.ones(n, bool), np.zeros(n, bool)):
+        got = magnetometer_valid(t, acc, mag, still, 0.1, np.radians(5.0))
+        want = _reference_magnetometer_valid(t, acc, mag, still, 0.1, np.radians(5.0))
+        np.testing.assert_array_equal(got[0], want[0])
+        assert got[1:] == want[1:]
