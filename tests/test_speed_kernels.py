@@ -64,3 +64,29 @@ def test_magnetometer_check_equals_the_numpy_code_on_random_fields():
         want = _reference_magnetometer_valid(t, acc, mag, still, 0.1, np.radians(5.0))
         np.testing.assert_array_equal(got[0], want[0])
         assert got[1:] == want[1:]
+
+
+@pytest.mark.parametrize("name", ["shoe", "ared", "amvd", "mbgtd", "huang_stance", "adaptive_shoe"])
+@pytest.mark.parametrize("rate", [100.0, 200.0])
+def test_skog_statistics_in_the_window_pass_equal_the_tests_on_the_moments(name, rate):
+    """The fused window pass gives the statistic of ``test(window_moments(...))``, the previous path, to the bit."""
+    from footzoo.conventions import GRAVITY as G
+    from footzoo.detectors.windows import window_moments
+    from footzoo.registry import build
+
+    r = simulate(n_strides=20, rate=rate, profile="physical", path="mixed_speed", noise=NoiseModel(seed=5))
+    det = build("detector", {"type": name, "window": 0.04}).detect(r.t, r.acc, r.gyr)
+    m = window_moments(np.ascontiguousarray(r.acc), np.ascontiguousarray(r.gyr), det.window_samples_, G)
+    np.testing.assert_array_equal(det.statistic_, det.test(m))
+
+
+def test_a_subclass_with_its_own_test_gets_the_moments():
+    from footzoo.detectors.shoe import SHOE
+
+    class Louder(SHOE):
+        def test(self, m):
+            return 2.0 * super().test(m)
+
+    r = simulate(n_strides=5, rate=100.0, profile="physical", noise=NoiseModel(seed=1))
+    np.testing.assert_array_equal(Louder().detect(r.t, r.acc, r.gyr).statistic_,
+                                  2.0 * SHOE().detect(r.t, r.acc, r.gyr).statistic_)
