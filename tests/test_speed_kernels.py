@@ -90,3 +90,30 @@ def test_a_subclass_with_its_own_test_gets_the_moments():
     r = simulate(n_strides=5, rate=100.0, profile="physical", noise=NoiseModel(seed=1))
     np.testing.assert_array_equal(Louder().detect(r.t, r.acc, r.gyr).statistic_,
                                   2.0 * SHOE().detect(r.t, r.acc, r.gyr).statistic_)
+
+
+def test_the_finite_check_without_a_temporary_equals_isfinite_all():
+    from footzoo.plugin import _all_finite
+
+    rng = np.random.default_rng(0)
+    big = np.finfo(float).max
+    cases = [rng.normal(size=(50, 3)), np.array([1.0, np.nan]), np.array([np.inf, -np.inf]), np.array([big, big]),
+             np.array([big, big, np.nan]), np.array([-big, big, 1.0]), np.zeros((0, 3)), np.array([1 + 2j, np.nan]),
+             rng.normal(size=(20, 4)).astype(np.float32), np.array([np.inf])]
+    for x in cases:
+        assert _all_finite(x) == bool(np.isfinite(x).all())
+
+
+def test_the_sample_table_wraps_the_outputs_and_copies_time_and_stance():
+    from footzoo._table import samples_frame
+
+    r = simulate(n_strides=5, rate=100.0, profile="physical", noise=NoiseModel(seed=2))
+    q, pos, vel = r.truth.quat.copy(), r.truth.pos.copy(), r.truth.vel.copy()
+    acc = np.zeros_like(pos)
+    frame = samples_frame(r.t, q, pos, vel, acc, r.truth.stance)
+    assert np.shares_memory(frame["qx"].to_numpy(), q) and np.shares_memory(frame["vel_d"].to_numpy(), vel)
+    assert not np.shares_memory(frame["t"].to_numpy(), r.t)
+    assert not np.shares_memory(frame["stance"].to_numpy(), r.truth.stance)
+    np.testing.assert_array_equal(frame[["pos_n", "pos_e", "pos_d"]].to_numpy(), pos)
+    with pytest.raises(ValueError, match="shape"):
+        samples_frame(r.t, q[:, :3], pos, vel, acc, r.truth.stance)
