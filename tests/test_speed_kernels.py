@@ -117,3 +117,87 @@ def test_the_sample_table_wraps_the_outputs_and_copies_time_and_stance():
     np.testing.assert_array_equal(frame[["pos_n", "pos_e", "pos_d"]].to_numpy(), pos)
     with pytest.raises(ValueError, match="shape"):
         samples_frame(r.t, q[:, :3], pos, vel, acc, r.truth.stance)
+
+
+def _reference_segment_argext(x, lo, hi, largest):
+    if len(lo) == 0:
+        return np.zeros(0, dtype=np.int64)
+    lengths = hi - lo
+    offsets = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+    idx = np.arange(int(lengths.sum()), dtype=np.int64) - np.repeat(offsets - lo, lengths)
+    values = x[idx]
+    ext = (np.maximum if largest else np.minimum).reduceat(values, offsets)
+    hit = np.flatnonzero(values == np.repeat(ext, hi - lo))
+    first = hit[np.searchsorted(hit, offsets)]
+    return idx[first]
+
+
+def _reference_gait_events(t, gyr, stances):
+    w = np.asarray(gyr, dtype=float)[:, 1]
+    n = len(t)
+    ts = np.asarray(t, dtype=float)
+    dt = np.diff(ts)
+    t = ts - 0.5 * np.concatenate([[np.median(dt)], dt])
+    k = len(stances) - 1
+    a, b = stances[:, 0], stances[:, 1]
+    mid = (a + b - 1) // 2
+    sw0, sw1 = b[:-1], a[1:]
+    p = _reference_segment_argext(w, np.minimum(sw0, n - 1), np.maximum(sw1, sw0 + 1), largest=True)
+    to_lo = np.minimum(mid[:-1], p)
+    j = _reference_segment_argext(w, to_lo, np.maximum(p, to_lo + 1), largest=False)
+    down = np.flatnonzero((w[:-1] > 0.0) & (w[1:] <= 0.0)) + 1
+    pos = np.searchsorted(down, p + 1)
+    c = down[np.minimum(pos, max(len(down) - 1, 0))] if len(down) else np.full(k, n)
+    ok = (pos < len(down)) & (c <= mid[1:]) & (w[p] > 0.0) & (w[j] < 0.0)
+    c = np.where(ok, c, 1)
+    den_c = w[c - 1] - w[c]
+    frac = np.where(ok, w[c - 1] / np.where(ok, den_c, 1.0), 0.0)
+    ic = t[c - 1] + frac * (t[c] - t[c - 1])
+    jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
+    den = w[jl] - 2.0 * w[j] + w[jr]
+    shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
+    shift = np.clip(shift, -0.5, 0.5)
+    dt = np.where(shift >= 0, t[jr] - t[j], t[j] - t[jl])
+    to = t[j] + shift * dt
+    to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])
+    ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
+    return to, ic, ok
+
+
+def test_segment_argext_equals_the_reduceat_code():
+    from footzoo.analysis.gait_events import segment_argext
+
+    rng = np.random.default_rng(4)
+    x = np.round(rng.normal(size=2000), 1)  # many ties
+    lo = np.sort(rng.integers(0, 1990, 300))
+    hi = lo + rng.integers(1, 10, 300)
+    # the steps table's highest point: the first minimum of pos_d is the first maximum of -pos_d
+    np.testing.assert_array_equal(segment_argext(x, lo, hi, False), _reference_segment_argext(-x, lo, hi, True))
+    for largest in (True, False):
+        np.testing.assert_array_equal(segment_argext(x, lo, hi, largest), _reference_segment_argext(x, lo, hi, largest))
+        np.testing.assert_array_equal(segment_argext(x[::2], lo // 2, np.maximum(hi // 2, lo // 2 + 1), largest),
+                                      _reference_segment_argext(x[::2], lo // 2, np.maximum(hi // 2, lo // 2 + 1),
+                                                                largest))
+
+
+@pytest.mark.parametrize("scenario", [
+    {"path": "mixed_speed", "rate": 100.0}, {"path": "stairs", "rate": 200.0}, {"path": "rectangle", "rate": 50.0}])
+@pytest.mark.parametrize("flip", [False, True])
+def test_gait_events_equal_the_vectorised_code(scenario, flip):
+    """The compiled searches and the mid-interval times of the event samples give the previous events to the bit."""
+    from footzoo.analysis.gait_events import detect_gait_events
+    from footzoo.analysis.strides import real_stances
+    from footzoo.registry import build
+
+    r = simulate(profile="physical", noise=NoiseModel(seed=6), n_strides=30, **scenario)
+    t = r.t + np.cumsum(np.random.default_rng(1).uniform(0.0, 1e-4, len(r.t)))  # uneven intervals
+    gyr = -r.gyr if flip else r.gyr  # upside down: no pattern, the fallbacks
+    stance = build("detector", {"type": "shoe"}).detect(t, r.acc, gyr).stance_
+    st = real_stances(stance, r.truth.pos)
+    for stances in (st, np.vstack([[0, 1], st]), st[:2]):
+        ev = detect_gait_events(t, gyr, stances)
+        to, ic, ok = _reference_gait_events(t, gyr, stances)
+        np.testing.assert_array_equal(ev.from_rate, ok)
+        np.testing.assert_array_equal(ev.to, to)
+        np.testing.assert_array_equal(ev.ic, ic)
+    assert 0 < ok.sum() or flip
