@@ -201,3 +201,48 @@ def test_gait_events_equal_the_vectorised_code(scenario, flip):
         np.testing.assert_array_equal(ev.to, to)
         np.testing.assert_array_equal(ev.ic, ic)
     assert 0 < ok.sum() or flip
+
+
+def _reference_dated_and_online_states(candidate, min_samples, initial=True):
+    c = np.asarray(candidate, dtype=bool)
+    n = c.shape[0]
+    g = max(int(min_samples), 1)
+    idx = np.arange(n)
+
+    def runs(x):
+        change = np.flatnonzero(x[1:] != x[:-1]) + 1
+        starts = np.concatenate([[0], change]).astype(np.int64)
+        return starts, np.diff(np.concatenate([starts, [n]]))
+
+    def fill(x, switch_at, value_at):
+        src = np.full(n, -1)
+        src[switch_at] = idx[value_at]
+        src = np.maximum.accumulate(src)
+        return np.where(src >= 0, x[np.maximum(src, 0)], initial)
+
+    starts, lengths = runs(c)
+    long_starts = starts[lengths >= g]
+    online = fill(c, long_starts + g - 1, long_starts)
+    short_still = c[starts] & (lengths < g) & (starts > 0) & (starts + lengths < n)
+    still = c & ~np.repeat(short_still, lengths)
+    starts, lengths = runs(still)
+    long_starts = starts[lengths >= g]
+    dated = fill(still, long_starts, long_starts)
+    return dated, online
+
+
+@pytest.mark.parametrize("min_samples", [0, 1, 2, 3, 5, 12])
+@pytest.mark.parametrize("initial", [True, False])
+def test_two_state_machine_equals_the_vectorised_code(min_samples, initial):
+    from footzoo.detectors.runs import dated_and_online_states
+
+    rng = np.random.default_rng(min_samples)
+    cases = [rng.random(3000) < p for p in (0.1, 0.5, 0.9)]
+    cases += [np.repeat(rng.random(400) < 0.5, rng.integers(1, 9, 400)), np.zeros(7, bool), np.ones(7, bool),
+              np.array([True]), np.array([False, True, True, False])]
+    for c in cases:
+        got = dated_and_online_states(c, min_samples, initial)
+        want = _reference_dated_and_online_states(c, min_samples, initial)
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
+        assert got[0].dtype == got[1].dtype == bool
