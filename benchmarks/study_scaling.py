@@ -181,9 +181,9 @@ def figure_cpu(s: Study, out: Path, table) -> list[float]:
             runs.append({**rec, "recording": row["recording"], "base": row["base"]})
     costs = []
     with tempfile.TemporaryDirectory() as tmp:
-        for t, r, f in report.figure_tasks(table, runs, list(s.factors)):
+        for task in report.figure_tasks(table, runs, list(s.factors)):
             c0 = time.process_time()
-            report.plot_study(t, r, f, Path(tmp))
+            report.draw_figure(task, Path(tmp))
             costs.append(time.process_time() - c0)
     return costs
 

@@ -75,12 +75,42 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
 
 
 def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> list[tuple]:
-    """:func:`plot_study` split into independent calls whose figures together are the whole call's.
+    """:func:`plot_study` as independent one-figure tasks for :func:`draw_figure`, in its order.
 
-    The trajectories and the threshold sweep need the runs but no metric rows (an empty table);
-    the metric plots of one factor need the table but no runs.
+    Each task carries only what its figure reads (the runs of one recording, the rows of one
+    metric, the threshold sweeps), so the tasks are cheap to send to worker processes and can
+    be shared out evenly; their figures together are the whole call's, labels included.
     """
-    return [(table.iloc[:0], runs, factors)] + [(table, [], [f]) for f in factors]
+    tasks: list[tuple] = []
+    labels = run_labels(runs, factors)
+    for rec in sorted({r["recording"] for r in runs}):
+        mine = [r for r in runs if r["recording"] == rec]
+        tasks.append(("trajectories", mine, {r["key"]: labels[r["key"]] for r in mine}, rec))
+    ok = table[table["metric"].notna()]
+    for f in factors:
+        for metric in sorted(ok["metric"].unique()):
+            tasks.append(("metric", ok[ok["metric"] == metric], f, metric))
+    detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
+    sweeps = [{k: r[k] for k in ("key", "recording", "roc") if k in r} for r in runs]
+    tasks.append(("roc", sweeps, run_labels(runs, factors, only=detector_factors or None)))
+    return tasks
+
+
+def draw_figure(task: tuple, out: Path) -> Path | None:
+    """Draw and save one task of :func:`figure_tasks` into ``out``; the file written, or None (nothing to draw)."""
+    from ..plots import save
+
+    kind = task[0]
+    if kind == "trajectories":
+        _, runs, labels, rec = task
+        fig, name = trajectories_figure(runs, labels, rec), f"trajectories_{_safe(rec)}.png"
+    elif kind == "metric":
+        _, rows, factor, metric = task
+        fig, name = metric_figure(rows, factor, metric), f"metric_{_safe(metric)}_by_{_safe(factor)}.png"
+    else:
+        _, runs, labels = task
+        fig, name = roc_figure(runs, labels), "roc.png"
+    return None if fig is None else save(fig, Path(out) / name)
 
 
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
@@ -92,7 +122,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         from joblib import Parallel, delayed
 
         figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
-            delayed(plot_study)(t, r, f, out) for t, r, f in figure_tasks(table, runs, factors))
+            delayed(draw_figure)(task, out) for task in figure_tasks(table, runs, factors))
     table.to_csv(out / "results.csv", index=False)
     _to_parquet(table, out / "results.parquet")
     step(1)
@@ -268,28 +298,11 @@ def metric_label(metric: str) -> str:
 def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> list[Path]:
     """Trajectories per recording, each metric per factor level, ROC of the detectors' threshold sweeps.
 
-    Returns the files written.
+    Returns the files written. The figures are the tasks of :func:`figure_tasks`, drawn in order.
     """
-    from ..plots import save
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    written = []
-    labels = run_labels(runs, factors)
-    for rec in sorted({r["recording"] for r in runs}):
-        fig = trajectories_figure([r for r in runs if r["recording"] == rec], labels, rec)
-        if fig is not None:
-            written.append(save(fig, out / f"trajectories_{_safe(rec)}.png"))
-    ok = table[table["metric"].notna()]
-    for f in factors:
-        for metric in sorted(ok["metric"].unique()):
-            fig = metric_figure(ok[ok["metric"] == metric], f, metric)
-            written.append(save(fig, out / f"metric_{_safe(metric)}_by_{_safe(f)}.png"))
-    detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
-    fig = roc_figure(runs, run_labels(runs, factors, only=detector_factors or None))
-    if fig is not None:
-        written.append(save(fig, out / "roc.png"))
-    return written
+    return [p for p in (draw_figure(task, out) for task in figure_tasks(table, runs, factors)) if p is not None]
 
 
 def _grid(plt, n: int, size: float = 2.6, max_cols: int = 8):
