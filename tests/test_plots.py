@@ -380,3 +380,8 @@ def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
     for p in old:
         assert (tmp_path / "new" / p.name).read_bytes() == p.read_bytes()
     assert [p.name for p in plot_study(table, runs, FACTORS, tmp_path / "again")] == [p.name for p in old]
+    from footzoo.ablation.report import render_figure
+
+    drawn = [d for d in (render_figure(t) for t in tasks) if d is not None]  # in memory, as on a Dask worker
+    assert [name for name, _ in drawn] == [p.name for p in old]
+    assert all(data == (tmp_path / "old" / name).read_bytes() for name, data in drawn)

@@ -7,6 +7,7 @@ import os
 import shutil
 import tempfile
 import textwrap
+import threading
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -53,20 +54,22 @@ def _fmt(v: Any, digits: int) -> str:
 
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                  step: Callable[[int], Any] | None = None, jobs: int = 1) -> None:
+                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: str | None = None) -> None:
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
     Everything is written into a staging folder first and then moved into ``out`` file by file
     (atomic renames): an interrupted report or two studies writing into one folder never leave a
     half-written file. With ``jobs`` other than 1 the figures are drawn by that many local worker
-    processes (see :func:`figure_tasks`) while this process writes the tables.
+    processes (see :func:`figure_tasks`) while this process writes the tables; with ``scheduler``
+    (a Dask scheduler's address) the cluster's workers draw them in memory
+    (:func:`render_figure`) and this process writes the files, since the workers may not see ``out``.
     """
     step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
-        _write_outputs(table, runs, factors, staging, step, jobs)
+        _write_outputs(table, runs, factors, staging, step, jobs, scheduler)
         for f in sorted(staging.iterdir()):
             if f.is_file():
                 os.replace(f, out / f.name)
@@ -96,33 +99,74 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
     return tasks
 
 
+def _figure(task: tuple) -> tuple[Any, str]:
+    """The figure of one task of :func:`figure_tasks` (None: nothing to draw) and its file name."""
+    kind = task[0]
+    if kind == "trajectories":
+        _, runs, labels, rec = task
+        return trajectories_figure(runs, labels, rec), f"trajectories_{_safe(rec)}.png"
+    if kind == "metric":
+        _, rows, factor, metric = task
+        return metric_figure(rows, factor, metric), f"metric_{_safe(metric)}_by_{_safe(factor)}.png"
+    _, runs, labels = task
+    return roc_figure(runs, labels), "roc.png"
+
+
 def draw_figure(task: tuple, out: Path) -> Path | None:
     """Draw and save one task of :func:`figure_tasks` into ``out``; the file written, or None (nothing to draw)."""
     from ..plots import save
 
-    kind = task[0]
-    if kind == "trajectories":
-        _, runs, labels, rec = task
-        fig, name = trajectories_figure(runs, labels, rec), f"trajectories_{_safe(rec)}.png"
-    elif kind == "metric":
-        _, rows, factor, metric = task
-        fig, name = metric_figure(rows, factor, metric), f"metric_{_safe(metric)}_by_{_safe(factor)}.png"
-    else:
-        _, runs, labels = task
-        fig, name = roc_figure(runs, labels), "roc.png"
+    fig, name = _figure(task)
     return None if fig is None else save(fig, Path(out) / name)
 
 
+#: pyplot and its rcParams are per process, not per thread: a worker with several threads draws one figure at a time.
+_DRAWING = threading.Lock()
+
+
+def render_figure(task: tuple) -> tuple[str, bytes] | None:
+    """One task of :func:`figure_tasks` drawn in memory: its file name and the bytes :func:`draw_figure` would write."""
+    from ..plots import png_bytes
+
+    with _DRAWING:
+        fig, name = _figure(task)
+        return None if fig is None else (name, png_bytes(fig))
+
+
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                   step: Callable[[int], Any], jobs: int = 1) -> None:
+                   step: Callable[[int], Any], jobs: int = 1, scheduler: str | None = None) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
+    if scheduler is not None:
+        from dask.distributed import Client, as_completed
+
+        with Client(scheduler) as client:  # the workers draw while this process writes the tables
+            futures = client.map(render_figure, figure_tasks(table, runs, factors), pure=False)
+            _write_tables(table, runs, factors, out, step)
+            for fut in as_completed(futures):
+                drawn = fut.result()
+                if drawn is not None:
+                    (out / drawn[0]).write_bytes(drawn[1])
+        step(1)
+        return
     figures = None
     if jobs != 1:  # started first: the workers draw while this process writes the tables
         from joblib import Parallel, delayed
 
         figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
             delayed(draw_figure)(task, out) for task in figure_tasks(table, runs, factors))
+    _write_tables(table, runs, factors, out, step)
+    if figures is None:
+        plot_study(table, runs, factors, out)
+    else:
+        for _ in figures:
+            pass
+    step(1)
+
+
+def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                  step: Callable[[int], Any]) -> None:
+    """The tidy table, the trajectories and sweeps, the summaries (``step(1)`` after each)."""
     table.to_csv(out / "results.csv", index=False)
     _to_parquet(table, out / "results.parquet")
     step(1)
@@ -140,12 +184,6 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         md.append("## failed runs\n\n" + to_markdown(errors))
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.tex").write_text("\n".join(tex))
-    step(1)
-    if figures is None:
-        plot_study(table, runs, factors, out)
-    else:
-        for _ in figures:
-            pass
     step(1)
 
 

@@ -390,9 +390,9 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
         else:
-            # figures on the local workers with jobs: N; with a Dask scheduler the workers may not see `out`
+            # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
-                          jobs=jobs if scheduler is None else 1)
+                          jobs=jobs if scheduler is None else 1, scheduler=scheduler)
             _write_manifest(Path(out), digest)
     return table
 
