@@ -54,7 +54,7 @@ def _fmt(v: Any, digits: int) -> str:
 
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: str | None = None) -> None:
+                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: Any = None) -> None:
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
@@ -62,7 +62,7 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     (atomic renames): an interrupted report or two studies writing into one folder never leave a
     half-written file. With ``jobs`` other than 1 the figures are drawn by that many local worker
     processes (see :func:`figure_tasks`) while this process writes the tables; with ``scheduler``
-    (a Dask scheduler's address) the cluster's workers draw them in memory
+    (a Dask scheduler's address, or a connected ``Client``) the cluster's workers draw them in memory
     (:func:`render_figure`) and this process writes the files, since the workers may not see ``out``.
     """
     step = step or (lambda n: None)
@@ -134,13 +134,16 @@ def render_figure(task: tuple) -> tuple[str, bytes] | None:
 
 
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                   step: Callable[[int], Any], jobs: int = 1, scheduler: str | None = None) -> None:
+                   step: Callable[[int], Any], jobs: int = 1, scheduler: Any = None) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
     if scheduler is not None:
+        import contextlib
+
         from dask.distributed import Client, as_completed
 
-        with Client(scheduler) as client:  # the workers draw while this process writes the tables
+        connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
+        with connected as client:  # the workers draw while this process writes the tables
             futures = client.map(render_figure, figure_tasks(table, runs, factors), pure=False)
             _write_tables(table, runs, factors, out, step)
             for fut in as_completed(futures):
