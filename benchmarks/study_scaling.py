@@ -16,8 +16,9 @@ measured too: the main process's (``time.process_time``) and each run's in its w
 in the cache entries, loading the recording included). From them, the time the same work would
 take on two otherwise idle cores: the main process's CPU plus the makespan of the chunks
 dispatched to two workers in order (each to the first free worker, as joblib and Dask do); with
-joblib the figures are drawn by the workers while the main process writes the tables, so the
-figure tasks are timed again one by one afterwards and scheduled the same way.
+joblib and Dask the figures are drawn by the workers while the main process writes the tables
+(with Dask in memory, the main process writing the files), so the figure tasks are timed again
+one by one afterwards and scheduled the same way.
 """
 
 from __future__ import annotations
@@ -111,7 +112,7 @@ def main() -> None:
                     workers = 1 if name == "serial" else 2
                     runs = main_cpu - REPORT_CPU[-1] + (makespan(s, out, workers) if workers > 1 else 0.0)
                     report_time = REPORT_CPU[-1]
-                    if name.startswith("joblib"):  # the workers draw the figures while the main writes tables
+                    if workers > 1:  # the workers draw the figures while the main process writes the tables
                         report_time = max(report_time, lpt(figure_cpu(s, out, tables[name]), workers))
                     idle[name].append(runs + report_time)
                     runs_only[name].append(runs)
@@ -181,9 +182,9 @@ def figure_cpu(s: Study, out: Path, table) -> list[float]:
             runs.append({**rec, "recording": row["recording"], "base": row["base"]})
     costs = []
     with tempfile.TemporaryDirectory() as tmp:
-        for t, r, f in report.figure_tasks(table, runs, list(s.factors)):
+        for task in report.figure_tasks(table, runs, list(s.factors)):
             c0 = time.process_time()
-            report.plot_study(t, r, f, Path(tmp))
+            report.draw_figure(task, Path(tmp))
             costs.append(time.process_time() - c0)
     return costs
 

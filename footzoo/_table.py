@@ -1,8 +1,10 @@
-"""The per-sample table of a :class:`~footzoo.data.Result`, built in one compiled pass.
+"""The per-sample table of a :class:`~footzoo.data.Result`, wrapped around the stages' outputs.
 
-The float columns are written into one ``(17, N)`` block that the DataFrame
-wraps without copying (pandas stores a frame's columns as the rows of such a
-block), so the table costs 137 bytes per sample and no temporaries.
+The attitude, position, velocity and acceleration arrays that the stages wrote are
+the table's columns as they are (the DataFrame keeps a view of each column, no
+copy); only the Z-Y-X Euler angles are new, computed in one compiled pass, and the
+time and stance columns are copied so the table does not alias the recording.
+A table costs 33 bytes per sample beyond the stages' outputs, and no pass over them.
 """
 
 from __future__ import annotations
@@ -19,25 +21,28 @@ FLOAT_COLUMNS = ["t", "qw", "qx", "qy", "qz", "roll", "pitch", "yaw", "pos_n", "
 
 
 @njit
-def _fill(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, vel: np.ndarray, acc: np.ndarray,
-          out: np.ndarray) -> None:
-    """Copy the signals into ``out`` (17, N) and add the Z-Y-X Euler angles (as ``conventions.quat_to_euler``)."""
-    for k in range(t.shape[0]):
+def _euler(quat: np.ndarray, out: np.ndarray) -> None:
+    """Z-Y-X Euler angles (rad) into ``out`` (3, N): roll, pitch, yaw (as ``conventions.quat_to_euler``)."""
+    for k in range(quat.shape[0]):
         w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
-        out[0, k] = t[k]
-        out[1, k], out[2, k], out[3, k], out[4, k] = w, x, y, z
-        out[5, k] = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-        out[6, k] = math.asin(min(max(2 * (w * y - x * z), -1.0), 1.0))
-        out[7, k] = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-        for j in range(3):
-            out[8 + j, k] = pos[k, j]
-            out[11 + j, k] = vel[k, j]
-            out[14 + j, k] = acc[k, j]
+        out[0, k] = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+        out[1, k] = math.asin(min(max(2 * (w * y - x * z), -1.0), 1.0))
+        out[2, k] = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def _as_float(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.shape != shape:
+        raise ValueError(f"samples_frame: expected an array of shape {shape}, got {a.shape}")
+    return a
 
 
 def samples_frame(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, vel: np.ndarray, acc_nav: np.ndarray,
                   stance: np.ndarray) -> pd.DataFrame:
     """The ``Result.samples`` table.
+
+    ``quat``, ``pos``, ``vel`` and ``acc_nav`` become the table's columns without a copy
+    (pass arrays nothing else writes to afterwards).
 
     Parameters
     ----------
@@ -57,10 +62,11 @@ def samples_frame(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, vel: np.ndar
         ``vel_n .. vel_d``, ``acc_n .. acc_d``, ``stance``.
     """
     n = len(t)
-    block = np.empty((len(FLOAT_COLUMNS), n))
-    _fill(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(quat, dtype=float),
-          np.ascontiguousarray(pos, dtype=float), np.ascontiguousarray(vel, dtype=float),
-          np.ascontiguousarray(acc_nav, dtype=float), block)
-    frame = pd.DataFrame(block.T, columns=FLOAT_COLUMNS, copy=False)
-    frame["stance"] = np.array(stance, dtype=bool)
-    return frame
+    q = _as_float(quat, (n, 4))
+    euler = np.empty((3, n))
+    _euler(q, euler)
+    columns = [np.array(t, dtype=float), *q.T, *euler, *_as_float(pos, (n, 3)).T, *_as_float(vel, (n, 3)).T,
+               *_as_float(acc_nav, (n, 3)).T]
+    data = dict(zip(FLOAT_COLUMNS, columns, strict=True))
+    data["stance"] = np.array(stance, dtype=bool)
+    return pd.DataFrame(data, copy=False)

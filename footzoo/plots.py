@@ -82,6 +82,22 @@ def save(fig: Figure, path: str | Path) -> Path:
     return out
 
 
+def png_bytes(fig: Figure) -> bytes:
+    """The PNG file :func:`save` would write for ``fig`` (same settings), in memory; closes the figure.
+
+    For figures drawn by workers that cannot see the output folder (a Dask cluster): they send
+    the bytes and the client writes them.
+    """
+    import io
+
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=STYLE["savefig.dpi"], bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
 # --------------------------------------------------------------------------- helpers
 
 

@@ -315,3 +315,22 @@ def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path):
     assert len(serial) > 5 and "roc.png" in serial
     assert serial.keys() == parallel.keys()
     assert all(serial[name] == parallel[name] for name in serial)
+
+
+@pytest.mark.parametrize("processes", [False, True])
+def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, processes):
+    """The cluster's workers draw in memory (one figure at a time per process), the client writes the files."""
+    from dask.distributed import LocalCluster
+
+    study = Study.from_dict({**SMALL, "sweep": {"points": 5}})
+    run_study(study, out=tmp_path / "serial")
+    with LocalCluster(n_workers=2 if processes else 1, threads_per_worker=1 if processes else 2, processes=processes,
+                      dashboard_address=None) as cluster:
+        table = run_study(study, out=tmp_path / "dask", scheduler=cluster.scheduler_address)
+    serial = {f.name: f.read_bytes() for f in (tmp_path / "serial").glob("*.png")}
+    dask = {f.name: f.read_bytes() for f in (tmp_path / "dask").glob("*.png")}
+    assert len(serial) > 3 and "roc.png" in serial
+    assert serial.keys() == dask.keys()
+    assert all(serial[name] == dask[name] for name in serial)
+    assert (tmp_path / "dask" / "summary.md").read_text() == (tmp_path / "serial" / "summary.md").read_text()
+    assert table.attrs["failed"] == 0

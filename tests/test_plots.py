@@ -340,3 +340,48 @@ def test_one_config_without_reference(tmp_path):
     fig = study_trajectories(runs, labels, "walk_0")
     assert legend_texts(fig) == ["threshold=0.1, zupt"]
     close(fig)
+
+
+def _reference_plot_study(table, runs, factors, out):
+    """The previous plot_study, all figures in one call (the parallel report split it by factor only)."""
+    from footzoo.ablation.report import _safe, trajectories_figure
+    from footzoo.plots import save
+
+    written = []
+    labels = run_labels(runs, factors)
+    for rec in sorted({r["recording"] for r in runs}):
+        fig = trajectories_figure([r for r in runs if r["recording"] == rec], labels, rec)
+        if fig is not None:
+            written.append(save(fig, out / f"trajectories_{_safe(rec)}.png"))
+    ok = table[table["metric"].notna()]
+    for f in factors:
+        for metric in sorted(ok["metric"].unique()):
+            fig = metric_figure(ok[ok["metric"] == metric], f, metric)
+            written.append(save(fig, out / f"metric_{_safe(metric)}_by_{_safe(f)}.png"))
+    detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
+    fig = roc_figure(runs, run_labels(runs, factors, only=detector_factors or None))
+    if fig is not None:
+        written.append(save(fig, out / "roc.png"))
+    return written
+
+
+def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
+    """The report's one-figure tasks (shared out to workers) give the previous plot_study's files, byte for byte."""
+    from footzoo.ablation.report import draw_figure, figure_tasks
+
+    runs = fake_runs(4, n_recordings=3)
+    table = table_of(runs, FACTORS)
+    (tmp_path / "old").mkdir()
+    old = _reference_plot_study(table, runs, FACTORS, tmp_path / "old")
+    tasks = figure_tasks(table, runs, FACTORS)
+    assert len(tasks) == 3 + len(FACTORS) + 1  # a trajectory per recording, a metric per factor, the ROC
+    new = [p for p in (draw_figure(t, tmp_path / "new") for t in reversed(tasks)) if p is not None]
+    assert sorted(p.name for p in new) == sorted(p.name for p in old)
+    for p in old:
+        assert (tmp_path / "new" / p.name).read_bytes() == p.read_bytes()
+    assert [p.name for p in plot_study(table, runs, FACTORS, tmp_path / "again")] == [p.name for p in old]
+    from footzoo.ablation.report import render_figure
+
+    drawn = [d for d in (render_figure(t) for t in tasks) if d is not None]  # in memory, as on a Dask worker
+    assert [name for name, _ in drawn] == [p.name for p in old]
+    assert all(data == (tmp_path / "old" / name).read_bytes() for name, data in drawn)

@@ -7,6 +7,7 @@ import os
 import shutil
 import tempfile
 import textwrap
+import threading
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -53,20 +54,22 @@ def _fmt(v: Any, digits: int) -> str:
 
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                  step: Callable[[int], Any] | None = None, jobs: int = 1) -> None:
+                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: Any = None) -> None:
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
     Everything is written into a staging folder first and then moved into ``out`` file by file
     (atomic renames): an interrupted report or two studies writing into one folder never leave a
     half-written file. With ``jobs`` other than 1 the figures are drawn by that many local worker
-    processes (see :func:`figure_tasks`) while this process writes the tables.
+    processes (see :func:`figure_tasks`) while this process writes the tables; with ``scheduler``
+    (a Dask scheduler's address, or a connected ``Client``) the cluster's workers draw them in memory
+    (:func:`render_figure`) and this process writes the files, since the workers may not see ``out``.
     """
     step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
-        _write_outputs(table, runs, factors, staging, step, jobs)
+        _write_outputs(table, runs, factors, staging, step, jobs, scheduler)
         for f in sorted(staging.iterdir()):
             if f.is_file():
                 os.replace(f, out / f.name)
@@ -75,24 +78,98 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
 
 
 def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> list[tuple]:
-    """:func:`plot_study` split into independent calls whose figures together are the whole call's.
+    """:func:`plot_study` as independent one-figure tasks for :func:`draw_figure`, in its order.
 
-    The trajectories and the threshold sweep need the runs but no metric rows (an empty table);
-    the metric plots of one factor need the table but no runs.
+    Each task carries only what its figure reads (the runs of one recording, the rows of one
+    metric, the threshold sweeps), so the tasks are cheap to send to worker processes and can
+    be shared out evenly; their figures together are the whole call's, labels included.
     """
-    return [(table.iloc[:0], runs, factors)] + [(table, [], [f]) for f in factors]
+    tasks: list[tuple] = []
+    labels = run_labels(runs, factors)
+    for rec in sorted({r["recording"] for r in runs}):
+        mine = [r for r in runs if r["recording"] == rec]
+        tasks.append(("trajectories", mine, {r["key"]: labels[r["key"]] for r in mine}, rec))
+    ok = table[table["metric"].notna()]
+    for f in factors:
+        for metric in sorted(ok["metric"].unique()):
+            tasks.append(("metric", ok[ok["metric"] == metric], f, metric))
+    detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
+    sweeps = [{k: r[k] for k in ("key", "recording", "roc") if k in r} for r in runs]
+    tasks.append(("roc", sweeps, run_labels(runs, factors, only=detector_factors or None)))
+    return tasks
+
+
+def _figure(task: tuple) -> tuple[Any, str]:
+    """The figure of one task of :func:`figure_tasks` (None: nothing to draw) and its file name."""
+    kind = task[0]
+    if kind == "trajectories":
+        _, runs, labels, rec = task
+        return trajectories_figure(runs, labels, rec), f"trajectories_{_safe(rec)}.png"
+    if kind == "metric":
+        _, rows, factor, metric = task
+        return metric_figure(rows, factor, metric), f"metric_{_safe(metric)}_by_{_safe(factor)}.png"
+    _, runs, labels = task
+    return roc_figure(runs, labels), "roc.png"
+
+
+def draw_figure(task: tuple, out: Path) -> Path | None:
+    """Draw and save one task of :func:`figure_tasks` into ``out``; the file written, or None (nothing to draw)."""
+    from ..plots import save
+
+    fig, name = _figure(task)
+    return None if fig is None else save(fig, Path(out) / name)
+
+
+#: pyplot and its rcParams are per process, not per thread: a worker with several threads draws one figure at a time.
+_DRAWING = threading.Lock()
+
+
+def render_figure(task: tuple) -> tuple[str, bytes] | None:
+    """One task of :func:`figure_tasks` drawn in memory: its file name and the bytes :func:`draw_figure` would write."""
+    from ..plots import png_bytes
+
+    with _DRAWING:
+        fig, name = _figure(task)
+        return None if fig is None else (name, png_bytes(fig))
 
 
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                   step: Callable[[int], Any], jobs: int = 1) -> None:
+                   step: Callable[[int], Any], jobs: int = 1, scheduler: Any = None) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
+    if scheduler is not None:
+        import contextlib
+
+        from dask.distributed import Client, as_completed
+
+        connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
+        with connected as client:  # the workers draw while this process writes the tables
+            futures = client.map(render_figure, figure_tasks(table, runs, factors), pure=False)
+            _write_tables(table, runs, factors, out, step)
+            for fut in as_completed(futures):
+                drawn = fut.result()
+                if drawn is not None:
+                    (out / drawn[0]).write_bytes(drawn[1])
+        step(1)
+        return
     figures = None
     if jobs != 1:  # started first: the workers draw while this process writes the tables
         from joblib import Parallel, delayed
 
         figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
-            delayed(plot_study)(t, r, f, out) for t, r, f in figure_tasks(table, runs, factors))
+            delayed(draw_figure)(task, out) for task in figure_tasks(table, runs, factors))
+    _write_tables(table, runs, factors, out, step)
+    if figures is None:
+        plot_study(table, runs, factors, out)
+    else:
+        for _ in figures:
+            pass
+    step(1)
+
+
+def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+                  step: Callable[[int], Any]) -> None:
+    """The tidy table, the trajectories and sweeps, the summaries (``step(1)`` after each)."""
     table.to_csv(out / "results.csv", index=False)
     _to_parquet(table, out / "results.parquet")
     step(1)
@@ -110,12 +187,6 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         md.append("## failed runs\n\n" + to_markdown(errors))
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.tex").write_text("\n".join(tex))
-    step(1)
-    if figures is None:
-        plot_study(table, runs, factors, out)
-    else:
-        for _ in figures:
-            pass
     step(1)
 
 
@@ -268,28 +339,11 @@ def metric_label(metric: str) -> str:
 def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> list[Path]:
     """Trajectories per recording, each metric per factor level, ROC of the detectors' threshold sweeps.
 
-    Returns the files written.
+    Returns the files written. The figures are the tasks of :func:`figure_tasks`, drawn in order.
     """
-    from ..plots import save
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    written = []
-    labels = run_labels(runs, factors)
-    for rec in sorted({r["recording"] for r in runs}):
-        fig = trajectories_figure([r for r in runs if r["recording"] == rec], labels, rec)
-        if fig is not None:
-            written.append(save(fig, out / f"trajectories_{_safe(rec)}.png"))
-    ok = table[table["metric"].notna()]
-    for f in factors:
-        for metric in sorted(ok["metric"].unique()):
-            fig = metric_figure(ok[ok["metric"] == metric], f, metric)
-            written.append(save(fig, out / f"metric_{_safe(metric)}_by_{_safe(f)}.png"))
-    detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
-    fig = roc_figure(runs, run_labels(runs, factors, only=detector_factors or None))
-    if fig is not None:
-        written.append(save(fig, out / "roc.png"))
-    return written
+    return [p for p in (draw_figure(task, out) for task in figure_tasks(table, runs, factors)) if p is not None]
 
 
 def _grid(plt, n: int, size: float = 2.6, max_cols: int = 8):

@@ -18,6 +18,7 @@ How a study runs:
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -297,7 +298,13 @@ def run_study(
         raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
     bar = _Progress(progress, "study")
     try:
-        return _run_study(study, jobs, scheduler, out, max_runs, bar)
+        if scheduler is None:
+            return _run_study(study, jobs, None, out, max_runs, bar)
+        cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
+        try:
+            return _run_study(study, jobs, cluster, out, max_runs, bar)
+        finally:
+            cluster.close()
     finally:
         bar.close()
 
@@ -378,9 +385,10 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
         else:
-            # figures on the local workers with jobs: N; with a Dask scheduler the workers may not see `out`
+            # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
-                          jobs=jobs if scheduler is None else 1)
+                          jobs=jobs if scheduler is None else 1,
+                          scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler)
             _write_manifest(Path(out), digest)
     return table
 
@@ -444,9 +452,9 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
     if not todo:
         return
     if scheduler is not None:
-        from dask.distributed import Client, as_completed
+        from dask.distributed import as_completed
 
-        with Client(scheduler) as client:
+        with _connected(scheduler) as client:
             workers = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
             chunks = _chunks(todo, cells, identity, max(workers, 1))
             futures = {client.submit(run_chunk, *task(idx), pure=False): idx for idx in chunks}
@@ -466,6 +474,34 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
     else:
         for idx in _chunks(todo, cells, identity, 1):
             yield idx, run_chunk(*task(idx), on_cell=lambda: bar.update(1))
+
+
+class _Cluster:
+    """A Dask scheduler's address and the client connected to it at the first use, closed by :meth:`close`."""
+
+    def __init__(self, address: str):
+        self.address = address
+        self._client: Any = None
+
+    @property
+    def client(self) -> Any:
+        if self._client is None:
+            from dask.distributed import Client
+
+            self._client = Client(self.address)
+        return self._client
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+
+def _connected(scheduler: Any) -> Any:
+    """A context giving a Dask client: the study's (left open) for a :class:`_Cluster`, else a new one."""
+    from dask.distributed import Client
+
+    return contextlib.nullcontext(scheduler.client) if isinstance(scheduler, _Cluster) else Client(scheduler)
 
 
 def _indexed(k: int, *args: Any) -> tuple[int, list[dict[str, Any]]]:

@@ -45,6 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit import njit
+
 
 @dataclass
 class GaitEvents:
@@ -80,16 +82,50 @@ def segment_ranges(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarr
 def segment_argext(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, largest: bool) -> np.ndarray:
     """Index of the maximum (``largest``) or minimum of ``x`` in each non-empty range ``[lo_i, hi_i)``.
 
-    Ties take the first sample. Vectorised with ``ufunc.reduceat``.
+    Ties take the first sample. One compiled pass over the ranges' samples, nothing allocated
+    but the result.
     """
-    if len(lo) == 0:
-        return np.zeros(0, dtype=np.int64)
-    idx, offsets = segment_ranges(lo, hi)
-    values = x[idx]
-    ext = (np.maximum if largest else np.minimum).reduceat(values, offsets)
-    hit = np.flatnonzero(values == np.repeat(ext, hi - lo))
-    first = hit[np.searchsorted(hit, offsets)]
-    return idx[first]
+    lo = np.asarray(lo, dtype=np.int64)
+    out = np.empty(len(lo), dtype=np.int64)
+    if len(lo):
+        _argext_kernel(np.asarray(x, dtype=float), lo, np.asarray(hi, dtype=np.int64), bool(largest), out)
+    return out
+
+
+@njit
+def _argext_kernel(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, largest: bool, out: np.ndarray) -> None:
+    for i in range(lo.shape[0]):
+        best = lo[i]
+        m = x[best]
+        for j in range(lo[i] + 1, hi[i]):
+            if (x[j] > m) if largest else (x[j] < m):
+                m = x[j]
+                best = j
+        out[i] = best
+
+
+@njit
+def _first_down_crossing(w: np.ndarray, after: np.ndarray, until: np.ndarray, out: np.ndarray) -> None:
+    """``out[i]``: the first ``c`` in ``[after_i + 1, until_i]`` with ``w[c-1] > 0 >= w[c]``, or −1."""
+    n = w.shape[0]
+    for i in range(after.shape[0]):
+        out[i] = -1
+        for c in range(after[i] + 1, min(until[i], n - 1) + 1):
+            if w[c - 1] > 0.0 and w[c] <= 0.0:
+                out[i] = c
+                break
+
+
+def _mid_times(ts: np.ndarray, idx: np.ndarray, needed: np.ndarray) -> np.ndarray:
+    """Middle of sample ``idx``'s interval, ``t[k] − (t[k] − t[k−1])/2`` (s), the median interval before the first.
+
+    Only the ``needed`` entries are meaningful (the median is computed only if one of them is sample 0).
+    """
+    d = ts[idx] - ts[np.maximum(idx - 1, 0)]
+    first = idx == 0
+    if (first & needed).any():
+        d[first] = np.median(np.diff(ts))
+    return ts[idx] - 0.5 * d
 
 
 def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> GaitEvents:
@@ -112,9 +148,8 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     w = np.asarray(gyr, dtype=float)[:, 1]
     n = len(t)
     # a sample is the mean over (t[k-1], t[k]] (footzoo's interval convention): it belongs to the middle
+    # of its interval, computed for the event samples only (_mid_times)
     ts = np.asarray(t, dtype=float)
-    dt = np.diff(ts)
-    t = ts - 0.5 * np.concatenate([[np.median(dt)], dt])
     k = len(stances) - 1
     if k < 1:
         empty = np.zeros(0)
@@ -128,21 +163,22 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     to_lo = np.minimum(mid[:-1], p)
     j = segment_argext(w, to_lo, np.maximum(p, to_lo + 1), largest=False)
     # IC: first downward zero crossing after p, before the next mid-stance
-    down = np.flatnonzero((w[:-1] > 0.0) & (w[1:] <= 0.0)) + 1
-    pos = np.searchsorted(down, p + 1)
-    c = down[np.minimum(pos, max(len(down) - 1, 0))] if len(down) else np.full(k, n)
-    ok = (pos < len(down)) & (c <= mid[1:]) & (w[p] > 0.0) & (w[j] < 0.0)
+    c = np.empty(k, dtype=np.int64)
+    _first_down_crossing(w, p.astype(np.int64), mid[1:].astype(np.int64), c)
+    ok = (c >= 0) & (w[p] > 0.0) & (w[j] < 0.0)
     c = np.where(ok, c, 1)
     # sub-sample refinement: linear crossing for IC, parabola through the minimum for TO
     den_c = w[c - 1] - w[c]
     frac = np.where(ok, w[c - 1] / np.where(ok, den_c, 1.0), 0.0)
-    ic = t[c - 1] + frac * (t[c] - t[c - 1])
+    t_c0, t_c = _mid_times(ts, c - 1, ok), _mid_times(ts, c, ok)
+    ic = t_c0 + frac * (t_c - t_c0)
     jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
     den = w[jl] - 2.0 * w[j] + w[jr]
     shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
     shift = np.clip(shift, -0.5, 0.5)  # at a segment's edge j need not be a local minimum: stay by the sample
-    dt = np.where(shift >= 0, t[jr] - t[j], t[j] - t[jl])
-    to = t[j] + shift * dt
+    t_j, t_jl, t_jr = _mid_times(ts, j, ok), _mid_times(ts, jl, ok), _mid_times(ts, jr, ok)
+    dt = np.where(shift >= 0, t_jr - t_j, t_j - t_jl)
+    to = t_j + shift * dt
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
     ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
     return GaitEvents(to=to, ic=ic, from_rate=ok)

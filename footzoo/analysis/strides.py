@@ -102,7 +102,8 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     stride_time = ic - start
     d = pos[mid[1:], :2] - pos[mid[:-1], :2]
     length = np.hypot(d[:, 0], d[:, 1])
-    top = segment_argext(-pos[:, 2], np.maximum(b[:-1] - 1, 0), np.minimum(a[1:] + 1, n), largest=True)
+    # highest point (up = −d): the first minimum of pos_d, as the first maximum of −pos_d
+    top = segment_argext(pos[:, 2], np.maximum(b[:-1] - 1, 0), np.minimum(a[1:] + 1, n), largest=False)
     return pd.DataFrame({
         "start_s": start, "to_s": to, "end_s": ic, "stride_time_s": stride_time, "stance_time_s": to - start,
         "swing_time_s": ic - to, "cadence_steps_min": 120.0 / stride_time, "stride_length_m": length,

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..registry import register
-from .skog import SkogTest
+from .skog import FUSED_TESTS, SkogTest
+from .windows import MV_TEST
 
 
 @register
@@ -44,3 +45,6 @@ class AMVD(SkogTest):
     def test(self, m: np.ndarray) -> np.ndarray:
         """T_k from the window moments."""
         return np.maximum(m[:, 3] - np.sum(m[:, :3] ** 2, axis=1), 0.0) / self.sigma_a**2
+
+
+FUSED_TESTS[AMVD.test] = MV_TEST

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..registry import register
-from .skog import SkogTest
+from .skog import FUSED_TESTS, SkogTest
+from .windows import ARE_TEST
 
 
 @register
@@ -43,3 +44,6 @@ class ARED(SkogTest):
     def test(self, m: np.ndarray) -> np.ndarray:
         """T_k from the window moments."""
         return m[:, 4] / self.sigma_g**2
+
+
+FUSED_TESTS[ARED.test] = ARE_TEST

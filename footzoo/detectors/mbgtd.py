@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..registry import register
-from .skog import SkogTest
+from .skog import FUSED_TESTS, SkogTest
+from .windows import MAG_TEST
 
 
 @register
@@ -45,3 +46,6 @@ class MBGTD(SkogTest):
     def test(self, m: np.ndarray) -> np.ndarray:
         """T_k from the window moments."""
         return m[:, 5] / self.sigma_a**2
+
+
+FUSED_TESTS[MBGTD.test] = MAG_TEST

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._jit import njit
+
 
 def dated_and_online_states(
     candidate: np.ndarray, min_samples: int, initial: bool = True
@@ -37,32 +39,46 @@ def dated_and_online_states(
         State as a live machine knows it at each sample (switch when the run
         reaches ``min_samples``).
     """
-    c = np.asarray(candidate, dtype=bool)
-    n = c.shape[0]
-    g = max(int(min_samples), 1)
-    idx = np.arange(n)
-
-    def runs(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        change = np.flatnonzero(x[1:] != x[:-1]) + 1
-        starts = np.concatenate([[0], change]).astype(np.int64)
-        return starts, np.diff(np.concatenate([starts, [n]]))
-
-    def fill(x: np.ndarray, switch_at: np.ndarray, value_at: np.ndarray) -> np.ndarray:
-        src = np.full(n, -1)
-        src[switch_at] = idx[value_at]
-        src = np.maximum.accumulate(src)
-        return np.where(src >= 0, x[np.maximum(src, 0)], initial)
-
-    starts, lengths = runs(c)
-    long_starts = starts[lengths >= g]
-    online = fill(c, long_starts + g - 1, long_starts)
-    # dated: short still runs are motion; then the machine ignores the short motion runs left (spikes in stance)
-    short_still = c[starts] & (lengths < g) & (starts > 0) & (starts + lengths < n)
-    still = c & ~np.repeat(short_still, lengths)
-    starts, lengths = runs(still)
-    long_starts = starts[lengths >= g]
-    dated = fill(still, long_starts, long_starts)
+    c = np.ascontiguousarray(candidate, dtype=bool)
+    dated = np.empty(c.shape[0], dtype=np.bool_)
+    online = np.empty(c.shape[0], dtype=np.bool_)
+    _two_state_kernel(c, max(int(min_samples), 1), bool(initial), dated, online)
     return dated, online
+
+
+@njit
+def _two_state_kernel(c: np.ndarray, g: int, initial: bool, dated: np.ndarray, online: np.ndarray) -> None:
+    """:func:`dated_and_online_states` in three passes over the samples, with ``dated`` as the work array."""
+    n = c.shape[0]
+    # online: switch to the run's value when the run reaches g samples
+    state = initial
+    run = 0
+    for k in range(n):
+        run = 1 if k == 0 or c[k] != c[k - 1] else run + 1
+        if run == g:
+            state = c[k]
+        online[k] = state
+    # still: c without its short still runs that touch neither end of the recording (into `dated`)
+    k = 0
+    while k < n:
+        s = k
+        while k < n and c[k] == c[s]:
+            k += 1
+        keep = c[s] and not (k - s < g and s > 0 and k < n)
+        for j in range(s, k):
+            dated[j] = keep
+    # dated: each run of `still` takes its value if it lasts g samples, else keeps the state before it
+    state = initial
+    k = 0
+    while k < n:
+        s = k
+        value = dated[s]
+        while k < n and dated[k] == value:
+            k += 1
+        if k - s >= g:
+            state = value
+        for j in range(s, k):
+            dated[j] = state
 
 
 def close_short_swings(stance: np.ndarray, min_samples: int) -> np.ndarray:

@@ -10,7 +10,8 @@ from ..checks import check_range
 from ..conventions import GRAVITY
 from ..registry import register
 from .runs import dated_and_online_states
-from .skog import SkogTest
+from .skog import FUSED_TESTS, SkogTest
+from .windows import SHOE_TEST
 
 
 @register
@@ -57,6 +58,9 @@ class SHOE(SkogTest):
         """
         acc_term = m[:, 3] - 2.0 * GRAVITY * np.linalg.norm(m[:, :3], axis=1) + GRAVITY**2
         return np.maximum(acc_term, 0.0) / self.sigma_a**2 + m[:, 4] / self.sigma_g**2
+
+
+FUSED_TESTS[SHOE.test] = SHOE_TEST
 
 
 @register

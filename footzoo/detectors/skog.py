@@ -8,7 +8,11 @@ from ..checks import check_range
 from ..conventions import GRAVITY
 from ..plugin import Detector
 from ..registry import check_positive
-from .windows import window_moments
+from .windows import window_moments, window_statistic
+
+#: Built-in ``test`` methods that :func:`~footzoo.detectors.windows.window_statistic` evaluates in its window pass,
+#: by the test code it takes (a subclass that overrides ``test`` gets the moments and its own method).
+FUSED_TESTS: dict[object, int] = {}
 
 
 class SkogTest(Detector):
@@ -62,9 +66,13 @@ class SkogTest(Detector):
     def _statistic(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
         rate = 1.0 / float(np.median(np.diff(t)))
         self.window_samples_ = max(int(round(self.window * rate)), 2)
-        m = window_moments(np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(gyr, dtype=float),
-                           self.window_samples_, GRAVITY)
-        return self.test(m)
+        acc = np.ascontiguousarray(acc, dtype=float)
+        gyr = np.ascontiguousarray(gyr, dtype=float)
+        fused = FUSED_TESTS.get(type(self).test)
+        if fused is not None:  # the same numbers as test(window_moments(...)), without the (N, 6) moments
+            return window_statistic(acc, gyr, self.window_samples_, GRAVITY, GRAVITY**2, fused, self.sigma_a**2,
+                                    self.sigma_g**2)
+        return self.test(window_moments(acc, gyr, self.window_samples_, GRAVITY))
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> SkogTest:
         """Evaluate the test over the whole recording.

@@ -11,8 +11,11 @@ the heading to the gyro; roll and pitch still come from the accelerometer.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from .._jit import njit
 from ..checks import check_bool, check_range
 from ..conventions import GRAVITY
 
@@ -40,6 +43,9 @@ def magnetometer_valid(
 ) -> tuple[np.ndarray, float, float]:
     """Which magnetometer samples agree with the undisturbed field, learned at the still start.
 
+    The reference comes from the leading samples only; the check of every sample is one
+    compiled pass (:func:`_valid_kernel`) that writes nothing but the flags.
+
     Parameters
     ----------
     t : (N,) ndarray
@@ -64,18 +70,52 @@ def magnetometer_valid(
     dip_ref : float
         Reference dip (rad).
     """
-    mn, dip = field_norm_and_dip(acc, mag)
+    t = np.ascontiguousarray(t, dtype=float)
+    f = np.ascontiguousarray(acc, dtype=float)
+    m = np.ascontiguousarray(mag, dtype=float)
     still = np.asarray(still, dtype=bool)
     n_lead = int(np.argmin(still)) if not still.all() else still.size
-    ref = (t - t[0] <= REFERENCE_DURATION) & (np.arange(t.size) < n_lead)
-    if ref.sum() < 2:
-        ref = t - t[0] <= 0.5
-    norm_ref = float(np.median(mn[ref]))
-    dip_ref = float(np.median(dip[ref]))
-    quiet = np.abs(np.linalg.norm(acc, axis=1) - GRAVITY) < 0.1 * GRAVITY
-    valid = np.abs(mn - norm_ref) <= norm_tolerance * norm_ref
-    valid &= ~quiet | (np.abs(dip - dip_ref) <= dip_tolerance)
+    # the reference samples are a prefix: t − t[0] <= T (t increases) and before the first moving sample
+    n_ref = min(_leading_within(t, REFERENCE_DURATION), n_lead)
+    if n_ref < 2:
+        n_ref = _leading_within(t, 0.5)
+    mn, dip = field_norm_and_dip(f[:n_ref], m[:n_ref])
+    norm_ref = float(np.median(mn))
+    dip_ref = float(np.median(dip))
+    valid = np.empty(t.shape[0], dtype=np.bool_)
+    _valid_kernel(f, m, norm_ref, dip_ref, norm_tolerance, dip_tolerance, GRAVITY, valid)
     return valid, norm_ref, dip_ref
+
+
+@njit
+def _leading_within(t: np.ndarray, duration: float) -> int:
+    """Number of leading samples with ``t[k] − t[0] <= duration`` (s)."""
+    k = 0
+    while k < t.shape[0] and t[k] - t[0] <= duration:
+        k += 1
+    return k
+
+
+@njit
+def _valid_kernel(acc: np.ndarray, mag: np.ndarray, norm_ref: float, dip_ref: float, norm_tolerance: float,
+                  dip_tolerance: float, g: float, valid: np.ndarray) -> None:
+    """``valid[k]``: ``| |m| − |m|_ref | <= tol |m|_ref``, and the dip within tolerance where ``| |f| − g | < 0.1 g``.
+
+    The arithmetic of :func:`field_norm_and_dip` per sample (the dip
+    ``asin(−m·f / (|m| |f|))`` clipped to ±1), evaluated only where it decides.
+    """
+    for k in range(acc.shape[0]):
+        mx, my, mz = mag[k, 0], mag[k, 1], mag[k, 2]
+        fx, fy, fz = acc[k, 0], acc[k, 1], acc[k, 2]
+        mn = math.sqrt(mx * mx + my * my + mz * mz)
+        ok = abs(mn - norm_ref) <= norm_tolerance * norm_ref
+        if ok:
+            fn = math.sqrt(fx * fx + fy * fy + fz * fz)
+            if abs(fn - g) < 0.1 * g:  # quiet: |f| ≈ g, the dip is meaningful
+                s = -(mx * fx + my * fy + mz * fz) / max(mn * fn, 1e-300)
+                dip = math.asin(min(max(s, -1.0), 1.0))
+                ok = abs(dip - dip_ref) <= dip_tolerance
+        valid[k] = ok
 
 
 def rejection_parameters(rejection: bool, norm_tolerance: float, dip_tolerance: float) -> tuple[bool, float, float]:
