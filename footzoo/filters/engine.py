@@ -300,7 +300,7 @@ class KalmanEngine:
     @staticmethod
     def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
         """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
-        from .kalman_fast import eskf_loop
+        from .kalman_fast import eskf_loop, scratch
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks = packed.arrays
@@ -309,13 +309,14 @@ class KalmanEngine:
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["gains"], out["dxs"])
         state = (packed.nav, packed.P, packed.mems)
+        work = scratch(packed.P.shape[0], packed.core[4])
         if packed.bound is not None:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
-                         k0)
+                         k0, work)
             return
         measures, feedbacks, afters = packed.functions
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0)
+                                                data_off, hooks), outputs, k0, work)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -370,10 +371,10 @@ def _bound_loop(functions: tuple) -> Any:
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
 
-        def bound(signals, core, state, arrays, out, k0):
+        def bound(signals, core, state, arrays, out, k0, work):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0)
+                                             data_off, hooks), out, k0, work)
 
         import numba
 
