@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import _jit
 from .._jit import njit
-from .smoother import feed_back_attitude, smoother_gain, spd_inverse
+from .smoother import feed_back_attitude, smoother_gain
 
 
 def _unowned(a):
@@ -57,10 +57,10 @@ if _jit.HAVE_NUMBA:
 @njit
 def _rows_add(P, r0, c0, b):
     """P[r0:r0+3, :] += b @ P[c0:c0+3, :], in place (rows c0… are not rows r0…)."""
-    for j in range(P.shape[1]):
-        x0, x1, x2 = P[c0, j], P[c0 + 1, j], P[c0 + 2, j]
-        for i in range(3):
-            P[r0 + i, j] += b[i, 0] * x0 + b[i, 1] * x1 + b[i, 2] * x2
+    for i in range(3):
+        b0, b1, b2 = b[i, 0], b[i, 1], b[i, 2]
+        for j in range(P.shape[1]):
+            P[r0 + i, j] += b0 * P[c0, j] + b1 * P[c0 + 1, j] + b2 * P[c0 + 2, j]
 
 
 @njit
@@ -118,14 +118,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     inv = np.empty((n, n))
     keep = np.empty(n, dtype=np.int64)
     M = np.empty((n, n))
-    S = np.empty((m_max, m_max))
-    SI = np.empty((m_max, m_max))
-    L = np.empty((m_max, m_max))
-    Ut = np.empty((m_max, n))
-    Kt = np.empty((m_max, n))
-    Gt = np.empty((m_max, n))
-    nzc = np.zeros((m_max, n), dtype=np.int64)
-    nnz = np.zeros(m_max, dtype=np.int64)
+    u = np.empty(n)
+    kv = np.empty(n)
+    g = np.empty(n)
+    nzc = np.zeros(n, dtype=np.int64)
     c = np.empty((3, 3))
     cdt = np.empty((3, 3))
     sdt = np.empty((3, 3))
@@ -157,6 +153,12 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             dyn[n_dyn - 3 + i] = att + i
     for e in range(n_dyn):
         moving[dyn[e]] = True
+    still = np.empty(n - n_dyn, dtype=np.int64)
+    e = 0
+    for i in range(n):
+        if not moving[i]:
+            still[e] = i
+            e += 1
     for i in range(4):
         quat[0, i] = nav[i]
     for i in range(3):
@@ -220,8 +222,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
         sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * fn2, 0.0, dt * fn0
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * fn1, -dt * fn0, 0.0
         # Φ P in place, rows in the order pos (reads vel), vel (reads att, acc_bias), att (reads gyro_bias)
-        for j in range(n):
-            for i in range(3):
+        for i in range(3):
+            for j in range(n):
                 P[pos_i + i, j] += dt * P[vel_i + i, j]
         if att >= 0:
             _rows_add(P, vel_i, att, sdt)
@@ -247,9 +249,12 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             _cols_add(P, dyn, att, gb_i, cdt)
         for e in range(n_dyn):
             i = dyn[e]
-            for j in range(n):
-                if not moving[j] or j > i:
-                    P[j, i] = P[i, j]
+            for e2 in range(n - n_dyn):
+                j = still[e2]
+                P[j, i] = P[i, j]
+            for e2 in range(e + 1, n_dyn):
+                j = dyn[e2]
+                P[j, i] = P[i, j]
         for i in range(n):
             P[i, i] += qn[i] * dt
         if smooth:  # P = P⁻_k
@@ -263,59 +268,46 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             m = measures[j](k0 + k, t[k], nav, w, f, st, m_idx[j], par[par_off[j]:par_off[j + 1]],
                             mems[mem_off[j]:mem_off[j + 1]], data[k, data_off[j]:data_off[j + 1]], z, H, rdiag, m)
         if m > 0:
-            # filterpy's update, K = P Hᵀ (H P Hᵀ + R)⁻¹, and the Joseph form (eq. 45),
-            # (I − KH) P (I − KH)ᵀ + K R Kᵀ = P − K Uᵀ − G Kᵀ with U = P Hᵀ, S = H U + R and
-            # G = U − K S (symmetric: its upper triangle is computed), on the nonzero entries of H
+            # filterpy's update, K = P Hᵀ (H P Hᵀ + R)⁻¹ and the Joseph form (eq. 45),
+            # (I − KH) P (I − KH)ᵀ + K R Kᵀ, one row of H at a time: R is diagonal, so the rows are
+            # independent measurements and updating with each in turn gives the same estimate and
+            # covariance as the stacked update. For a row h with variance r: u = P hᵀ, s = h u + r,
+            # k = u / s, dx ← dx + k (z − h dx) and P ← P − k uᵀ − g kᵀ with g = u − k s (symmetric:
+            # its upper triangle is computed), on the nonzero entries of h
+            for i in range(n):
+                dx[i] = 0.0
             for a in range(m):
                 cnt = 0
                 for b in range(n):
                     if H[a, b] != 0.0:
-                        nzc[a, cnt] = b
+                        nzc[cnt] = b
                         cnt += 1
-                nnz[a] = cnt
-            for a in range(m):  # Uᵀ = H P (P is symmetric)
+                innov = z[a]
                 for i in range(n):
-                    Ut[a, i] = 0.0
-                for e in range(nnz[a]):
-                    b = nzc[a, e]
+                    u[i] = 0.0
+                for e in range(cnt):
+                    b = nzc[e]
                     h = H[a, b]
-                    for i in range(n):
-                        Ut[a, i] += P[b, i] * h
-            for a in range(m):
-                for b2 in range(m):
-                    acc_ = 0.0
-                    for e in range(nnz[a]):
-                        i = nzc[a, e]
-                        acc_ += H[a, i] * Ut[b2, i]
-                    S[a, b2] = acc_
-                S[a, a] += rdiag[a]
-            spd_inverse(S, m, L, SI)
-            for i in range(n):
-                for a in range(m):
-                    acc_ = 0.0
-                    for b2 in range(m):
-                        acc_ += Ut[b2, i] * SI[b2, a]
-                    Kt[a, i] = acc_
-                acc_ = 0.0
-                for a in range(m):
-                    acc_ += Kt[a, i] * z[a]
-                dx[i] = acc_
-            for i in range(n):
-                for a in range(m):
-                    acc_ = Ut[a, i]
-                    for b2 in range(m):
-                        acc_ -= Kt[b2, i] * S[b2, a]
-                    Gt[a, i] = acc_
-            for i in range(n):
-                for a in range(m):
-                    ki, gi = Kt[a, i], Gt[a, i]
+                    innov -= h * dx[b]
+                    for i in range(n):  # P is symmetric: row b is column b
+                        u[i] += P[b, i] * h
+                hu = 0.0
+                for e in range(cnt):
+                    b = nzc[e]
+                    hu += H[a, b] * u[b]
+                    H[a, b] = 0.0  # leave H all zero for the next sample
+                s_ = hu + rdiag[a]
+                for i in range(n):
+                    kv[i] = u[i] / s_
+                for i in range(n):
+                    g[i] = u[i] - kv[i] * s_
+                    dx[i] += kv[i] * innov
+                for i in range(n):
+                    ki, gi = kv[i], g[i]
                     for j in range(i, n):
-                        P[i, j] -= ki * Ut[a, j] + gi * Kt[a, j]
-                for j in range(i + 1, n):
-                    P[j, i] = P[i, j]
-            for a in range(m):  # leave H all zero for the next sample
-                for e in range(nnz[a]):
-                    H[a, nzc[a, e]] = 0.0
+                        P[i, j] -= ki * u[j] + gi * kv[j]
+                    for j in range(i + 1, n):
+                        P[j, i] = P[i, j]
             # feedback, eqs. 49-52: q <- exp(−δφ) ⊗ q, p <- p − δp, v <- v − δv, b <- b + δb
             if att >= 0 and not use_ext:
                 feed_back_attitude(nav, dx[att], dx[att + 1], dx[att + 2])
