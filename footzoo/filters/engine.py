@@ -310,13 +310,14 @@ class KalmanEngine:
                    out["P_diag"], out["gains"], out["dxs"])
         state = (packed.nav, packed.P, packed.mems)
         work = scratch(packed.P.shape[0], packed.core[4])
-        if packed.bound is not None:
+        if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
                          k0, work)
             return
         measures, feedbacks, afters = packed.functions
+        gain = _gain_function(out["gains"].shape[0] > 0)
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0, work)
+                                                data_off, hooks), outputs + (gain,), k0, work)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -338,6 +339,28 @@ def _address(fn: Any) -> Any:
 
 
 _ADDRESSES: dict[int, Any] = {}
+_GAINS: dict[bool, Any] = {}
+
+
+def _gain_function(smooth: bool) -> Any:
+    """The smoother's gain function for the compiled loop (a no-op with its signature without the smoother).
+
+    Compiled on its own with a fixed signature and passed as a first-class function, so the loop
+    does not compile it, and a run without the smoother compiles only the no-op.
+    """
+    from . import smoother
+
+    fn = _jit.compiled(smoother.smoother_gain) if smooth else smoother.no_gain
+    if not _jit.HAVE_NUMBA:
+        return fn
+    if smooth not in _GAINS:
+        import numba
+        from numba import types as t
+
+        a2 = t.float64[:, ::1]
+        signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
+        _GAINS[smooth] = _address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn)))
+    return _GAINS[smooth]
 
 if _jit.HAVE_NUMBA:
     from numba.core.types.function_type import WrapperAddressProtocol
@@ -370,11 +393,12 @@ def _bound_loop(functions: tuple) -> Any:
 
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
+        no_gain = _gain_function(False)
 
         def bound(signals, core, state, arrays, out, k0, work):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0, work)
+                                             data_off, hooks), out + (no_gain,), k0, work)
 
         import numba
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import _jit
 from .._jit import njit
-from .smoother import feed_back_attitude, smoother_gain
+from .smoother import feed_back_attitude
 
 
 def _unowned(a):
@@ -94,9 +94,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
         the corrections' functions and their arrays, in stacking order.
     out : tuple
         ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n),
-        gains (N or 0, n, n), dxs (N or 0, n))``; row 0 receives the incoming state. ``P_diag``,
-        and the smoother's gains ``A_k`` and fed-back errors (:mod:`footzoo.filters.smoother`),
-        with 0 rows are not written.
+        gains (N or 0, n, n), dxs (N or 0, n), smoother_gain)``; row 0 receives the incoming state.
+        ``P_diag``, and the smoother's gains ``A_k`` and fed-back errors
+        (:mod:`footzoo.filters.smoother`), with 0 rows are not written; ``smoother_gain`` is
+        :func:`footzoo.filters.smoother.smoother_gain` (compiled on its own, called only with gains).
     k0 : int
         Index of sample 0 in the whole recording (a stream passes its running count).
     scratch : tuple
@@ -107,7 +108,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     idx, qn, gravity, use_ext, m_max = core
     nav_owned, P, mems_owned = state
     measures, feedbacks, afters, idx_owned, par_owned, par_off, mem_off, data_owned, data_off, hooks = models
-    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs = out
+    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs, smoother_gain = out
     N = t.shape[0]
     n = P.shape[0]
     smooth = gains.shape[0] == N
