@@ -5,11 +5,14 @@ The same equations as :func:`footzoo.filters.kalman_reference.run_reference`
 measurement model called through its compiled functions (the contract is in
 :mod:`footzoo.filters.measurement`); this module knows no correction.
 
-The covariance prediction uses the sparsity of Φ = I + Δ
-(``P ← P + ΔP + (P + ΔP)Δᵀ + Q``), the update filterpy's formulas with the
-Joseph form, expanded so that only the nonzero entries of H are touched. The
-loop allocates nothing per sample and writes its outputs into arrays the
-caller allocates. A test keeps both engines equal to 1e-9 relative.
+The covariance prediction works in place on the nonzero blocks of Φ = I + Δ
+(the rows of Φ P, then the columns of the rows that move, mirrored: P stays
+exactly symmetric); the update is filterpy's, in the Joseph form, taking the
+rows of H one at a time (R is diagonal) and touching only their nonzero
+entries. Every array the models' functions get is a view that owns no
+reference, so a call costs no reference counting. The loop allocates nothing:
+its buffers (:func:`scratch`) and outputs are the caller's. A test keeps both
+engines equal to 1e-9 relative.
 """
 
 from __future__ import annotations
@@ -64,9 +67,9 @@ def _rows_add(P, r0, c0, b):
 
 
 @njit
-def _cols_add(P, rows, r0, c0, b):
-    """P[i, r0:r0+3] += P[i, c0:c0+3] @ b.T for the rows i in ``rows``, in place."""
-    for e in range(rows.shape[0]):
+def _cols_add(P, rows, n_rows, r0, c0, b):
+    """P[i, r0:r0+3] += P[i, c0:c0+3] @ b.T for the first ``n_rows`` rows i in ``rows``, in place."""
+    for e in range(n_rows):
         i = rows[e]
         x0, x1, x2 = P[i, c0], P[i, c0 + 1], P[i, c0 + 2]
         for j in range(3):
@@ -101,8 +104,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     k0 : int
         Index of sample 0 in the whole recording (a stream passes its running count).
     scratch : tuple
-        ``(z (m_max,), H (m_max, n), R (m_max,), dx (n,), w (3,), f (3,))``: the buffers handed to
-        the models' functions (:func:`scratch`), any content.
+        The loop's buffers, from :func:`scratch` (any content).
     """
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max = core
@@ -114,22 +116,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     smooth = gains.shape[0] == N
     keep_p = pdiag.shape[0] == N
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
-    sub = np.empty((n, n))
-    Ls = np.empty((n, n))
-    inv = np.empty((n, n))
-    keep = np.empty(n, dtype=np.int64)
-    M = np.empty((n, n))
-    u = np.empty(n)
-    kv = np.empty(n)
-    g = np.empty(n)
-    nzc = np.zeros(n, dtype=np.int64)
-    c = np.empty((3, 3))
-    cdt = np.empty((3, 3))
-    sdt = np.empty((3, 3))
-    a_n = np.empty(3)
     # the arrays handed to the models, as views that own no reference: passing them costs no
     # reference counting (they are the caller's, alive during the whole call)
-    z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned = scratch
+    (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, M, sub, Ls, inv, keep, u, kv, g, nzc, dyn, still, c, cdt,
+     sdt, a_n) = scratch
     nav, mems, m_idx, par, data = (_unowned(nav_owned), _unowned(mems_owned), _unowned(idx_owned),
                                    _unowned(par_owned), _unowned(data_owned))
     z, H, rdiag, dx, w, f = (_unowned(z_owned), _unowned(H_owned), _unowned(r_owned), _unowned(dx_owned),
@@ -143,21 +133,20 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     # the order the in-place products need; the other rows and columns of P keep their values
     vel_moves = att >= 0 or ab_i >= 0
     att_moves = att >= 0 and gb_i >= 0
-    moving = np.zeros(n, dtype=np.bool_)
     n_dyn = 3 + (3 if vel_moves else 0) + (3 if att_moves else 0)
-    dyn = np.empty(n_dyn, dtype=np.int64)
     for i in range(3):
         dyn[i] = pos_i + i
         if vel_moves:
             dyn[3 + i] = vel_i + i
         if att_moves:
             dyn[n_dyn - 3 + i] = att + i
-    for e in range(n_dyn):
-        moving[dyn[e]] = True
-    still = np.empty(n - n_dyn, dtype=np.int64)
     e = 0
     for i in range(n):
-        if not moving[i]:
+        moves = False
+        for e2 in range(n_dyn):
+            if dyn[e2] == i:
+                moves = True
+        if not moves:
             still[e] = i
             e += 1
     for i in range(4):
@@ -243,11 +232,11 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             for j in range(3):
                 P[i, pos_i + j] += dt * P[i, vel_i + j]
         if att >= 0:
-            _cols_add(P, dyn, vel_i, att, sdt)
+            _cols_add(P, dyn, n_dyn, vel_i, att, sdt)
         if ab_i >= 0:
-            _cols_add(P, dyn, vel_i, ab_i, cdt)
+            _cols_add(P, dyn, n_dyn, vel_i, ab_i, cdt)
         if att_moves:
-            _cols_add(P, dyn, att, gb_i, cdt)
+            _cols_add(P, dyn, n_dyn, att, gb_i, cdt)
         for e in range(n_dyn):
             i = dyn[e]
             for e2 in range(n - n_dyn):
@@ -342,5 +331,15 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
 
 
 def scratch(n: int, m_max: int) -> tuple:
-    """The buffers :func:`eskf_loop` hands the models (allocated by the caller, so they outlive the loop)."""
-    return np.zeros(m_max), np.zeros((m_max, n)), np.zeros(m_max), np.zeros(n), np.zeros(3), np.zeros(3)
+    """The buffers of :func:`eskf_loop`, allocated by the caller (so they outlive the views of them).
+
+    ``z`` (m_max,), ``H`` (m_max, n), ``R`` (m_max,), ``dx`` (n,), ``w``, ``f`` (3,): handed to the
+    models' functions; ``M``, and the smoother's work arrays (n, n) ×3 and (n,) int; ``u``, ``k``,
+    ``g`` (n,); nonzero columns, moving and still rows (n,) int; ``C``, ``C dt``, ``−[f^n×] dt``
+    (3, 3) and ``a_n`` (3,).
+    """
+    i8 = np.int64
+    return (np.zeros(m_max), np.zeros((m_max, n)), np.zeros(m_max), np.zeros(n), np.zeros(3), np.zeros(3),
+            np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros(n, i8), np.zeros(n),
+            np.zeros(n), np.zeros(n), np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros((3, 3)),
+            np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3))
