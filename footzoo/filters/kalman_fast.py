@@ -263,7 +263,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             # independent measurements and updating with each in turn gives the same estimate and
             # covariance as the stacked update. For a row h with variance r: u = P hᵀ, s = h u + r,
             # k = u / s, dx ← dx + k (z − h dx) and P ← P − k uᵀ − g kᵀ with g = u − k s (symmetric:
-            # its upper triangle is computed), on the nonzero entries of h
+            # its upper triangle is computed, mirrored after the last row), on the nonzero entries of h
             for i in range(n):
                 dx[i] = 0.0
             for a in range(m):
@@ -279,7 +279,9 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                     b = nzc[e]
                     h = H[a, b]
                     innov -= h * dx[b]
-                    for i in range(n):  # P is symmetric: row b is column b
+                    for i in range(b):  # P is symmetric; its upper triangle is the current one
+                        u[i] += P[i, b] * h
+                    for i in range(b, n):
                         u[i] += P[b, i] * h
                 hu = 0.0
                 for e in range(cnt):
@@ -296,8 +298,9 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                     ki, gi = kv[i], g[i]
                     for j in range(i, n):
                         P[i, j] -= ki * u[j] + gi * kv[j]
-                    for j in range(i + 1, n):
-                        P[j, i] = P[i, j]
+            for i in range(n):
+                for j in range(i + 1, n):
+                    P[j, i] = P[i, j]
             # feedback, eqs. 49-52: q <- exp(−δφ) ⊗ q, p <- p − δp, v <- v − δv, b <- b + δb
             if att >= 0 and not use_ext:
                 feed_back_attitude(nav, dx[att], dx[att + 1], dx[att + 2])
