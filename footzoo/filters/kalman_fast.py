@@ -108,18 +108,22 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     """
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max = core
-    nav_owned, P, mems_owned = state
+    nav_owned, P_owned, mems_owned = state
     measures, feedbacks, afters, idx_owned, par_owned, par_off, mem_off, data_owned, data_off, hooks = models
     quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs, smoother_gain = out
     N = t.shape[0]
-    n = P.shape[0]
+    n = P_owned.shape[0]
     smooth = gains.shape[0] == N
     keep_p = pdiag.shape[0] == N
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
     # the arrays handed to the models, as views that own no reference: passing them costs no
     # reference counting (they are the caller's, alive during the whole call)
-    (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, M, sub, Ls, inv, keep, u, kv, g, nzc, dyn, still, c, cdt,
-     sdt, a_n) = scratch
+    (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, M, sub, Ls, inv, keep, u_o, kv_o, g_o, nzc_o, dyn_o,
+     still_o, c_o, cdt_o, sdt_o, an_o) = scratch
+    P = _unowned(P_owned)  # also handed to the small compiled functions below
+    u, kv, g, nzc, dyn, still = (_unowned(u_o), _unowned(kv_o), _unowned(g_o), _unowned(nzc_o), _unowned(dyn_o),
+                                 _unowned(still_o))
+    c, cdt, sdt, a_n = _unowned(c_o), _unowned(cdt_o), _unowned(sdt_o), _unowned(an_o)
     nav, mems, m_idx, par, data = (_unowned(nav_owned), _unowned(mems_owned), _unowned(idx_owned),
                                    _unowned(par_owned), _unowned(data_owned))
     z, H, rdiag, dx, w, f = (_unowned(z_owned), _unowned(H_owned), _unowned(r_owned), _unowned(dx_owned),
@@ -279,9 +283,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                     b = nzc[e]
                     h = H[a, b]
                     innov -= h * dx[b]
-                    for i in range(b):  # P is symmetric; its upper triangle is the current one
-                        u[i] += P[i, b] * h
-                    for i in range(b, n):
+                    for i in range(n):  # P is symmetric up to rounding
                         u[i] += P[b, i] * h
                 hu = 0.0
                 for e in range(cnt):
@@ -296,7 +298,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                     dx[i] += kv[i] * innov
                 for i in range(n):
                     ki, gi = kv[i], g[i]
-                    for j in range(i, n):
+                    for j in range(n):  # whole rows (faster than the triangle: full vectors)
                         P[i, j] -= ki * u[j] + gi * kv[j]
             for i in range(n):
                 for j in range(i + 1, n):
