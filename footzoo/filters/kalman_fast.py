@@ -58,25 +58,6 @@ if _jit.HAVE_NUMBA:
 
 
 @njit
-def _rows_add(P, r0, c0, b):
-    """P[r0:r0+3, :] += b @ P[c0:c0+3, :], in place (rows c0… are not rows r0…)."""
-    for i in range(3):
-        b0, b1, b2 = b[i, 0], b[i, 1], b[i, 2]
-        for j in range(P.shape[1]):
-            P[r0 + i, j] += b0 * P[c0, j] + b1 * P[c0 + 1, j] + b2 * P[c0 + 2, j]
-
-
-@njit
-def _cols_add(P, rows, n_rows, r0, c0, b):
-    """P[i, r0:r0+3] += P[i, c0:c0+3] @ b.T for the first ``n_rows`` rows i in ``rows``, in place."""
-    for e in range(n_rows):
-        i = rows[e]
-        x0, x1, x2 = P[i, c0], P[i, c0 + 1], P[i, c0 + 2]
-        for j in range(3):
-            P[i, r0 + j] += x0 * b[j, 0] + x1 * b[j, 1] + x2 * b[j, 2]
-
-
-@njit
 def eskf_loop(signals, core, state, models, out, k0, scratch):
     """Run samples 1… of ``signals`` from ``state`` (updated in place); outputs into ``out``.
 
@@ -219,12 +200,14 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
         for i in range(3):
             for j in range(n):
                 P[pos_i + i, j] += dt * P[vel_i + i, j]
-        if att >= 0:
-            _rows_add(P, vel_i, att, sdt)
-        if ab_i >= 0:
-            _rows_add(P, vel_i, ab_i, cdt)
-        if att_moves:
-            _rows_add(P, att, gb_i, cdt)
+        for blk in range(3):  # P[r0:r0+3, :] += B P[c0:c0+3, :] for the 3×3 blocks B of Δ
+            r0, c0, bm = (vel_i, att, sdt) if blk == 0 else (vel_i, ab_i, cdt) if blk == 1 else (att, gb_i, cdt)
+            if r0 < 0 or c0 < 0:
+                continue
+            for i in range(3):
+                b0, b1, b2 = bm[i, 0], bm[i, 1], bm[i, 2]
+                for j in range(n):
+                    P[r0 + i, j] += b0 * P[c0, j] + b1 * P[c0 + 1, j] + b2 * P[c0 + 2, j]
         if smooth:  # M = Φ P⁺_{k−1}
             for i in range(n):
                 for j in range(n):
@@ -235,12 +218,15 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             i = dyn[e]
             for j in range(3):
                 P[i, pos_i + j] += dt * P[i, vel_i + j]
-        if att >= 0:
-            _cols_add(P, dyn, n_dyn, vel_i, att, sdt)
-        if ab_i >= 0:
-            _cols_add(P, dyn, n_dyn, vel_i, ab_i, cdt)
-        if att_moves:
-            _cols_add(P, dyn, n_dyn, att, gb_i, cdt)
+        for blk in range(3):  # P[i, r0:r0+3] += P[i, c0:c0+3] Bᵀ
+            r0, c0, bm = (vel_i, att, sdt) if blk == 0 else (vel_i, ab_i, cdt) if blk == 1 else (att, gb_i, cdt)
+            if r0 < 0 or c0 < 0:
+                continue
+            for e in range(n_dyn):
+                i = dyn[e]
+                x0, x1, x2 = P[i, c0], P[i, c0 + 1], P[i, c0 + 2]
+                for j in range(3):
+                    P[i, r0 + j] += x0 * bm[j, 0] + x1 * bm[j, 1] + x2 * bm[j, 2]
         for e in range(n_dyn):
             i = dyn[e]
             for e2 in range(n - n_dyn):
@@ -267,7 +253,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             # independent measurements and updating with each in turn gives the same estimate and
             # covariance as the stacked update. For a row h with variance r: u = P hᵀ, s = h u + r,
             # k = u / s, dx ← dx + k (z − h dx) and P ← P − k uᵀ − g kᵀ with g = u − k s (symmetric:
-            # its upper triangle is computed, mirrored after the last row), on the nonzero entries of h
+            # whole rows are computed, the upper triangle mirrored after the last row), on the nonzero
+            # entries of h
             for i in range(n):
                 dx[i] = 0.0
             for a in range(m):
