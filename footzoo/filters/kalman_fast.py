@@ -212,9 +212,11 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             for i in range(n):
                 for j in range(n):
                     M[i, j] = P[i, j]
-        # (Φ P) Φᵀ in place, columns in the same order, on the moving rows; Φ P Φᵀ is symmetric
-        # and its other rows are those of Φ P: mirrored
-        for e in range(n_dyn):
+        # (Φ P) Φᵀ in place, columns in the same order, on the moving rows. Φ P Φᵀ is symmetric:
+        # of its moving block only the entries (dyn[e], dyn[e2]) with e ≤ e2 are computed (the
+        # columns of the block dyn[b:b+3] on the rows dyn[:b+3]), then mirrored, as are the
+        # other rows, which are those of Φ P
+        for e in range(3):
             i = dyn[e]
             for j in range(3):
                 P[i, pos_i + j] += dt * P[i, vel_i + j]
@@ -222,7 +224,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             r0, c0, bm = (vel_i, att, sdt) if blk == 0 else (vel_i, ab_i, cdt) if blk == 1 else (att, gb_i, cdt)
             if r0 < 0 or c0 < 0:
                 continue
-            for e in range(n_dyn):
+            for e in range(6 if blk < 2 else n_dyn):
                 i = dyn[e]
                 x0, x1, x2 = P[i, c0], P[i, c0 + 1], P[i, c0 + 2]
                 for j in range(3):
