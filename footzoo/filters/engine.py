@@ -141,6 +141,7 @@ class Packed:
     functions: tuple
     arrays: tuple
     bound: Any = None  # the compiled loop with the functions bound in (live use): see KalmanEngine.live
+    work: tuple | None = None  # the loop's buffers (kalman_fast.scratch), allocated at the first step
 
 
 class KalmanEngine:
@@ -309,7 +310,9 @@ class KalmanEngine:
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["gains"], out["dxs"])
         state = (packed.nav, packed.P, packed.mems)
-        work = scratch(packed.P.shape[0], packed.core[4])
+        if packed.work is None:
+            packed.work = scratch(packed.P.shape[0], packed.core[4])
+        work = packed.work
         if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
                          k0, work)
