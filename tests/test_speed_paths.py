@@ -168,3 +168,35 @@ def test_alignment_runs_fqa_of_one_sample_as_python_with_the_compiled_kernels_nu
         py = getattr(fqa_sample, "py_func", fqa_sample)
         assert np.array_equal(fqa(a[None], m[None])[0], np.array(py(*a, *m, True)))
         assert np.array_equal(fqa(a[None])[0], np.array(py(*a, 0.0, 0.0, 0.0, False)))
+
+
+def _allocating_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """Test model: allocates a temporary array (so it needs numba's reference counting)."""
+    v = np.zeros(3)
+    for i in range(3):
+        v[i] = nav[7 + i]
+    if not stance:
+        return m
+    for i in range(3):
+        H[m, idx[3] + i] = 1.0
+        z[m] = v[i]
+        R[m] = par[0]
+        m += 1
+    return m
+
+
+def test_measurement_functions_compile_without_reference_counting_unless_they_allocate():
+    from footzoo import _jit
+    from footzoo.corrections.ekf_zupt import zero_velocity_measure
+
+    if not _jit.HAVE_NUMBA:
+        pytest.skip("numba not installed")
+    assert zero_velocity_measure.targetoptions.get("_nrt") is False
+    fn = measurement_function(_allocating_measure)
+    assert fn.targetoptions.get("_nrt", True) is not False
+    z, H, R = np.zeros(3), np.zeros((3, 9)), np.zeros(3)
+    nav = np.zeros(16)
+    nav[7:10] = [1.0, 2.0, 3.0]
+    idx = np.array([0, -1, 3, 6, -1], dtype=np.int64)
+    m = fn(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0), z, H, R, 0)
+    assert m == 3 and z.tolist() == [1.0, 2.0, 3.0] and H[:, 6:9].tolist() == np.eye(3).tolist()

@@ -44,8 +44,9 @@ if _jit.HAVE_NUMBA:
         def _unowned(typingctx, a):  # noqa: F811 - the compiled form of the function above
             """A view of array ``a`` without an owner: numba counts no references for it.
 
-            Only for arrays that outlive every use of the view (arguments and locals of the
-            loop handed to the models' functions, which return no array).
+            Only for arrays that outlive every use of the view: the loop's arguments (a local
+            array is freed after its last use, which may be the call of this function), handed
+            to the models' functions, which return no array.
             """
 
             def codegen(context, builder, sig, args):
@@ -97,11 +98,12 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     smooth = gains.shape[0] == N
     keep_p = pdiag.shape[0] == N
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
-    # the arrays handed to the models, as views that own no reference: passing them costs no
-    # reference counting (they are the caller's, alive during the whole call)
+    # the arrays the loop works on and hands to the models' functions, as views that own no
+    # reference: handing them on costs no reference counting (they are the caller's arguments,
+    # alive during the whole call)
     (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, M, sub, Ls, inv, keep, u_o, kv_o, g_o, nzc_o, dyn_o,
      still_o, c_o, cdt_o, sdt_o, an_o) = scratch
-    P = _unowned(P_owned)  # also handed to the small compiled functions below
+    P = _unowned(P_owned)
     u, kv, g, nzc, dyn, still = (_unowned(u_o), _unowned(kv_o), _unowned(g_o), _unowned(nzc_o), _unowned(dyn_o),
                                  _unowned(still_o))
     c, cdt, sdt, a_n = _unowned(c_o), _unowned(cdt_o), _unowned(sdt_o), _unowned(an_o)

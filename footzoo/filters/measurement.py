@@ -105,6 +105,13 @@ def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[...,
             return fn
         fn = fn.py_func
     try:
+        # first without reference counting: the same machine code for a function that allocates no
+        # array (numba refuses to compile one that does, here or in a function it calls), minus the
+        # counting of every array argument at each call
+        return numba.njit(signature, cache=True, nogil=True, _nrt=False)(fn)
+    except Exception:  # it allocates (or numba lacks the option): with reference counting
+        pass
+    try:
         return numba.njit(signature, cache=True, nogil=True)(fn)
     except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
         pass
