@@ -125,9 +125,11 @@ def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[...,
 def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
     """Compile a ``measure`` function with the engine's signature (plain Python without numba).
 
-    Use as a decorator in a correction's module. A function that does not
-    compile raises :class:`NotCompilable` with numba's reason; leave the
-    decorator off to run such a correction on the reference engine.
+    Use as a decorator in a correction's module. A function that creates no
+    array is compiled without numba's reference counting (cheaper calls from
+    the compiled loop). A function that does not compile raises
+    :class:`NotCompilable` with numba's reason; leave the decorator off to run
+    such a correction on the reference engine.
     """
     return _compile(fn, MEASURE_SIGNATURE, "measure")
 
