@@ -238,7 +238,7 @@ class KalmanEngine:
                                  state["nav"], self.gravity, data, k0, smoother)
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
-               "acc_nav": np.empty((n, 3)), "gyro_bias": np.empty((n, 3)), "acc_bias": np.empty((n, 3)),
+               "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)

@@ -80,6 +80,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     out : tuple
         ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n),
         gains (N or 0, n, n), dxs (N or 0, n), smoother_gain)``; row 0 receives the incoming state.
+        A bias without its error-state block stays zero and is not written: pass zeros.
         ``P_diag``, and the smoother's gains ``A_k`` and fed-back errors
         (:mod:`footzoo.filters.smoother`), with 0 rows are not written; ``smoother_gain`` is
         :func:`footzoo.filters.smoother.smoother_gain` (compiled on its own, called only with gains).
@@ -141,8 +142,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
     for i in range(3):
         pos[0, i] = nav[4 + i]
         vel[0, i] = nav[7 + i]
-        gb_out[0, i] = nav[10 + i]
-        ab_out[0, i] = nav[13 + i]
+        if gb_i >= 0:  # without the block the estimate stays 0 (the caller's zeros)
+            gb_out[0, i] = nav[10 + i]
+        if ab_i >= 0:
+            ab_out[0, i] = nav[13 + i]
         acc_nav[0, i] = 0.0
     if keep_p:
         for i in range(n):
@@ -318,8 +321,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
         for i in range(3):
             pos[k, i] = nav[4 + i]
             vel[k, i] = nav[7 + i]
-            gb_out[k, i] = nav[10 + i]
-            ab_out[k, i] = nav[13 + i]
+            if gb_i >= 0:
+                gb_out[k, i] = nav[10 + i]
+            if ab_i >= 0:
+                ab_out[k, i] = nav[13 + i]
             acc_nav[k, i] = a_n[i]
         if keep_p:
             for i in range(n):
