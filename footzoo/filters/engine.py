@@ -242,6 +242,9 @@ class KalmanEngine:
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
+        for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
+            if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
+                out[key][:] = state.nav[at:at + 3]
         return out
 
     def diagnostics(self, state: Any) -> dict[str, Any]:
