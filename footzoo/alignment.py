@@ -6,7 +6,7 @@ import numpy as np
 
 from .conventions import quat_conj, quat_from_rotvec, quat_mul
 from .errors import RecordingError
-from .orientation.fqa import fqa
+from .orientation.fqa import fqa_sample
 
 
 def initial_attitude(
@@ -47,7 +47,10 @@ def initial_attitude(
     start, stop = first_still_window(t, gyr, duration, max_gyr)
     a = acc[start:stop].mean(axis=0)
     m = mag[start:stop].mean(axis=0) if mag is not None else None
-    q = fqa(a[None, :], None if m is None else m[None, :])[0]
+    # FQA of this one sample, its per-sample function run as Python: the same arithmetic as the
+    # compiled batch kernel, which a first run would otherwise compile (about half a second)
+    args = (*a, *m, True) if m is not None else (*a, 0.0, 0.0, 0.0, False)
+    q = np.array(getattr(fqa_sample, "py_func", fqa_sample)(*(float(x) for x in args[:6]), args[6]))
     for k in range(start, 0, -1):
         q = quat_mul(q, quat_conj(quat_from_rotvec(gyr[k] * (t[k] - t[k - 1]))))
     return q

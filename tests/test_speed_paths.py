@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from footzoo import Pipeline
+from footzoo.filters.measurement import measurement_function
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
@@ -100,3 +101,101 @@ def test_kernels_are_compiled_at_first_call_and_callers_see_the_compiled_callees
     if out["numba"]:
         assert out["lazy"] == "_Kernel"
         assert out["after"] == ["CPUDispatcher"] * 3
+
+
+@measurement_function
+def _dense_rows_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """Test model: in stance, three rows each a mix of the velocity (true value 0) and small attitude
+    and position terms (several nonzero entries per row)."""
+    if not stance:
+        return m
+    for r in range(3):
+        zr = 0.0
+        for j in range(3):
+            H[m, idx[3] + j] = par[r * 9 + j]
+            zr += par[r * 9 + j] * nav[7 + j]
+            if par[r * 9 + 3 + j] != 0.0:
+                H[m, idx[0] + j] = par[r * 9 + 3 + j]
+            if par[r * 9 + 6 + j] != 0.0:
+                H[m, idx[2] + j] = par[r * 9 + 6 + j]
+        z[m] = zr
+        R[m] = 1e-4 * (r + 1)
+        m += 1
+    return m
+
+
+def _dense_engine(engine):
+    from footzoo.filters.engine import KalmanEngine, NavigationNoise
+    from footzoo.filters.measurement import MeasurementModel, StateBlock
+
+    rng = np.random.default_rng(3)
+    par = np.zeros(27)
+    for r in range(3):
+        par[r * 9: r * 9 + 3] = np.eye(3)[r] + 0.3 * rng.normal(size=3)
+        par[r * 9 + 3: r * 9 + 9] = 0.01 * rng.normal(size=6) * (rng.random(6) < 0.5)
+    model = MeasurementModel(measure=_dense_rows_measure, max_rows=3, par=par)
+    blocks = [StateBlock("gyro_bias", 3, 1e-6, 1e-10), StateBlock("acc_bias", 3, 1e-4, 1e-8)]
+    return KalmanEngine(True, blocks, [model], NavigationNoise(), 9.81, engine=engine)
+
+
+def test_rows_taken_one_at_a_time_equal_the_stacked_update(walk):
+    """Rows with several nonzero entries each, updated in turn (fast) and stacked (filterpy): the same filter."""
+    stance = np.asarray(Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml").detect(walk).stance_)
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    ref = _dense_engine("reference").run(walk.t, walk.acc, walk.gyr, stance, q0)
+    fast = _dense_engine("fast").run(walk.t, walk.acc, walk.gyr, stance, q0)
+    for key in ("quat", "vel", "pos", "gyro_bias", "acc_bias"):
+        a, b = ref[key], fast[key]
+        assert np.max(np.abs(a - b)) <= 1e-9 * max(np.max(np.abs(a)), 1.0), key
+    np.testing.assert_allclose(fast["P_diag"], ref["P_diag"], rtol=1e-9, atol=1e-15)
+
+
+def test_compiled_loop_keeps_the_covariance_exactly_symmetric(walk):
+    eng = _dense_engine("fast")
+    stance = np.asarray(Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml").detect(walk).stance_)
+    state = eng.start(np.array([1.0] + [0.0] * 15))
+    eng.advance(state, walk.t, walk.acc, walk.gyr, stance, None, [None], 0)
+    assert np.array_equal(state.P, state.P.T)
+    assert state.work is not None  # the loop's buffers, kept for the next call
+
+
+def test_alignment_runs_fqa_of_one_sample_as_python_with_the_compiled_kernels_numbers():
+    from footzoo.orientation.fqa import fqa, fqa_sample
+
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        a, m = rng.normal(size=3), rng.normal(size=3)
+        py = getattr(fqa_sample, "py_func", fqa_sample)
+        assert np.array_equal(fqa(a[None], m[None])[0], np.array(py(*a, *m, True)))
+        assert np.array_equal(fqa(a[None])[0], np.array(py(*a, 0.0, 0.0, 0.0, False)))
+
+
+def _allocating_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """Test model: allocates a temporary array (so it needs numba's reference counting)."""
+    v = np.zeros(3)
+    for i in range(3):
+        v[i] = nav[7 + i]
+    if not stance:
+        return m
+    for i in range(3):
+        H[m, idx[3] + i] = 1.0
+        z[m] = v[i]
+        R[m] = par[0]
+        m += 1
+    return m
+
+
+def test_measurement_functions_compile_without_reference_counting_and_allocating_ones_still_work():
+    from footzoo import _jit
+    from footzoo.corrections.ekf_zupt import zero_velocity_measure
+
+    if not _jit.HAVE_NUMBA:
+        pytest.skip("numba not installed")
+    assert zero_velocity_measure.targetoptions.get("_nrt") is False
+    fn = measurement_function(_allocating_measure)  # compiled with reference counting (or loaded so from the cache)
+    z, H, R = np.zeros(3), np.zeros((3, 9)), np.zeros(3)
+    nav = np.zeros(16)
+    nav[7:10] = [1.0, 2.0, 3.0]
+    idx = np.array([0, -1, 3, 6, -1], dtype=np.int64)
+    m = fn(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0), z, H, R, 0)
+    assert m == 3 and z.tolist() == [1.0, 2.0, 3.0] and H[:, 6:9].tolist() == np.eye(3).tolist()

@@ -141,6 +141,7 @@ class Packed:
     functions: tuple
     arrays: tuple
     bound: Any = None  # the compiled loop with the functions bound in (live use): see KalmanEngine.live
+    work: tuple | None = None  # the loop's buffers (kalman_fast.scratch), allocated at the first step
 
 
 class KalmanEngine:
@@ -237,10 +238,13 @@ class KalmanEngine:
                                  state["nav"], self.gravity, data, k0, smoother)
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
-               "acc_nav": np.empty((n, 3)), "gyro_bias": np.empty((n, 3)), "acc_bias": np.empty((n, 3)),
+               "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
+        for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
+            if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
+                out[key][:] = state.nav[at:at + 3]
         return out
 
     def diagnostics(self, state: Any) -> dict[str, Any]:
@@ -300,7 +304,7 @@ class KalmanEngine:
     @staticmethod
     def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
         """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
-        from .kalman_fast import eskf_loop
+        from .kalman_fast import eskf_loop, scratch
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks = packed.arrays
@@ -309,13 +313,17 @@ class KalmanEngine:
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["gains"], out["dxs"])
         state = (packed.nav, packed.P, packed.mems)
-        if packed.bound is not None:
+        if packed.work is None:
+            packed.work = scratch(packed.P.shape[0], packed.core[4])
+        work = packed.work
+        if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
-                         k0)
+                         k0, work)
             return
         measures, feedbacks, afters = packed.functions
+        gain = _gain_function(out["gains"].shape[0] > 0)
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0)
+                                                data_off, hooks), outputs + (gain,), k0, work)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -337,6 +345,28 @@ def _address(fn: Any) -> Any:
 
 
 _ADDRESSES: dict[int, Any] = {}
+_GAINS: dict[bool, Any] = {}
+
+
+def _gain_function(smooth: bool) -> Any:
+    """The smoother's gain function for the compiled loop (a no-op with its signature without the smoother).
+
+    Compiled on its own with a fixed signature and passed as a first-class function, so the loop
+    does not compile it, and a run without the smoother compiles only the no-op.
+    """
+    from . import smoother
+
+    fn = _jit.compiled(smoother.smoother_gain) if smooth else smoother.no_gain
+    if not _jit.HAVE_NUMBA:
+        return fn
+    if smooth not in _GAINS:
+        import numba
+        from numba import types as t
+
+        a2 = t.float64[:, ::1]
+        signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
+        _GAINS[smooth] = _address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn)))
+    return _GAINS[smooth]
 
 if _jit.HAVE_NUMBA:
     from numba.core.types.function_type import WrapperAddressProtocol
@@ -369,11 +399,12 @@ def _bound_loop(functions: tuple) -> Any:
 
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
+        no_gain = _gain_function(False)
 
-        def bound(signals, core, state, arrays, out, k0):
+        def bound(signals, core, state, arrays, out, k0, work):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0)
+                                             data_off, hooks), out + (no_gain,), k0, work)
 
         import numba
 

@@ -105,6 +105,13 @@ def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[...,
             return fn
         fn = fn.py_func
     try:
+        # first without reference counting: the same machine code for a function that allocates no
+        # array (numba refuses to compile one that does, here or in a function it calls), minus the
+        # counting of every array argument at each call
+        return numba.njit(signature, cache=True, nogil=True, _nrt=False)(fn)
+    except Exception:  # it allocates (or numba lacks the option): with reference counting
+        pass
+    try:
         return numba.njit(signature, cache=True, nogil=True)(fn)
     except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
         pass
@@ -118,9 +125,11 @@ def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[...,
 def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
     """Compile a ``measure`` function with the engine's signature (plain Python without numba).
 
-    Use as a decorator in a correction's module. A function that does not
-    compile raises :class:`NotCompilable` with numba's reason; leave the
-    decorator off to run such a correction on the reference engine.
+    Use as a decorator in a correction's module. A function that creates no
+    array is compiled without numba's reference counting (cheaper calls from
+    the compiled loop). A function that does not compile raises
+    :class:`NotCompilable` with numba's reason; leave the decorator off to run
+    such a correction on the reference engine.
     """
     return _compile(fn, MEASURE_SIGNATURE, "measure")
 
