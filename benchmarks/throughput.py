@@ -282,7 +282,7 @@ def main_table(n: int, repeat: int, slow: int) -> tuple[list[str], dict]:
         best, med, cpu = it.n / min(it.wall), it.n / statistics.median(it.wall), it.n / min(it.cpu)
         frac, frac_cpu = best / lim_wall, cpu / lim_cpu
         target = TARGETS.get(it.kind)
-        if it is hw or it.name.startswith("("):
+        if it is hw or it.name.startswith("(") or target is None:
             met = ""
         else:
             met = "yes" if frac_cpu >= target else ("wall-clock only" if frac >= target else "no")
