@@ -27,8 +27,8 @@ JITTER = 1e-12
 
 
 @njit
-def spd_inverse(S, m, L, out):
-    """Inverse of the symmetric positive definite ``S[:m, :m]`` by Cholesky, into ``out[:m, :m]``."""
+def cholesky(S, m, L):
+    """Lower Cholesky factor of the symmetric positive definite ``S[:m, :m]``, into ``L[:m, :m]``."""
     for i in range(m):
         for j in range(i + 1):
             acc_ = S[i, j]
@@ -38,25 +38,15 @@ def spd_inverse(S, m, L, out):
                 L[i, i] = math.sqrt(acc_)
             else:
                 L[i, j] = acc_ / L[j, j]
-    # solve L Lᵀ X = I column by column
-    for col in range(m):
-        for i in range(m):  # forward: L y = e_col
-            acc_ = 1.0 if i == col else 0.0
-            for k in range(i):
-                acc_ -= L[i, k] * out[k, col]
-            out[i, col] = acc_ / L[i, i]
-        for i in range(m - 1, -1, -1):  # backward: Lᵀ x = y
-            acc_ = out[i, col]
-            for k in range(i + 1, m):
-                acc_ -= L[k, i] * out[k, col]
-            out[i, col] = acc_ / L[i, i]
 
 
 @njit
-def smoother_gain(M, P_pred, A, sub, L, inv, keep):
+def smoother_gain(M, P_pred, A, sub, L, x, keep):
     """``A = Mᵀ (P⁻)⁻¹`` with ``M = Φ P⁺`` (so ``Mᵀ = P⁺ Φᵀ``), over the states with variance.
 
-    ``sub``, ``L``, ``inv`` (n, n) and ``keep`` (n,) int are work arrays.
+    Row i of A solves ``P⁻ aᵢ = M[:, i]`` (P⁻ symmetric) with the Cholesky factor of P⁻: one
+    factorisation and two triangular solves per row, no explicit inverse. ``sub``, ``L``,
+    ``x`` (n, n) and ``keep`` (n,) int are work arrays.
     """
     n = P_pred.shape[0]
     top = 0.0
@@ -71,18 +61,26 @@ def smoother_gain(M, P_pred, A, sub, L, inv, keep):
         for b in range(m):
             sub[a, b] = P_pred[keep[a], keep[b]]
         sub[a, a] += JITTER * top
-    spd_inverse(sub, m, L, inv)
+    cholesky(sub, m, L)
     for i in range(n):
         for j in range(n):
             A[i, j] = 0.0
+        y = x[i]
+        for a in range(m):  # forward: L y = M[keep, i]
+            acc_ = M[keep[a], i]
+            for k in range(a):
+                acc_ -= L[a, k] * y[k]
+            y[a] = acc_ / L[a, a]
+        for a in range(m - 1, -1, -1):  # backward: Lᵀ aᵢ = y
+            acc_ = y[a]
+            for k in range(a + 1, m):
+                acc_ -= L[k, a] * y[k]
+            y[a] = acc_ / L[a, a]
         for b in range(m):
-            acc_ = 0.0
-            for a in range(m):
-                acc_ += M[keep[a], i] * inv[a, b]
-            A[i, keep[b]] = acc_
+            A[i, keep[b]] = y[b]
 
 
-def no_gain(M, P_pred, A, sub, L, inv, keep):  # noqa: ARG001 - the signature of smoother_gain
+def no_gain(M, P_pred, A, sub, L, x, keep):  # noqa: ARG001 - the signature of smoother_gain
     """Stands for :func:`smoother_gain` in a run without the smoother (never called)."""
     return None
 
