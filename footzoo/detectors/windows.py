@@ -37,6 +37,31 @@ def window_max(x: np.ndarray, half: int) -> np.ndarray:
 
 
 @njit
+def _window_sums(acc, gyr, first, window, g, rate_sums, gravity_sums):
+    """Sums over samples ``first … first + window − 1`` (clipped to the recording, edges replicated).
+
+    Returns Σ y_a (three components), Σ ‖y_a‖², Σ ‖y_ω‖² (if ``rate_sums``) and Σ (‖y_a‖ − g)²
+    (if ``gravity_sums``; both zero otherwise).
+    """
+    n = acc.shape[0]
+    mx = my = mz = a2 = w2 = dg = 0.0
+    for j in range(first, first + window):
+        i = min(max(j, 0), n - 1)
+        ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
+        mx += ax
+        my += ay
+        mz += az
+        na2 = ax * ax + ay * ay + az * az
+        a2 += na2
+        if rate_sums:
+            w2 += gyr[i, 0] * gyr[i, 0] + gyr[i, 1] * gyr[i, 1] + gyr[i, 2] * gyr[i, 2]
+        if gravity_sums:
+            d = math.sqrt(na2) - g
+            dg += d * d
+    return mx, my, mz, a2, w2, dg
+
+
+@njit
 def window_moments(acc: np.ndarray, gyr: np.ndarray, window: int, g: float) -> np.ndarray:
     """Per-sample moments over a centred window of ``window`` samples (edges replicated).
 
@@ -49,18 +74,7 @@ def window_moments(acc: np.ndarray, gyr: np.ndarray, window: int, g: float) -> n
     out = np.empty((n, 6))
     start = -(window // 2)
     for k in range(n):
-        mx = my = mz = a2 = w2 = dg = 0.0
-        for j in range(k + start, k + start + window):
-            i = min(max(j, 0), n - 1)
-            ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
-            mx += ax
-            my += ay
-            mz += az
-            na2 = ax * ax + ay * ay + az * az
-            a2 += na2
-            w2 += gyr[i, 0] * gyr[i, 0] + gyr[i, 1] * gyr[i, 1] + gyr[i, 2] * gyr[i, 2]
-            d = math.sqrt(na2) - g
-            dg += d * d
+        mx, my, mz, a2, w2, dg = _window_sums(acc, gyr, k + start, window, g, True, True)
         out[k, 0], out[k, 1], out[k, 2] = mx / window, my / window, mz / window
         out[k, 3], out[k, 4], out[k, 5] = a2 / window, w2 / window, dg / window
     return out
@@ -89,21 +103,9 @@ def window_statistic(acc: np.ndarray, gyr: np.ndarray, window: int, g: float, g2
     n = acc.shape[0]
     out = np.empty(n)
     start = -(window // 2)
+    rate_sums = test == SHOE_TEST or test == ARE_TEST
     for k in range(n):
-        mx = my = mz = a2 = w2 = dg = 0.0
-        for j in range(k + start, k + start + window):
-            i = min(max(j, 0), n - 1)
-            ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
-            mx += ax
-            my += ay
-            mz += az
-            na2 = ax * ax + ay * ay + az * az
-            a2 += na2
-            if test == SHOE_TEST or test == ARE_TEST:
-                w2 += gyr[i, 0] * gyr[i, 0] + gyr[i, 1] * gyr[i, 1] + gyr[i, 2] * gyr[i, 2]
-            if test == MAG_TEST:
-                d = math.sqrt(na2) - g
-                dg += d * d
+        mx, my, mz, a2, w2, dg = _window_sums(acc, gyr, k + start, window, g, rate_sums, test == MAG_TEST)
         mx, my, mz = mx / window, my / window, mz / window
         if test == SHOE_TEST:
             acc_term = a2 / window - 2.0 * g * math.sqrt(mx * mx + my * my + mz * mz) + g2
