@@ -135,48 +135,68 @@ def speed_per_sample(t: np.ndarray, starts: np.ndarray, ends: np.ndarray, peaks:
     p = np.where(np.isfinite(peaks), peaks, peaks[nearest])
     lo = np.searchsorted(t, t[starts] - reach, side="left")
     hi = np.searchsorted(t, t[np.maximum(ends - 1, 0)] + reach, side="right")
-    for j in np.argsort(p, kind="stable"):  # ascending: the larger peak wins where reaches overlap
-        out[lo[j]:hi[j]] = p[j]
+    _paint(out, lo, hi, p, np.argsort(p, kind="stable"))  # ascending: the larger peak wins where reaches overlap
     return out
 
 
+@njit
+def _paint(out: np.ndarray, lo: np.ndarray, hi: np.ndarray, value: np.ndarray, order: np.ndarray) -> None:
+    """``out[lo[j]:hi[j]] = value[j]`` for j in ``order``."""
+    for j in order:
+        out[lo[j]:hi[j]] = value[j]
+
+
+@njit
 def close_still_gaps(stance: np.ndarray, min_samples: int, speed: np.ndarray, still_speed: float) -> np.ndarray:
     """Close the swings shorter than ``min_samples`` in which the foot stayed slower than ``still_speed`` (m/s).
 
-    A short gap where the foot moved (the push-off before a pause of the test) is a
-    real swing and stays open.
+    Only swings with a stance on both sides (as :func:`~footzoo.detectors.runs.close_short_swings`);
+    a short gap where the foot moved (the push-off before a pause of the test) is a real swing and
+    stays open.
     """
-    closed = close_short_swings(stance, min_samples)
-    filled = closed & ~stance
-    edges = np.flatnonzero(np.diff(np.r_[False, filled, False].astype(np.int8)))
-    for a, b in zip(edges[::2], edges[1::2], strict=True):
-        if speed[a:b].max() > still_speed:
-            closed[a:b] = False
-    return closed
+    n = stance.shape[0]
+    out = stance.copy()
+    k = 0
+    while k < n:
+        if stance[k]:
+            k += 1
+            continue
+        a = k
+        fastest = 0.0
+        while k < n and not stance[k]:
+            fastest = max(fastest, speed[k])
+            k += 1
+        if a > 0 and k < n and k - a < min_samples and fastest <= still_speed:
+            out[a:k] = True
+    return out
 
 
+@njit
 def drop_pauses(stance: np.ndarray, min_samples: int) -> np.ndarray:
     """Of two stance runs less than ``min_samples`` apart, remove the shorter if it is shorter than that.
 
     What is left of such a pair after :func:`close_still_gaps` is a foot that moved in the
     gap: a stance and a pause in the air (the end of the push-off, or just before the
-    landing), not two stances, which are a swing apart.
+    landing), not two stances, which are a swing apart. The runs are judged as they come from
+    :func:`close_still_gaps` (a removed run does not merge its neighbours' gaps).
     """
-    out = np.asarray(stance, dtype=bool).copy()
-    n = out.size
-    if n == 0:
-        return out
-    change = np.flatnonzero(out[1:] != out[:-1]) + 1
-    starts = np.r_[0, change]
-    lengths = np.diff(np.r_[starts, n])
-    is_stance = out[starts]
-    for i in range(1, len(starts) - 1):  # a swing run with a stance run on each side
-        if is_stance[i] or lengths[i] >= min_samples:
+    n = stance.shape[0]
+    out = stance.copy()
+    starts = np.empty(n + 1, dtype=np.int64)
+    r = 0
+    for k in range(n):
+        if k == 0 or stance[k] != stance[k - 1]:
+            starts[r] = k
+            r += 1
+    starts[r] = n
+    for i in range(1, r - 1):  # a swing run with a stance run on each side
+        if stance[starts[i]] or starts[i + 1] - starts[i] >= min_samples:
             continue
-        a, b = i - 1, i + 1
-        short = a if lengths[a] <= lengths[b] else b
-        if lengths[short] < min_samples:
-            out[starts[short]:starts[short] + lengths[short]] = False
+        la = starts[i] - starts[i - 1]
+        lb = starts[i + 2] - starts[i + 1]
+        j, length = (i - 1, la) if la <= lb else (i + 1, lb)
+        if length < min_samples:
+            out[starts[j]:starts[j] + length] = False
     return out
 
 
