@@ -79,6 +79,9 @@ class Stream:
             reasons.append("no Kalman-filter correction")
         if pipeline.analysis:
             reasons.append("analysis plug-ins run on whole recordings")
+        if pipeline.smoother != "none":
+            reasons.append(f"smoother {pipeline.smoother!r} runs backwards over the whole recording "
+                           "(live: smoother: none)")
         if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
         for label, value in (("max_gap", max_gap), ("max_wait", max_wait)):

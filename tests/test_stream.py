@@ -46,6 +46,11 @@ def test_non_causal_pipelines_are_rejected_with_the_reason():
         Stream(Pipeline.from_yaml("configs/yun2012.yaml"))
     with pytest.raises(ConfigError, match=r"detector 'windowed'"):
         Stream(Pipeline.from_yaml("configs/duong2015_zupt.yaml"))
+    # a smoother runs backwards: a stream would silently give the forward filter's estimate instead
+    d = Pipeline.from_yaml("configs/nguyen2016.yaml").to_dict()
+    d["smoother"] = "rts"
+    with pytest.raises(ConfigError, match=r"smoother 'rts' runs backwards .*live: smoother: none"):
+        Stream(Pipeline.from_dict(d))
 
 
 def test_bad_live_input_is_reported(walk):
