@@ -9,6 +9,7 @@ import numpy as np
 from .._jit import njit
 from ..checks import check_range
 from ..conventions import GRAVITY
+from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..plugin import Detector
 from ..registry import check_positive, register
 
@@ -54,21 +55,6 @@ def _ring_mean3(ring, count, window, x0, x1, x2):
 
 
 @njit
-def _quat_mul(a0, a1, a2, a3, b0, b1, b2, b3):
-    return (a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-            a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
-
-
-@njit
-def _rotvec_quat(rx, ry, rz):
-    """Unit quaternion of the rotation vector (rad), scalar first."""
-    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-    half = 0.5 * angle
-    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-    return math.cos(half), kk * rx, kk * ry, kk * rz
-
-
-@njit
 def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ring_sq, ring_dg, count, hist, hist_q):
     """``s_c`` (eq. 9) of ``d_g`` (eq. 3) per sample, resumable: the state arrays carry on between calls.
 
@@ -107,7 +93,7 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ri
         w_m = math.sqrt((gyr[k, 0] * gyr[k, 0] + gyr[k, 1] * gyr[k, 1]) + gyr[k, 2] * gyr[k, 2])
         slot = c % lag
         dt = t[k] - hist[(c - 1) % lag, 0] if c > 0 else 0.0
-        hist_q[slot, 0], hist_q[slot, 1], hist_q[slot, 2], hist_q[slot, 3] = _rotvec_quat(
+        hist_q[slot, 0], hist_q[slot, 1], hist_q[slot, 2], hist_q[slot, 3] = rotvec_quat(
             gyr[k, 0] * dt, gyr[k, 1] * dt, gyr[k, 2] * dt)
         if c < lag:
             d_g = 0.0
@@ -116,8 +102,8 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ri
             q0, q1, q2, q3 = 1.0, 0.0, 0.0, 0.0
             for j in range(lag):
                 i = (c - lag + 1 + j) % lag
-                q0, q1, q2, q3 = _quat_mul(q0, q1, q2, q3, hist_q[i, 0], hist_q[i, 1], hist_q[i, 2], hist_q[i, 3])
-            gx, gy, gz = _rotate(q0, q1, q2, q3, a0, a1, a2)
+                q0, q1, q2, q3 = quat_product(q0, q1, q2, q3, hist_q[i, 0], hist_q[i, 1], hist_q[i, 2], hist_q[i, 3])
+            gx, gy, gz = rotate(q0, q1, q2, q3, a0, a1, a2)
             old = hist[slot]  # the sample lag steps back (not yet overwritten)
             dx, dy, dz = gx - old[3], gy - old[4], gz - old[5]
             d_am = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -128,15 +114,6 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ri
         hist[slot, 3], hist[slot, 4], hist[slot, 5] = a0, a1, a2
         count[0] = c + 1
     return s_c, d_g_out
-
-
-@njit
-def _rotate(w, x, y, z, fx, fy, fz):
-    """``q f q*`` for a unit quaternion (scalar first)."""
-    gx = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
-    gy = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
-    gz = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz
-    return gx, gy, gz
 
 
 def dgp_initial_state(s_d0: float, th0: float, delay: int = 2) -> np.ndarray:

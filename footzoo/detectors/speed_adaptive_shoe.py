@@ -8,6 +8,7 @@ import numpy as np
 
 from .._jit import njit
 from ..checks import check_range
+from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..registry import register
 from .adaptive_shoe import AdaptiveSHOE, adaptive_threshold_kernel
 from .runs import close_short_swings
@@ -21,7 +22,9 @@ def swing_speeds(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nda
     For each run of ``stance == False`` (a swing, samples ``[s, e)``): the attitude at
     ``s`` is levelled on the mean specific force of the stance samples in the last
     ``lead`` seconds before it (yaw zero: a speed does not depend on it), the rate is
-    integrated (``q ← q ⊗ exp(ω Δt)``), the specific force rotated to NED and gravity
+    integrated (``q ← q ⊗ exp(ω Δt)``), the specific force rotated to NED (with the attitude at
+    the sample's end, not mid-interval as :mod:`footzoo.filters.strapdown` does: for a speed
+    feature the half-sample lag is negligible and absorbed by the dedrift) and gravity
     (the mean ‖f‖ of the same stance samples, so an accelerometer scale error cancels)
     removed, the velocity integrated from zero and linearly dedrifted to zero at the
     next stance sample ``e`` (Yun 2012's correction). A swing that starts or ends the
@@ -46,14 +49,17 @@ def swing_speeds(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nda
     """
     n = t.shape[0]
     m = 0
+    longest = run = 0
     for k in range(n):
         if not stance[k] and (k == 0 or stance[k - 1]):
             m += 1
+        run = 0 if stance[k] else run + 1
+        longest = max(longest, run)
     starts = np.empty(m, dtype=np.int64)
     ends = np.empty(m, dtype=np.int64)
     peaks = np.full(m, np.nan)
     speed = np.zeros(n)
-    vel = np.empty((n, 3))
+    vel = np.empty((longest + 1, 3))  # one swing's velocity at a time
     j = 0
     k = 0
     while k < n:
@@ -88,25 +94,18 @@ def swing_speeds(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nda
             vx = vy = vz = 0.0
             for i in range(s, e + 1):
                 dt = t[i] - t[i - 1]
-                rx, ry, rz = gyr[i, 0] * dt, gyr[i, 1] * dt, gyr[i, 2] * dt
-                ang = math.sqrt(rx * rx + ry * ry + rz * rz)
-                kk = math.sin(0.5 * ang) / ang if ang > 1e-12 else 0.5
-                dw, dx, dy, dz = math.cos(0.5 * ang), kk * rx, kk * ry, kk * rz
-                qw, qx, qy, qz = (qw * dw - qx * dx - qy * dy - qz * dz, qw * dx + qx * dw + qy * dz - qz * dy,
-                                  qw * dy - qx * dz + qy * dw + qz * dx, qw * dz + qx * dy - qy * dx + qz * dw)
-                ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
-                an0 = (1 - 2 * (qy * qy + qz * qz)) * ax + 2 * (qx * qy - qw * qz) * ay + 2 * (qx * qz + qw * qy) * az
-                an1 = 2 * (qx * qy + qw * qz) * ax + (1 - 2 * (qx * qx + qz * qz)) * ay + 2 * (qy * qz - qw * qx) * az
-                an2 = 2 * (qx * qz - qw * qy) * ax + 2 * (qy * qz + qw * qx) * ay + (1 - 2 * (qx * qx + qy * qy)) * az
+                dw, dx, dy, dz = rotvec_quat(gyr[i, 0] * dt, gyr[i, 1] * dt, gyr[i, 2] * dt)
+                qw, qx, qy, qz = quat_product(qw, qx, qy, qz, dw, dx, dy, dz)
+                an0, an1, an2 = rotate(qw, qx, qy, qz, acc[i, 0], acc[i, 1], acc[i, 2])
                 vx += an0 * dt
                 vy += an1 * dt
                 vz += (an2 + g) * dt
-                vel[i, 0], vel[i, 1], vel[i, 2] = vx, vy, vz
+                vel[i - s, 0], vel[i - s, 1], vel[i - s, 2] = vx, vy, vz
             span = t[e] - t[s - 1]
             peak = 0.0
             for i in range(s, e):
                 r = (t[i] - t[s - 1]) / span
-                ex, ey, ez = vel[i, 0] - r * vx, vel[i, 1] - r * vy, vel[i, 2] - r * vz
+                ex, ey, ez = vel[i - s, 0] - r * vx, vel[i - s, 1] - r * vy, vel[i - s, 2] - r * vz
                 speed[i] = math.sqrt(ex * ex + ey * ey + ez * ez)
                 peak = max(peak, speed[i])
             peaks[j] = peak
