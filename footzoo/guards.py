@@ -46,6 +46,7 @@ import numpy as np
 from ._jit import njit
 from .checks import check_range
 from .errors import ConfigError, GuardWarning, did_you_mean
+from .metrics import intervals
 
 
 @njit
@@ -76,12 +77,6 @@ def _still_instants(score: np.ndarray, still: float, sep: int, half: int) -> np.
             hi += 1
             out[hi] = True
     return out
-
-
-def _runs(mask: np.ndarray) -> np.ndarray:
-    """``[start, end)`` of the runs of True in ``mask``, as an (k, 2) int array."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
-    return edges.reshape(-1, 2)
 
 
 @dataclass
@@ -166,7 +161,7 @@ class StanceGuard:
         if n < 2:
             return out, report
         rate = 1.0 / float(np.median(np.diff(t)))
-        swings = _runs(~s)
+        swings = intervals(~s)
         if len(swings):
             report["longest_swing"] = float(np.max(swings[:, 1] - swings[:, 0]) / rate)
         if self.max_swing <= 0.0 or not len(swings):
@@ -183,7 +178,7 @@ class StanceGuard:
             added = _still_instants(np.ascontiguousarray(score[a:b]), self.still_rate, sep, half)
             out[a:b] |= added
             report["long_swings"].append([float(t[a]), float(t[b - 1])])
-            report["stances_added"] += len(_runs(added))
+            report["stances_added"] += len(intervals(added))
             report["samples_added"] += int(np.count_nonzero(added))
         return out, report
 
