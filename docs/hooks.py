@@ -44,8 +44,8 @@ def use_checkout() -> None:
 
 log = logging.getLogger("mkdocs.hooks.footzoo")
 
-KIND_TITLES = {"orientation": "Orientation", "detector": "Stance detectors", "correction": "Corrections",
-               "analysis": "Analysis"}
+KIND_TITLES = {"calibration": "Calibration", "orientation": "Orientation", "detector": "Stance detectors",
+               "correction": "Corrections", "analysis": "Analysis"}
 #: Class attributes of a plug-in that are not capabilities.
 NOT_CAPABILITIES = {"kind", "name", "paper", "units"}
 

@@ -25,6 +25,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "description": "free text",
     "gravity": "gravity magnitude g (m/s²), default 9.81",
     "init": "initial alignment: {duration: s of stillness at the start (default 0.5)}",
+    "calibration": "list of in-situ sensor calibrations applied first [{type: hard_iron}, ...]",
     "orientation": "orientation plug-in {type: ..., params}",
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
@@ -73,7 +74,8 @@ def top_level_errors(d: dict[str, Any]) -> list[str]:
             if key not in INIT_KEYS:
                 errors.append(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; "
                               f"valid: {list(INIT_KEYS)}")
-    for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]")):
+    for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]"),
+                         ("calibration", "[{type: hard_iron}]")):
         if not isinstance(d.get(key, []) or [], list):
             errors.append(f"{key} must be a list, e.g. {example}")
     return errors

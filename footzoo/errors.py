@@ -27,6 +27,10 @@ class SensorWarning(FootzooWarning):
     """Suspicious sensor data: saturated (clipped) axes, isolated spikes (glitches)."""
 
 
+class CalibrationWarning(FootzooWarning):
+    """An in-situ calibration could not be fitted reliably and was not applied (:mod:`footzoo.calibration`)."""
+
+
 class GuardWarning(FootzooWarning):
     """A pipeline guard fired: the detector missed stances, or the estimate diverged (:mod:`footzoo.guards`)."""
 

@@ -1,6 +1,7 @@
 """Compose plug-ins into a pipeline and run it on a recording.
 
-``Pipeline.run`` is four named stages: :meth:`~Pipeline.detect` (gait phase),
+``Pipeline.run`` is five named stages: :meth:`~Pipeline.calibrate` (in-situ sensor calibration,
+if any), :meth:`~Pipeline.detect` (gait phase),
 :meth:`~Pipeline.orient` (attitude, unless the Kalman filter carries it),
 :meth:`~Pipeline.navigate` (velocity and position: the error-state Kalman engine, or batch
 corrections and integration) and :meth:`~Pipeline.analyse` (strides and analysis plug-ins).
@@ -9,6 +10,7 @@ The stages read the plug-ins' base classes and declared capabilities, never thei
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,7 @@ from .guards import StanceGuard, check_speed
 from .plugin import (
     AccelerationCorrection,
     Analysis,
+    Calibration,
     Detector,
     KalmanCorrection,
     Orientation,
@@ -73,6 +76,10 @@ class Pipeline:
         What a run does when the detector misses stances (stance at the stillest instants of a
         swing longer than ``max_swing``) and the speed bound of the estimate; see
         :mod:`footzoo.guards`. On by default.
+    calibration : list of Calibration, optional
+        In-situ sensor calibrations (:mod:`footzoo.calibration`), fitted on each recording and
+        applied in order before every other stage; their reports are in
+        ``Result.diagnostics["calibration"]``.
     """
 
     SMOOTHERS = ("none", "rts")
@@ -90,7 +97,12 @@ class Pipeline:
         smoother: str = "none",
         plugins: list[str] | None = None,
         guards: StanceGuard | dict[str, Any] | None = None,
+        calibration: list[Calibration] | None = None,
     ):
+        self.calibration = list(calibration or [])
+        for i, c in enumerate(self.calibration):
+            if not isinstance(c, Calibration):
+                raise ConfigError(f"calibration[{i}] must be a footzoo.plugin.Calibration, got {type(c).__name__}")
         self.orientation = orientation
         self.detector = detector
         self.corrections = list(corrections or [])
@@ -120,6 +132,7 @@ class Pipeline:
         """
         check_top_level(d)
         plugins = [p["spec"] for p in load_plugins(d.get("plugins"), base_dir)]
+        calibration = [build("calibration", c, f"calibration[{i}]") for i, c in enumerate(d.get("calibration") or [])]
         orientation = build("orientation", d["orientation"], "orientation")
         detector = build("detector", d["detector"], "detector")
         corrections = [
@@ -138,6 +151,7 @@ class Pipeline:
             smoother=d.get("smoother", "none"),
             plugins=plugins,
             guards=d.get("guards"),
+            calibration=calibration,
         )
 
     @classmethod
@@ -158,6 +172,7 @@ class Pipeline:
             "navigation": self.navigation.to_dict(),
             "smoother": self.smoother,
             "guards": self.guards.to_dict(),
+            "calibration": [c.spec() for c in self.calibration],
             "orientation": self.orientation.spec(),
             "detector": self.detector.spec(),
             "corrections": [c.spec() for c in self.corrections],
@@ -201,6 +216,7 @@ class Pipeline:
         if not isinstance(rec, Recording):
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
         self._check_inputs(rec)
+        rec, calibration = self.calibrate(rec)
         detector = self.detect(rec)
         stance, guard_report = self.guard(rec, detector)
         q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
@@ -210,6 +226,8 @@ class Pipeline:
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
                        "guards": guard_report, **nav["diagnostics"]}
+        if self.calibration:
+            diagnostics["calibration"] = calibration
         config = self.to_dict()
         config["engine"] = nav["engine"]
         samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
@@ -220,10 +238,22 @@ class Pipeline:
         return rec.mag is not None and bool(getattr(self.orientation, "use_magnetometer", False))
 
     def _check_inputs(self, rec: Recording) -> None:
-        for p in [self.orientation, self.detector, *self.corrections, *self.analysis]:
+        for p in [*self.calibration, self.orientation, self.detector, *self.corrections, *self.analysis]:
             if p.needs_magnetometer and rec.mag is None:
                 raise RecordingError(f"{p.kind} {p.name!r} needs a magnetometer; the recording {rec.name!r} has none: "
                                      f"load one with mag_x, mag_y, mag_z or choose another {p.kind}")
+
+    def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
+        """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""
+        if not self.calibration:
+            return rec, []
+        out = copy.copy(rec)
+        reports = []
+        for c in self.calibration:
+            fitted = c.clone().calibrate(out.t, out.acc, out.gyr, out.mag)
+            out.acc, out.gyr, out.mag = _calibrated(c, out, fitted)
+            reports.append({"type": c.name, **fitted.report_})
+        return out, reports
 
     def detect(self, rec: Recording) -> Detector:
         """Stage 1: the fitted detector (``stance_``, ``statistic_``)."""
@@ -290,6 +320,24 @@ class Pipeline:
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps
+
+
+def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np.ndarray, ...]:
+    """The calibrated signals, checked: same shapes as the input, finite (a plug-in error names the plug-in)."""
+    out = []
+    for name, before in (("acc", rec.acc), ("gyr", rec.gyr), ("mag", rec.mag)):
+        after = getattr(fitted, f"{name}_", None)
+        if before is None and after is None:
+            out.append(None)
+            continue
+        after = None if after is None else np.asarray(after, dtype=float)
+        if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
+            what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
+                    else "NaN/inf")
+            raise RecordingError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
+                                 f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)")
+        out.append(after)
+    return tuple(out)
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

@@ -1,15 +1,15 @@
 """Plug-in kinds as base classes: what each kind takes, does, returns and declares.
 
 Every plug-in (built-in or yours) derives from one of :class:`Orientation`, :class:`Detector`,
-:class:`VelocityCorrection`, :class:`AccelerationCorrection`, :class:`KalmanCorrection` or
-:class:`Analysis`, and is made available by name with :func:`footzoo.register`. The rules, as in
+:class:`VelocityCorrection`, :class:`AccelerationCorrection`, :class:`KalmanCorrection`,
+:class:`Analysis` or :class:`Calibration`, and is made available by name with :func:`footzoo.register`. The rules, as in
 scikit-learn:
 
 * ``__init__`` takes every parameter as a keyword with its paper's default, stores it under the
   same name (validated, converted to plain numbers), and does nothing else that depends on data;
 * ``units`` gives the unit of every numeric parameter, ``paper`` the reference, the class
   docstring the equations;
-* the one action method (``estimate``, ``detect``, ``apply``, ``apply_acceleration``,
+* the one action method (``calibrate``, ``estimate``, ``detect``, ``apply``, ``apply_acceleration``,
   ``analyze``; a Kalman correction's ``model``) sets results as attributes ending in ``_`` and
   returns ``self`` (or the corrected array);
 * capabilities are class attributes the pipeline reads instead of names: ``needs_magnetometer``,
@@ -34,7 +34,7 @@ from .errors import RecordingError
 from .filters.measurement import MeasurementModel, StateBlock
 
 #: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
-ACTIONS = ("estimate", "detect", "apply", "apply_acceleration", "analyze")
+ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
 
 
 def _all_finite(value: np.ndarray) -> bool:
@@ -146,6 +146,25 @@ def _plain(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+class Calibration(Plugin):
+    """In-situ sensor calibration: fitted on the recording itself, applied before every other stage.
+
+    ``calibrate(t, acc, gyr, mag)`` takes time (s), specific force (m/s², FRD), angular rate
+    (rad/s, FRD) and the magnetometer (any unit, or None) and sets ``acc_``, ``gyr_`` and ``mag_``
+    (corrected copies in the same units; ``mag_`` None without a magnetometer; the inputs are not
+    changed) and ``report_`` (a dict of plain numbers, text and lists: what was fitted or why
+    nothing was, shown in ``Result.diagnostics["calibration"]``). A calibration that cannot be
+    fitted reliably on a recording leaves the signals as they are and says so (warning and
+    ``report_``); it never guesses. It sees the whole recording, so :class:`footzoo.stream.Stream` runs none.
+    """
+
+    kind: ClassVar[str] = "calibration"
+
+    def calibrate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> Calibration:
+        """Set ``acc_``, ``gyr_``, ``mag_`` and ``report_``; returns ``self``."""
+        raise NotImplementedError
 
 
 class Orientation(Plugin):
@@ -287,6 +306,7 @@ class Analysis(Plugin):
 
 #: Base class of each kind.
 BASES: dict[str, tuple[type[Plugin], ...]] = {
+    "calibration": (Calibration,),
     "orientation": (Orientation,),
     "detector": (Detector,),
     "correction": (VelocityCorrection, AccelerationCorrection, KalmanCorrection),

@@ -23,8 +23,8 @@ from .plugin import BASES, Plugin
 
 KINDS: tuple[str, ...] = tuple(BASES)
 #: Packages whose import registers the built-in plug-ins.
-BUILTIN_PACKAGES: tuple[str, ...] = ("footzoo.orientation", "footzoo.detectors", "footzoo.corrections",
-                                     "footzoo.analysis")
+BUILTIN_PACKAGES: tuple[str, ...] = ("footzoo.calibration", "footzoo.orientation", "footzoo.detectors",
+                                     "footzoo.corrections", "footzoo.analysis")
 
 _REGISTRY: dict[str, dict[str, type[Plugin]]] = {k: {} for k in KINDS}
 _LOADED = False

@@ -79,6 +79,9 @@ class Stream:
             reasons.append("no Kalman-filter correction")
         if pipeline.analysis:
             reasons.append("analysis plug-ins run on whole recordings")
+        if pipeline.calibration:
+            reasons.append(f"calibration {[c.name for c in pipeline.calibration]} is fitted on the whole recording "
+                           "(live: remove it)")
         if pipeline.smoother != "none":
             reasons.append(f"smoother {pipeline.smoother!r} runs backwards over the whole recording "
                            "(live: smoother: none)")

@@ -20,6 +20,8 @@ The checks:
   parameters; ``clone()`` gives an equal, unfitted, independent copy;
 * the action method leaves its inputs untouched, returns results of the documented shapes,
   finite, and refuses NaN input with a footzoo error;
+* a calibration returns corrected copies shaped like its inputs and a ``report_`` dict, and
+  passes a recording without a magnetometer through;
 * a ``causal`` detector gives the same stance fed chunk by chunk as in one batch;
 * a Kalman correction gives the same trajectory (1e-9) on the compiled and the reference
   engine (or runs on the reference one, with a warning, when its model does not compile), and
@@ -40,6 +42,7 @@ from .errors import FootzooError
 from .plugin import (
     AccelerationCorrection,
     Analysis,
+    Calibration,
     Detector,
     KalmanCorrection,
     Orientation,
@@ -68,7 +71,9 @@ def check_plugin(cls: type[Plugin]) -> None:
     instance = cls()
     _check_params(cls, instance)
     _check_round_trip(cls, instance)
-    if isinstance(instance, Detector):
+    if isinstance(instance, Calibration):
+        _check_calibration(instance)
+    elif isinstance(instance, Detector):
         _check_detector(instance)
     elif isinstance(instance, Orientation):
         _check_orientation(instance)
@@ -192,6 +197,30 @@ def _check_detector(d: Detector) -> None:
         chunks = [live.step(t[i:i + 7], acc[i:i + 7], gyr[i:i + 7]) for i in range(0, len(t), 7)]
         streamed = np.concatenate([np.asarray(c, dtype=bool) for c in chunks])
         assert np.array_equal(streamed, stance), f"{who}: causal, but chunk-by-chunk stance differs from the batch"
+
+
+def _check_calibration(c: Calibration) -> None:
+    rec = _walk()
+    t, acc, gyr, mag = _signals(rec)
+    who = f"calibration {c.name!r}"
+    for m in (mag, None):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = c.clone().calibrate(t, acc, gyr, m)
+        _unchanged((rec.t, rec.acc, rec.gyr, rec.mag), (t, acc, gyr, mag), who)
+        for name, before in (("acc", acc), ("gyr", gyr), ("mag", m)):
+            after = getattr(out, f"{name}_", "missing")
+            if before is None:
+                assert after is None, f"{who}: without a magnetometer, mag_ must be None"
+                continue
+            assert isinstance(after, np.ndarray) and after.shape == before.shape and np.isfinite(after).all(), (
+                f"{who}: {name}_ must be a finite array shaped like the input {before.shape}")
+        assert isinstance(out.report_, dict), f"{who}: report_ must be a dict"
+        try:
+            yaml.safe_dump(out.report_)
+        except yaml.YAMLError as err:
+            raise AssertionError(f"{who}: report_ must hold plain values (numbers, text, lists): {err}") from None
+    _expect_nan_error(lambda: c.clone().calibrate(t, _nan(acc), gyr, mag), who)
 
 
 def _check_orientation(o: Orientation) -> None:
