@@ -21,7 +21,7 @@ def config_errors(d: dict[str, Any]) -> list[str]:
     if not isinstance(d, dict):
         return errors
     sections: list[tuple[str, str, Any]] = [(k, k, d[k]) for k in ("orientation", "detector") if k in d]
-    for key, kind in (("corrections", "correction"), ("analysis", "analysis")):
+    for key, kind in (("calibration", "calibration"), ("corrections", "correction"), ("analysis", "analysis")):
         items = d.get(key) or []
         if isinstance(items, list):
             sections += [(f"{key}[{i}]", kind, spec) for i, spec in enumerate(items)]

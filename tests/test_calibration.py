@@ -133,6 +133,15 @@ def test_calibration_config_errors_are_clear():
         Pipeline(None, None, calibration=["hard_iron"])  # type: ignore[arg-type]
 
 
+def test_validate_lists_a_bad_calibration_with_the_other_problems():
+    from footzoo.config_check import config_errors
+
+    errors = config_errors({"orientation": {"type": "madgwik"}, "detector": {"type": "shoe"},
+                            "calibration": [{"type": "hard_iron", "min_spread": 2}]})
+    assert len(errors) == 2
+    assert any("calibration[0]" in e and "min_spread" in e for e in errors)
+
+
 def test_a_stream_refuses_a_calibration():
     pipe = Pipeline.from_dict({"orientation": {"type": "ins"}, "detector": {"type": "dgp"},
                                "corrections": [{"type": "zupt"}], "calibration": [{"type": "hard_iron"}]})
