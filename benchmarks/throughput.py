@@ -23,7 +23,8 @@ less). Items:
 
 The pure-Python baselines (b, c) run on the first ``--slow-samples`` samples of the same walk
 (their cost per sample does not depend on the length). Optional sections: ``--scaling`` (µs per
-sample and peak memory beyond the input, 1e5 to 1e7 samples, one new process per size),
+sample and peak memory beyond the input, 1e5 to 1e7 samples, one new process per size; again
+with numpy's huge-page hint off),
 ``--cold`` (a new process with an empty numba cache: import and first run of a config on a
 simulated 80-stride walk), ``--import-time``. The ``met`` column judges the CPU-time fraction
 ("wall-clock only": met by the wall-clock minima alone).
@@ -338,19 +339,21 @@ print(json.dumps({{"us_per_sample": cpu / n * 1e6, "sys_us_per_sample": sys_ / n
 """
 
 
-def scaling(names: list[str], sizes=(100_000, 1_000_000, 10_000_000), repeat: int = 5) -> list[str]:
+def scaling(names: list[str], sizes=(100_000, 1_000_000, 10_000_000), repeat: int = 5,
+            env: dict[str, str] | None = None) -> list[str]:
     """µs per sample (CPU time, min over runs) and peak RSS beyond the input; a new process per config and size.
 
     The system part of the CPU time is given apart: it is the kernel's work for memory the run
     touches for the first time (page faults, zeroing), which grows with the recording's length
-    once its arrays are too large for the allocator to recycle.
+    once its arrays are too large for the allocator to recycle. ``env``: extra environment
+    variables of the child processes (e.g. ``NUMPY_MADVISE_HUGEPAGE=0``).
     """
     rows: dict[str, list[tuple[float, float]]] = {c: [] for c in names}
     for n in sizes:
         for c in names:
             code = _SCALING_CHILD.format(root=str(ROOT), n=n, name=c, repeat=repeat if n < 10**7 else 3)
             proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True,
-                                  cwd=ROOT)
+                                  cwd=ROOT, env={**os.environ, **(env or {})})
             if proc.returncode != 0:
                 raise RuntimeError(proc.stderr[-2000:])
             res = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -426,8 +429,13 @@ def main() -> None:
         if args.json:
             args.json.write_text(json.dumps(results, indent=1))
     if args.scaling:
-        sections.append(("Scaling and memory (CPU time, min of runs; peak RSS beyond the input)",
-                         scaling(["(a)", "yun2012", "huang2016", "nguyen2016_ins_zvu"])))
+        names = ["(a)", "yun2012", "huang2016", "nguyen2016_ins_zvu"]
+        sections.append(("Scaling and memory (CPU time, min of runs; peak RSS beyond the input)", scaling(names)))
+        _emit(sections[-1])
+        # numpy asks Linux for transparent huge pages for large arrays; where a huge-page fault costs
+        # more than the 512 small ones it replaces (some virtual machines), that alone breaks linearity
+        sections.append(("The same with NUMPY_MADVISE_HUGEPAGE=0 (numpy gives the kernel no huge-page hint)",
+                         scaling(names, env={"NUMPY_MADVISE_HUGEPAGE": "0"})))
         _emit(sections[-1])
     if args.cold:
         sections.append(("Cold start (new process, empty numba cache)",
