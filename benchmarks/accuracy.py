@@ -208,6 +208,15 @@ def footprints(steps: pd.DataFrame) -> np.ndarray:
     return np.vstack([first, steps[["end_n", "end_e"]].to_numpy()])
 
 
+#: Benchmark metric <- key of :attr:`footzoo.data.Result.metrics` (:func:`footzoo.metrics.stride_errors`).
+GAITMAP_METRICS = {
+    "strides_matched": "matched_strides", "strides_reference": "ref_strides",
+    "stride_length_rms_m": "stride_length_rms_error_m",
+    "stride_length_rms_straight_m": "stride_length_rms_error_straight_m",
+    "fpa_bias_deg": "fpa_mean_error_deg", "fpa_rms_deg": "fpa_rms_error_deg",
+}
+
+
 def stride_metrics(dataset: str, spec: dict[str, Any], config: Path) -> list[dict[str, Any]]:
     """Per-stride comparisons that need the result's stride table (gaitmap mocap, Köroğlu footprints)."""
     from footzoo.io import load
@@ -228,24 +237,11 @@ def stride_metrics(dataset: str, spec: dict[str, Any], config: Path) -> list[dic
             res = Pipeline.from_yaml(config).run(rec)
         steps = res.steps
         if dataset.startswith("gaitmap"):
-            from footzoo.io.gaitmap_reference import reference_strides
-            from footzoo.metrics import match_strides
-
-            ref = reference_strides(Path(spec["path"]).parent, spec["foot"])
-            matched = match_strides(steps, ref)
-            add("strides_matched", len(matched))
-            add("strides_reference", len(ref))
-            if len(matched):
-                straight = matched[~matched["turn"]]
-                err = matched["est_stride_length_m"] - matched["stride_length_m"]
-                add("stride_length_rms_m", np.sqrt(np.mean(err**2)))
-                if len(straight):
-                    e2 = straight["est_stride_length_m"] - straight["stride_length_m"]
-                    add("stride_length_rms_straight_m", np.sqrt(np.mean(e2**2)))
-                if "est_fpa_rad" in matched and matched["est_fpa_rad"].notna().any() and len(straight):
-                    f = np.degrees(straight["est_fpa_rad"] - straight["fpa_rad"]).dropna()
-                    add("fpa_bias_deg", f.mean())
-                    add("fpa_rms_deg", np.sqrt(np.mean(f**2)))
+            # the reader's reference and the library's comparison: what Result.metrics and Session report
+            metrics = res.metrics
+            for name, key in GAITMAP_METRICS.items():
+                if key in metrics:
+                    add(name, metrics[key])
         else:  # Köroğlu: strides counted on the floor, footprints measured with a ruler
             from scipy.io import loadmat
 

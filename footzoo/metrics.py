@@ -243,12 +243,32 @@ def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str = "t
 def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: float = 0.3) -> dict[str, float]:
     """Per-stride errors (estimate − reference) of the matched strides (:func:`match_strides`).
 
-    Returns the count of reference and matched strides, and where both sides
-    have the column: median absolute error of the initial contact
-    (``ic_error_median_abs_s``, on ``end_s``) and toe-off (``to_error_median_abs_s``),
-    mean signed errors, stride-time error, stride-length RMS and mean error (m),
-    and FPA mean and RMS error (deg). Turn strides (``turn``) are left out of
-    the stride-length and FPA errors.
+    The one implementation of the stride comparison: :attr:`footzoo.data.Result.metrics`,
+    :class:`footzoo.Session` and the accuracy benchmark all report these values.
+
+    Parameters
+    ----------
+    estimated : DataFrame
+        Estimated stride table (:func:`footzoo.analysis.strides.segment_steps`).
+    reference : DataFrame
+        Reference stride table (see :class:`footzoo.data.Truth`); an optional
+        boolean ``turn`` column flags the strides that change direction.
+    tolerance : float
+        Largest time difference (s) of a pair (:func:`match_strides`).
+
+    Returns
+    -------
+    dict
+        The count of reference and matched strides, and where both sides have
+        the column: median absolute error of the initial contact
+        (``ic_error_median_abs_s``, on ``end_s``) and toe-off
+        (``to_error_median_abs_s``), mean signed errors, stride-time error;
+        stride-length RMS and mean error (m) over every matched stride
+        (``stride_length_rms_error_m``, ``stride_length_mean_error_m``) and over
+        the straight ones only (``stride_length_rms_error_straight_m``,
+        ``stride_length_mean_error_straight_m``, all strides when the reference
+        flags no turns); FPA mean and RMS error (deg) over the straight strides
+        (the line of progression of a turn stride is not defined).
     """
     m = match_strides(estimated, reference, tolerance=tolerance)
     out: dict[str, float] = {"ref_strides": float(len(reference)), "matched_strides": float(len(m))}
@@ -274,10 +294,11 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         d = d[np.isfinite(d)]
         if d.size:
             out["stride_time_error_median_abs_s"] = float(np.median(np.abs(d)))
-    d = diff("stride_length_m", straight)
-    if d is not None and d.size:
-        out["stride_length_rms_error_m"] = float(np.sqrt(np.mean(d**2)))
-        out["stride_length_mean_error_m"] = float(np.mean(d))
+    for suffix, mask in (("", None), ("_straight", straight)):
+        d = diff("stride_length_m", mask)
+        if d is not None and d.size:
+            out[f"stride_length_rms_error{suffix}_m"] = float(np.sqrt(np.mean(d**2)))
+            out[f"stride_length_mean_error{suffix}_m"] = float(np.mean(d))
     d = diff("fpa_rad", straight)
     if d is not None and d.size:
         d = np.degrees(d)

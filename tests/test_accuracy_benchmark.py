@@ -1,4 +1,4 @@
-"""benchmarks/accuracy.py: its --quick path on a simulated walk only, and its alignment helper."""
+"""benchmarks/accuracy.py: its --quick path on a simulated walk only, its helpers, its gaitmap strides."""
 
 import importlib.util
 from pathlib import Path
@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+
+from .conftest import data_file
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -52,3 +54,20 @@ def test_motion_classes_follow_the_recording_day(accuracy):
     assert accuracy.motion_class("2017-11-22-11-22-03") == "walking"
     assert accuracy.motion_class("2017-12-15-18-01-18") == "running/fast"
     assert accuracy.motion_class("2018-02-22-10-09-36") == "inverted"
+
+
+def test_gaitmap_stride_errors_are_the_ones_session_reports(accuracy):
+    """One implementation: the benchmark's gaitmap rows are Session.per_foot's values (Result.metrics)."""
+    from footzoo import Pipeline, Session
+
+    path = data_file("gaitmap_example", "imu_sample.csv")
+    config = ROOT / "configs" / "yun2012.yaml"
+    per_foot = Session.load(path).run(Pipeline.from_yaml(config)).per_foot
+    for foot in ("left", "right"):
+        rows = accuracy.stride_metrics(f"gaitmap_{foot}", {"path": str(path), "format": "gaitmap", "foot": foot},
+                                       config)
+        got = {r["metric"]: r["value"] for r in rows}
+        assert got["strides_matched"] == got["strides_reference"] == per_foot.loc[foot, "ref_strides"] >= 28
+        assert got["stride_length_rms_m"] == pytest.approx(per_foot.loc[foot, "stride_length_rms_error_m"])
+        assert got["stride_length_rms_straight_m"] == pytest.approx(
+            per_foot.loc[foot, "stride_length_rms_error_straight_m"])
