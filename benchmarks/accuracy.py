@@ -420,7 +420,10 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
         gp = g.pivot_table(index=["config", "dataset"], columns="metric", values="value").reset_index()
         lines += ["## gaitmap example walk: strides against motion capture", "",
                   "Stride length RMS over all matched strides and over the straight ones (turn strides change "
-                  "direction by more than 20°); FPA bias and RMS (deg) where the config computes it.", "",
+                  "direction by more than 20°); FPA bias and RMS (deg) where the config computes it. Strides pair "
+                  "one to one when their toe-off and initial contact both agree within 0.3 s "
+                  "(footzoo.metrics.match_strides): the left foot's turn, one reference stride over two steps, "
+                  "stays unpaired.", "",
                   to_markdown(gp, 3), ""]
     k = table[(table["dataset"] == "koroglu") & table["metric"].notna()]
     if not k.empty:

@@ -49,7 +49,8 @@ def test_gaitmap_stride_errors_are_the_ones_session_reports(accuracy):
         rows = accuracy.stride_metrics(f"gaitmap_{foot}", {"path": str(path), "format": "gaitmap", "foot": foot},
                                        config)
         got = {r["metric"]: r["value"] for r in rows}
-        assert got["strides_matched"] == got["strides_reference"] == per_foot.loc[foot, "ref_strides"] >= 28
+        assert got["strides_reference"] == per_foot.loc[foot, "ref_strides"] >= 28
+        assert got["strides_matched"] == per_foot.loc[foot, "matched_strides"] >= 27
         assert got["stride_length_rms_m"] == pytest.approx(per_foot.loc[foot, "stride_length_rms_error_m"])
         assert got["stride_length_rms_straight_m"] == pytest.approx(
             per_foot.loc[foot, "stride_length_rms_error_straight_m"])
