@@ -178,88 +178,41 @@ def run_dataset(name: str, recs: list[dict[str, Any]], configs: list[Path], resu
 # ------------------------------------------------------------------------- per-stride references
 
 
-def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> np.ndarray:
-    """``est`` (K, 2) moved onto ``ref`` by the least-squares rotation (or reflection) and translation.
-
-    Kabsch/Umeyama without scale: ``R = V diag(1, d) Uᵀ`` from the SVD of the cross-covariance
-    ``Σ (e − ē)(r − r̄)ᵀ = U S Vᵀ``, with ``d = sign det(V Uᵀ)`` for a proper rotation, or the
-    better of the two when a reflection is allowed.
-    """
-    e0, r0 = est - est.mean(axis=0), ref - ref.mean(axis=0)
-    u, _, vt = np.linalg.svd(e0.T @ r0)
-    candidates = [np.diag([1.0, 1.0]), np.diag([1.0, -1.0])]
-    best, best_err = None, np.inf
-    for d in candidates:
-        rot = vt.T @ d @ u.T
-        if not reflection and np.linalg.det(rot) < 0:
-            continue
-        moved = e0 @ rot.T + ref.mean(axis=0)
-        err = float(np.sum((moved - ref) ** 2))
-        if err < best_err:
-            best, best_err = moved, err
-    return best
-
-
-def footprints(steps: pd.DataFrame) -> np.ndarray:
-    """Where the foot stood (K + 1, 2): the middle of each stance around K strides (north, east)."""
-    if steps.empty:
-        return np.zeros((0, 2))
-    first = steps[["start_n", "start_e"]].to_numpy()[:1]
-    return np.vstack([first, steps[["end_n", "end_e"]].to_numpy()])
+#: Per dataset: benchmark metric <- key of :attr:`footzoo.data.Result.metrics`, which compares the
+#: stride table with the reference the reader loads (:func:`footzoo.metrics.stride_errors` for
+#: gaitmap's motion capture, :func:`footzoo.metrics.footprint_errors` for Köroğlu's footprints):
+#: the benchmark, ``footzoo run`` and :class:`footzoo.Session` report the same numbers.
+REFERENCE_METRICS: dict[str, dict[str, str]] = {
+    "gaitmap": {
+        "strides_matched": "matched_strides", "strides_reference": "ref_strides",
+        "stride_length_rms_m": "stride_length_rms_error_m",
+        "stride_length_rms_straight_m": "stride_length_rms_error_straight_m",
+        "fpa_bias_deg": "fpa_mean_error_deg", "fpa_rms_deg": "fpa_rms_error_deg",
+    },
+    "koroglu": {
+        "strides_detected": "strides", "strides_reference": "stride_count_ref",
+        "stride_count_error": "stride_count_error", "footprint_error_mean_m": "footprint_error_mean_m",
+        "footprint_error_rms_m": "footprint_error_rms_m", "footprint_error_end_m": "footprint_error_end_m",
+    },
+}
 
 
 def stride_metrics(dataset: str, spec: dict[str, Any], config: Path) -> list[dict[str, Any]]:
-    """Per-stride comparisons that need the result's stride table (gaitmap mocap, Köroğlu footprints)."""
+    """Per-stride comparisons (gaitmap mocap, Köroğlu footprints): the run's :attr:`~footzoo.data.Result.metrics`."""
     from footzoo.io import load
     from footzoo.pipeline import Pipeline
 
     label = Path(spec["path"]).stem
     rows: list[dict[str, Any]] = []
-
-    def add(metric: str, value: float) -> None:
-        rows.append({"dataset": dataset, "recording": label, "config": config.stem, "metric": metric,
-                     "value": float(value), "error": None})
-
     try:
         options = {k: v for k, v in spec.items() if k not in ("path", "format")}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             rec = load(spec["path"], format=spec["format"], **options)
-            res = Pipeline.from_yaml(config).run(rec)
-        steps = res.steps
-        if dataset.startswith("gaitmap"):
-            from footzoo.io.gaitmap_reference import reference_strides
-            from footzoo.metrics import match_strides
-
-            ref = reference_strides(Path(spec["path"]).parent, spec["foot"])
-            matched = match_strides(steps, ref)
-            add("strides_matched", len(matched))
-            add("strides_reference", len(ref))
-            if len(matched):
-                straight = matched[~matched["turn"]]
-                err = matched["est_stride_length_m"] - matched["stride_length_m"]
-                add("stride_length_rms_m", np.sqrt(np.mean(err**2)))
-                if len(straight):
-                    e2 = straight["est_stride_length_m"] - straight["stride_length_m"]
-                    add("stride_length_rms_straight_m", np.sqrt(np.mean(e2**2)))
-                if "est_fpa_rad" in matched and matched["est_fpa_rad"].notna().any() and len(straight):
-                    f = np.degrees(straight["est_fpa_rad"] - straight["fpa_rad"]).dropna()
-                    add("fpa_bias_deg", f.mean())
-                    add("fpa_rms_deg", np.sqrt(np.mean(f**2)))
-        else:  # Köroğlu: strides counted on the floor, footprints measured with a ruler
-            from scipy.io import loadmat
-
-            m = loadmat(Path(spec["path"]).with_suffix(".mat"))
-            n_ref = int(np.ravel(m["numberOfStrides"])[0])
-            add("strides_detected", len(steps))
-            add("strides_reference", n_ref)
-            add("stride_count_error", len(steps) - n_ref)
-            gcp = np.asarray(m["GCP_meters"], float)
-            fp = footprints(steps)
-            if len(fp) == len(gcp):
-                d = np.linalg.norm(rigid_align_2d(fp, gcp) - gcp, axis=1)
-                add("footprint_error_mean_m", d.mean())
-                add("footprint_error_max_m", d.max())
+            metrics = Pipeline.from_yaml(config).run(rec).metrics
+        names = REFERENCE_METRICS["gaitmap" if dataset.startswith("gaitmap") else "koroglu"]
+        rows += [{"dataset": dataset, "recording": label, "config": config.stem, "metric": name,
+                  "value": float(metrics[key]), "error": None} for name, key in names.items() if key in metrics]
     except Exception as err:  # one failing run is reported, not fatal (as in the ablation runner)
         rows.append({"dataset": dataset, "recording": label, "config": config.stem, "metric": None,
                      "value": np.nan, "error": f"{type(err).__name__}: {err}"})
@@ -467,7 +420,10 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
         gp = g.pivot_table(index=["config", "dataset"], columns="metric", values="value").reset_index()
         lines += ["## gaitmap example walk: strides against motion capture", "",
                   "Stride length RMS over all matched strides and over the straight ones (turn strides change "
-                  "direction by more than 20°); FPA bias and RMS (deg) where the config computes it.", "",
+                  "direction by more than 20°); FPA bias and RMS (deg) where the config computes it. Strides pair "
+                  "one to one when their toe-off and initial contact both agree within 0.3 s "
+                  "(footzoo.metrics.match_strides): the left foot's turn, one reference stride over two steps, "
+                  "stays unpaired.", "",
                   to_markdown(gp, 3), ""]
     k = table[(table["dataset"] == "koroglu") & table["metric"].notna()]
     if not k.empty:

@@ -581,7 +581,9 @@ class Result:
         yaw alignment) and ``pyshoe_error_m``. With a hand count:
         ``stride_count_ref``, ``stride_count_error``. With reference strides: the
         matched count and the median absolute IC/TO errors (s), stride-length
-        RMS error (m), stride-time and FPA errors. With footprints: per-footprint
+        RMS and mean error (m) over every matched stride and over the straight
+        ones (``..._straight_m``), stride-time and FPA errors
+        (:func:`footzoo.metrics.stride_errors`). With footprints: per-footprint
         error after a 2-D rigid alignment. With per-stride trajectories: the
         median per-stride 3-D path RMS after a yaw alignment. See :func:`footzoo.metrics.result_metrics`.
         """

@@ -215,40 +215,99 @@ def nearest_index(sorted_values: np.ndarray, queries: np.ndarray) -> np.ndarray:
     return np.where(np.abs(v[k - 1] - q) <= np.abs(v[k] - q), k - 1, k)
 
 
-def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str = "to_s",
-                  tolerance: float = 0.3) -> pd.DataFrame:
-    """Pair each reference stride with the estimated stride nearest in time.
+#: Events that must agree for two strides to pair: the borders of the swing (toe-off, initial contact).
+MATCH_ON = ("to_s", "end_s")
 
-    Strides are paired by the column ``on`` (default the toe-off ``to_s``, which
-    every stride has), each reference stride taking the nearest estimated one
-    within ``tolerance`` (s). Vectorised. Returns the matched reference rows with
-    the estimate's columns added as ``est_<column>``.
+
+def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str | tuple[str, ...] = MATCH_ON,
+                  tolerance: float = 0.3) -> pd.DataFrame:
+    """Pair the estimated and reference strides that cover the same swing, one to one.
+
+    Each reference stride is paired with the estimated stride nearest in time on
+    the first column of ``on``; the pair counts only when every column of ``on``
+    that both tables have (by default the toe-off ``to_s`` and the initial
+    contact ``end_s`` that border the swing) differs by at most ``tolerance``
+    (s), as gaitmap's stride matching requires of both borders
+    (``gaitmap.evaluation_utils.match_stride_lists``). So a reference stride
+    that spans two estimated ones (a stance the reference missed, or a swing
+    the estimate split) stays unpaired instead of being compared with one of
+    them, and an estimated stride pairs with one reference stride at most (the
+    nearest). A border missing (NaN) on either side is not checked. Vectorised.
+
+    Parameters
+    ----------
+    estimated, reference : DataFrame
+        Stride tables (:func:`footzoo.analysis.strides.segment_steps`; the
+        reference with footzoo's column names or the simulator's, see
+        :func:`reference_steps`).
+    on : str or tuple of str
+        Event columns (s) that must agree; the first one pairs the strides. A
+        reference without the first column pairs on ``end_s``.
+    tolerance : float
+        Largest time difference (s) of each event of a pair.
+
+    Returns
+    -------
+    DataFrame
+        The paired reference rows, in the reference's order, with the
+        estimate's columns added as ``est_<column>``.
     """
     est = estimated.reset_index(drop=True)
     ref = reference_steps(reference).reset_index(drop=True)
-    if on not in ref.columns and "end_s" in ref.columns:
-        on = "end_s"
-    e = est[on].to_numpy(dtype=float)
-    r = ref[on].to_numpy(dtype=float)
-    if len(e) == 0 or len(r) == 0:
+    cols = [on] if isinstance(on, str) else list(on)
+    if cols[0] not in ref.columns and "end_s" in ref.columns:
+        cols[0] = "end_s"
+    cols = list(dict.fromkeys(c for c in cols if c in ref.columns and c in est.columns))
+    if not cols or len(est) == 0 or len(ref) == 0:
         return pd.DataFrame(columns=[*ref.columns, *(f"est_{c}" for c in est.columns)])
+    e = est[cols[0]].to_numpy(dtype=float)
+    r = ref[cols[0]].to_numpy(dtype=float)
     order = np.argsort(e)
-    es = e[order]
-    nearest = nearest_index(es, r)
-    ok = np.abs(es[nearest] - r) <= tolerance
-    matched = est.iloc[order[nearest[ok]]].reset_index(drop=True).add_prefix("est_")
+    pick = order[nearest_index(e[order], r)]  # row of est paired with each reference stride
+    gap = np.abs(e[pick] - r)
+    ok = gap <= tolerance
+    for c in cols[1:]:
+        d = np.abs(est[c].to_numpy(dtype=float)[pick] - ref[c].to_numpy(dtype=float))
+        ok &= ~(d > tolerance)  # NaN: not checked
+    # one to one: an estimated stride taken by several reference strides keeps the nearest
+    cand = np.flatnonzero(ok)
+    first = cand[np.lexsort((gap[cand], pick[cand]))]
+    keep = first[np.concatenate([[True], pick[first][1:] != pick[first][:-1]])] if len(first) else first
+    ok = np.zeros(len(ref), bool)
+    ok[keep] = True
+    matched = est.iloc[pick[ok]].reset_index(drop=True).add_prefix("est_")
     return pd.concat([ref[ok].reset_index(drop=True), matched], axis=1)
 
 
 def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: float = 0.3) -> dict[str, float]:
     """Per-stride errors (estimate − reference) of the matched strides (:func:`match_strides`).
 
-    Returns the count of reference and matched strides, and where both sides
-    have the column: median absolute error of the initial contact
-    (``ic_error_median_abs_s``, on ``end_s``) and toe-off (``to_error_median_abs_s``),
-    mean signed errors, stride-time error, stride-length RMS and mean error (m),
-    and FPA mean and RMS error (deg). Turn strides (``turn``) are left out of
-    the stride-length and FPA errors.
+    The one implementation of the stride comparison: :attr:`footzoo.data.Result.metrics`,
+    :class:`footzoo.Session` and the accuracy benchmark all report these values.
+
+    Parameters
+    ----------
+    estimated : DataFrame
+        Estimated stride table (:func:`footzoo.analysis.strides.segment_steps`).
+    reference : DataFrame
+        Reference stride table (see :class:`footzoo.data.Truth`); an optional
+        boolean ``turn`` column flags the strides that change direction.
+    tolerance : float
+        Largest time difference (s) of a pair (:func:`match_strides`).
+
+    Returns
+    -------
+    dict
+        The count of reference and matched strides, and where both sides have
+        the column: median absolute error of the initial contact
+        (``ic_error_median_abs_s``, on ``end_s``) and toe-off
+        (``to_error_median_abs_s``), mean signed errors, stride-time error;
+        stride-length RMS and mean error (m) over every matched stride
+        (``stride_length_rms_error_m``, ``stride_length_mean_error_m``) and over
+        the straight ones only (``stride_length_rms_error_straight_m``,
+        ``stride_length_mean_error_straight_m``, all strides when the reference
+        flags no turns); FPA mean and RMS error (deg) over the straight strides
+        (the line of progression of a turn stride is not defined).
     """
     m = match_strides(estimated, reference, tolerance=tolerance)
     out: dict[str, float] = {"ref_strides": float(len(reference)), "matched_strides": float(len(m))}
@@ -274,10 +333,11 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         d = d[np.isfinite(d)]
         if d.size:
             out["stride_time_error_median_abs_s"] = float(np.median(np.abs(d)))
-    d = diff("stride_length_m", straight)
-    if d is not None and d.size:
-        out["stride_length_rms_error_m"] = float(np.sqrt(np.mean(d**2)))
-        out["stride_length_mean_error_m"] = float(np.mean(d))
+    for suffix, mask in (("", None), ("_straight", straight)):
+        d = diff("stride_length_m", mask)
+        if d is not None and d.size:
+            out[f"stride_length_rms_error{suffix}_m"] = float(np.sqrt(np.mean(d**2)))
+            out[f"stride_length_mean_error{suffix}_m"] = float(np.mean(d))
     d = diff("fpa_rad", straight)
     if d is not None and d.size:
         d = np.degrees(d)

@@ -1,4 +1,4 @@
-"""benchmarks/accuracy.py: its --quick path on a simulated walk only, and its alignment helper."""
+"""benchmarks/accuracy.py: its --quick path on a simulated walk only, its helpers, its per-stride references."""
 
 import importlib.util
 from pathlib import Path
@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+
+from .conftest import data_file
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -30,25 +32,47 @@ def test_quick_run_without_datasets_skips_them_and_writes_table_and_summary(accu
     assert "## Simulator scenarios" in text and "## PyShoe" not in text
 
 
-def test_rigid_alignment_undoes_a_rotation_and_a_reflection(accuracy):
-    rng = np.random.default_rng(0)
-    ref = rng.uniform(-5, 5, (12, 2))
-    a = 0.8
-    rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
-    moved = ref @ rot.T + [3.0, -1.0]
-    np.testing.assert_allclose(accuracy.rigid_align_2d(moved, ref), ref, atol=1e-9)
-    mirrored = moved * [1.0, -1.0]  # Köroğlu's ground control points have y flipped
-    np.testing.assert_allclose(accuracy.rigid_align_2d(mirrored, ref), ref, atol=1e-9)
-    # a proper rotation alone cannot undo the mirror
-    assert np.abs(accuracy.rigid_align_2d(mirrored, ref, reflection=False) - ref).max() > 0.5
-
-
-def test_footprints_are_the_stance_middles_around_strides(accuracy):
-    steps = pd.DataFrame({"start_n": [0.0, 1.0], "start_e": [0.0, 0.1], "end_n": [1.0, 2.0], "end_e": [0.1, 0.0]})
-    np.testing.assert_allclose(accuracy.footprints(steps), [[0, 0], [1, 0.1], [2, 0]])
-
-
 def test_motion_classes_follow_the_recording_day(accuracy):
     assert accuracy.motion_class("2017-11-22-11-22-03") == "walking"
     assert accuracy.motion_class("2017-12-15-18-01-18") == "running/fast"
     assert accuracy.motion_class("2018-02-22-10-09-36") == "inverted"
+
+
+def test_gaitmap_stride_errors_are_the_ones_session_reports(accuracy):
+    """One implementation: the benchmark's gaitmap rows are Session.per_foot's values (Result.metrics)."""
+    from footzoo import Pipeline, Session
+
+    path = data_file("gaitmap_example", "imu_sample.csv")
+    config = ROOT / "configs" / "yun2012.yaml"
+    per_foot = Session.load(path).run(Pipeline.from_yaml(config)).per_foot
+    for foot in ("left", "right"):
+        rows = accuracy.stride_metrics(f"gaitmap_{foot}", {"path": str(path), "format": "gaitmap", "foot": foot},
+                                       config)
+        got = {r["metric"]: r["value"] for r in rows}
+        assert got["strides_reference"] == per_foot.loc[foot, "ref_strides"] >= 28
+        assert got["strides_matched"] == per_foot.loc[foot, "matched_strides"] >= 27
+        assert got["stride_length_rms_m"] == pytest.approx(per_foot.loc[foot, "stride_length_rms_error_m"])
+        assert got["stride_length_rms_straight_m"] == pytest.approx(
+            per_foot.loc[foot, "stride_length_rms_error_straight_m"])
+
+
+def test_koroglu_footprint_errors_against_the_measured_footprints(accuracy):
+    """Where the stride count is exact, the benchmark reports the footprint error against GCP_meters."""
+    from scipy.io import loadmat
+
+    from footzoo import Pipeline
+    from footzoo.io import load
+    from footzoo.metrics import rigid_align_2d
+
+    path = data_file("koroglu_gcp", "SensorConnectData_31.csv")
+    config = ROOT / "configs" / "recommended.yaml"
+    got = {r["metric"]: r["value"] for r in accuracy.stride_metrics("koroglu", {"path": str(path),
+                                                                                 "format": "sensorconnect"}, config)}
+    gcp = np.asarray(loadmat(path.with_suffix(".mat"))["GCP_meters"], float)
+    steps = Pipeline.from_yaml(config).run(load(path)).steps
+    assert got["stride_count_error"] == 0 and got["strides_detected"] == len(steps) == len(gcp) - 1
+    # the footprints by hand: the first stride's start and every stride's end, rigidly aligned (reflection allowed)
+    est = np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
+    aligned, _ = rigid_align_2d(est, gcp)
+    assert got["footprint_error_mean_m"] == pytest.approx(np.linalg.norm(aligned - gcp, axis=1).mean())
+    assert 0 < got["footprint_error_mean_m"] < 1.0  # measured 0.24 m over a 51 m walk
