@@ -90,6 +90,15 @@ def test_a_straight_walk_is_left_uncalibrated_with_the_reason():
     assert out.mag_ is rec.mag
 
 
+def test_readings_turned_about_one_axis_only_are_refused_not_a_crash():
+    ang = np.linspace(0, 4 * np.pi, 500)  # yaw only, noise-free: the readings lie on one circle
+    c, s_ = np.cos(ang), np.sin(ang)
+    m = np.column_stack([c * FIELD[0] + s_ * FIELD[1], -s_ * FIELD[0] + c * FIELD[1], np.full_like(ang, FIELD[2])])
+    with pytest.warns(CalibrationWarning, match="turned too little"):
+        out = HardIron().calibrate(ang, np.zeros((500, 3)), np.zeros((500, 3)), m + OFFSET)
+    assert out.report_["applied"] is False and out.mag_ is not None
+
+
 def test_a_known_offset_is_removed_as_given_and_no_magnetometer_passes_through(loop):
     out = HardIron(offset=[0.1, 0.2, 0.3]).calibrate(loop.t, loop.acc, loop.gyr, loop.mag)
     np.testing.assert_array_equal(out.mag_, loop.mag - [0.1, 0.2, 0.3])

@@ -50,11 +50,13 @@ def _sphere(mag: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
     a[:, 3] = 1.0
     y = np.einsum("ij,ij->i", mag, mag)
     ata = a.T @ a
-    sol = np.linalg.solve(ata, a.T @ y)
+    # minimum-norm solution: readings that never left a plane (one rotation axis) leave the
+    # offset along its normal undetermined; the spread test then refuses the fit
+    sol = np.linalg.lstsq(ata, a.T @ y, rcond=None)[0]
     b = sol[:3]
     r = float(np.sqrt(max(sol[3] + b @ b, 0.0)))
     s2 = float(np.sum((a @ sol - y) ** 2)) / max(len(mag) - 4, 1)
-    return b, r, np.sqrt(np.clip(s2 * np.diag(np.linalg.inv(ata))[:3], 0.0, None))
+    return b, r, np.sqrt(np.clip(s2 * np.diag(np.linalg.pinv(ata))[:3], 0.0, None))
 
 
 #: Samples a fit uses at most (drawn at random, reproducibly, from the whole recording): the
