@@ -99,6 +99,17 @@ def test_readings_turned_about_one_axis_only_are_refused_not_a_crash():
     assert out.report_["applied"] is False and out.mag_ is not None
 
 
+def test_soft_iron_or_a_disturbed_room_is_refused():
+    m = sphere_readings(seed=5) - OFFSET
+    m = m * [1.3, 1.0, 0.75] + OFFSET  # strong soft iron: an ellipsoid, which no offset calibrates
+    with pytest.warns(CalibrationWarning, match="no sphere"):
+        out = HardIron().calibrate(np.arange(len(m)) * 0.01, np.zeros_like(m), np.zeros_like(m), m)
+    assert out.report_["applied"] is False and out.mag_ is not None
+    mild = sphere_readings(seed=5) - OFFSET
+    mild = mild * [1.01, 1.0, 0.99] + OFFSET  # a percent of soft iron: the offset still fits
+    assert HardIron().calibrate(np.arange(len(m)) * 0.01, np.zeros_like(m), np.zeros_like(m), mild).report_["applied"]
+
+
 def test_a_known_offset_is_removed_as_given_and_no_magnetometer_passes_through(loop):
     out = HardIron(offset=[0.1, 0.2, 0.3]).calibrate(loop.t, loop.acc, loop.gyr, loop.mag)
     np.testing.assert_array_equal(out.mag_, loop.mag - [0.1, 0.2, 0.3])
