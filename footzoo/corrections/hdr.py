@@ -94,6 +94,12 @@ class HDR(AccelerationCorrection, KalmanCorrection):
     this stance with the mean of the two previous stances' final yaws (eq. 23)
     and is kept only when ``|δψ| ≤ th_γ`` (eq. 24), so real turns pass.
 
+    A turn slower than ``th_γ`` per stride is taken for drift too: on a curved path HDR
+    straightens the trajectory (the simulated 437.5 m running track, about 0.03 rad per
+    stride in its bends: ``nguyen2016`` ends 98 % of the distance off, walking a straight line;
+    PyShoe's room loops: up to 1.02 m against 0.27 m without HDR). Use it, as the paper does,
+    on walks along straight corridors.
+
     * With an error-state filter (``ekf_zupt``, ``orientation: ins``), δψ is the
       first component of the measurement ``m`` (eq. 28) in every stance sample,
       with the current yaw in place of ``γ^{T_i}``, observing the attitude error's
