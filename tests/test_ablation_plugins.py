@@ -263,3 +263,39 @@ def test_a_plugin_that_writes_into_its_input_fails_its_cells_not_the_others(tmp_
     clean = run_study(Study.from_dict({**d, "factors": {"detector.type": ["angular_rate_fsm"]}}, root=tmp_path))
     builtin = table[table["detector.type"] == "angular_rate_fsm"]
     np.testing.assert_array_equal(builtin["value"].to_numpy(), clean["value"].to_numpy())
+
+
+CALIBRATION = '''
+from footzoo.calibration import HardIron
+from footzoo.registry import register
+
+
+@register
+class MyHardIron(HardIron):
+    """footzoo's hard_iron under another name (a test plug-in of the calibration kind)."""
+
+    name = "{name}"
+'''
+
+
+def test_a_calibration_plugin_file_runs_in_a_parallel_study_like_the_builtin(tmp_path):
+    name = "cal_" + "".join(c if c.isalnum() else "_" for c in tmp_path.name)
+    (tmp_path / "my_calibration.py").write_text(CALIBRATION.format(name=name))
+    study = {
+        "name": "calibration_plugin",
+        "plugins": ["my_calibration.py"],
+        "base": {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
+                 "corrections": [{"type": "zvu_dedrift"}]},
+        "factors": {"calibration": [[{"type": "hard_iron"}], [{"type": name}]]},
+        "recordings": [{"simulate": {"path": "rectangle", "length": 10.0, "width": 5.0, "rate": 50,
+                                     "noise": {"scale": 1}}, "seeds": [0]}],
+        "metrics": ["loop_closure_xy_m", "armse_3d_m"],
+    }
+    (tmp_path / "study.yaml").write_text(yaml.safe_dump(study))
+    serial = run_study(tmp_path / "study.yaml")
+    parallel = run_study(Study.from_yaml(tmp_path / "study.yaml"), jobs=2)
+    assert serial["error"].isna().all() and serial.equals(parallel)
+    ok = serial[serial["metric"].notna()].sort_values("metric")
+    mine = ok[ok["calibration"].str.contains(name)]["value"].to_numpy()
+    builtin = ok[~ok["calibration"].str.contains(name)]["value"].to_numpy()
+    np.testing.assert_array_equal(mine, builtin)  # same algorithm, same numbers, in the workers too
