@@ -53,6 +53,11 @@ class _Kernel:
     def __repr__(self) -> str:
         return f"<footzoo kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
 
+    @property
+    def _numba_type_(self) -> Any:
+        """numba's type of the dispatcher: compiled code outside footzoo may name the kernel before it exists."""
+        return compiled(self)._numba_type_
+
 
 def _compile(fn: Callable[..., Any]) -> Any:
     return _numba.njit(cache=True, nogil=True)(fn)
@@ -62,7 +67,7 @@ def _materialise() -> None:
     """Import numba, make every pending kernel a dispatcher, rebind the module attributes that named it."""
     global _numba, _materialised, HAVE_NUMBA
     with _lock:
-        if not _pending:  # another thread did it
+        if _materialised:  # another thread did it
             return
         try:
             import numba
@@ -95,6 +100,16 @@ def njit(fn: Callable[..., Any]) -> Callable[..., Any]:
     kernel = _Kernel(fn)
     _pending.append(kernel)
     return kernel
+
+
+def load_numba() -> Any:
+    """numba itself, imported now if it is not yet (every pending kernel then becomes its dispatcher).
+
+    For code that compiles functions of its own (e.g. with an explicit signature). ``None`` without numba.
+    """
+    if HAVE_NUMBA and not _materialised:
+        _materialise()
+    return _numba
 
 
 def compiled(fn: Any) -> Any:

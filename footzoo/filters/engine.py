@@ -10,6 +10,7 @@ loop, ``"reference"`` the filterpy loop, ``"auto"`` the compiled one when every 
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import asdict, dataclass, fields
@@ -21,7 +22,7 @@ from .. import _jit
 from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
-from .measurement import CORE_BLOCKS, NO_AFTER, NO_FEEDBACK, MeasurementModel, NotCompilable, StateBlock
+from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -275,7 +276,7 @@ class KalmanEngine:
         data_off = np.cumsum([0] + widths).astype(np.int64)
         functions = (tuple(_address(m.measure) for m in models), tuple(_address(m.feedback) for m in models),
                      tuple(_address(m.after) for m in models))
-        hooks = np.array([[m.feedback is not NO_FEEDBACK, m.after is not NO_AFTER] for m in models], dtype=np.int64)
+        hooks = np.array([[not is_no_op(m.feedback), not is_no_op(m.after)] for m in models], dtype=np.int64)
         arrays = (m_idx, par, par_off, mem_off, data_off, hooks)
         return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays)
 
@@ -340,7 +341,7 @@ def _address(fn: Any) -> Any:
         return fn
     cached = _ADDRESSES.get(id(fn))
     if cached is None or cached.dispatcher is not fn:
-        cached = _ADDRESSES[id(fn)] = _FixedAddress(fn)
+        cached = _ADDRESSES[id(fn)] = _fixed_address_type()(fn)
     return cached
 
 
@@ -360,19 +361,21 @@ def _gain_function(smooth: bool) -> Any:
     if not _jit.HAVE_NUMBA:
         return fn
     if smooth not in _GAINS:
-        import numba
-        from numba import types as t
-
+        numba = _jit.load_numba()
+        t = numba.types
         a2 = t.float64[:, ::1]
         signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
         _GAINS[smooth] = _address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn)))
     return _GAINS[smooth]
 
-if _jit.HAVE_NUMBA:
+
+@functools.cache
+def _fixed_address_type() -> type:
+    """The class of :func:`_address`'s objects (defined at first use: it derives from a numba class)."""
     from numba.core.types.function_type import WrapperAddressProtocol
     from numba.experimental.function_type import _get_wrapper_address
 
-    class _FixedAddress(WrapperAddressProtocol):
+    class FixedAddress(WrapperAddressProtocol):
         """A dispatcher compiled for one signature, seen by numba through its address."""
 
         def __init__(self, dispatcher: Any):
@@ -389,6 +392,8 @@ if _jit.HAVE_NUMBA:
 
         def __call__(self, *args: Any) -> Any:
             return self.dispatcher(*args)
+
+    return FixedAddress
 
 
 def _bound_loop(functions: tuple) -> Any:
