@@ -22,14 +22,14 @@ def _count(x: float) -> int:
 def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
     """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and of the last ``lag`` samples.
 
-    ``sums`` (2f + 2, 7): the running sums of eq. 8's acceleration (columns 0–2), of its means
-    (3–5) and of their squared norms (6); ``sums_dg`` (n_c + 1, 1): of ``d_g`` (eq. 9); the sample
-    count; ``hist`` (lag, 6): time, ``a_local``, ``w_m`` and the specific force of the last
-    ``lag`` samples; ``hist_q`` (lag, 4): their rotations ``exp(ω dt)``.
+    Running sums (2f + 2 rows) of eq. 8's acceleration, of its means and of their squared
+    norms; of ``d_g`` (n_c + 1 rows, eq. 9); the sample count; ``hist`` (lag, 6): time,
+    ``a_local``, ``w_m`` and the specific force of the last ``lag`` samples; ``hist_q`` (lag, 4):
+    their rotations ``exp(ω dt)``.
     """
     w = 2 * f + 1
-    return (np.zeros((w + 1, 7)), np.zeros((n_c + 1, 1)), np.zeros(1, dtype=np.int64), np.zeros((lag, 6)),
-            np.zeros((lag, 4)))
+    return (np.zeros((w + 1, 3)), np.zeros((w + 1, 3)), np.zeros(w + 1), np.zeros(n_c + 1),
+            np.zeros(1, dtype=np.int64), np.zeros((lag, 6)), np.zeros((lag, 4)))
 
 
 @njit
@@ -39,18 +39,27 @@ def _next(i, size):
 
 
 @njit
-def _push_mean(ring, col, cur, old, lo, k, x):
-    """Running sum in column ``col`` of ``ring``: row ``cur`` = row ``old`` + ``x``; the mean ``(c_cur − c_lo)/k``.
+def _push_mean(ring, cur, old, lo, k, x):
+    """Running sum in ``ring``: row ``cur`` = row ``old`` + ``x``; returns the mean ``(c_cur − c_lo)/k``.
 
     The sums are ``c_k = c_{k−1} + x_k`` and the mean of the last ``k`` values is
     ``(c_k − c_{k−k})/k``: the arithmetic of a cumulative sum over the whole recording.
     """
-    ring[cur, col] = ring[old, col] + x
-    return (ring[cur, col] - ring[lo, col]) / k
+    ring[cur] = ring[old] + x
+    return (ring[cur] - ring[lo]) / k
 
 
 @njit
-def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, sums, sums_dg, count, hist, hist_q):
+def _push_mean3(ring, cur, old, lo, k, x0, x1, x2):
+    """:func:`_push_mean` for a 3-vector, component by component, without allocating."""
+    ring[cur, 0] = ring[old, 0] + x0
+    ring[cur, 1] = ring[old, 1] + x1
+    ring[cur, 2] = ring[old, 2] + x2
+    return (ring[cur, 0] - ring[lo, 0]) / k, (ring[cur, 1] - ring[lo, 1]) / k, (ring[cur, 2] - ring[lo, 2]) / k
+
+
+@njit
+def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ring_sq, ring_dg, count, hist, hist_q):
     """``s_c`` (eq. 9) of ``d_g`` (eq. 3) per sample, resumable: the state arrays carry on between calls.
 
     Each change in eq. 3 is taken over one sample of the paper's rate, i.e.
@@ -82,7 +91,7 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, sums, sums_dg, count, 
     d_g_out = np.empty(n)
     c = count[0]
     # sample c writes row (c + 1) mod size from row c mod size; its mean starts at row (c + 1 − k) mod size
-    size, size_dg = sums.shape[0], sums_dg.shape[0]
+    size, size_dg = ring_acc.shape[0], ring_dg.shape[0]
     old, lo = c % size, (c + 1 - min(c + 1, window)) % size
     old_dg, lo_dg = c % size_dg, (c + 1 - min(c + 1, n_c)) % size_dg
     slot = c % lag  # row of sample c in hist, hist_q
@@ -90,13 +99,9 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, sums, sums_dg, count, 
         cur, cur_dg = _next(old, size), _next(old_dg, size_dg)
         kw = min(c + 1, window)
         a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
-        v0 = _push_mean(sums, 0, cur, old, lo, kw, a0)  # eq. 8
-        v1 = _push_mean(sums, 1, cur, old, lo, kw, a1)
-        v2 = _push_mean(sums, 2, cur, old, lo, kw, a2)
-        m0 = _push_mean(sums, 3, cur, old, lo, kw, v0)
-        m1 = _push_mean(sums, 4, cur, old, lo, kw, v1)
-        m2 = _push_mean(sums, 5, cur, old, lo, kw, v2)
-        mean_sq = _push_mean(sums, 6, cur, old, lo, kw, (v0 * v0 + v1 * v1) + v2 * v2)
+        v0, v1, v2 = _push_mean3(ring_acc, cur, old, lo, kw, a0, a1, a2)  # eq. 8
+        m0, m1, m2 = _push_mean3(ring_ave, cur, old, lo, kw, v0, v1, v2)
+        mean_sq = _push_mean(ring_sq, cur, old, lo, kw, (v0 * v0 + v1 * v1) + v2 * v2)
         local_sq = ((a0 * a0 + a1 * a1) + a2 * a2) - 2 * ((a0 * m0 + a1 * m1) + a2 * m2) + mean_sq  # eq. 7
         a_local = math.sqrt(max(local_sq, 0.0))
         g0, g1, g2 = gyr[k, 0], gyr[k, 1], gyr[k, 2]
@@ -119,7 +124,7 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, sums, sums_dg, count, 
             d_local, d_w = abs(a_local - hist[slot, 1]), abs(w_m - hist[slot, 2])
             d_g = scale * (d_am / GRAVITY + (d_local / GRAVITY + d_w))  # eq. 3
         d_g_out[k] = d_g
-        s_c[k] = _push_mean(sums_dg, 0, cur_dg, old_dg, lo_dg, min(c + 1, n_c), d_g)  # eq. 9
+        s_c[k] = _push_mean(ring_dg, cur_dg, old_dg, lo_dg, min(c + 1, n_c), d_g)  # eq. 9
         hist[slot, 0], hist[slot, 1], hist[slot, 2] = t[k], a_local, w_m
         hist[slot, 3], hist[slot, 4], hist[slot, 5] = a0, a1, a2
         c += 1
