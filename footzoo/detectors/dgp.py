@@ -32,13 +32,13 @@ def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
             np.zeros(1, dtype=np.int64), np.zeros((lag, 6)), np.zeros((lag, 4)))
 
 
-@njit
+@njit(inline=True)
 def _next(i, size):
     """Row after ``i`` in a ring of ``size`` rows."""
     return i + 1 if i + 1 < size else 0
 
 
-@njit
+@njit(inline=True)
 def _push_mean(ring, cur, old, lo, k, x):
     """Running sum in ``ring``: row ``cur`` = row ``old`` + ``x``; returns the mean ``(c_cur − c_lo)/k``.
 
@@ -49,7 +49,7 @@ def _push_mean(ring, cur, old, lo, k, x):
     return (ring[cur] - ring[lo]) / k
 
 
-@njit
+@njit(inline=True)
 def _push_mean3(ring, cur, old, lo, k, x0, x1, x2):
     """:func:`_push_mean` for a 3-vector, component by component, without allocating."""
     ring[cur, 0] = ring[old, 0] + x0
