@@ -80,11 +80,6 @@ def smoother_gain(M, P_pred, A, sub, L, x, keep):
             A[i, keep[b]] = y[b]
 
 
-def no_gain(M, P_pred, A, sub, L, x, keep):  # noqa: ARG001 - the signature of smoother_gain
-    """Stands for :func:`smoother_gain` in a run without the smoother (never called)."""
-    return None
-
-
 @njit
 def feed_back_attitude(q, ex, ey, ez):
     """``q ← exp(−e) ⊗ q``, normalised, in place (the attitude feedback of Nguyen & La eqs. 51–52)."""
