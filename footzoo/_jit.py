@@ -61,9 +61,12 @@ class _Kernel:
 
 
 def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
+    # no C-callable wrapper: kernels are called from Python and from kernels, never through a
+    # function pointer (the measurement functions, which are, are compiled elsewhere)
+    options = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
     if inline:  # numba copies its typed body into each caller: no compilation and no cache entry of its own
-        return _numba.njit(cache=True, nogil=True, inline="always")(fn)
-    return _numba.njit(cache=True, nogil=True)(fn)
+        options["inline"] = "always"
+    return _numba.njit(**options)(fn)
 
 
 def _materialise() -> None:
