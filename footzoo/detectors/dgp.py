@@ -32,7 +32,7 @@ def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
             np.zeros(1, dtype=np.int64), np.zeros((lag, 6)), np.zeros((lag, 4)))
 
 
-@njit(inline=True)
+@njit
 def _next(i, size):
     """Row after ``i`` in a ring of ``size`` rows."""
     return i + 1 if i + 1 < size else 0

@@ -279,7 +279,7 @@ class MeasurementModel:
         )
 
 
-@njit
+@njit(inline=True)
 def yaw_of(nav: np.ndarray) -> float:
     """Z-Y-X heading of ``nav``'s attitude (rad); usable inside compiled measurement functions."""
     w, x, y, z = nav[0], nav[1], nav[2], nav[3]
