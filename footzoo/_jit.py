@@ -40,9 +40,10 @@ class _Kernel:
     and every footzoo module attribute that named it is rebound to the dispatcher.
     """
 
-    def __init__(self, fn: Callable[..., Any]):
+    def __init__(self, fn: Callable[..., Any], inline: bool = False):
         functools.update_wrapper(self, fn)
         self.py_func = fn
+        self.inline = inline
         self.dispatcher: Any = None
 
     def __call__(self, *args: Any) -> Any:
@@ -53,16 +54,26 @@ class _Kernel:
     def __repr__(self) -> str:
         return f"<footzoo kernel {self.py_func.__module__}.{self.py_func.__qualname__}>"
 
+    @property
+    def _numba_type_(self) -> Any:
+        """numba's type of the dispatcher: compiled code outside footzoo may name the kernel before it exists."""
+        return compiled(self)._numba_type_
 
-def _compile(fn: Callable[..., Any]) -> Any:
-    return _numba.njit(cache=True, nogil=True)(fn)
+
+def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
+    # no C-callable wrapper: kernels are called from Python and from kernels, never through a
+    # function pointer (the measurement functions, which are, are compiled elsewhere)
+    options = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
+    if inline:  # numba copies its typed body into each caller: no compilation and no cache entry of its own
+        options["inline"] = "always"
+    return _numba.njit(**options)(fn)
 
 
 def _materialise() -> None:
     """Import numba, make every pending kernel a dispatcher, rebind the module attributes that named it."""
     global _numba, _materialised, HAVE_NUMBA
     with _lock:
-        if not _pending:  # another thread did it
+        if _materialised:  # another thread did it
             return
         try:
             import numba
@@ -72,7 +83,7 @@ def _materialise() -> None:
         _numba = numba
         kernels = {id(k): k for k in _pending}
         for k in kernels.values():
-            k.dispatcher = _compile(k.py_func) if numba is not None else k.py_func
+            k.dispatcher = _compile(k.py_func, k.inline) if numba is not None else k.py_func
         _pending.clear()
         _materialised = True
         for name, module in list(sys.modules.items()):
@@ -84,17 +95,34 @@ def _materialise() -> None:
                     attrs[attr] = value.dispatcher
 
 
-def njit(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``numba.njit(cache=True, nogil=True)`` when available (created lazily), else the function itself."""
+def njit(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
+    """``numba.njit(cache=True, nogil=True)`` when available (created lazily), else the function itself.
+
+    ``@njit(inline=True)`` marks a small scalar helper of other kernels: numba inlines its typed
+    body into each kernel that calls it instead of compiling it on its own (the same arithmetic;
+    one compilation fewer per helper). Called from Python it is compiled as usual.
+    """
+    if fn is None:
+        return functools.partial(njit, inline=inline)
     if not HAVE_NUMBA:
         return fn
     if _numba is not None:  # numba already imported: a module imported after the first kernel call
-        return _compile(fn)
+        return _compile(fn, inline)
     if _materialised:  # numba failed to import
         return fn
-    kernel = _Kernel(fn)
+    kernel = _Kernel(fn, inline)
     _pending.append(kernel)
     return kernel
+
+
+def load_numba() -> Any:
+    """numba itself, imported now if it is not yet (every pending kernel then becomes its dispatcher).
+
+    For code that compiles functions of its own (e.g. with an explicit signature). ``None`` without numba.
+    """
+    if HAVE_NUMBA and not _materialised:
+        _materialise()
+    return _numba
 
 
 def compiled(fn: Any) -> Any:

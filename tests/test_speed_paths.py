@@ -83,6 +83,29 @@ def test_import_footzoo_loads_no_heavy_dependency():
     assert "Pipeline" in out["all"] and "load" in out["all"]
 
 
+def test_pipeline_and_readers_load_no_compiler_until_a_kernel_runs():
+    """``from footzoo import Pipeline, load`` and building every plug-in import neither numba, scipy nor filterpy.
+
+    The measurement functions of the Kalman corrections are compiled at their first use, not when
+    their modules are imported; numba comes with the first run.
+    """
+    script = (
+        "import sys, json; from footzoo import Pipeline, load; heavy = ('numba', 'scipy', 'filterpy');"
+        "out = {'import': [m for m in heavy if m in sys.modules]};"
+        "from footzoo.registry import available; [available(k) for k in ('orientation', 'detector', 'correction')];"
+        "p = Pipeline.from_yaml('configs/nguyen2016.yaml'); out['build'] = [m for m in heavy if m in sys.modules];"
+        "from footzoo.sim import simulate; p.run(simulate(n_strides=3, rate=100.0, profile='physical'));"
+        "import footzoo._jit as j; out['run'] = 'numba' in sys.modules; out['jit'] = j.HAVE_NUMBA;"
+        "print(json.dumps(out))"
+    )
+    proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True, text=True, cwd=ROOT,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["import"] == [] and out["build"] == []
+    assert out["run"] == out["jit"]
+
+
 def test_kernels_are_compiled_at_first_call_and_callers_see_the_compiled_callees():
     """After the first kernel call every footzoo module attribute naming a kernel is numba's dispatcher."""
     script = (

@@ -163,7 +163,7 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
     return fpa
 
 
-@njit
+@njit(inline=True)  # inlined: no compilation per constant value of right
 def _bisect(t: np.ndarray, v: float, right: bool) -> int:
     """``np.searchsorted(t, v, side="right" if right else "left")`` for sorted ``t`` (cheaper to compile)."""
     lo, hi = 0, t.shape[0]

@@ -20,37 +20,41 @@ def _count(x: float) -> int:
 
 
 def dgp_statistic_state(f: int, n_c: int, lag: int) -> tuple[np.ndarray, ...]:
-    """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and of the last ``lag`` samples."""
+    """State of :func:`dgp_statistic_kernel`: ring buffers of running sums and of the last ``lag`` samples.
+
+    Running sums (2f + 2 rows) of eq. 8's acceleration, of its means and of their squared
+    norms; of ``d_g`` (n_c + 1 rows, eq. 9); the sample count; ``hist`` (lag, 6): time,
+    ``a_local``, ``w_m`` and the specific force of the last ``lag`` samples; ``hist_q`` (lag, 4):
+    their rotations ``exp(ω dt)``.
+    """
     w = 2 * f + 1
     return (np.zeros((w + 1, 3)), np.zeros((w + 1, 3)), np.zeros(w + 1), np.zeros(n_c + 1),
             np.zeros(1, dtype=np.int64), np.zeros((lag, 6)), np.zeros((lag, 4)))
 
 
 @njit
-def _ring_mean(ring, count, window, value):
-    """Push ``value`` into the running sum kept in ``ring`` (row ``count`` mod len); mean of the last ``window``.
+def _next(i, size):
+    """Row after ``i`` in a ring of ``size`` rows."""
+    return i + 1 if i + 1 < size else 0
 
-    The sums are ``c_k = c_{k−1} + x_k`` and the mean ``(c_k − c_lo)/(k − lo)``, the
-    arithmetic of a cumulative sum over the whole recording.
+
+@njit(inline=True)
+def _push_mean(ring, cur, old, lo, k, x):
+    """Running sum in ``ring``: row ``cur`` = row ``old`` + ``x``; returns the mean ``(c_cur − c_lo)/k``.
+
+    The sums are ``c_k = c_{k−1} + x_k`` and the mean of the last ``k`` values is
+    ``(c_k − c_{k−k})/k``: the arithmetic of a cumulative sum over the whole recording.
     """
-    size = ring.shape[0]
-    cur = (count + 1) % size
-    ring[cur] = ring[count % size] + value
-    k = min(count + 1, window)
-    return (ring[cur] - ring[(count + 1 - k) % size]) / k
+    ring[cur] = ring[old] + x
+    return (ring[cur] - ring[lo]) / k
 
 
-@njit
-def _ring_mean3(ring, count, window, x0, x1, x2):
-    """:func:`_ring_mean` for a 3-vector, component by component, without allocating."""
-    size = ring.shape[0]
-    cur = (count + 1) % size
-    old = count % size
+@njit(inline=True)
+def _push_mean3(ring, cur, old, lo, k, x0, x1, x2):
+    """:func:`_push_mean` for a 3-vector, component by component, without allocating."""
     ring[cur, 0] = ring[old, 0] + x0
     ring[cur, 1] = ring[old, 1] + x1
     ring[cur, 2] = ring[old, 2] + x2
-    k = min(count + 1, window)
-    lo = (count + 1 - k) % size
     return (ring[cur, 0] - ring[lo, 0]) / k, (ring[cur, 1] - ring[lo, 1]) / k, (ring[cur, 2] - ring[lo, 2]) / k
 
 
@@ -77,42 +81,59 @@ def dgp_statistic_kernel(t, acc, gyr, window, n_c, scale, ring_acc, ring_ave, ri
     ``scale`` = (paper's sample interval) / (lag interval) corrects the rest
     when the lag cannot be exactly one paper sample (rates below the paper's,
     or not a multiple of it).
+
+    The state comes from :func:`dgp_statistic_state`. The rows of the rings are found once per
+    call and then advanced by one per sample.
     """
     n = t.shape[0]
     lag = hist.shape[0]
     s_c = np.empty(n)
     d_g_out = np.empty(n)
+    c = count[0]
+    # sample c writes row (c + 1) mod size from row c mod size; its mean starts at row (c + 1 − k) mod size
+    size, size_dg = ring_acc.shape[0], ring_dg.shape[0]
+    old, lo = c % size, (c + 1 - min(c + 1, window)) % size
+    old_dg, lo_dg = c % size_dg, (c + 1 - min(c + 1, n_c)) % size_dg
+    slot = c % lag  # row of sample c in hist, hist_q
     for k in range(n):
-        c = count[0]
+        cur, cur_dg = _next(old, size), _next(old_dg, size_dg)
+        kw = min(c + 1, window)
         a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
-        v0, v1, v2 = _ring_mean3(ring_acc, c, window, a0, a1, a2)  # eq. 8
-        m0, m1, m2 = _ring_mean3(ring_ave, c, window, v0, v1, v2)
-        mean_sq = _ring_mean(ring_sq, c, window, (v0 * v0 + v1 * v1) + v2 * v2)
+        v0, v1, v2 = _push_mean3(ring_acc, cur, old, lo, kw, a0, a1, a2)  # eq. 8
+        m0, m1, m2 = _push_mean3(ring_ave, cur, old, lo, kw, v0, v1, v2)
+        mean_sq = _push_mean(ring_sq, cur, old, lo, kw, (v0 * v0 + v1 * v1) + v2 * v2)
         local_sq = ((a0 * a0 + a1 * a1) + a2 * a2) - 2 * ((a0 * m0 + a1 * m1) + a2 * m2) + mean_sq  # eq. 7
         a_local = math.sqrt(max(local_sq, 0.0))
-        w_m = math.sqrt((gyr[k, 0] * gyr[k, 0] + gyr[k, 1] * gyr[k, 1]) + gyr[k, 2] * gyr[k, 2])
-        slot = c % lag
-        dt = t[k] - hist[(c - 1) % lag, 0] if c > 0 else 0.0
-        hist_q[slot, 0], hist_q[slot, 1], hist_q[slot, 2], hist_q[slot, 3] = rotvec_quat(
-            gyr[k, 0] * dt, gyr[k, 1] * dt, gyr[k, 2] * dt)
+        g0, g1, g2 = gyr[k, 0], gyr[k, 1], gyr[k, 2]
+        w_m = math.sqrt((g0 * g0 + g1 * g1) + g2 * g2)
+        dt = t[k] - hist[slot - 1 if slot > 0 else lag - 1, 0] if c > 0 else 0.0
+        hist_q[slot, 0], hist_q[slot, 1], hist_q[slot, 2], hist_q[slot, 3] = rotvec_quat(g0 * dt, g1 * dt, g2 * dt)
         if c < lag:
             d_g = 0.0
         else:
             # rotation from the body at k − lag to the body at k: exp(ω dt) of the lag samples, oldest first
             q0, q1, q2, q3 = 1.0, 0.0, 0.0, 0.0
-            for j in range(lag):
-                i = (c - lag + 1 + j) % lag
+            i = _next(slot, lag)
+            for _ in range(lag):
                 q0, q1, q2, q3 = quat_product(q0, q1, q2, q3, hist_q[i, 0], hist_q[i, 1], hist_q[i, 2], hist_q[i, 3])
+                i = _next(i, lag)
             gx, gy, gz = rotate(q0, q1, q2, q3, a0, a1, a2)
-            old = hist[slot]  # the sample lag steps back (not yet overwritten)
-            dx, dy, dz = gx - old[3], gy - old[4], gz - old[5]
+            # the sample lag steps back is in row slot (not yet overwritten)
+            dx, dy, dz = gx - hist[slot, 3], gy - hist[slot, 4], gz - hist[slot, 5]
             d_am = math.sqrt(dx * dx + dy * dy + dz * dz)
-            d_g = scale * (d_am / GRAVITY + (abs(a_local - old[1]) / GRAVITY + abs(w_m - old[2])))  # eq. 3
+            d_local, d_w = abs(a_local - hist[slot, 1]), abs(w_m - hist[slot, 2])
+            d_g = scale * (d_am / GRAVITY + (d_local / GRAVITY + d_w))  # eq. 3
         d_g_out[k] = d_g
-        s_c[k] = _ring_mean(ring_dg, c, n_c, d_g)  # eq. 9
+        s_c[k] = _push_mean(ring_dg, cur_dg, old_dg, lo_dg, min(c + 1, n_c), d_g)  # eq. 9
         hist[slot, 0], hist[slot, 1], hist[slot, 2] = t[k], a_local, w_m
         hist[slot, 3], hist[slot, 4], hist[slot, 5] = a0, a1, a2
-        count[0] = c + 1
+        c += 1
+        old, old_dg, slot = cur, cur_dg, _next(slot, lag)
+        if c + 1 > window:  # the windows are full: their first row moves on
+            lo = _next(lo, size)
+        if c + 1 > n_c:
+            lo_dg = _next(lo_dg, size_dg)
+    count[0] = c
     return s_c, d_g_out
 
 

@@ -10,6 +10,7 @@ loop, ``"reference"`` the filterpy loop, ``"auto"`` the compiled one when every 
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import asdict, dataclass, fields
@@ -21,7 +22,7 @@ from .. import _jit
 from ..checks import check_range
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
-from .measurement import CORE_BLOCKS, NO_AFTER, NO_FEEDBACK, MeasurementModel, NotCompilable, StateBlock
+from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -275,7 +276,7 @@ class KalmanEngine:
         data_off = np.cumsum([0] + widths).astype(np.int64)
         functions = (tuple(_address(m.measure) for m in models), tuple(_address(m.feedback) for m in models),
                      tuple(_address(m.after) for m in models))
-        hooks = np.array([[m.feedback is not NO_FEEDBACK, m.after is not NO_AFTER] for m in models], dtype=np.int64)
+        hooks = np.array([[not is_no_op(m.feedback), not is_no_op(m.after)] for m in models], dtype=np.int64)
         arrays = (m_idx, par, par_off, mem_off, data_off, hooks)
         return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays)
 
@@ -304,14 +305,14 @@ class KalmanEngine:
     @staticmethod
     def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
         """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
-        from .kalman_fast import eskf_loop, scratch
+        from .kalman_fast import eskf_loop, scratch, smoother_arrays
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks = packed.arrays
         signals = (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
                    np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
-                   out["P_diag"], out["gains"], out["dxs"])
+                   out["P_diag"])
         state = (packed.nav, packed.P, packed.mems)
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
@@ -321,9 +322,9 @@ class KalmanEngine:
                          k0, work)
             return
         measures, feedbacks, afters = packed.functions
-        gain = _gain_function(out["gains"].shape[0] > 0)
+        smoother = smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0] else None
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs + (gain,), k0, work)
+                                                data_off, hooks), outputs, k0, work, smoother)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -340,39 +341,41 @@ def _address(fn: Any) -> Any:
         return fn
     cached = _ADDRESSES.get(id(fn))
     if cached is None or cached.dispatcher is not fn:
-        cached = _ADDRESSES[id(fn)] = _FixedAddress(fn)
+        cached = _ADDRESSES[id(fn)] = _fixed_address_type()(fn)
     return cached
 
 
 _ADDRESSES: dict[int, Any] = {}
-_GAINS: dict[bool, Any] = {}
+_GAIN: list[Any] = []
 
 
-def _gain_function(smooth: bool) -> Any:
-    """The smoother's gain function for the compiled loop (a no-op with its signature without the smoother).
+def _gain_function() -> Any:
+    """The smoother's gain function for the compiled loop, compiled once with a fixed signature.
 
-    Compiled on its own with a fixed signature and passed as a first-class function, so the loop
-    does not compile it, and a run without the smoother compiles only the no-op.
+    Passed as a first-class function, so the loop does not compile it; a run without the smoother
+    compiles neither it nor the loop's smoothing code.
     """
     from . import smoother
 
-    fn = _jit.compiled(smoother.smoother_gain) if smooth else smoother.no_gain
+    fn = _jit.compiled(smoother.smoother_gain)
     if not _jit.HAVE_NUMBA:
         return fn
-    if smooth not in _GAINS:
-        import numba
-        from numba import types as t
-
+    if not _GAIN:
+        numba = _jit.load_numba()
+        t = numba.types
         a2 = t.float64[:, ::1]
         signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
-        _GAINS[smooth] = _address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn)))
-    return _GAINS[smooth]
+        _GAIN.append(_address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn))))
+    return _GAIN[0]
 
-if _jit.HAVE_NUMBA:
+
+@functools.cache
+def _fixed_address_type() -> type:
+    """The class of :func:`_address`'s objects (defined at first use: it derives from a numba class)."""
     from numba.core.types.function_type import WrapperAddressProtocol
     from numba.experimental.function_type import _get_wrapper_address
 
-    class _FixedAddress(WrapperAddressProtocol):
+    class FixedAddress(WrapperAddressProtocol):
         """A dispatcher compiled for one signature, seen by numba through its address."""
 
         def __init__(self, dispatcher: Any):
@@ -390,6 +393,8 @@ if _jit.HAVE_NUMBA:
         def __call__(self, *args: Any) -> Any:
             return self.dispatcher(*args)
 
+    return FixedAddress
+
 
 def _bound_loop(functions: tuple) -> Any:
     """The compiled loop with these measurement functions as constants (compiled once per process and set)."""
@@ -399,12 +404,11 @@ def _bound_loop(functions: tuple) -> Any:
 
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
-        no_gain = _gain_function(False)
 
         def bound(signals, core, state, arrays, out, k0, work):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out + (no_gain,), k0, work)
+                                             data_off, hooks), out, k0, work, None)
 
         import numba
 

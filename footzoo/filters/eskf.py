@@ -26,7 +26,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 
 @dataclass
@@ -91,6 +90,8 @@ class ErrorStateFilter:
     """
 
     def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray):
+        from filterpy.kalman import KalmanFilter  # imported here: the compiled engine does not need it
+
         self.layout = layout
         self.kf = KalmanFilter(dim_x=layout.n, dim_z=1)
         self.kf.P = np.diag(np.asarray(p0, dtype=float))

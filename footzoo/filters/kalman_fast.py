@@ -18,6 +18,7 @@ engines equal to 1e-9 relative.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -59,7 +60,7 @@ if _jit.HAVE_NUMBA:
 
 
 @njit
-def eskf_loop(signals, core, state, models, out, k0, scratch):
+def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
     """Run samples 1… of ``signals`` from ``state`` (updated in place); outputs into ``out``.
 
     Parameters
@@ -78,32 +79,34 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
         data (N, d), data_off (L+1,), hooks (L, 2) int: model j has a feedback / an after function)``:
         the corrections' functions and their arrays, in stacking order.
     out : tuple
-        ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n),
-        gains (N or 0, n, n), dxs (N or 0, n), smoother_gain)``; row 0 receives the incoming state.
-        A bias without its error-state block stays zero and is not written: pass zeros.
-        ``P_diag``, and the smoother's gains ``A_k`` and fed-back errors
-        (:mod:`footzoo.filters.smoother`), with 0 rows are not written; ``smoother_gain`` is
-        :func:`footzoo.filters.smoother.smoother_gain` (compiled on its own, called only with gains).
+        ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n))``; row 0
+        receives the incoming state. A bias without its error-state block stays zero and is not
+        written: pass zeros. ``P_diag`` with 0 rows is not written.
     k0 : int
         Index of sample 0 in the whole recording (a stream passes its running count).
     scratch : tuple
         The loop's buffers, from :func:`scratch` (any content).
+    smoother : tuple or None
+        For an RTS smoother (:mod:`footzoo.filters.smoother`), from :func:`smoother_arrays`: its
+        gains ``A_k`` (N, n, n) and fed-back errors (N, n) are written. ``None`` (no smoother):
+        numba compiles the loop without the smoother's code.
     """
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max = core
     nav_owned, P_owned, mems_owned = state
     measures, feedbacks, afters, idx_owned, par_owned, par_off, mem_off, data_owned, data_off, hooks = models
-    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, gains, dxs, smoother_gain = out
+    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag = out
     N = t.shape[0]
     n = P_owned.shape[0]
-    smooth = gains.shape[0] == N
     keep_p = pdiag.shape[0] == N
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
     # the arrays the loop works on and hands to the models' functions, as views that own no
     # reference: handing them on costs no reference counting (they are the caller's arguments,
     # alive during the whole call)
-    (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, M, sub, Ls, inv, keep, u_o, kv_o, g_o, nzc_o, dyn_o,
-     still_o, c_o, cdt_o, sdt_o, an_o) = scratch
+    (z_owned, H_owned, r_owned, dx_owned, w_owned, f_owned, u_o, kv_o, g_o, nzc_o, dyn_o, still_o, c_o, cdt_o, sdt_o,
+     an_o) = scratch
+    if smoother is not None:
+        gains, dxs, smoother_gain, M, sub, Ls, inv, keep = smoother
     P = _unowned(P_owned)
     u, kv, g, nzc, dyn, still = (_unowned(u_o), _unowned(kv_o), _unowned(g_o), _unowned(nzc_o), _unowned(dyn_o),
                                  _unowned(still_o))
@@ -213,7 +216,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                 b0, b1, b2 = bm[i, 0], bm[i, 1], bm[i, 2]
                 for j in range(n):
                     P[r0 + i, j] += b0 * P[c0, j] + b1 * P[c0 + 1, j] + b2 * P[c0 + 2, j]
-        if smooth:  # M = Φ P⁺_{k−1}
+        if smoother is not None:  # M = Φ P⁺_{k−1}
             for i in range(n):
                 for j in range(n):
                     M[i, j] = P[i, j]
@@ -244,7 +247,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
                 P[j, i] = P[i, j]
         for i in range(n):
             P[i, i] += qn[i] * dt
-        if smooth:  # P = P⁻_k
+        if smoother is not None:  # P = P⁻_k
             smoother_gain(M, P, gains[k - 1], sub, Ls, inv, keep)
             for i in range(n):
                 dxs[k, i] = 0.0
@@ -310,7 +313,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch):
             for j in range(len(feedbacks)):
                 if hooks[j, 0]:
                     feedbacks[j](dx, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
-            if smooth:
+            if smoother is not None:
                 for i in range(n):
                     dxs[k, i] = dx[i]
         for j in range(len(afters)):
@@ -335,12 +338,22 @@ def scratch(n: int, m_max: int) -> tuple:
     """The buffers of :func:`eskf_loop`, allocated by the caller (so they outlive the views of them).
 
     ``z`` (m_max,), ``H`` (m_max, n), ``R`` (m_max,), ``dx`` (n,), ``w``, ``f`` (3,): handed to the
-    models' functions; ``M``, and the smoother's work arrays (n, n) ×3 and (n,) int; ``u``, ``k``,
-    ``g`` (n,); nonzero columns, moving and still rows (n,) int; ``C``, ``C dt``, ``−[f^n×] dt``
-    (3, 3) and ``a_n`` (3,).
+    models' functions; ``u``, ``k``, ``g`` (n,); nonzero columns, moving and still rows (n,) int;
+    ``C``, ``C dt``, ``−[f^n×] dt`` (3, 3) and ``a_n`` (3,).
     """
     i8 = np.int64
     return (np.zeros(m_max), np.zeros((m_max, n)), np.zeros(m_max), np.zeros(n), np.zeros(3), np.zeros(3),
-            np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros(n, i8), np.zeros(n),
-            np.zeros(n), np.zeros(n), np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros((3, 3)),
+            np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros((3, 3)),
             np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3))
+
+
+def smoother_arrays(gains: np.ndarray, dxs: np.ndarray, gain: Any) -> tuple:
+    """The ``smoother`` argument of :func:`eskf_loop`: its outputs, gain function and work arrays.
+
+    ``gains`` (N, n, n) and ``dxs`` (N, n) receive the smoother's gains and the fed-back errors;
+    ``gain`` is :func:`footzoo.filters.smoother.smoother_gain`, compiled on its own; then ``M``
+    and the gain function's work arrays, (n, n) ×4 and (n,) int.
+    """
+    n = dxs.shape[1]
+    return (gains, dxs, gain, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+            np.zeros(n, np.int64))

@@ -60,6 +60,7 @@ that needs the corrected state, e.g. the heading at the end of a stance).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -67,10 +68,8 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import HAVE_NUMBA
-
-if HAVE_NUMBA:  # measurement functions are compiled eagerly, with the engine's fixed signature
-    import numba
+from .. import _jit
+from .._jit import njit
 
 #: Offsets in ``nav``: quaternion, position, velocity, gyro bias, accelerometer bias.
 Q, P, V, BG, BA = 0, 4, 7, 10, 13
@@ -79,69 +78,124 @@ NAV_SIZE = 16
 ATT, GYRO_BIAS, POS, VEL, ACC_BIAS, OWN = 0, 1, 2, 3, 4, 5
 CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
 
-if HAVE_NUMBA:
-    from numba import types as _t
-
-    MEASURE_SIGNATURE = _t.int64(
-        _t.int64, _t.float64, _t.float64[::1], _t.float64[::1], _t.float64[::1], _t.boolean, _t.int64[::1],
-        _t.float64[:], _t.float64[:], _t.float64[:], _t.float64[::1], _t.float64[:, ::1], _t.float64[::1],
-        _t.int64,
-    )
-    FEEDBACK_SIGNATURE = _t.none(_t.float64[::1], _t.int64[::1], _t.float64[:], _t.float64[:])
-    AFTER_SIGNATURE = _t.none(_t.int64, _t.float64[::1], _t.boolean, _t.int64[::1], _t.float64[:], _t.float64[:])
-else:  # pragma: no cover - exercised with FOOTZOO_DISABLE_JIT=1
-    MEASURE_SIGNATURE = FEEDBACK_SIGNATURE = AFTER_SIGNATURE = None
-
 
 class NotCompilable(Exception):
     """A measurement model's functions cannot be compiled; carries the reason."""
 
 
-def _compile(fn: Callable[..., Any], signature: Any, role: str) -> Callable[..., Any]:
-    if not HAVE_NUMBA:
+@functools.cache
+def signature(role: str) -> Any:
+    """numba's signature of the engine's ``measure``, ``feedback`` or ``after`` functions (imports numba)."""
+    from numba import types as t
+
+    f1, i1, f = t.float64[::1], t.int64[::1], t.float64[:]
+    return {
+        "measure": t.int64(t.int64, t.float64, f1, f1, f1, t.boolean, i1, f, f, f, f1, t.float64[:, ::1], f1, t.int64),
+        "feedback": t.none(f1, i1, f, f),
+        "after": t.none(t.int64, f1, t.boolean, i1, f, f),
+    }[role]
+
+
+def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
+    """``fn`` compiled with the engine's signature for ``role``; raises :class:`NotCompilable` with numba's reason."""
+    numba = _jit.load_numba()
+    if numba is None:
         return fn
+    if isinstance(fn, ModelFunction):
+        return fn.compiled()
+    sig = signature(role)
     if isinstance(fn, numba.core.registry.CPUDispatcher):
-        if fn.signatures and all(tuple(s) == tuple(signature.args) for s in fn.signatures):
+        if fn.signatures and all(tuple(s) == tuple(sig.args) for s in fn.signatures):
             return fn
         fn = fn.py_func
     try:
         # first without reference counting: the same machine code for a function that allocates no
         # array (numba refuses to compile one that does, here or in a function it calls), minus the
         # counting of every array argument at each call
-        return numba.njit(signature, cache=True, nogil=True, _nrt=False)(fn)
+        return numba.njit(sig, cache=True, nogil=True, _nrt=False)(fn)
     except Exception:  # it allocates (or numba lacks the option): with reference counting
         pass
     try:
-        return numba.njit(signature, cache=True, nogil=True)(fn)
+        return numba.njit(sig, cache=True, nogil=True)(fn)
     except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
         pass
     try:
-        return numba.njit(signature, cache=False, nogil=True)(fn)
+        return numba.njit(sig, cache=False, nogil=True)(fn)
     except Exception as err:  # numba raises many types; the message is what matters
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise NotCompilable(f"{role} function {getattr(fn, '__qualname__', fn)!r}: {first}") from None
 
 
-def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
-    """Compile a ``measure`` function with the engine's signature (plain Python without numba).
+class ModelFunction:
+    """A measurement model's function, compiled with the engine's signature at its first use.
 
-    Use as a decorator in a correction's module. A function that creates no
-    array is compiled without numba's reference counting (cheaper calls from
-    the compiled loop). A function that does not compile raises
-    :class:`NotCompilable` with numba's reason; leave the decorator off to run
-    such a correction on the reference engine.
+    Calling it, or asking for numba's attributes (``signatures``, ``targetoptions``, ...),
+    compiles it (or loads it from numba's cache); :meth:`compiled` gives numba's dispatcher.
+    Nothing is imported or compiled before: importing a correction's module stays cheap.
     """
-    return _compile(fn, MEASURE_SIGNATURE, "measure")
+
+    def __init__(self, fn: Callable[..., Any], role: str):
+        functools.update_wrapper(self, fn)
+        self.py_func = fn
+        self.role = role
+        self._dispatcher: Any = None
+        self._error: str | None = None
+
+    def compiled(self) -> Any:
+        """numba's dispatcher (compiled once); raises :class:`NotCompilable` with the reason (tried once)."""
+        if self._dispatcher is None:
+            if self._error is not None:
+                raise NotCompilable(self._error)
+            try:
+                self._dispatcher = _compile(self.py_func, self.role)
+            except NotCompilable as err:
+                self._error = str(err)
+                raise
+        return self._dispatcher
+
+    def __call__(self, *args: Any) -> Any:
+        try:
+            fn = self.compiled()
+        except NotCompilable:  # the reference engine runs it as Python
+            fn = self.py_func
+        return fn(*args)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("py_func", "role", "_dispatcher", "_error"):
+            raise AttributeError(name)
+        return getattr(self.compiled(), name)
+
+    def __repr__(self) -> str:
+        return f"<footzoo {self.role} function {self.py_func.__module__}.{self.py_func.__qualname__}>"
+
+
+def _lazy(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
+    if not _jit.HAVE_NUMBA or isinstance(fn, ModelFunction):
+        return fn
+    return ModelFunction(fn, role)
+
+
+def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
+    """Mark a ``measure`` function for compilation with the engine's signature (plain Python without numba).
+
+    Use as a decorator in a correction's module. The function is compiled at its first use
+    (a call, or the engine's compiled loop), not when the module is imported. A function that
+    creates no array is compiled without numba's reference counting (cheaper calls from the
+    compiled loop). A function that does not compile raises :class:`NotCompilable` with numba's
+    reason at its first use; the engine then runs the reference loop under ``engine="auto"``
+    (leave the decorator off to get there without trying).
+    """
+    return _lazy(fn, "measure")
 
 
 def feedback_function(fn: Callable[..., None]) -> Callable[..., None]:
-    """Compile a ``feedback`` function with the engine's signature."""
-    return _compile(fn, FEEDBACK_SIGNATURE, "feedback")
+    """Mark a ``feedback`` function for compilation with the engine's signature."""
+    return _lazy(fn, "feedback")
 
 
 def after_function(fn: Callable[..., None]) -> Callable[..., None]:
-    """Compile an ``after`` function with the engine's signature."""
-    return _compile(fn, AFTER_SIGNATURE, "after")
+    """Mark an ``after`` function for compilation with the engine's signature."""
+    return _lazy(fn, "after")
 
 
 def _no_feedback(dx, idx, par, mem):  # noqa: ARG001 - the signature is the contract
@@ -154,6 +208,11 @@ def _no_after(k, nav, stance, idx, par, mem):  # noqa: ARG001
 
 NO_FEEDBACK = feedback_function(_no_feedback)
 NO_AFTER = after_function(_no_after)
+
+
+def is_no_op(fn: Any) -> bool:
+    """Whether ``fn`` is :data:`NO_FEEDBACK` or :data:`NO_AFTER`, compiled or not (the engine skips its calls)."""
+    return any(fn is f or fn is getattr(f, "_dispatcher", None) for f in (NO_FEEDBACK, NO_AFTER))
 
 
 @dataclass
@@ -214,17 +273,15 @@ class MeasurementModel:
     def compiled(self) -> MeasurementModel:
         """The same model with its functions compiled; raises :class:`NotCompilable` with the reason."""
         return MeasurementModel(
-            measure=measurement_function(self.measure), max_rows=self.max_rows, par=self.par, mem=self.mem,
-            data=self.data, feedback=feedback_function(self.feedback), after=after_function(self.after),
+            measure=_compile(self.measure, "measure"), max_rows=self.max_rows, par=self.par, mem=self.mem,
+            data=self.data, feedback=_compile(self.feedback, "feedback"), after=_compile(self.after, "after"),
             block_names=self.block_names, diagnostics=self.diagnostics,
         )
 
 
+@njit(inline=True)
 def yaw_of(nav: np.ndarray) -> float:
     """Z-Y-X heading of ``nav``'s attitude (rad); usable inside compiled measurement functions."""
     w, x, y, z = nav[0], nav[1], nav[2], nav[3]
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
-
-if HAVE_NUMBA:
-    yaw_of = numba.njit(cache=True, nogil=True)(yaw_of)

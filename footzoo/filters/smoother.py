@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from .._jit import njit
+from .strapdown import quat_product, rotvec_quat
 
 JITTER = 1e-12
 
@@ -80,24 +81,11 @@ def smoother_gain(M, P_pred, A, sub, L, x, keep):
             A[i, keep[b]] = y[b]
 
 
-def no_gain(M, P_pred, A, sub, L, x, keep):  # noqa: ARG001 - the signature of smoother_gain
-    """Stands for :func:`smoother_gain` in a run without the smoother (never called)."""
-    return None
-
-
-@njit
+@njit(inline=True)
 def feed_back_attitude(q, ex, ey, ez):
     """``q ← exp(−e) ⊗ q``, normalised, in place (the attitude feedback of Nguyen & La eqs. 51–52)."""
-    rx, ry, rz = -ex, -ey, -ez
-    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-    half = 0.5 * angle
-    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-    aw, ax, ay, az = math.cos(half), kk * rx, kk * ry, kk * rz
-    bw, bx, by, bz = q[0], q[1], q[2], q[3]
-    qw = aw * bw - ax * bx - ay * by - az * bz
-    qx = aw * bx + ax * bw + ay * bz - az * by
-    qy = aw * by - ax * bz + ay * bw + az * bx
-    qz = aw * bz + ax * by - ay * bx + az * bw
+    aw, ax, ay, az = rotvec_quat(-ex, -ey, -ez)
+    qw, qx, qy, qz = quat_product(aw, ax, ay, az, q[0], q[1], q[2], q[3])
     nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
     q[0], q[1], q[2], q[3] = qw / nq, qx / nq, qy / nq, qz / nq
 

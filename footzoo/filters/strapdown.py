@@ -21,14 +21,14 @@ from .._jit import njit
 from ..conventions import GRAVITY
 
 
-@njit
+@njit(inline=True)
 def quat_product(a0, a1, a2, a3, b0, b1, b2, b3):
     """``a ⊗ b`` of two quaternions given by their components (scalar first), for compiled loops."""
     return (a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
             a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
 
 
-@njit
+@njit(inline=True)
 def rotvec_quat(rx, ry, rz):
     """Unit quaternion ``exp(r/2)`` of the rotation vector r (rad), scalar first, for compiled loops."""
     angle = math.sqrt(rx * rx + ry * ry + rz * rz)
@@ -37,7 +37,7 @@ def rotvec_quat(rx, ry, rz):
     return math.cos(half), kk * rx, kk * ry, kk * rz
 
 
-@njit
+@njit(inline=True)
 def rotate(w, x, y, z, fx, fy, fz):
     """``q f q*`` for a unit quaternion q (scalar first, body → NED): f in NED, for compiled loops."""
     gx = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz

@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.io as sio
 
 from ..data import Recording, Truth
 from ..errors import FormatError
@@ -30,6 +29,8 @@ TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
 
 def read(path: Path, **options: Any) -> Recording:
     """Read a PyShoe ``.mat`` trial with its VICON reference as truth."""
+    import scipy.io as sio  # here: loading footzoo's readers does not load scipy
+
     try:
         d = sio.loadmat(path)
     except Exception as err:  # scipy raises several types for bad files

@@ -69,11 +69,9 @@ def _fqa_many(acc, mag, use_mag):
     n = acc.shape[0]
     out = np.empty((n, 4))
     for k in range(n):
-        if use_mag:
-            r = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2], True)
-        else:
-            r = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0, False)
-        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = r
+        # use_mag a variable, not a constant: one compilation of fqa_sample, not one per constant
+        mx, my, mz = (mag[k, 0], mag[k, 1], mag[k, 2]) if use_mag else (0.0, 0.0, 0.0)
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = fqa_sample(acc[k, 0], acc[k, 1], acc[k, 2], mx, my, mz, use_mag)
     return out
 
 

@@ -76,12 +76,12 @@ def complementary_kernel(
         pz = w * dz + x * dy - y * dx + z * dw
         kk = gain[k] * h
         if kk != 0.0:
-            if mag_ok[k]:
-                sw, sx, sy, sz = static_sample(acc[k, 0], acc[k, 1], acc[k, 2], mag[k, 0], mag[k, 1], mag[k, 2],
-                                               True, gyr[k, 0], gyr[k, 1], gyr[k, 2], h)
-            else:
-                sw, sx, sy, sz = static_sample(acc[k, 0], acc[k, 1], acc[k, 2], 0.0, 0.0, 0.0,
-                                               False, gyr[k, 0], gyr[k, 1], gyr[k, 2], h)
+            # use_mag a variable, not a constant: one compilation of static_sample, not one per constant
+            use_mag = mag_ok[k]
+            mx, my, mz = (mag[k, 0], mag[k, 1], mag[k, 2]) if use_mag else (0.0, 0.0, 0.0)
+            sw, sx, sy, sz = static_sample(acc[k, 0], acc[k, 1], acc[k, 2], mx, my, mz, use_mag, gyr[k, 0], gyr[k, 1],
+                                           gyr[k, 2], h)
+            if not use_mag:
                 # give q_s the current estimate's heading: q_z(ψ̂ − ψ_s) ⊗ q_s
                 psi = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)) - math.atan2(
                     2.0 * (sw * sz + sx * sy), 1.0 - 2.0 * (sy * sy + sz * sz))

@@ -33,7 +33,7 @@ def madgwick_kernel(
     n = gyr.shape[0]
     out = np.empty((n, 4))
     w, x, y, z = q0[0], q0[1], q0[2], q0[3]
-    out[0] = (w, x, y, z)
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z  # a row from a tuple would compile a shape check
     for k in range(1, n):
         h = dt[k]
         gx, gy, gz = gyr[k, 0], gyr[k, 1], gyr[k, 2]
