@@ -4,8 +4,9 @@ Usage: python benchmarks/select_recommended.py [--jobs 2] [--results benchmarks/
                                                [--data ../shared/data] [--write]
 
 A small grid of settings (stance detector type and threshold, :data:`THRESHOLDS`, × zero-velocity
-Kalman filter noise, :data:`NOISE_GRID`, × offline RTS smoothing or not, :data:`SMOOTHERS`, × the
-maximum-swing guard on or off, :data:`GUARDS`) runs on the 36 PyShoe VICON trials through footzoo's
+Kalman filter noise, :data:`NOISE_GRID`, × velocity noise growing with the acceleration or not,
+:data:`IMPACT`, × offline RTS smoothing or not, :data:`SMOOTHERS`, × the maximum-swing guard on or
+off, :data:`GUARDS`) runs on the 36 PyShoe VICON trials through footzoo's
 ablation runner
 (cached). The score of a setting on a set of trials is the mean, over the motion classes in the
 set, of the geometric mean over the class's trials of ``error / PyShoe's per-trial best``
@@ -102,6 +103,10 @@ THRESHOLDS: dict[str, tuple[str, list[Any]]] = {
 #: no longer changes above 0.01).
 NOISE_GRID = [(1.7e-6, 8.3e-5, 0.01), (1e-5, 1e-3, 0.05), (1e-6, 0.03, 0.03)]
 
+#: ``navigation.impact_noise`` (s): velocity noise uniform in time (0), or growing with the squared
+#: acceleration (heel strikes; on gaitmap's walk the stride-length error follows the impact's velocity error).
+IMPACT = [0.0, 1e-5, 3e-5]
+
 #: Offline smoothing: the forward filter alone, or with the RTS backward pass.
 SMOOTHERS = ["none", "rts"]
 
@@ -117,10 +122,13 @@ RATE_CHECK_M = 0.5
 def candidates() -> list[dict[str, Any]]:
     """Every grid setting as a full config."""
     out = []
-    for det, (att, vel, vstd), smoother, guard in itertools.product(detector_grid(), NOISE_GRID, SMOOTHERS, GUARDS):
+    for det, (att, vel, vstd), impact, smoother, guard in itertools.product(detector_grid(), NOISE_GRID, IMPACT,
+                                                                             SMOOTHERS, GUARDS):
         cfg = copy.deepcopy(BASE)
         cfg["detector"] = det
         cfg["navigation"].update(attitude_noise=att, velocity_noise=vel)
+        if impact:
+            cfg["navigation"]["impact_noise"] = impact
         cfg["corrections"][0]["velocity_std"] = vstd
         if smoother != "none":
             cfg["smoother"] = smoother
@@ -137,7 +145,9 @@ def setting_name(cfg: dict[str, Any]) -> str:
     params = ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in det.items() if k != "type")
     o = cfg["navigation"]
     return (f"{det['type']}({params})|att={o['attitude_noise']:g},vel={o['velocity_noise']:g},"
-            f"zupt={cfg['corrections'][0]['velocity_std']:g}" + ("|rts" if cfg.get("smoother") == "rts" else "")
+            f"zupt={cfg['corrections'][0]['velocity_std']:g}"
+            + (f",impact={o['impact_noise']:g}" if o.get("impact_noise") else "")
+            + ("|rts" if cfg.get("smoother") == "rts" else "")
             + ("|no swing guard" if "guards" in cfg else ""))
 
 
@@ -225,7 +235,8 @@ def main(argv: list[str] | None = None) -> int:
     lines = ["# Selection of `configs/recommended.yaml`", "",
              (__doc__ or "").split("\n\n", 2)[2].strip().replace("\n", " "), "",
              f"Grid: {len(cands)} settings × {len(err)} trials (detector settings: "
-             f"{len(detector_grid())}, Kalman noise settings: {len(NOISE_GRID)}, smoothing: {len(SMOOTHERS)}, "
+             f"{len(detector_grid())}, Kalman noise settings: {len(NOISE_GRID)}, impact noise: {len(IMPACT)}, "
+             f"smoothing: {len(SMOOTHERS)}, "
              f"swing guard: {len(GUARDS)}); "
              f"{len(qualified)} pass the rate "
              f"check (simulated mixed-speed walk, ARMSE ≤ {RATE_CHECK_M} m at both 100 and 200 Hz) and are "
@@ -253,7 +264,8 @@ def write_config(cfg: dict[str, Any], cv: dict[str, Any]) -> None:
     header = [
         "# footzoo's recommended setting for foot-mounted IMUs (not a paper's): one fixed setting for walking,",
         "# running, slow unusual motion and any sensor mounting. Chosen by benchmarks/select_recommended.py:",
-        "# a small grid (detector type and threshold x Kalman filter noise x RTS smoothing x swing guard)",
+        "# a small grid (detector type and threshold x Kalman filter noise x impact noise x RTS smoothing x",
+        "# swing guard)",
         "# on the 36 PyShoe VICON trials, scored per motion class, selected by leave-one-motion-class-out",
         "# cross-validation (never per trial); see benchmarks/recommended_selection.md.",
         f"# Cross-validated: median ratio to PyShoe's per-trial best {cv['median ratio']:.2f}, "

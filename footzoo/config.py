@@ -33,7 +33,7 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
     "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
                   "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
-                  "initial_position_std: m}",
+                  "initial_position_std: m, impact_noise: s (velocity noise per squared acceleration)}",
     "guards": "what happens when the detector misses stances: {max_swing: s (default 1.5, 0 = off), still_rate: "
               "rad/s, min_step: s, half_width: s, window: s, max_speed: m/s (default 50, 0 = off)}",
     "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",

@@ -54,6 +54,12 @@ class NavigationNoise:
         Standard deviation of the initial velocity error (m/s); the start is still: 0.
     initial_position_std : float
         Standard deviation of the initial position error (m); the origin is the start: 0.
+    impact_noise : float
+        Velocity error variance growth per squared motion acceleration (s, i.e. ((m/s)²/s) per
+        (m/s²)²): each velocity axis grows by ``(velocity_noise + impact_noise·|a|²)·dt``, with
+        ``a`` the NED motion acceleration of the sample. Accelerometer scale-factor, misalignment
+        and clipping errors grow with the acceleration, most at the heel strike (footzoo's; a
+        white-noise stand-in for them; 0, the default: uniform in time, as in the papers).
     """
 
     attitude_noise: float = 0.01
@@ -62,13 +68,15 @@ class NavigationNoise:
     initial_attitude_std: float = 0.01
     initial_velocity_std: float = 0.0
     initial_position_std: float = 0.0
+    impact_noise: float = 0.0
 
     units = {"attitude_noise": "rad^2/s", "velocity_noise": "(m/s)^2/s", "position_noise": "m^2/s",
-             "initial_attitude_std": "rad", "initial_velocity_std": "m/s", "initial_position_std": "m"}
+             "initial_attitude_std": "rad", "initial_velocity_std": "m/s", "initial_position_std": "m",
+             "impact_noise": "s"}
     #: Accepted range of each value (physically plausible for a foot-mounted IMU).
     ranges = {"attitude_noise": (0.0, 1.0), "velocity_noise": (0.0, 100.0), "position_noise": (0.0, 100.0),
               "initial_attitude_std": (0.0, math.pi), "initial_velocity_std": (0.0, 10.0),
-              "initial_position_std": (0.0, 100.0)}
+              "initial_position_std": (0.0, 100.0), "impact_noise": (0.0, 0.01)}
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -171,6 +179,7 @@ class KalmanEngine:
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
         self.layout, self.p0, self.q = assemble(carries_attitude, blocks, noise)
+        self.impact = float(noise.impact_noise)
         self.carries_attitude = carries_attitude
         self.gravity = float(gravity)
         self.names = names or [f"correction {i}" for i in range(len(models))]
@@ -223,7 +232,7 @@ class KalmanEngine:
     def start(self, nav0: np.ndarray) -> Any:
         """The filter's state before sample 0 (resumable with :meth:`advance`)."""
         if self.engine == "reference":
-            kf = ErrorStateFilter(self.layout, self.p0, self.q)
+            kf = ErrorStateFilter(self.layout, self.p0, self.q, self.impact)
             models = [MeasurementModel(**{**m.__dict__, "mem": np.array(m.mem, dtype=float)}) for m in self.models]
             return {"kf": kf, "models": models, "nav": np.array(nav0, dtype=float)}
         return self.pack(nav0)
@@ -263,7 +272,7 @@ class KalmanEngine:
         models = self.models
         core = (np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64),
                 np.ascontiguousarray(self.q, dtype=float), self.gravity, not self.carries_attitude,
-                max(1, sum(m.max_rows for m in models)))
+                max(1, sum(m.max_rows for m in models)), self.impact)
         width = max(len(i) for i in self.idx)
         m_idx = np.full((len(models), width), -1, dtype=np.int64)
         for j, ix in enumerate(self.idx):

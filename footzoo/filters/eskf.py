@@ -87,19 +87,29 @@ class ErrorStateFilter:
         Initial variances.
     q : (n,) array
         Process-noise variance growth per second of each state (Q = diag(q) dt).
+    impact : float
+        Velocity variance growth per squared motion acceleration (s): the velocity rows of Q
+        grow by ``impact·|a|²·dt`` (see :class:`footzoo.filters.engine.NavigationNoise`).
     """
 
-    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray):
+    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray, impact: float = 0.0):
         from filterpy.kalman import KalmanFilter  # imported here: the compiled engine does not need it
 
         self.layout = layout
         self.kf = KalmanFilter(dim_x=layout.n, dim_z=1)
         self.kf.P = np.diag(np.asarray(p0, dtype=float))
         self.q = np.asarray(q, dtype=float)
+        self.impact = float(impact)
 
-    def predict(self, F: np.ndarray, dt: float) -> None:
-        """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates."""
-        self.kf.predict(F=F, Q=np.diag(self.q * dt))
+    def predict(self, F: np.ndarray, dt: float, acc_sq: float = 0.0) -> None:
+        """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates.
+
+        ``acc_sq``: the squared motion acceleration |a|² ((m/s²)²) of the sample, for ``impact``.
+        """
+        q = self.q * dt
+        if self.impact > 0.0:
+            q[self.layout["vel"]] += self.impact * acc_sq * dt
+        self.kf.predict(F=F, Q=np.diag(q))
 
     def update(self, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:
         """Measurement update (eqs. 40, 43, 45) and return of the error, which is then reset."""

@@ -71,7 +71,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
     core : tuple
         ``(idx (5,) int: offsets of att, gyro_bias, pos, vel, acc_bias, −1 if absent;
         q (n,) variance growth per second; gravity m/s²; use_ext bool: attitude from quat_ext;
-        m_max int: most rows of one update)``.
+        m_max int: most rows of one update; impact s: velocity variance growth per squared
+        motion acceleration)``.
     state : tuple
         ``(nav (16,): q, p, v, b_g, b_a; P (n, n) covariance; mems (s,) all models' memory)``.
     models : tuple
@@ -92,7 +93,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
         numba compiles the loop without the smoother's code.
     """
     t, acc, gyr, stance, quat_ext = signals
-    idx, qn, gravity, use_ext, m_max = core
+    idx, qn, gravity, use_ext, m_max, impact = core
     nav_owned, P_owned, mems_owned = state
     measures, feedbacks, afters, idx_owned, par_owned, par_off, mem_off, data_owned, data_off, hooks = models
     quat, vel, pos, acc_nav, gb_out, ab_out, pdiag = out
@@ -247,6 +248,10 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
                 P[j, i] = P[i, j]
         for i in range(n):
             P[i, i] += qn[i] * dt
+        if impact > 0.0:  # accelerometer errors that grow with the acceleration (heel strikes)
+            qa = impact * (a_n[0] * a_n[0] + a_n[1] * a_n[1] + a_n[2] * a_n[2]) * dt
+            for i in range(3):
+                P[vel_i + i, vel_i + i] += qa
         if smoother is not None:  # P = P⁻_k
             smoother_gain(M, P, gains[k - 1], sub, Ls, inv, keep)
             for i in range(n):

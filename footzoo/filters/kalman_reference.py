@@ -99,7 +99,7 @@ def run_reference(
         nav[4:7] = nav[4:7] + 0.5 * (v_prev + nav[7:10]) * dt
         F = transition(layout, c, f_n, dt)
         p_post = kf.P.copy()
-        kf.predict(F, dt)
+        kf.predict(F, dt, float(a_n @ a_n))
         if smooth:
             smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
         z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
