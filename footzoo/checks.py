@@ -19,11 +19,12 @@ Physical bounds (SI units) shared by the recording checks and the stream:
 from __future__ import annotations
 
 import math
-from typing import Any
+from dataclasses import asdict, fields
+from typing import Any, ClassVar
 
 import numpy as np
 
-from .errors import ConfigError, RecordingError
+from .errors import ConfigError, RecordingError, did_you_mean
 
 #: Plausible gravity magnitude g on the Earth's surface (m/s²), inclusive bounds.
 GRAVITY_RANGE = (9.7, 9.9)
@@ -199,3 +200,42 @@ def validate_sample(
         if np.isinf(d).any():
             raise RecordingError(f"dist at t = {tf!r} is infinite ({d.tolist()}); use NaN where there is no reading")
     return tf, a, g, m, d
+
+
+class Settings:
+    """Base of a config's settings blocks (``navigation:``, ``guards:``): a dataclass of numbers.
+
+    A subclass is a ``@dataclass`` whose fields are the keys (with their defaults) and sets
+    ``section`` (the config key), ``units`` and ``ranges`` (per field) and ``example`` (a valid
+    mapping, for the error message). Values are checked against their ranges on construction;
+    :meth:`from_dict` refuses unknown keys with the valid ones; :meth:`to_dict` gives every value.
+    """
+
+    section: ClassVar[str] = ""
+    example: ClassVar[str] = ""
+    units: ClassVar[dict[str, str]] = {}
+    ranges: ClassVar[dict[str, tuple[float, float]]] = {}
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            lo, hi = self.ranges[f.name]
+            setattr(self, f.name, check_range(f"{self.section}.{f.name}", getattr(self, f.name), lo, hi,
+                                              self.units[f.name]))
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any] | None) -> Any:
+        """Build from the config's mapping (None or missing keys: the defaults)."""
+        if d is None:
+            return cls()
+        if not isinstance(d, dict):
+            raise ConfigError(f"{cls.section} must be a mapping like {cls.example}, got {d!r}")
+        valid = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        for key in d:
+            if key not in valid:
+                raise ConfigError(f"unknown {cls.section} key {key!r}{did_you_mean(str(key), valid)}; "
+                                  f"valid: {valid}")
+        return cls(**d)
+
+    def to_dict(self) -> dict[str, float]:
+        """Every value, explicit (for ``Result.config``)."""
+        return asdict(self)  # type: ignore[call-overload]

@@ -38,14 +38,14 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import asdict, dataclass, fields
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ._jit import njit
-from .checks import check_range
-from .errors import ConfigError, GuardWarning, did_you_mean
+from .checks import Settings
+from .errors import GuardWarning
 from .metrics import intervals
 
 
@@ -80,7 +80,7 @@ def _still_instants(score: np.ndarray, still: float, sep: int, half: int) -> np.
 
 
 @dataclass
-class StanceGuard:
+class StanceGuard(Settings):
     """Stance at the stillest instants of every swing longer than ``max_swing`` (see the module docstring).
 
     Parameters
@@ -106,33 +106,12 @@ class StanceGuard:
     window: float = 0.04
     max_speed: float = 50.0
 
-    units: ClassVar[dict[str, str]] = {"max_swing": "s", "still_rate": "rad/s", "min_step": "s",
-                                       "half_width": "s", "window": "s", "max_speed": "m/s"}
-    ranges: ClassVar[dict[str, tuple[float, float]]] = {
-        "max_swing": (0.0, 3600.0), "still_rate": (0.0, 50.0), "min_step": (0.0, 10.0),
-        "half_width": (0.0, 1.0), "window": (0.0, 1.0), "max_speed": (0.0, 1000.0)}
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            lo, hi = self.ranges[f.name]
-            setattr(self, f.name, check_range(f"guards.{f.name}", getattr(self, f.name), lo, hi, self.units[f.name]))
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any] | None) -> StanceGuard:
-        """Build from a config's ``guards:`` mapping (missing keys: defaults)."""
-        if d is None:
-            return cls()
-        if not isinstance(d, dict):
-            raise ConfigError(f"guards must be a mapping like {{max_swing: 1.5}}, got {d!r}")
-        valid = [f.name for f in fields(cls)]
-        for key in d:
-            if key not in valid:
-                raise ConfigError(f"unknown guards key {key!r}{did_you_mean(str(key), valid)}; valid: {valid}")
-        return cls(**d)
-
-    def to_dict(self) -> dict[str, float]:
-        """Every parameter, explicit."""
-        return asdict(self)
+    section = "guards"
+    example = "{max_swing: 1.5}"
+    units = {"max_swing": "s", "still_rate": "rad/s", "min_step": "s", "half_width": "s", "window": "s",
+             "max_speed": "m/s"}
+    ranges = {"max_swing": (0.0, 3600.0), "still_rate": (0.0, 50.0), "min_step": (0.0, 10.0),
+              "half_width": (0.0, 1.0), "window": (0.0, 1.0), "max_speed": (0.0, 1000.0)}
 
     def apply(self, t: np.ndarray, gyr: np.ndarray, stance: np.ndarray) -> tuple[np.ndarray, dict[str, Any]]:
         """The stance mask with the over-long swings given stances, and the report.

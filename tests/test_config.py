@@ -93,3 +93,18 @@ def test_cli_validate_reports_errors_with_exit_code_2(tmp_path, capsys):
     good.write_text("orientation: {type: fqa_complementary}\ndetector: {type: angular_rate_fsm}\n")
     assert main(["validate", str(good)]) == 0
     assert "valid" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("navigation", {"velocity_nosie": 0.1}, "unknown navigation key 'velocity_nosie' (did you mean 'velocity_noise'?)"),
+    ("navigation", "0.1", "navigation must be a mapping like"),
+    ("guards", {"max_swnig": 1.0}, "unknown guards key 'max_swnig' (did you mean 'max_swing'?)"),
+    ("guards", [1.5], "guards must be a mapping like"),
+])
+def test_settings_blocks_refuse_unknown_keys_and_non_mappings_alike(key, value, message):
+    from footzoo import Pipeline
+
+    cfg = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}], key: value}
+    with pytest.raises(ConfigError) as err:
+        Pipeline.from_dict(cfg)
+    assert message in str(err.value)

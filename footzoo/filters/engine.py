@@ -13,13 +13,13 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from .. import _jit
-from ..checks import check_range
+from ..checks import Settings
 from ..errors import ConfigError, FootzooWarning
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
@@ -31,7 +31,7 @@ warnings.filterwarnings("ignore", message=".*First-class function type feature i
 
 
 @dataclass
-class NavigationNoise:
+class NavigationNoise(Settings):
     """Process noise and initial uncertainty of the INS core of the error-state filter.
 
     Set in a pipeline's YAML under ``navigation:``, whatever the orientation source. Nguyen &
@@ -70,6 +70,8 @@ class NavigationNoise:
     initial_position_std: float = 0.0
     impact_noise: float = 0.0
 
+    section = "navigation"
+    example = "{velocity_noise: 0.01}"
     units = {"attitude_noise": "rad^2/s", "velocity_noise": "(m/s)^2/s", "position_noise": "m^2/s",
              "initial_attitude_std": "rad", "initial_velocity_std": "m/s", "initial_position_std": "m",
              "impact_noise": "s"}
@@ -77,26 +79,6 @@ class NavigationNoise:
     ranges = {"attitude_noise": (0.0, 1.0), "velocity_noise": (0.0, 100.0), "position_noise": (0.0, 100.0),
               "initial_attitude_std": (0.0, math.pi), "initial_velocity_std": (0.0, 10.0),
               "initial_position_std": (0.0, 100.0), "impact_noise": (0.0, 0.01)}
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            lo, hi = self.ranges[f.name]
-            setattr(self, f.name, check_range(f"navigation.{f.name}", getattr(self, f.name), lo, hi,
-                                              self.units[f.name]))
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any] | None) -> NavigationNoise:
-        """Build from a YAML mapping, rejecting unknown keys with the valid ones."""
-        d = dict(d or {})
-        valid = [f.name for f in fields(cls)]
-        unknown = [k for k in d if k not in valid]
-        if unknown:
-            raise ConfigError(f"navigation: unknown key(s) {unknown}; valid keys: {valid}")
-        return cls(**d)
-
-    def to_dict(self) -> dict[str, float]:
-        """Every value, for ``Result.config``."""
-        return asdict(self)
 
 
 def assemble(carries_attitude: bool, blocks: list[StateBlock], noise: NavigationNoise):
