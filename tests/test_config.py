@@ -102,8 +102,6 @@ def test_cli_validate_reports_errors_with_exit_code_2(tmp_path, capsys):
     ("guards", [1.5], "guards must be a mapping like"),
 ])
 def test_settings_blocks_refuse_unknown_keys_and_non_mappings_alike(key, value, message):
-    from footzoo import Pipeline
-
     cfg = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}], key: value}
     with pytest.raises(ConfigError) as err:
         Pipeline.from_dict(cfg)
