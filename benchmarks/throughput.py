@@ -26,7 +26,8 @@ The pure-Python baselines (b, c) run on the first ``--slow-samples`` samples of 
 sample and peak memory beyond the input, 1e5 to 1e7 samples, one new process per size; again
 with numpy's huge-page hint off),
 ``--cold`` (a new process with an empty numba cache: import, build and first run of a config on a
-simulated 80-stride walk), ``--import-time``. The ``met`` column judges the CPU-time fraction
+simulated 80-stride walk; from the source tree and from a wheel built from it, which ships the
+kernels of the shipped configs), ``--import-time``. The ``met`` column judges the CPU-time fraction
 ("wall-clock only": met by the wall-clock minima alone).
 """
 
@@ -370,38 +371,58 @@ def scaling(names: list[str], sizes=(100_000, 1_000_000, 10_000_000), repeat: in
 
 
 # ------------------------------------------------------------------------------ cold start, import
-def cold_start(names: list[str]) -> list[str]:
+def cold_start(names: list[str], wheel: bool = True) -> list[str]:
     """A new process, an empty numba cache: import, build and the first run of one config on a simulated 80-stride walk.
 
-    Wall-clock and CPU seconds (the CPU time of the process, which load from other processes
-    on a shared machine does not inflate). The build (``Pipeline.from_yaml``) is timed apart: work
-    done there (importing numba, compiling) is not in the first run, so the last columns add the
-    three.
+    Twice: from the source tree (every kernel compiled at its first call), and, with ``wheel``, from
+    a wheel built from this tree (``pip wheel``, which runs setup.py's kernel precompilation) and
+    installed into a temporary folder, with its shipped kernels. Wall-clock and CPU seconds (the
+    CPU time of the process, which load from other processes on a shared machine does not
+    inflate). The build (``Pipeline.from_yaml``) is timed apart: work done there (importing numba,
+    compiling) is not in the first run, so the total adds the three.
     """
-    lines = ["| config | import footzoo, wall / CPU (s) | build the pipeline, wall / CPU (s) | "
+    lines = ["| config | installed as | import footzoo, wall / CPU (s) | build the pipeline, wall / CPU (s) | "
              "first run, empty cache, wall / CPU (s) | import + build + first run, wall / CPU (s) | "
-             "first run, a second process with the cache filled, wall / CPU (s) |", "|---|---|---|---|---|---|"]
+             "first run, a second process with the cache filled, wall / CPU (s) |", "|---|---|---|---|---|---|---|"]
     code = ("import time; c0, w0 = time.process_time(), time.perf_counter(); import footzoo;"
             "c1, w1 = time.process_time(), time.perf_counter();"
             "from footzoo.sim import simulate; rec = simulate(n_strides=80, rate=100.0, profile='physical');"
-            "c2, w2 = time.process_time(), time.perf_counter(); p = footzoo.Pipeline.from_yaml('configs/{c}.yaml');"
+            "c2, w2 = time.process_time(), time.perf_counter(); p = footzoo.Pipeline.from_yaml({config!r});"
             "c3, w3 = time.process_time(), time.perf_counter(); p.run(rec);"
             "print(w1 - w0, c1 - c0, w3 - w2, c3 - c2, time.perf_counter() - w3, time.process_time() - c3)")
-    for c in names:
-        with tempfile.TemporaryDirectory() as cache:
-            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-            out = []
-            for _ in range(2):
-                proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code.format(c=c)], capture_output=True,
-                                      text=True, cwd=ROOT, env=env)
-                if proc.returncode != 0:
-                    raise RuntimeError(proc.stderr[-2000:])
-                out.append([float(x) for x in proc.stdout.split()])
-        first = out[0]
-        lines.append(f"| {c} | {first[0]:.2f} / {first[1]:.2f} | {first[2]:.2f} / {first[3]:.2f} | "
-                     f"{first[4]:.2f} / {first[5]:.2f} | {first[0] + first[2] + first[4]:.2f} / "
-                     f"{first[1] + first[3] + first[5]:.2f} | {out[1][4]:.2f} / {out[1][5]:.2f} |")
+    with tempfile.TemporaryDirectory() as tmp:
+        setups = [("source tree (compiled at first use)", ROOT, {})]
+        if wheel:
+            setups.append(("wheel (kernels shipped)", Path(tmp), {"PYTHONPATH": _installed_wheel(Path(tmp))}))
+        for c in names:
+            for label, cwd, extra in setups:
+                with tempfile.TemporaryDirectory() as cache:
+                    env = {**os.environ, **extra, "NUMBA_CACHE_DIR": cache}
+                    out = []
+                    script = code.format(config=str(ROOT / "configs" / f"{c}.yaml"))
+                    for _ in range(2):
+                        proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True,
+                                              text=True, cwd=cwd, env=env)
+                        if proc.returncode != 0:
+                            raise RuntimeError(proc.stderr[-2000:])
+                        out.append([float(x) for x in proc.stdout.split()])
+                first = out[0]
+                lines.append(f"| {c} | {label} | {first[0]:.2f} / {first[1]:.2f} | {first[2]:.2f} / {first[3]:.2f} | "
+                             f"{first[4]:.2f} / {first[5]:.2f} | {first[0] + first[2] + first[4]:.2f} / "
+                             f"{first[1] + first[3] + first[5]:.2f} | {out[1][4]:.2f} / {out[1][5]:.2f} |")
     return lines
+
+
+def _installed_wheel(tmp: Path) -> str:
+    """Build a wheel of this tree as pip does (precompiling its kernels) and install it into ``tmp``."""
+    pip = [sys.executable, "-m", "pip", "-q"]
+    subprocess.run([*pip, "wheel", "--no-deps", "-w", str(tmp / "dist"), str(ROOT)], check=True)
+    site = tmp / "site"
+    subprocess.run([*pip, "install", "--no-deps", "--target", str(site), *map(str, (tmp / "dist").glob("*.whl"))],
+                   check=True)
+    if not list(site.glob("footzoo/_compiled/*/*.nbi")):
+        raise RuntimeError("the wheel carries no compiled kernels: see the output of setup.py above")
+    return str(site)
 
 
 def import_time(repeat: int = 5) -> list[str]:
@@ -444,7 +465,7 @@ def main() -> None:
                          scaling(names, env={"NUMPY_MADVISE_HUGEPAGE": "0"})))
         _emit(sections[-1])
     if args.cold:
-        sections.append(("Cold start (new process, empty numba cache)",
+        sections.append(("Cold start (new process, empty numba cache; source tree and installed wheel)",
                          cold_start(["yun2012", "huang2016", "duong2015_zupt", "nguyen2016"])))
         _emit(sections[-1])
     if args.import_time:

@@ -10,7 +10,8 @@ imported at the first call of any kernel (which keeps ``import footzoo`` fast),
 and each kernel is compiled at its first call, only for the argument types it
 gets (so a pipeline compiles only the kernels it uses). The machine code is
 cached on disk next to the module (or in ``NUMBA_CACHE_DIR``), so a new process
-loads it instead of compiling again.
+loads it instead of compiling again; a wheel also ships the kernels its configs
+use, compiled when it was built (:mod:`footzoo._kernel_cache`).
 """
 
 from __future__ import annotations
@@ -66,7 +67,19 @@ def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
     options = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
     if inline:  # numba copies its typed body into each caller: no compilation and no cache entry of its own
         options["inline"] = "always"
-    return _numba.njit(**options)(fn)
+    from . import _kernel_cache
+
+    return _kernel_cache.attach(_numba.njit(**options)(fn))
+
+
+def njit_signature(fn: Callable[..., Any], signature: Any, **options: Any) -> Any:
+    """``numba.njit(signature, cache=True, **options)(fn)``, with footzoo's kernel cache (:mod:`footzoo._kernel_cache`).
+
+    Compiles now, for that signature only; numba's errors propagate. Needs numba (:func:`load_numba`).
+    """
+    from . import _kernel_cache
+
+    return _kernel_cache.compile_with(load_numba().njit(cache=True, **options)(fn), signature)
 
 
 def _materialise() -> None:
@@ -113,6 +126,11 @@ def njit(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
     kernel = _Kernel(fn, inline)
     _pending.append(kernel)
     return kernel
+
+
+def materialised() -> bool:
+    """Whether the kernels have become numba dispatchers (numba imported, or found broken) in this process."""
+    return _materialised
 
 
 def load_numba() -> Any:

@@ -235,6 +235,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_compile(args: argparse.Namespace) -> int:
+    """Compile and cache the kernels of pipeline configs (or write them into a wheel's folder with --ship)."""
+    from .precompile import compile_kernels
+
+    for config, seconds in compile_kernels(args.configs, ship=args.ship):
+        print(f"{config}: {seconds:.1f} s")
+    return 0
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     """Simulate a recording with ground truth and write it as canonical CSV/Parquet."""
     import numpy as np
@@ -338,6 +347,13 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
                      "errors (with a reference), strides, fpa (.png, needs --out)")
     run.set_defaults(func=cmd_run)
+
+    comp = sub.add_parser("compile", help="compile the kernels of pipeline configs now, so that their first "
+                          "run loads them from numba's cache (e.g. before a study on a new machine)")
+    comp.add_argument("configs", nargs="+", help="pipeline YAML files, e.g. configs/*.yaml (not study files)")
+    comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
+                      "(what setup.py does for a wheel's footzoo/_compiled)")
+    comp.set_defaults(func=cmd_compile)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
     sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",

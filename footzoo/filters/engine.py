@@ -356,7 +356,7 @@ def _gain_function() -> Any:
         t = numba.types
         a2 = t.float64[:, ::1]
         signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
-        _GAIN.append(_address(numba.njit(signature, cache=True, nogil=True)(getattr(fn, "py_func", fn))))
+        _GAIN.append(_address(_jit.njit_signature(getattr(fn, "py_func", fn), signature, nogil=True)))
     return _GAIN[0]
 
 

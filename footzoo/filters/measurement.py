@@ -112,11 +112,11 @@ def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
         # first without reference counting: the same machine code for a function that allocates no
         # array (numba refuses to compile one that does, here or in a function it calls), minus the
         # counting of every array argument at each call
-        return numba.njit(sig, cache=True, nogil=True, _nrt=False)(fn)
+        return _jit.njit_signature(fn, sig, nogil=True, _nrt=False)
     except Exception:  # it allocates (or numba lacks the option): with reference counting
         pass
     try:
-        return numba.njit(sig, cache=True, nogil=True)(fn)
+        return _jit.njit_signature(fn, sig, nogil=True)
     except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
         pass
     try:

@@ -1,0 +1,132 @@
+"""Shipped kernels: ``footzoo compile --ship`` writes machine code a new process loads instead of compiling.
+
+Each case runs in new processes with their own empty numba cache, and counts the footzoo kernels
+numba compiles there (numba's compile events).
+"""
+
+import json
+import os
+import pickle
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from footzoo import _jit
+from footzoo.cli import main as cli_main
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = str(ROOT / "configs" / "yun2012.yaml")
+pytestmark = pytest.mark.skipif(not _jit.HAVE_NUMBA, reason="needs numba")
+
+# run the config on a simulated walk; print the footzoo kernels numba compiled and the end position
+RUN = f"""
+import json, warnings
+warnings.simplefilter("ignore")
+from numba.core import event
+import footzoo
+from footzoo.sim import simulate
+compiled = []
+class Listener(event.Listener):
+    def on_start(self, ev):
+        d = ev.data.get("dispatcher")
+        if d is not None and getattr(d.py_func, "__module__", "").startswith("footzoo"):
+            compiled.append(d.py_func.__qualname__)
+    def on_end(self, ev):
+        pass
+rec = simulate(n_strides=6, rate=100.0, profile="physical")
+with event.install_listener("numba:compile", Listener()):
+    result = footzoo.Pipeline.from_yaml({CONFIG!r}).run(rec)
+print(json.dumps({{"compiled": compiled, "pos": result.pos[-1].tolist()}}))
+"""
+
+
+def _run(code_or_args: str | list[str], cache: Path, shipped: Path | None = None) -> subprocess.CompletedProcess:
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    env.pop("FOOTZOO_SHIPPED_KERNELS", None)
+    if shipped is not None:
+        env["FOOTZOO_SHIPPED_KERNELS"] = str(shipped)
+    args = ["-c", code_or_args] if isinstance(code_or_args, str) else ["-m", "footzoo", *code_or_args]
+    proc = subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return proc
+
+
+def _cached_files(folder: Path) -> list[Path]:
+    return sorted(folder.rglob("*.nbi"))
+
+
+@pytest.fixture(scope="module")
+def shipped(tmp_path_factory):
+    """A folder of shipped kernels for yun2012, written by ``footzoo compile --ship``."""
+    tmp = tmp_path_factory.mktemp("kernels")
+    proc = _run(["compile", "--ship", str(tmp / "shipped"), CONFIG], cache=tmp / "cache")
+    assert "yun2012.yaml" in proc.stdout
+    return tmp
+
+
+def test_shipping_writes_the_kernels_into_the_folder_and_not_into_numbas_cache(shipped):
+    names = [p.name for p in _cached_files(shipped / "shipped")]
+    # the folders mirror the package's modules (orientation/fqa.py -> orientation/)
+    assert any(p.parent.name == "orientation" and p.name.startswith("fqa.") for p in _cached_files(shipped / "shipped"))
+    assert any(n.startswith("fsm.") or n.startswith("angular_rate_fsm.") for n in names) or len(names) >= 5
+    assert _cached_files(shipped / "cache") == []
+
+
+def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, tmp_path):
+    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
+    warm = json.loads(_run(RUN, cache=tmp_path / "b", shipped=shipped / "shipped").stdout)
+    assert len(cold["compiled"]) >= 5  # without the folder: compiled
+    assert warm["compiled"] == []
+    assert warm["pos"] == cold["pos"]  # the same machine code
+    assert _cached_files(tmp_path / "b") == []  # nothing had to be compiled and cached
+
+
+def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_path):
+    changed = tmp_path / "shipped"
+    subprocess.run(["cp", "-r", str(shipped / "shipped"), str(changed)], check=True)
+    for index in _cached_files(changed):  # as if the module's source had changed since: another content hash
+        with open(index, "rb") as f:
+            version = pickle.load(f)
+            stamp, overloads = pickle.loads(f.read())
+        with open(index, "wb") as f:
+            pickle.dump(version, f)
+            f.write(pickle.dumps(("0" * 64, overloads)))
+    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
+    stale = json.loads(_run(RUN, cache=tmp_path / "b", shipped=changed).stdout)
+    assert sorted(stale["compiled"]) == sorted(cold["compiled"])
+    assert stale["pos"] == cold["pos"]
+
+
+def test_compile_without_ship_fills_numbas_cache(tmp_path):
+    _run(["compile", CONFIG], cache=tmp_path / "cache")
+    assert len(_cached_files(tmp_path / "cache")) >= 5
+    after = json.loads(_run(RUN, cache=tmp_path / "cache").stdout)
+    assert after["compiled"] == []
+    assert np.all(np.isfinite(after["pos"]))
+
+
+def test_ship_refuses_a_process_that_already_compiled(monkeypatch, tmp_path):
+    from footzoo.precompile import compile_kernels
+
+    monkeypatch.setattr(_jit, "_materialised", True)
+    with pytest.raises(RuntimeError, match="new process"):
+        compile_kernels([CONFIG], ship=tmp_path)
+
+
+def test_compile_takes_a_study_file_for_every_config_of_its_grid(capsys):
+    assert cli_main(["compile", str(ROOT / "configs" / "study_quick.yaml")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    # 2 detectors x 2 corrections on one base: four distinct pipelines, whatever the recordings
+    assert len(lines) == 4
+    assert sum("detector.type=shoe" in line for line in lines) == 2
+
+
+def test_compile_names_a_file_that_is_not_a_config(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("orientation: {type: no_such_filter}\n")
+    assert cli_main(["compile", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.yaml" in err or "no_such_filter" in err
