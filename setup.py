@@ -28,7 +28,9 @@ class BuildWithKernels(build_py):
         shutil.rmtree(target, ignore_errors=True)
         here = Path(__file__).resolve().parent
         configs = sorted(str(p) for p in (here / "configs").glob("*.yaml") if not p.name.startswith("study_"))
-        env = {**os.environ, "PYTHONPATH": str(build_lib), "FOOTZOO_DISABLE_JIT": ""}
+        # the build first, then what pip's isolated build environment put on the path (its numba, numpy...)
+        path = os.pathsep.join([str(build_lib), *filter(None, [os.environ.get("PYTHONPATH")]), *sys.path])
+        env = {**os.environ, "PYTHONPATH": path, "FOOTZOO_DISABLE_JIT": ""}
         cmd = [sys.executable, "-m", "footzoo", "compile", "--ship", str(target), *configs]
         proc = subprocess.run(cmd, env=env, capture_output=True, text=True)
         if proc.returncode != 0:
