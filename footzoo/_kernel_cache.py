@@ -21,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import inspect
 import os
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -31,7 +32,7 @@ PACKAGE = Path(__file__).resolve().parent
 #: where the shipped machine code is read from (and written to by ``footzoo compile --ship``)
 SHIPPED = Path(os.environ.get("FOOTZOO_SHIPPED_KERNELS") or PACKAGE / "_compiled")
 
-_state = {"shipping": False}
+_state = {"shipping": False, "warned": False}
 _stamps: dict[Path, str] = {}
 
 
@@ -43,6 +44,12 @@ def ship(directory: str | os.PathLike) -> None:
     global SHIPPED
     SHIPPED = Path(directory).resolve()
     _state["shipping"] = True
+
+
+def _warn_once(message: str) -> None:
+    if not _state.get("warned"):
+        _state["warned"] = True
+        warnings.warn(message, RuntimeWarning, stacklevel=2)
 
 
 def _content_stamp(path: Path) -> str:
@@ -74,9 +81,14 @@ class KernelCache(FunctionCache):
             return None
         data = None if _state["shipping"] else super()._load_overload(sig, target_context)
         if data is None:
-            shipped = self._shipped.load(self._index_key(sig, target_context.codegen()))
-            if shipped is not None:
-                data = self._impl.rebuild(target_context, shipped)
+            try:
+                shipped = self._shipped.load(self._index_key(sig, target_context.codegen()))
+                if shipped is not None:
+                    data = self._impl.rebuild(target_context, shipped)
+            except Exception as err:  # a damaged or foreign file: compile instead, and say so once
+                _warn_once(f"footzoo: the shipped machine code of {self._name} could not be loaded "
+                           f"({type(err).__name__}: {err}); compiling it instead. Reinstall footzoo, or set "
+                           "FOOTZOO_SHIPPED_KERNELS to an empty folder to silence this")
         return data
 
     def _save_overload(self, sig: Any, data: Any) -> None:

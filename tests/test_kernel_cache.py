@@ -130,3 +130,17 @@ def test_compile_names_a_file_that_is_not_a_config(tmp_path, capsys):
     assert cli_main(["compile", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.yaml" in err or "no_such_filter" in err
+
+
+def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_path):
+    damaged = tmp_path / "shipped"
+    subprocess.run(["cp", "-r", str(shipped / "shipped"), str(damaged)], check=True)
+    for data in damaged.rglob("*.nbc"):
+        data.write_bytes(b"not a pickle")
+    proc = _run(RUN.replace('warnings.simplefilter("ignore")', 'warnings.simplefilter("default")'),
+                cache=tmp_path / "b", shipped=damaged)
+    result = json.loads(proc.stdout)
+    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
+    assert sorted(result["compiled"]) == sorted(cold["compiled"])
+    assert result["pos"] == cold["pos"]
+    assert "could not be loaded" in proc.stderr
