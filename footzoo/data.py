@@ -318,9 +318,14 @@ class Recording:
 
 
 def _floats(name: str, value: Any) -> np.ndarray:
-    """``value`` as a contiguous float array, or a RecordingError naming the input."""
+    """``value`` as a contiguous, writable float array, or a RecordingError naming the input.
+
+    Writable always (a copy of a read-only input, such as pandas' copy-on-write views): the
+    compiled kernels then see one array type whatever the reader, and compile once.
+    """
     try:
-        return np.ascontiguousarray(value, dtype=float)
+        array = np.ascontiguousarray(value, dtype=float)
+        return array if array.flags.writeable else array.copy()
     except (TypeError, ValueError) as err:
         raise RecordingError(
             f"{name} must be numbers (an array of floats), got {type(value).__name__}: {err}"

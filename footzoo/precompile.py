@@ -1,12 +1,12 @@
 """Compile the kernels of pipeline configs now, so their first real run loads them instead.
 
 numba compiles each kernel at its first call (about 5 s for a Kalman pipeline) and caches the
-machine code on disk. :func:`compile_kernels` runs each config once on a short simulated walk,
-which compiles and caches every kernel the config uses: run it once on a new machine, or before a
-study starts its workers (``footzoo compile configs/*.yaml``; a study file stands for every
-config of its grid). With ``ship`` it writes the code
-into a folder instead: ``setup.py`` does so when it builds a wheel, which then carries the
-compiled kernels of the shipped configs (see :mod:`footzoo._kernel_cache`).
+machine code on disk. :func:`compile_kernels` runs each config once on two short simulated walks
+(with magnetometer and distance sensors, and without), which compiles and caches every kernel the
+config uses: run it once on a new machine, or before a study starts its workers
+(``footzoo compile configs/*.yaml``; a study file stands for every config of its grid). With
+``ship`` it writes the code into a folder instead: ``setup.py`` does so when it builds a wheel,
+which then carries the compiled kernels of the shipped configs (see :mod:`footzoo._kernel_cache`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from typing import Any
 from . import _jit
 from .ablation.study import Study
 from .config import load_yaml
-from .errors import ConfigError
+from .errors import ConfigError, RecordingError
 from .pipeline import Pipeline
 from .sim import simulate
 
@@ -73,15 +73,22 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
         from . import _kernel_cache
 
         _kernel_cache.ship(ship)
-    # 8 strides at 100 Hz with every sensor a config may read (magnetometer, distance sensors): the
-    # kernels' argument types do not depend on the length
-    recording = simulate(n_strides=8, rate=100.0, profile="physical", distance_sensors=True)
+    # 8 strides at 100 Hz, with every sensor a config may read (magnetometer, distance sensors) and
+    # with none (most recordings: the kernels that take an optional channel get None); the kernels'
+    # argument types depend on neither the length nor the rate
+    recordings = [simulate(n_strides=8, rate=100.0, profile="physical", distance_sensors=True),
+                  simulate(n_strides=8, rate=100.0, profile="physical", magnetometer=False)]
     times = []
     pipelines = [p for config in configs for p in _pipelines(config)]  # every file checked before any compiles
     for name, pipeline in pipelines:
         start = time.perf_counter()
-        with warnings.catch_warnings():  # a short walk: calibration and guards may warn; irrelevant here
-            warnings.simplefilter("ignore")
-            pipeline.run(recording)
+        for recording in recordings:
+            with warnings.catch_warnings():  # a short walk: calibration and guards may warn; irrelevant here
+                warnings.simplefilter("ignore")
+                try:
+                    pipeline.run(recording)
+                except RecordingError:  # a config that needs a channel the second walk lacks
+                    if recording is recordings[0]:
+                        raise
         times.append((name, time.perf_counter() - start))
     return times

@@ -105,3 +105,23 @@ def test_round_trip_through_a_dataframe_keeps_truth():
     back = Recording.from_dataframe(rec.to_dataframe())
     np.testing.assert_allclose(back.acc, rec.acc)
     assert back.truth is not None and back.truth.stance.all()
+
+
+def test_read_only_inputs_become_writable_copies_and_the_caller_keeps_theirs():
+    """pandas' copy-on-write columns are read-only: the recording owns writable copies (one type for the kernels)."""
+    import numpy as np
+
+    from footzoo.data import Recording
+
+    n = 200
+    t = np.arange(n) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (n, 1))
+    gyr = np.zeros((n, 3))
+    for a in (t, acc, gyr):
+        a.flags.writeable = False
+    rec = Recording(t=t, acc=acc, gyr=gyr)
+    assert all(a.flags.writeable and a.flags.c_contiguous for a in (rec.t, rec.acc, rec.gyr))
+    assert not np.shares_memory(rec.acc, acc)
+    np.testing.assert_array_equal(rec.acc, acc)
+    writable = np.zeros((n, 3))
+    assert Recording(t=np.arange(n) / 100.0, acc=acc, gyr=writable).gyr is writable  # no copy when not needed

@@ -36,11 +36,11 @@ class Listener(event.Listener):
             compiled.append(d.py_func.__qualname__)
     def on_end(self, ev):
         pass
-rec = simulate(n_strides=6, rate=100.0, profile="physical")
+rec = RECORDING
 with event.install_listener("numba:compile", Listener()):
     result = footzoo.Pipeline.from_yaml({CONFIG!r}).run(rec)
 print(json.dumps({{"compiled": compiled, "pos": result.pos[-1].tolist()}}))
-"""
+""".replace("RECORDING", 'simulate(n_strides=6, rate=100.0, profile="physical")')
 
 
 def _run(code_or_args: str | list[str], cache: Path, shipped: Path | None = None) -> subprocess.CompletedProcess:
@@ -82,6 +82,19 @@ def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, t
     assert warm["compiled"] == []
     assert warm["pos"] == cold["pos"]  # the same machine code
     assert _cached_files(tmp_path / "b") == []  # nothing had to be compiled and cached
+
+
+def test_a_recording_read_from_a_file_without_magnetometer_needs_no_compilation_either(shipped, tmp_path):
+    """The shipped code covers what readers give (pandas' read-only columns, no magnetometer), not only simulations."""
+    from footzoo.io.canonical import write
+    from footzoo.sim import simulate
+
+    path = tmp_path / "walk.csv"
+    write(simulate(n_strides=6, rate=100.0, profile="physical", magnetometer=False), path)
+    run = RUN.replace('simulate(n_strides=6, rate=100.0, profile="physical")', f"footzoo.load({str(path)!r})")
+    warm = json.loads(_run(run, cache=tmp_path / "b", shipped=shipped / "shipped").stdout)
+    assert warm["compiled"] == []
+    assert np.all(np.isfinite(warm["pos"]))
 
 
 def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_path):
