@@ -350,7 +350,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     comp = sub.add_parser("compile", help="compile the kernels of pipeline configs now, so that their first "
                           "run loads them from numba's cache (e.g. before a study on a new machine)")
-    comp.add_argument("configs", nargs="+", help="pipeline YAML files, e.g. configs/*.yaml (not study files)")
+    comp.add_argument("configs", nargs="+", help="pipeline YAML files or study files (every config of the "
+                      "grid), e.g. configs/*.yaml")
     comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
                       "(what setup.py does for a wheel's footzoo/_compiled)")
     comp.set_defaults(func=cmd_compile)
