@@ -71,11 +71,18 @@ def styled(func: Callable[P, R]) -> Callable[P, R]:
     return wrapper
 
 
+def _bbox(fig: Figure) -> str | None:
+    """``"tight"`` (fit the saved area to what was drawn, so no legend is cut off), unless the figure's
+    layout engine already fitted it: a constrained layout places the legends inside the figure, and
+    ``"tight"`` would draw the whole figure a second time to measure it."""
+    return None if fig.get_layout_engine() is not None else "tight"
+
+
 def save(fig: Figure, path: str | Path) -> Path:
-    """Save ``fig`` (format from the suffix; bounding box fitted so no legend is cut off) and close it."""
+    """Save ``fig`` (format from the suffix; no legend cut off, see :func:`_bbox`) and close it."""
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=STYLE["savefig.dpi"], bbox_inches="tight")
+    fig.savefig(out, dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
     import matplotlib.pyplot as plt
 
     plt.close(fig)
@@ -93,7 +100,7 @@ def png_bytes(fig: Figure) -> bytes:
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=STYLE["savefig.dpi"], bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
     plt.close(fig)
     return buf.getvalue()
 

@@ -385,3 +385,27 @@ def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
     drawn = [d for d in (render_figure(t) for t in tasks) if d is not None]  # in memory, as on a Dask worker
     assert [name for name, _ in drawn] == [p.name for p in old]
     assert all(data == (tmp_path / "old" / name).read_bytes() for name, data in drawn)
+
+
+@pytest.mark.parametrize("layout", ["constrained", None])
+def test_saved_figures_keep_a_legend_placed_below_the_axes(tmp_path, layout):
+    """A constrained figure is saved as laid out (drawn once); others are fitted to what was drawn."""
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from footzoo.plots import STYLE, save
+
+    fig, ax = plt.subplots(figsize=(4, 3), layout=layout)
+    ax.plot([0, 1], [0, 1], label="a long legend entry that reaches far to the side")
+    legend = ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    fig.canvas.draw()
+    box, frame = legend.get_window_extent(), fig.bbox
+    if layout == "constrained":  # the layout moved the legend inside the figure: nothing to fit
+        assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0
+    path = save(fig, tmp_path / "f.png")
+    width, height = Image.open(path).size
+    dpi = STYLE["savefig.dpi"]
+    if layout == "constrained":
+        assert (width, height) == (round(4 * dpi), round(3 * dpi))
+    else:  # without a layout engine the legend hangs below the figure: the saved area grows to hold it
+        assert height > 3 * dpi * 1.05
