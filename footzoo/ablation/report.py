@@ -99,6 +99,16 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
     return tasks
 
 
+#: the figure tasks' kinds, most expensive first: the ROC draws every run's sweep, a trajectory plot the
+#: runs of one recording, a metric plot one box per level
+_COST_RANK = {"roc": 0, "trajectories": 1, "metric": 2}
+
+
+def _largest_first(tasks: list[tuple]) -> list[tuple]:
+    """The tasks in the order workers should take them: the longest first, so none is left alone at the end."""
+    return sorted(tasks, key=lambda task: _COST_RANK.get(task[0], 1))
+
+
 def _figure(task: tuple) -> tuple[Any, str]:
     """The figure of one task of :func:`figure_tasks` (None: nothing to draw) and its file name."""
     kind = task[0]
@@ -144,7 +154,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
 
         connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
         with connected as client:  # the workers draw while this process writes the tables
-            futures = client.map(render_figure, figure_tasks(table, runs, factors), pure=False)
+            futures = client.map(render_figure, _largest_first(figure_tasks(table, runs, factors)), pure=False)
             _write_tables(table, runs, factors, out, step)
             for fut in as_completed(futures):
                 drawn = fut.result()
@@ -157,7 +167,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         from joblib import Parallel, delayed
 
         figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
-            delayed(draw_figure)(task, out) for task in figure_tasks(table, runs, factors))
+            delayed(draw_figure)(task, out) for task in _largest_first(figure_tasks(table, runs, factors)))
     _write_tables(table, runs, factors, out, step)
     if figures is None:
         plot_study(table, runs, factors, out)
