@@ -25,6 +25,7 @@ import numpy as np
 from .. import _jit
 from .._jit import njit
 from .smoother import feed_back_attitude
+from .strapdown import quat_product, rotvec_quat
 
 
 def _unowned(a):
@@ -165,15 +166,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
                 nav[i] = quat_ext[k, i]
         else:
             # q ⊗ exp(w dt), the exact form of Nguyen & La eq. 37
-            rx, ry, rz = w[0] * dt, w[1] * dt, w[2] * dt
-            angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-            half = 0.5 * angle
-            kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-            dw, dx_, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
-            nav[0] = pw * dw - px * dx_ - py * dy - pz * dz
-            nav[1] = pw * dx_ + px * dw + py * dz - pz * dy
-            nav[2] = pw * dy - px * dz + py * dw + pz * dx_
-            nav[3] = pw * dz + px * dy - py * dx_ + pz * dw
+            dw, dx_, dy, dz = rotvec_quat(w[0] * dt, w[1] * dt, w[2] * dt)
+            nav[0], nav[1], nav[2], nav[3] = quat_product(pw, px, py, pz, dw, dx_, dy, dz)
         dot = pw * nav[0] + px * nav[1] + py * nav[2] + pz * nav[3]
         sg = 1.0 if dot >= 0 else -1.0
         mw, mx, my, mz = nav[0] + sg * pw, nav[1] + sg * px, nav[2] + sg * py, nav[3] + sg * pz

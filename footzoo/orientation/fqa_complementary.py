@@ -8,7 +8,7 @@ import numpy as np
 
 from .._jit import njit
 from ..checks import check_bool, check_range
-from ..filters.strapdown import sample_intervals
+from ..filters.strapdown import quat_product, rotvec_quat, sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .fqa import fqa_sample
@@ -113,13 +113,8 @@ def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
     """
     w, x, y, z = fqa_sample(ax, ay, az, mx, my, mz, use_mag)
     # ⊗ exp(ω dt / 4): rotation by half the interval
-    rx, ry, rz = wx * 0.5 * h, wy * 0.5 * h, wz * 0.5 * h
-    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-    half = 0.5 * angle
-    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-    dw, dx, dy, dz = math.cos(half), kk * rx, kk * ry, kk * rz
-    return (w * dw - x * dx - y * dy - z * dz, w * dx + x * dw + y * dz - z * dy,
-            w * dy - x * dz + y * dw + z * dx, w * dz + x * dy - y * dx + z * dw)
+    dw, dx, dy, dz = rotvec_quat(wx * 0.5 * h, wy * 0.5 * h, wz * 0.5 * h)
+    return quat_product(w, x, y, z, dw, dx, dy, dz)
 
 
 @register

@@ -8,7 +8,7 @@ import numpy as np
 
 from .._jit import njit
 from ..checks import check_bool, check_range
-from ..filters.strapdown import sample_intervals
+from ..filters.strapdown import rotate, sample_intervals
 from ..plugin import Orientation
 from ..registry import register
 from .magnetic import magnetometer_valid, rejection_parameters
@@ -53,7 +53,7 @@ def madgwick_kernel(
                 mn = math.sqrt(mx * mx + my * my + mz * mz)
                 if mn > 0.0:
                     mx, my, mz = mx / mn, my / mn, mz / mn
-                    hx, hy, hz = _rotate(w, x, y, z, mx, my, mz)
+                    hx, hy, hz = rotate(w, x, y, z, mx, my, mz)
                     bx, bz = math.sqrt(hx * hx + hy * hy), hz
                     t0, t1, t2, t3 = _grad(w, x, y, z, bx, 0.0, bz, mx, my, mz)
                     s0, s1, s2, s3 = s0 + t0, s1 + t1, s2 + t2, s3 + t3
@@ -69,16 +69,6 @@ def madgwick_kernel(
         w, x, y, z = w / nrm, x / nrm, y / nrm, z / nrm
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = w, x, y, z
     return out
-
-
-@njit
-def _rotate(w, x, y, z, vx, vy, vz):
-    """q ⊗ v ⊗ q* (body -> nav)."""
-    return (
-        (1 - 2 * (y * y + z * z)) * vx + 2 * (x * y - w * z) * vy + 2 * (x * z + w * y) * vz,
-        2 * (x * y + w * z) * vx + (1 - 2 * (x * x + z * z)) * vy + 2 * (y * z - w * x) * vz,
-        2 * (x * z - w * y) * vx + 2 * (y * z + w * x) * vy + (1 - 2 * (x * x + y * y)) * vz,
-    )
 
 
 @njit
