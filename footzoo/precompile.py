@@ -16,6 +16,7 @@ import os
 import time
 import warnings
 from collections.abc import Iterable
+from pathlib import Path
 from typing import Any
 
 from . import _jit
@@ -29,9 +30,10 @@ from .sim import simulate
 def _pipelines(path: str | os.PathLike) -> list[tuple[str, Pipeline]]:
     """The pipeline of a config file, or one per distinct config of a study file's grid, with names."""
     data = load_yaml(path)
+    base_dir = Path(path).parent  # a config's plug-in paths are relative to its file, as in Pipeline.from_yaml
     if "base" not in data and "factors" not in data:
         configs = [(str(path), data)]
-    else:
+    else:  # a study's plug-in paths are made absolute when it is read
         unique: dict[str, tuple[str, dict[str, Any]]] = {}
         for cell in Study.from_yaml(path).cells():
             name = f"{path} [{', '.join(f'{k}={v}' for k, v in cell.levels.items())}]"
@@ -40,7 +42,7 @@ def _pipelines(path: str | os.PathLike) -> list[tuple[str, Pipeline]]:
     pipelines = []
     for name, config in configs:
         try:
-            pipelines.append((name, Pipeline.from_dict(config)))
+            pipelines.append((name, Pipeline.from_dict(config, base_dir=base_dir)))
         except ConfigError as err:
             raise ConfigError(f"{name}: {err}") from None
     return pipelines

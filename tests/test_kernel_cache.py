@@ -157,3 +157,23 @@ def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_
     assert sorted(result["compiled"]) == sorted(cold["compiled"])
     assert result["pos"] == cold["pos"]
     assert "could not be loaded" in proc.stderr
+
+
+def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_none_of_it(tmp_path):
+    """A user's Kalman correction (the plug-in guide's example, beside its YAML) is compiled and cached like a
+    built-in one, whichever folder the command runs from."""
+    plugin = ROOT / "examples" / "plugins" / "magnetometer_heading_update.py"
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    (folder / plugin.name).write_text(plugin.read_text())
+    config = folder / "magu.yaml"
+    config.write_text(f"plugins: [{plugin.name}]\norientation: {{type: ins}}\ndetector: {{type: shoe}}\n"
+                      "corrections: [{type: ekf_zupt}, {type: magnetometer_heading}]\n")
+    env_run = dict(cache=tmp_path / "cache")
+    proc = subprocess.run([sys.executable, "-m", "footzoo", "compile", str(config)], capture_output=True, text=True,
+                          cwd=tmp_path, env={**os.environ, "NUMBA_CACHE_DIR": str(env_run["cache"])}, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    run = RUN.replace(f"footzoo.Pipeline.from_yaml({CONFIG!r})", f"footzoo.Pipeline.from_yaml({str(config)!r})")
+    after = json.loads(_run(run, **env_run).stdout)
+    assert after["compiled"] == []  # the plug-in's measure function too: it is in numba's cache
+    assert np.all(np.isfinite(after["pos"]))
