@@ -170,8 +170,11 @@ def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_non
     config.write_text(f"plugins: [{plugin.name}]\norientation: {{type: ins}}\ndetector: {{type: shoe}}\n"
                       "corrections: [{type: ekf_zupt}, {type: magnetometer_heading}]\n")
     env_run = dict(cache=tmp_path / "cache")
+    # the footzoo the other processes here run (the checkout, not an installed copy: another source, another cache)
+    path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
     proc = subprocess.run([sys.executable, "-m", "footzoo", "compile", str(config)], capture_output=True, text=True,
-                          cwd=tmp_path, env={**os.environ, "NUMBA_CACHE_DIR": str(env_run["cache"])}, timeout=600)
+                          cwd=tmp_path, timeout=600,
+                          env={**os.environ, "NUMBA_CACHE_DIR": str(env_run["cache"]), "PYTHONPATH": path})
     assert proc.returncode == 0, proc.stderr[-3000:]
     run = RUN.replace(f"footzoo.Pipeline.from_yaml({CONFIG!r})", f"footzoo.Pipeline.from_yaml({str(config)!r})")
     after = json.loads(_run(run, **env_run).stdout)
