@@ -1,9 +1,9 @@
 """Build hook: a wheel also carries the compiled kernels of the shipped configs.
 
 Everything else is in setup.cfg. After the usual build, ``footzoo compile --ship`` runs every
-pipeline config in ``configs/`` once on a short simulated walk and writes the machine code numba
+pipeline config in ``footzoo/config/builtin/`` once on a short simulated walk and writes the machine code numba
 produces into ``footzoo/_compiled`` of the build: an installed footzoo then loads it at its first
-run instead of compiling (see footzoo/_kernel_cache.py for when the code is valid). This needs the
+run instead of compiling (see footzoo/kernels/cache.py for when the code is valid). This needs the
 build requirements of pyproject.toml. If it fails, or FOOTZOO_NO_PRECOMPILE=1 is set, the wheel is
 built without them and kernels are compiled at first use, as in an editable install.
 """
@@ -27,7 +27,7 @@ class BuildWithKernels(build_py):
         target = build_lib / "footzoo" / "_compiled"
         shutil.rmtree(target, ignore_errors=True)
         here = Path(__file__).resolve().parent
-        configs = sorted(str(p) for p in (here / "configs").glob("*.yaml") if not p.name.startswith("study_"))
+        configs = sorted(str(p) for p in (here / "footzoo" / "config" / "builtin").glob("*.yaml") if not p.name.startswith("study_"))
         # the build first, then what pip's isolated build environment put on the path (its numba, numpy...)
         path = os.pathsep.join([str(build_lib), *filter(None, [os.environ.get("PYTHONPATH")]), *sys.path])
         env = {**os.environ, "PYTHONPATH": path, "FOOTZOO_DISABLE_JIT": ""}

@@ -4,12 +4,12 @@ Usage: python benchmarks/accuracy.py [--jobs 2] [--quick] [--results benchmarks/
                                      [--data ../shared/data] [--configs yun2012,nguyen2016]
                                      [--summary benchmarks/accuracy.md]
 
-Every config in ``configs/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
+Every config in ``footzoo/config/builtin/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
 ablation runner (one study per dataset: parallel with ``--jobs``, cached in
 ``RESULTS/<dataset>/cache`` so a rerun only computes what changed), on:
 
 * the 36 PyShoe VICON trials (Wagstaff et al.): PyShoe's own 2-D metric (``pyshoe_error_m``,
-  :func:`footzoo.metrics.pyshoe_error`) beside PyShoe's per-trial best (``trial_error``, the minimum
+  :func:`footzoo.evaluation.metrics.pyshoe_error`) beside PyShoe's per-trial best (``trial_error``, the minimum
   over its five detectors, each at a threshold re-tuned for that trial), and a 3-D ARMSE after a
   least-squares yaw alignment; medians per motion class;
 * x-io's short walk, a closed loop: horizontal end-to-start distance;
@@ -41,8 +41,9 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from footzoo.ablation import Study, run_cell, run_study, tidy  # noqa: E402
-from footzoo.ablation.report import to_markdown  # noqa: E402
+from footzoo.config import BUILTIN  # noqa: E402
+from footzoo.studies import Study, run_cell, run_study, tidy  # noqa: E402
+from footzoo.studies.report import to_markdown  # noqa: E402
 
 DEFAULT_DATA = ROOT.parent / "shared" / "data"
 DEFAULT_RESULTS = ROOT / "benchmarks" / "results"
@@ -85,8 +86,8 @@ TARGETS = {
 
 
 def shipped_configs(names: list[str] | None = None) -> list[Path]:
-    """The pipeline configs in ``configs/`` (not the study files), optionally only ``names``."""
-    paths = sorted(p for p in (ROOT / "configs").glob("*.yaml") if not p.stem.startswith("study"))
+    """The pipeline configs in ``footzoo/config/builtin/`` (not the study files), optionally only ``names``."""
+    paths = sorted(p for p in BUILTIN.glob("*.yaml") if not p.stem.startswith("study"))
     if names:
         unknown = sorted(set(names) - {p.stem for p in paths})
         if unknown:
@@ -148,7 +149,7 @@ def run_cached(study: Study, folder: Path, jobs: int = 1, plots: bool = False, p
     """A study's tidy table through the ablation runner, cached in ``folder/cache``.
 
     ``plots`` also writes the runner's report (tables and one plot per recording, slow for
-    thousands of runs); without it the cells go through :func:`footzoo.ablation.run_cell`
+    thousands of runs); without it the cells go through :func:`footzoo.studies.run_cell`
     with the same cache, so a rerun only computes what changed.
     """
     if plots:
@@ -178,9 +179,9 @@ def run_dataset(name: str, recs: list[dict[str, Any]], configs: list[Path], resu
 # ------------------------------------------------------------------------- per-stride references
 
 
-#: Per dataset: benchmark metric <- key of :attr:`footzoo.data.Result.metrics`, which compares the
-#: stride table with the reference the reader loads (:func:`footzoo.metrics.stride_errors` for
-#: gaitmap's motion capture, :func:`footzoo.metrics.footprint_errors` for Köroğlu's footprints):
+#: Per dataset: benchmark metric <- key of :attr:`footzoo.core.data.Result.metrics`, which compares the
+#: stride table with the reference the reader loads (:func:`footzoo.evaluation.metrics.stride_errors` for
+#: gaitmap's motion capture, :func:`footzoo.evaluation.metrics.footprint_errors` for Köroğlu's footprints):
 #: the benchmark, ``footzoo run`` and :class:`footzoo.Session` report the same numbers.
 REFERENCE_METRICS: dict[str, dict[str, str]] = {
     "gaitmap": {
@@ -198,9 +199,9 @@ REFERENCE_METRICS: dict[str, dict[str, str]] = {
 
 
 def stride_metrics(dataset: str, spec: dict[str, Any], config: Path) -> list[dict[str, Any]]:
-    """Per-stride comparisons (gaitmap mocap, Köroğlu footprints): the run's :attr:`~footzoo.data.Result.metrics`."""
+    """Per-stride comparisons (gaitmap mocap, Köroğlu footprints): the run's ``Result.metrics``."""
     from footzoo.io import load
-    from footzoo.pipeline import Pipeline
+    from footzoo.runtime.pipeline import Pipeline
 
     label = Path(spec["path"]).stem
     rows: list[dict[str, Any]] = []
@@ -422,7 +423,8 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
                   "Stride length RMS over all matched strides and over the straight ones (turn strides change "
                   "direction by more than 20°); FPA bias and RMS (deg) where the config computes it. Strides pair "
                   "one to one when their toe-off and initial contact both agree within 0.3 s "
-                  "(footzoo.metrics.match_strides): the left foot's turn, one reference stride over two steps, "
+                  "(footzoo.evaluation.metrics.match_strides):\n"
+                   "the left foot's turn, one reference stride over two steps, "
                   "stays unpaired.", "",
                   to_markdown(gp, 3), ""]
     k = table[(table["dataset"] == "koroglu") & table["metric"].notna()]

@@ -36,8 +36,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from footzoo.ablation import Study, run_study  # noqa: E402
 from footzoo.config import load_yaml  # noqa: E402
+from footzoo.studies import Study, run_study  # noqa: E402
 
 
 def study(strides: int) -> Study:
@@ -46,7 +46,7 @@ def study(strides: int) -> Study:
         sim = {"path": "straight", "n_strides": strides, "rate": 100, "profile": "physical", "noise": {"scale": 1}}
     return Study.from_dict({
         "name": "scaling",
-        "base": {**load_yaml(ROOT / "configs" / "yun2012.yaml"), "name": "yun2012"},
+        "base": {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012"},
         "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
                     "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
         "recordings": [{"simulate": sim, "seeds": list(range(8))}],
@@ -85,7 +85,7 @@ def main() -> None:
     args = ap.parse_args()
     from dask.distributed import LocalCluster
 
-    from footzoo.ablation import report
+    from footzoo.studies import report
 
     report.write_outputs = _timed_report(report.write_outputs)
     s = study(args.strides)
@@ -153,7 +153,7 @@ def _timed_report(write_outputs):
 
 def makespan(s: Study, out: Path, workers: int) -> float:
     """CPU seconds until the last worker is done, the chunks handed out in order to the first free one."""
-    from footzoo.ablation import runner
+    from footzoo.studies import runner
 
     cells = s.cells()
     identity = {id(r): r.identity() for r in s.recordings}
@@ -173,7 +173,7 @@ def lpt(costs: list[float], workers: int) -> float:
 
 def figure_cpu(s: Study, out: Path, table) -> list[float]:
     """CPU seconds of each figure task the workers drew, measured again here one after the other."""
-    from footzoo.ablation import report, runner
+    from footzoo.studies import report, runner
 
     runs = []
     for key, (_, row) in zip(table["run"], table.iterrows(), strict=True):

@@ -12,7 +12,7 @@ less). Items:
 
 * (a) the hardware limit: a minimal compiled strapdown loop that stores attitude, velocity
   and position for every sample (benchmarks/hardware_limit.py);
-* every config in configs/ end to end (``Pipeline.run``: detector, alignment, orientation,
+* every config shipped with footzoo end to end (``Pipeline.run``: detector, alignment, orientation,
   corrections, the sample table and the step table);
 * each orientation filter and each detector alone;
 * (b) plain filterpy loops: a 9-state (position, velocity, attitude) and a 15-state (plus gyro
@@ -52,7 +52,7 @@ sys.path.insert(0, str(ROOT))
 import footzoo  # noqa: E402
 from footzoo.sim import NoiseModel, simulate  # noqa: E402
 
-CONFIGS = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml") if not p.stem.startswith("study"))
+CONFIGS = sorted(p.stem for p in footzoo.config.BUILTIN.glob("*.yaml") if not p.stem.startswith("study"))
 #: Targets of issue 16 as the fraction of (a)'s speed, by kind of item.
 TARGETS = {"no Kalman filter": 1 / 8, "9-state Kalman": 1 / 10, "15-state Kalman": 1 / 20,
            "21-state Kalman": 1 / 50, "orientation filter": 1 / 3, "detector": 1 / 2}
@@ -108,7 +108,7 @@ def kalman_states(p) -> int:
 def config_items(rec, warm) -> list[Item]:
     items = []
     for name in CONFIGS:
-        p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
+        p = footzoo.Pipeline.from_yaml(ROOT / "footzoo" / "config" / "builtin" / f"{name}.yaml")
         p.run(warm)  # compile / load the compiled kernels
         n_states = kalman_states(p)
         kind = "no Kalman filter" if n_states == 0 else f"{min((9, 15, 21), key=lambda s: abs(s - n_states))}" \
@@ -129,7 +129,7 @@ def config_items(rec, warm) -> list[Item]:
 
 
 def plugin_items(rec, warm) -> list[Item]:
-    from footzoo.registry import available, build
+    from footzoo.plugins.registry import available, build
 
     t, acc, gyr, mag = rec.t, rec.acc, rec.gyr, rec.mag
     stance = build("detector", {"type": "windowed"}).detect(t, acc, gyr).stance_
@@ -163,7 +163,7 @@ def filterpy_zupt(t, acc, gyr, stance, q0, biases: bool, g: float = 9.81) -> np.
     """
     from filterpy.kalman import KalmanFilter
 
-    from footzoo.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
+    from footzoo.core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 
     n_x = 15 if biases else 9
     kf = KalmanFilter(dim_x=n_x, dim_z=3)
@@ -208,8 +208,8 @@ def filterpy_zupt(t, acc, gyr, stance, q0, biases: bool, g: float = 9.81) -> np.
 
 def baseline_items(rec, slow: int) -> list[Item]:
     """(b) plain filterpy loops and (c) other libraries, on the first ``slow`` samples."""
-    from footzoo.alignment import initial_attitude
-    from footzoo.registry import build
+    from footzoo.plugins.registry import build
+    from footzoo.runtime.alignment import initial_attitude
 
     s = slice(0, slow)
     t, acc, gyr, mag = rec.t[s], rec.acc[s], rec.gyr[s], rec.mag[s]
@@ -273,7 +273,7 @@ def main_table(n: int, repeat: int, slow: int) -> tuple[list[str], dict]:
     lim_cpu = hw.n / min(hw.cpu)
     lines = [
         f"{n} samples of a simulated 100 Hz walk, {repeat} interleaved repetitions, one core; "
-        f"numba {'on' if footzoo._jit.HAVE_NUMBA else 'off'}.",
+        f"numba {'on' if footzoo.kernels.jit.HAVE_NUMBA else 'off'}.",
         "",
         "| item | kind | M samples/s (min time) | M samples/s (median) | fraction of (a), wall | "
         "fraction of (a), CPU | target | met (CPU) |",
@@ -314,7 +314,7 @@ if name == "(a)":
     class p:
         run = staticmethod(lambda r: strapdown(r.t, r.acc, r.gyr, np.array([1.0, 0.0, 0.0, 0.0])))
 else:
-    p = footzoo.Pipeline.from_yaml({root!r} + f"/configs/{{name}}.yaml")
+    p = footzoo.Pipeline.from_yaml({root!r} + f"/footzoo/config/builtin/{{name}}.yaml")
 p.run(walk(3000))  # load the compiled kernels, on little memory
 rec = walk(n)
 gc.collect()
@@ -399,7 +399,7 @@ def cold_start(names: list[str], wheel: bool = True) -> list[str]:
                 with tempfile.TemporaryDirectory() as cache:
                     env = {**os.environ, **extra, "NUMBA_CACHE_DIR": cache}
                     out = []
-                    script = code.format(config=str(ROOT / "configs" / f"{c}.yaml"))
+                    script = code.format(config=str(ROOT / "footzoo" / "config" / "builtin" / f"{c}.yaml"))
                     for _ in range(2):
                         proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True,
                                               text=True, cwd=cwd, env=env)

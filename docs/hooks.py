@@ -130,7 +130,7 @@ def plugin_pages() -> dict[str, str]:
     """``{src_uri: markdown}`` of the plug-in zoo."""
     import yaml
 
-    from footzoo import registry
+    from footzoo.plugins import registry
 
     pages: dict[str, str] = {}
     rows = []
@@ -182,7 +182,7 @@ def plugin_pages() -> dict[str, str]:
 
 
 def plugin_nav() -> list[Any]:
-    from footzoo import registry
+    from footzoo.plugins import registry
 
     nav: list[Any] = ["zoo/index.md"]
     for kind in registry.KINDS:
@@ -217,7 +217,7 @@ def reader_pages() -> dict[str, str]:
         sig = inspect.signature(fn)
         params = numpy_section(inspect.getdoc(fn) or "", "Parameters")
         lines = [f"# `{fmt}`: {first_line(inspect.getdoc(mod) or '')}", "",
-                 "```bash", f"footzoo run configs/yun2012.yaml --data FILE --format {fmt}", "```", "",
+                 "```bash", f"footzoo run yun2012 --data FILE --format {fmt}", "```", "",
                  "```python", "import footzoo", "", f'rec = footzoo.load("FILE", format="{fmt}")', "```", "",
                  "The format is also detected from the file's extension and header when `format` is left out."]
         opts = [p for p in sig.parameters.values() if p.name != "path" and p.kind is not p.VAR_KEYWORD]
@@ -230,7 +230,7 @@ def reader_pages() -> dict[str, str]:
             if any(p.kind is p.VAR_KEYWORD for p in sig.parameters.values()):
                 lines.append("")
                 lines.append("Other keywords (units, `duplicates`, `nan_policy`, `max_gap`) go to "
-                             "[`Recording.from_dataframe`](../api.md#footzoo.data.Recording.from_dataframe).")
+                             "[`Recording.from_dataframe`](../api.md#footzoo.core.data.Recording.from_dataframe).")
         lines += ["", "## Format, units, axis map and reference data", "",
                   f"::: {modname}", "    options:", "      show_root_heading: false",
                   "      show_root_toc_entry: false", "      members: false", ""]

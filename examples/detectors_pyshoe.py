@@ -21,16 +21,16 @@ import numpy as np
 import pandas as pd
 
 import footzoo
-from footzoo.metrics import pyshoe_error
+from footzoo.evaluation.metrics import pyshoe_error
 
 CLASSES = ("walking", "running", "slow", "inverted")
 PIPELINES = {
-    "duong2015_zupt (zupt)": "configs/duong2015_zupt.yaml",
+    "duong2015_zupt (zupt)": "duong2015_zupt",
     "ekf_zupt (biases, no hdr)": {"name": "ekf_zupt", "orientation": {"type": "ins"},
                                   "corrections": [{"type": "ekf_zupt", "gyro_bias": True, "accel_bias": True,
                                                    "zero_rate": True}]},
-    "nguyen2016 (ekf_zupt + hdr)": "configs/nguyen2016.yaml",
-    "yun2012 (zvu_dedrift)": "configs/yun2012.yaml",
+    "nguyen2016 (ekf_zupt + hdr)": "nguyen2016",
+    "yun2012 (zvu_dedrift)": "yun2012",
 }
 DETECTORS = [{"type": "adaptive_shoe"}, {"type": "shoe"}, {"type": "ared"}, {"type": "amvd"}, {"type": "mbgtd"},
              {"type": "dgp", "min_swing": 0.2}, {"type": "angular_rate_fsm"}, {"type": "huang_stance"},

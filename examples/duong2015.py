@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 
 import footzoo
-from footzoo.conventions import quat_from_euler, quat_rotate
+from footzoo.core.conventions import quat_from_euler, quat_rotate
 from footzoo.corrections.height import TABLE1_DIRECTIONS, TABLE1_POSITIONS
-from footzoo.metrics import pyshoe_error
+from footzoo.evaluation.metrics import pyshoe_error
 from footzoo.sim import NoiseModel, simulate
 
 CONFIGS = {"duong2015": "proposed method", "duong2015_zupt": "K.F. (zero velocity)",
@@ -39,7 +39,7 @@ def table2(seeds: int) -> pd.DataFrame:
     for seed in range(seeds):
         rec = walk(seed)
         for name, label in CONFIGS.items():
-            e = rms(footzoo.Pipeline.from_yaml(f"configs/{name}.yaml").run(rec), rec)
+            e = rms(footzoo.Pipeline.from_yaml(name).run(rec), rec)
             rows.append({"method": label, "E_rms_x": e[0], "E_rms_y": e[1], "E_rms_z": e[2], "sum": e.sum()})
     out = pd.DataFrame(rows).groupby("method", sort=False).mean()
     out["paper_z"] = [PAPER_TABLE2_WALKING[n][2] for n in CONFIGS]
@@ -77,7 +77,7 @@ def table3(seeds: int) -> pd.DataFrame:
 
 def pyshoe(root: Path) -> pd.DataFrame:
     trials = pd.read_csv(root / "trials.csv")
-    p = footzoo.Pipeline.from_yaml("configs/duong2015_zupt.yaml")
+    p = footzoo.Pipeline.from_yaml("duong2015_zupt")
     rows = []
     for _, tr in trials.iterrows():
         rec = footzoo.load(root / f"{tr.trial}.mat")

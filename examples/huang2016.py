@@ -14,8 +14,8 @@ import pandas as pd
 
 import footzoo
 from footzoo.analysis import calibrate_foot_vector
+from footzoo.evaluation.metrics import match_strides
 from footzoo.io.gaitmap_reference import reference_strides
-from footzoo.metrics import match_strides
 from footzoo.sim import NoiseModel, simulate, simulate_calibration
 
 SPEEDS = {1.0: (1.1, 1.1), 1.2: (1.25, 1.04), 1.4: (1.4, 1.0)}
@@ -29,7 +29,7 @@ def simulated_conditions() -> pd.DataFrame:
     path = Path(tempfile.mkdtemp()) / "foot.yaml"
     fv = calibrate_foot_vector(cal)
     fv.save(path)
-    cfg = footzoo.config.load_yaml("configs/huang2016.yaml")
+    cfg = footzoo.config.load_yaml("huang2016")
     cfg["analysis"][0]["calibration"] = str(path)
     pipeline = footzoo.Pipeline.from_dict(cfg)
     rows = []
@@ -52,7 +52,7 @@ def gaitmap(folder: Path) -> pd.DataFrame:
     rows = []
     for foot in ("left", "right"):
         rec = footzoo.load(folder / "imu_sample.csv", foot=foot)
-        steps = footzoo.Pipeline.from_yaml("configs/huang2016.yaml").run(rec).steps
+        steps = footzoo.Pipeline.from_yaml("huang2016").run(rec).steps
         m = match_strides(steps, reference_strides(folder, foot))
         for turn in (False, True):
             s = m[m["turn"] == turn]

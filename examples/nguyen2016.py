@@ -12,7 +12,7 @@ import pandas as pd
 
 import footzoo
 from footzoo.detectors import DGP, AdaptiveSHOE, AngularRateFSM
-from footzoo.metrics import loop_closure, pyshoe_error, step_detection
+from footzoo.evaluation.metrics import loop_closure, pyshoe_error, step_detection
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
 CONFIGS = ("nguyen2016_ins_zvu", "nguyen2016_ins_zvu_hdr", "nguyen2016")
@@ -38,7 +38,7 @@ def hallway_table(seeds: int) -> pd.DataFrame:
         rec = simulate(path="rectangle", profile="physical", rate=100.0, noise=NoiseModel(seed=seed), seed=seed,
                        disturbance=MagneticDisturbance(field=(0.0, 0.1, 0.0), north=(10.0, 30.0), east=(-1.0, 1.0)))
         for name in CONFIGS:
-            res = footzoo.Pipeline.from_yaml(f"configs/{name}.yaml").run(rec)
+            res = footzoo.Pipeline.from_yaml(name).run(rec)
             rows.append({"seed": seed, "config": name, **loop_closure(res.pos)})
     return pd.DataFrame(rows)
 
@@ -46,8 +46,8 @@ def hallway_table(seeds: int) -> pd.DataFrame:
 def pyshoe_table(root: Path) -> pd.DataFrame:
     """PyShoe's error for the three configs (plus the EKF with other detectors, as ablation rows)."""
     trials = pd.read_csv(root / "trials.csv")
-    pipelines = {name: footzoo.Pipeline.from_yaml(f"configs/{name}.yaml") for name in CONFIGS}
-    base = footzoo.config.load_yaml("configs/nguyen2016.yaml")
+    pipelines = {name: footzoo.Pipeline.from_yaml(name) for name in CONFIGS}
+    base = footzoo.config.load_yaml("nguyen2016")
     for det in ("angular_rate_fsm", "oracle"):
         pipelines[f"nguyen2016[{det}]"] = footzoo.Pipeline.from_dict({**base, "detector": {"type": det}})
     rows = []

@@ -1,7 +1,7 @@
 """Run a pipeline on every PyShoe VICON trial and compare with PyShoe's published best.
 
 Usage: python examples/pyshoe_table.py [CONFIG] [DATA_DIR]
-(defaults: configs/yun2012.yaml, ../shared/data/pyshoe_vicon)
+(defaults: yun2012, ../shared/data/pyshoe_vicon)
 """
 
 import sys
@@ -10,11 +10,11 @@ from pathlib import Path
 import pandas as pd
 
 import footzoo
-from footzoo.metrics import armse, pyshoe_error
+from footzoo.evaluation.metrics import armse, pyshoe_error
 
 
 def main() -> None:
-    cfg = sys.argv[1] if len(sys.argv) > 1 else "configs/yun2012.yaml"
+    cfg = sys.argv[1] if len(sys.argv) > 1 else "yun2012"
     root = Path(sys.argv[2] if len(sys.argv) > 2 else "../shared/data/pyshoe_vicon")
     trials = pd.read_csv(root / "trials.csv")
     pipeline = footzoo.Pipeline.from_yaml(cfg)

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from footzoo import Pipeline
-from footzoo.conventions import quat_conj, quat_mul
+from footzoo.core.conventions import quat_conj, quat_mul
 from footzoo.orientation import FQAComplementary
 from footzoo.sim import NoiseModel, simulate, simulate_pendulum
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError
-from footzoo.ablation import Study, run_study, set_dotted
-from footzoo.compat import check, combinations
+from footzoo.apps.compat import check, combinations
+from footzoo.studies import Study, run_study, set_dotted
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -9,12 +9,12 @@ import pytest
 import yaml
 
 from footzoo import ConfigError, Pipeline
-from footzoo.ablation import CacheWarning, Study, read_trajectories, run_study
-from footzoo.ablation import runner as runner_mod
-from footzoo.ablation.runner import CACHE_FORMAT, read_entry
-from footzoo.cli import main
+from footzoo.apps.cli import main
 from footzoo.io.canonical import write
 from footzoo.sim import NoiseModel, simulate
+from footzoo.studies import CacheWarning, Study, read_trajectories, run_study
+from footzoo.studies import runner as runner_mod
+from footzoo.studies.runner import CACHE_FORMAT, read_entry
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -143,7 +143,7 @@ def test_failed_cells_are_retried_when_footzoos_code_changes_and_only_then(tmp_p
 
 
 def test_a_one_off_run_cell_checks_the_cache_too(tmp_path):
-    from footzoo.ablation import run_cell
+    from footzoo.studies import run_cell
 
     cell = Study.from_dict(SMALL).cells()[0]
     first = run_cell(cell, str(tmp_path))
@@ -189,7 +189,7 @@ def test_trajectories_are_stored_apart_from_the_table(tmp_path):
 
 
 def test_each_recording_is_loaded_once_and_shared_by_its_configs(monkeypatch):
-    from footzoo.ablation.study import RecordingSpec
+    from footzoo.studies.study import RecordingSpec
 
     loads = []
     original = RecordingSpec.load

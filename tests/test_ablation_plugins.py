@@ -8,10 +8,10 @@ import pytest
 import yaml
 
 from footzoo import ConfigError, Pipeline
-from footzoo import extensions as ext
-from footzoo.ablation import Study, run_study
-from footzoo.registry import available
+from footzoo.plugins import extensions as ext
+from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
+from footzoo.studies import Study, run_study
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -19,7 +19,7 @@ pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 # equal the built-in's exactly; THRESHOLD is what the "edit" tests change.
 PLUGIN = '''
 from footzoo.detectors import AngularRateFSM
-from footzoo.registry import register
+from footzoo.plugins.registry import register
 
 THRESHOLD = {threshold}
 
@@ -267,7 +267,7 @@ def test_a_plugin_that_writes_into_its_input_fails_its_cells_not_the_others(tmp_
 
 CALIBRATION = '''
 from footzoo.calibration import HardIron
-from footzoo.registry import register
+from footzoo.plugins.registry import register
 
 
 @register

@@ -43,7 +43,7 @@ def test_gaitmap_stride_errors_are_the_ones_session_reports(accuracy):
     from footzoo import Pipeline, Session
 
     path = data_file("gaitmap_example", "imu_sample.csv")
-    config = ROOT / "configs" / "yun2012.yaml"
+    config = ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"
     per_foot = Session.load(path).run(Pipeline.from_yaml(config)).per_foot
     for foot in ("left", "right"):
         rows = accuracy.stride_metrics(f"gaitmap_{foot}", {"path": str(path), "format": "gaitmap", "foot": foot},
@@ -61,11 +61,11 @@ def test_koroglu_footprint_errors_against_the_measured_footprints(accuracy):
     from scipy.io import loadmat
 
     from footzoo import Pipeline
+    from footzoo.evaluation.metrics import rigid_align_2d
     from footzoo.io import load
-    from footzoo.metrics import rigid_align_2d
 
     path = data_file("koroglu_gcp", "SensorConnectData_31.csv")
-    config = ROOT / "configs" / "recommended.yaml"
+    config = ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml"
     got = {r["metric"]: r["value"] for r in accuracy.stride_metrics("koroglu", {"path": str(path),
                                                                                  "format": "sensorconnect"}, config)}
     gcp = np.asarray(loadmat(path.with_suffix(".mat"))["GCP_meters"], float)

@@ -21,21 +21,21 @@ import pytest
 import scipy.io as sio
 
 from footzoo import ConfigError, FormatError, Pipeline, RecordingError
-from footzoo.ablation.study import Study
 from footzoo.analysis.foot_vector import FootVector
-from footzoo.cli import EXIT_DATA, EXIT_INTERNAL, EXIT_USAGE, main
+from footzoo.apps.cli import EXIT_DATA, EXIT_INTERNAL, EXIT_USAGE, main
 from footzoo.config import load_yaml
+from footzoo.core.data import Recording, Truth
+from footzoo.core.errors import SensorWarning
 from footzoo.corrections.height import load_calibration
-from footzoo.data import Recording, Truth
-from footzoo.errors import SensorWarning
 from footzoo.io import load
 from footzoo.io.canonical import write
+from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
-from footzoo.stream import Stream
+from footzoo.studies.study import Study
 
 ROOT = Path(__file__).resolve().parents[1]
-YUN = (ROOT / "configs" / "yun2012.yaml").read_text()
-NGUYEN = ROOT / "configs" / "nguyen2016.yaml"
+YUN = (ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml").read_text()
+NGUYEN = ROOT / "footzoo" / "config" / "builtin" / "nguyen2016.yaml"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
 
@@ -378,7 +378,7 @@ def test_alias_bomb_fails_fast_with_bounded_memory(tmp_path):
 
 
 def test_yaml_12_scalars():
-    from footzoo.yamlsafe import load_text
+    from footzoo.core.yamlsafe import load_text
 
     assert load_text("a: yes\nb: 1:30\nc: 010\nd: 1e-3\ne: 2024-01-01\nf: True\ng: 0x10") == {
         "a": "yes", "b": "1:30", "c": 10, "d": 0.001, "e": "2024-01-01", "f": True, "g": 16}
@@ -422,11 +422,11 @@ def test_clean_recordings_raise_no_sensor_warning(walk):
 
 # --------------------------------------------------------------------------- command line
 CLI_CASES = [
-    ("data-directory", lambda d, w: ["run", "configs/yun2012.yaml", "--data", str(d)], EXIT_DATA,
+    ("data-directory", lambda d, w: ["run", "yun2012", "--data", str(d)], EXIT_DATA,
      "is a directory"),
     ("calibrate-dev-zero", lambda d, w: ["calibrate", "--data", "/dev/zero", "--out", str(d / "fv.yaml")], EXIT_DATA,
      "not a regular file"),
-    ("out-under-a-file", lambda d, w: ["run", "configs/yun2012.yaml", "--data", str(_csv(d, w)), "--out",
+    ("out-under-a-file", lambda d, w: ["run", "yun2012", "--data", str(_csv(d, w)), "--out",
                                        str(_text(d, "f.txt", "x"))], EXIT_DATA, "is not a directory"),
     ("simulate-out-missing-folder", lambda d, w: ["simulate", "straight", "--out", str(d / "no" / "x.csv")],
      EXIT_DATA, "does not exist"),
@@ -438,7 +438,7 @@ CLI_CASES = [
      "gravity = 98.1"),
     ("config-latin1", lambda d, w: ["validate", str(_text(d, "l.yaml", b"name: caf\xe9\n"))], EXIT_USAGE,
      "not UTF-8"),
-    ("data-impossible", lambda d, w: ["run", "configs/yun2012.yaml", "--data", _impossible_csv(d, w)], EXIT_DATA,
+    ("data-impossible", lambda d, w: ["run", "yun2012", "--data", _impossible_csv(d, w)], EXIT_DATA,
      "beyond any body-worn IMU"),
 ]
 
@@ -465,12 +465,12 @@ def test_cli_read_only_out(tmp_path, capsys, monkeypatch):
     ro = tmp_path / "ro"
     ro.mkdir()
     ro.chmod(0o555)
-    assert main(["run", "configs/yun2012.yaml", "--out", str(ro / "x")]) == EXIT_DATA
+    assert main(["run", "yun2012", "--out", str(ro / "x")]) == EXIT_DATA
     assert "permission denied" in capsys.readouterr().err
 
 
 def test_cli_internal_error_exit_1_and_debug_shows_traceback(monkeypatch, capsys):
-    import footzoo.cli as cli
+    import footzoo.apps.cli as cli
 
     def boom(args):
         raise RuntimeError("kaboom")
@@ -501,7 +501,7 @@ def _ranged_parameters() -> list[tuple[str, str, str, float]]:
     """Every (kind, plug-in, parameter, edge value) of a range-checked parameter, read from its error message."""
     import re
 
-    from footzoo.registry import available, build
+    from footzoo.plugins.registry import available, build
 
     out = []
     for kind in ("orientation", "detector", "correction"):
@@ -530,7 +530,7 @@ def sensors_walk() -> Recording:
 @pytest.mark.parametrize("kind, name, param, value", RANGED, ids=[f"{n}.{p}={v:g}" for _, n, p, v in RANGED])
 def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name, param, value, sensors_walk):
     """The documented ranges are safe: no NaN or crash at either end (or a clear footzoo error)."""
-    yun, nguyen, duong = (load_yaml(ROOT / "configs" / f"{c}.yaml") for c in ("yun2012", "nguyen2016", "duong2015"))
+    yun, nguyen, duong = (load_yaml(c) for c in ("yun2012", "nguyen2016", "duong2015"))
     if kind == "orientation":
         cfg = nguyen if name == "ins" else yun
         cfg["orientation"] = {"type": name, param: value}

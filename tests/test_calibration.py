@@ -9,14 +9,15 @@ import numpy as np
 import pytest
 import yaml
 
+import footzoo
 from footzoo import Pipeline, Recording, register
+from footzoo.apps.testing import check_plugin
 from footzoo.calibration import HardIron, fit_hard_iron
-from footzoo.conventions import quat_to_matrix
-from footzoo.errors import CalibrationWarning, ConfigError, RecordingError
-from footzoo.plugin import Calibration
+from footzoo.core.conventions import quat_to_matrix
+from footzoo.core.errors import CalibrationWarning, ConfigError, RecordingError
+from footzoo.plugins.base import Calibration
+from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
-from footzoo.stream import Stream
-from footzoo.testing import check_plugin
 
 FIELD = np.array([0.22, 0.05, 0.42])  # NED field (G), inclination about 62°
 OFFSET = np.array([0.031, -0.018, 0.012])
@@ -40,7 +41,7 @@ def sphere_readings(n: int = 2000, noise: float = 0.0, seed: int = 1) -> np.ndar
 @pytest.fixture
 def scratch_registry(monkeypatch):
     """Test plug-ins registered inside a test are gone after it (the registry is process-wide)."""
-    import footzoo.registry as registry
+    import footzoo.plugins.registry as registry
 
     registry.available("calibration")  # built-ins loaded first
     monkeypatch.setitem(registry._REGISTRY, "calibration", dict(registry._REGISTRY["calibration"]))
@@ -131,7 +132,7 @@ def test_bad_parameters_are_refused_with_the_name():
 
 def test_the_pipeline_calibrates_a_copy_and_reports_it(loop):
     rec = copy.deepcopy(loop)
-    cfg = yaml.safe_load(open("configs/yun2012.yaml"))
+    cfg = yaml.safe_load(footzoo.config.path("yun2012").read_text())
     res = Pipeline.from_dict(cfg).run(rec)
     np.testing.assert_array_equal(rec.mag, loop.mag)  # the caller's recording is unchanged
     (report,) = res.diagnostics["calibration"]
@@ -154,7 +155,7 @@ def test_calibration_config_errors_are_clear():
 
 
 def test_validate_lists_a_bad_calibration_with_the_other_problems():
-    from footzoo.config_check import config_errors
+    from footzoo.runtime.validate import config_errors
 
     errors = config_errors({"orientation": {"type": "madgwik"}, "detector": {"type": "shoe"},
                             "calibration": [{"type": "hard_iron", "min_spread": 2}]})

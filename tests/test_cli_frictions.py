@@ -9,12 +9,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo.cli import build_parser, main
-from footzoo.compat import check
+from footzoo.apps.cli import build_parser, main
+from footzoo.apps.compat import check
 from footzoo.io.canonical import write
 from footzoo.sim import simulate
 
-YUN = "configs/yun2012.yaml"
+YUN = "yun2012"
 
 
 def test_acc_and_gyr_unit_options_read_a_canonical_file_in_g_and_deg_s(tmp_path, capsys):
@@ -76,7 +76,7 @@ def test_compatibility_list_keeps_whole_reasons(capsys):
 
 
 def test_missing_pyarrow_warns_instead_of_silently_skipping_parquet(tmp_path, monkeypatch):
-    from footzoo.ablation.report import write_outputs
+    from footzoo.studies.report import write_outputs
 
     def no_pyarrow(*args, **kwargs):
         raise ImportError("Unable to find a usable engine; tried using: 'pyarrow'")
@@ -93,7 +93,7 @@ def test_config_comments_show_commands_that_parse():
     """Every `footzoo ...` command quoted in a config comment is accepted by the parser."""
     parser = build_parser()
     found = 0
-    for cfg in Path("configs").glob("*.yaml"):
+    for cfg in Path("footzoo/config/builtin").glob("*.yaml"):
         for line in cfg.read_text().splitlines():
             m = re.search(r"#.*?footzoo ((?:run|calibrate|simulate|validate|list|ablate)\b[^,;]*)", line)
             if m:
@@ -106,7 +106,7 @@ def test_config_comments_show_commands_that_parse():
 def test_steps_csv_columns_carry_units(tmp_path):
     rec = simulate(n_strides=4, rate=50.0)
     path = write(rec, tmp_path / "walk.csv")
-    assert main(["run", "configs/huang2016.yaml", "--data", str(path), "--out", str(tmp_path / "out")]) == 0
+    assert main(["run", "huang2016", "--data", str(path), "--out", str(tmp_path / "out")]) == 0
     cols = pd.read_csv(tmp_path / "out" / "steps.csv").columns
     unit = re.compile(r"_(s|m|m_s|rad|steps_min)$")
     assert all(unit.search(c) for c in cols if c != "events_from_rate"), list(cols)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline
-from footzoo.cli import main
+from footzoo.apps.cli import main
 
 GOOD = {
     "name": "t",

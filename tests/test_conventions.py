@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from footzoo.conventions import (
+from footzoo.core.conventions import (
     quat_conj,
     quat_from_euler,
     quat_from_matrix,

@@ -6,9 +6,9 @@ import pytest
 
 import footzoo
 from footzoo import Recording, RecordingError
-from footzoo.data import DEFAULT_MAX_GAP
-from footzoo.errors import FootzooWarning
-from footzoo.metrics import loop_closure
+from footzoo.core.data import DEFAULT_MAX_GAP
+from footzoo.core.errors import FootzooWarning
+from footzoo.evaluation.metrics import loop_closure
 from footzoo.sim import simulate
 
 from .conftest import data_file
@@ -52,7 +52,7 @@ def test_a_regular_recording_has_no_gap_entry(recwarn):
 @pytest.fixture(scope="module")
 def loop_walk():
     rec = simulate(path="rectangle", length=10.0, width=5.0, rate=100.0, profile="physical", magnetometer=False)
-    pipe = footzoo.Pipeline.from_yaml("configs/duong2015_zupt.yaml")
+    pipe = footzoo.Pipeline.from_yaml("duong2015_zupt")
     return rec, pipe, loop_closure(pipe.run(rec).pos)
 
 

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from footzoo import Recording, RecordingError
-from footzoo.data import Truth
+from footzoo.core.data import Truth
 
 
 def frame(n=400, rate=100.0, acc_scale=1.0, gyr_scale=1.0):
@@ -111,7 +111,7 @@ def test_read_only_inputs_become_writable_copies_and_the_caller_keeps_theirs():
     """pandas' copy-on-write columns are read-only: the recording owns writable copies (one type for the kernels)."""
     import numpy as np
 
-    from footzoo.data import Recording
+    from footzoo.core.data import Recording
 
     n = 200
     t = np.arange(n) / 100.0

@@ -9,7 +9,7 @@ import pytest
 from footzoo.detectors import SHOE, AdaptiveSHOE
 from footzoo.detectors.adaptive_shoe import adaptive_threshold_kernel
 from footzoo.detectors.runs import close_short_swings
-from footzoo.metrics import intervals, stance_scores, step_detection
+from footzoo.evaluation.metrics import intervals, stance_scores, step_detection
 from footzoo.sim import NoiseModel, simulate
 
 from .conftest import data_file

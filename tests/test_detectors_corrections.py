@@ -36,7 +36,7 @@ def test_detector_threshold_and_sample_count_from_seconds():
 
 @pytest.mark.parametrize("bad", [{"threshold": -1}, {"threshold": "x"}, {"min_duration": -0.1}])
 def test_detector_rejects_bad_parameters(bad):
-    from footzoo.errors import ConfigError
+    from footzoo.core.errors import ConfigError
 
     with pytest.raises(ConfigError):
         AngularRateFSM(**bad)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from footzoo.detectors import DGP
-from footzoo.metrics import stance_scores, step_detection
+from footzoo.evaluation.metrics import stance_scores, step_detection
 from footzoo.sim import NoiseModel, simulate
 
 from .detector_sims import GAITS, RATES, walk
@@ -68,7 +68,7 @@ def test_no_collapse_on_real_walking_and_running():
     """
     import scipy.io
 
-    from footzoo.metrics import intervals
+    from footzoo.evaluation.metrics import intervals
 
     from .conftest import data_file
 
@@ -124,7 +124,7 @@ def test_rotation_bound_against_vicon_labels_on_real_walking():
     import scipy.io
 
     from footzoo.detectors.runs import close_short_swings
-    from footzoo.metrics import intervals
+    from footzoo.evaluation.metrics import intervals
 
     from .conftest import data_file
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from footzoo.detectors import AngularRateFSM, dated_and_online_states
-from footzoo.metrics import intervals, stance_scores
+from footzoo.evaluation.metrics import intervals, stance_scores
 from footzoo.sim import simulate
 
 from .detector_sims import GAITS, RATES, walk

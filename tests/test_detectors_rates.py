@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from footzoo.metrics import stance_scores
-from footzoo.registry import available
+from footzoo.evaluation.metrics import stance_scores
+from footzoo.plugins.registry import available
 
 from .detector_sims import GAITS, RATES, walk
 

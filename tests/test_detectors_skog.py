@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from footzoo.conventions import GRAVITY
+from footzoo.core.conventions import GRAVITY
 from footzoo.detectors import AMVD, ARED, MBGTD, SHOE
-from footzoo.metrics import stance_scores
+from footzoo.evaluation.metrics import stance_scores
 
 from .conftest import data_file
 from .detector_sims import GAITS, RATES, walk

@@ -15,7 +15,7 @@ from footzoo.detectors.speed_adaptive_shoe import (
     speed_per_sample,
     swing_speeds,
 )
-from footzoo.metrics import intervals, stance_scores
+from footzoo.evaluation.metrics import intervals, stance_scores
 
 from .conftest import data_file
 from .detector_sims import GAITS, RATES, walk
@@ -97,7 +97,7 @@ def test_a_pause_in_the_air_is_not_a_stance():
 def test_the_simulated_foot_pausing_in_the_air_gives_no_extra_stances():
     """The simulator's physical run stops the foot after the push-off and before the landing (|v| = 0 in the
     air): raised thresholds see those pauses, :func:`drop_pauses` removes them (every stride found, none extra)."""
-    from footzoo.metrics import step_detection
+    from footzoo.evaluation.metrics import step_detection
     from footzoo.sim import simulate
 
     rec = simulate(path="run", n_strides=20, rate=200.0, profile="physical", noise={"scale": 1.0, "seed": 0})

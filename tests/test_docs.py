@@ -2,7 +2,7 @@
 
 The blocks of one file run as one script (like a notebook), in a fresh process (a plug-in defined
 in the docs must not meet one registered by another test) and a fresh folder holding a copy of
-``configs/``. A block preceded by the line ``<!-- docs: no-run -->`` is skipped (e.g. one that
+``footzoo/config/builtin/``. A block preceded by the line ``<!-- docs: no-run -->`` is skipped (e.g. one that
 needs a Dask scheduler); a line ``--8<-- "path"`` includes that file, as in the built site. The
 files the README's shell examples would create first (``walk.csv`` from ``footzoo simulate``)
 are made here, small; gaitmap's example files are copied from ``../shared/data`` (the README
@@ -62,7 +62,6 @@ def test_block_extraction():
 @pytest.mark.parametrize("path", markdown_files(), ids=lambda p: str(p.relative_to(ROOT)))
 def test_code_blocks_run(path, tmp_path):
     blocks = [b for b in python_blocks(path.read_text()) if b[2]]
-    shutil.copytree(ROOT / "configs", tmp_path / "configs")
     if path.name == "README.md":
         from footzoo.io import canonical
         from footzoo.sim import simulate

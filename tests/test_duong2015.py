@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from footzoo import Pipeline, RecordingError
-from footzoo.conventions import quat_from_euler, quat_rotate
+from footzoo.core.conventions import quat_from_euler, quat_rotate
 from footzoo.corrections import load_calibration, save_calibration
 from footzoo.corrections.height import TABLE1_DIRECTIONS, TABLE1_POSITIONS
 from footzoo.detectors import Windowed
-from footzoo.metrics import step_detection
+from footzoo.evaluation.metrics import step_detection
 from footzoo.sim import NoiseModel, simulate
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
@@ -49,7 +49,7 @@ def rms(res, rec):
 
 def test_table_2_distance_sensors_cut_the_height_error(walk_with_range_sensors):
     rec = walk_with_range_sensors
-    errors = {name: rms(Pipeline.from_yaml(f"configs/{name}.yaml").run(rec), rec) for name in CONFIGS}
+    errors = {name: rms(Pipeline.from_yaml(name).run(rec), rec) for name in CONFIGS}
     # paper, walking: z RMS 3.0 mm (distance sensors) vs 12.1 mm (ZUPT only); measured here 3.4 vs 38 mm
     assert errors["duong2015"][2] * 3 < errors["duong2015_zupt"][2]
     assert errors["duong2015_zupt_height"][2] < errors["duong2015_zupt"][2]
@@ -59,7 +59,7 @@ def test_table_2_distance_sensors_cut_the_height_error(walk_with_range_sensors):
 
 def test_missing_and_out_of_range_readings_do_not_spike_the_height(walk_with_range_sensors):
     rec = walk_with_range_sensors
-    clean = Pipeline.from_yaml("configs/duong2015.yaml").run(rec)
+    clean = Pipeline.from_yaml("duong2015").run(rec)
     broken = rec.to_dataframe()
     rng = np.random.default_rng(1)
     has = np.flatnonzero(np.isfinite(broken["dist_a"].to_numpy()))
@@ -70,7 +70,7 @@ def test_missing_and_out_of_range_readings_do_not_spike_the_height(walk_with_ran
     from footzoo import Recording
 
     rec2 = Recording.from_dataframe(broken, meta=rec.meta)
-    res = Pipeline.from_yaml("configs/duong2015.yaml").run(rec2)
+    res = Pipeline.from_yaml("duong2015").run(rec2)
     z_err = np.abs(res.pos[:, 2] - rec.truth.pos[:, 2])
     assert z_err.max() < 0.03
     assert rms(res, rec)[2] < 1.5 * rms(clean, rec)[2]
@@ -106,4 +106,4 @@ def test_calibration_recovers_the_height_relevant_mounting_and_helps_the_9_state
 def test_height_distance_needs_range_columns():
     rec = simulate(n_strides=2)
     with pytest.raises(RecordingError, match="needs 2 distance-sensor columns"):
-        Pipeline.from_yaml("configs/duong2015.yaml").run(rec)
+        Pipeline.from_yaml("duong2015").run(rec)

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline
-from footzoo.errors import FootzooWarning
+from footzoo.core.errors import FootzooWarning
+from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
-from footzoo.stream import Stream
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def external(tmp_path_factory):
         import footzoo
         from footzoo.corrections import ZUPT
         from footzoo.filters.measurement import VEL, MeasurementModel
-        from footzoo.plugin import KalmanCorrection
+        from footzoo.plugins.base import KalmanCorrection
 
 
         @footzoo.register
@@ -110,7 +110,7 @@ def test_a_correction_that_does_not_compile_falls_back_loudly_and_never_drops(wa
 
 
 def test_check_plugin_accepts_the_external_corrections(external):
-    from footzoo.testing import check_plugin
+    from footzoo.apps.testing import check_plugin
 
     check_plugin(external.MyZUPT)
     with warnings.catch_warnings():

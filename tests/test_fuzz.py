@@ -1,6 +1,6 @@
 """Property-based fuzzing: readers, YAML, configs, studies and live samples raise only footzoo's documented errors.
 
-Documented errors: :class:`~footzoo.errors.FootzooError` and its subclasses
+Documented errors: :class:`~footzoo.core.errors.FootzooError` and its subclasses
 (``ConfigError``, ``RecordingError``, ``FormatError``). Anything else escaping
 is a bug. Parsing is bounded by the loader's limits (size, depth, aliases), so
 every example finishes quickly with bounded memory.
@@ -27,13 +27,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from footzoo import Pipeline
-from footzoo.ablation.study import STUDY_KEYS, Study
-from footzoo.checks import validate_sample
 from footzoo.config import TOP_LEVEL_KEYS
-from footzoo.errors import FootzooError
+from footzoo.core.checks import validate_sample
+from footzoo.core.errors import FootzooError
+from footzoo.core.yamlsafe import load_text
 from footzoo.io import READERS, load
-from footzoo.registry import available
-from footzoo.yamlsafe import load_text
+from footzoo.plugins.registry import available
+from footzoo.studies.study import STUDY_KEYS, Study
 
 CI_EXAMPLES = int(os.environ.get("FOOTZOO_FUZZ_EXAMPLES", "25"))
 NIGHTLY_EXAMPLES = 2000
@@ -207,14 +207,14 @@ def live_samples(t, acc, gyr, previous) -> None:
     _only_footzoo_errors(lambda: validate_sample(t, acc, gyr, None, None, previous, None))
 
 
-_STREAM_PIPELINE = Path(__file__).resolve().parents[1] / "configs" / "nguyen2016.yaml"
+_STREAM_PIPELINE = Path(__file__).resolve().parents[1] / "footzoo" / "config" / "builtin" / "nguyen2016.yaml"
 SAMPLE = st.tuples(st.floats(0.002, 0.05), st.lists(st.floats(-60.0, 60.0), min_size=3, max_size=3),
                    st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))
 
 
 def stream_pushes(samples: list, use_mag: bool, offset: float) -> None:
     """A live stream fed odd but well-formed samples: only footzoo errors, finite estimates."""
-    from footzoo.stream import Stream
+    from footzoo.runtime.stream import Stream
 
     stream = Stream(Pipeline.from_yaml(_STREAM_PIPELINE))
     t = offset

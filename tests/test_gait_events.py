@@ -8,14 +8,14 @@ import pytest
 
 from footzoo.analysis.gait_events import detect_gait_events, segment_argext
 from footzoo.analysis.strides import STEP_COLUMNS, real_stances, segment_steps
-from footzoo.metrics import match_strides, reference_steps, stride_errors
-from footzoo.pipeline import Pipeline
+from footzoo.evaluation.metrics import match_strides, reference_steps, stride_errors
+from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import NoiseModel, simulate
 
 from .conftest import data_file
 
-YUN = "configs/yun2012.yaml"
-HUANG = "configs/huang2016.yaml"
+YUN = "yun2012"
+HUANG = "huang2016"
 
 
 def test_segment_argext_matches_a_loop():

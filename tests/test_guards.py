@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline
-from footzoo.errors import GuardWarning
-from footzoo.guards import StanceGuard, check_speed
+from footzoo.core.errors import GuardWarning
+from footzoo.runtime.guards import StanceGuard, check_speed
 from footzoo.sim import NoiseModel, simulate
 
 
@@ -85,7 +85,7 @@ def test_missed_running_stances_degrade_instead_of_running_away_against_simulato
     truth = np.linalg.norm(sprint.truth.pos[-1, :2] - sprint.truth.pos[0, :2])
     err = {}
     for key, guards in (("off", {"max_swing": 0}), ("on", {})):
-        r, caught = _run("configs/yun2012.yaml", sprint, guards)
+        r, caught = _run("yun2012", sprint, guards)
         err[key] = abs(np.linalg.norm(r.pos[-1, :2] - r.pos[0, :2]) - truth)
         report = r.diagnostics["guards"]
         assert report["longest_swing"] > 8.0
@@ -103,7 +103,7 @@ def test_missed_running_stances_degrade_instead_of_running_away_against_simulato
 def test_the_guard_does_not_fire_on_the_papers_simulated_walks():
     rec = simulate(path="straight", n_strides=8, profile="physical", rate=100.0, noise=NoiseModel(seed=0), seed=0)
     for config in ("yun2012", "nguyen2016", "duong2015_zupt"):
-        r, caught = _run(f"configs/{config}.yaml", rec, {})
+        r, caught = _run(config, rec, {})
         assert not caught, config
         assert r.diagnostics["guards"]["stances_added"] == 0
         assert r.diagnostics["guards"]["longest_swing"] < 1.5
@@ -145,14 +145,14 @@ def test_real_running_trial_within_a_metre_with_the_guard(config):
     """PyShoe 2017-11-27-11-19-16 (running): the angular-rate machine finds 2 of 26 stances, the windowed
     test 2 as well; without the guard the dedrift ends 30 m off and the Kalman filter 35 m."""
     from footzoo import load
-    from footzoo.metrics import pyshoe_error
+    from footzoo.evaluation.metrics import pyshoe_error
 
     from .conftest import data_file
 
     rec = load(data_file("pyshoe_vicon", "2017-11-27-11-19-16.mat"), format="pyshoe")
     err = {}
     for key, guards in (("off", {"max_swing": 0}), ("on", {})):
-        r, caught = _run(f"configs/{config}.yaml", rec, guards)
+        r, caught = _run(config, rec, guards)
         err[key] = pyshoe_error(r.pos, rec.truth.pos)
         assert bool(caught) == (key == "on")
     assert err["off"] > 10.0
@@ -190,10 +190,10 @@ def test_bias_estimates_stay_within_the_bias_guard():
 
 def test_a_live_stream_warns_when_its_detector_reaches_max_swing(sprint):
     """Live, a swing's stillest instants are not known yet: the stream warns instead of adding stances."""
-    from footzoo.stream import Stream
+    from footzoo.runtime.stream import Stream
 
-    p = Pipeline.from_yaml("configs/nguyen2016.yaml")
-    batch, _ = _run("configs/nguyen2016.yaml", sprint, {})
+    p = Pipeline.from_yaml("nguyen2016")
+    batch, _ = _run("nguyen2016", sprint, {})
     assert batch.diagnostics["guards"]["stances_added"] > 0
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

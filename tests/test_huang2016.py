@@ -6,10 +6,10 @@ from ahrs.filters import Madgwick as AhrsMadgwick
 
 from footzoo import Pipeline
 from footzoo.analysis import FootVector, calibrate_foot_vector
-from footzoo.cli import main
-from footzoo.conventions import quat_conj, quat_from_euler, quat_rotate, quat_to_euler
+from footzoo.apps.cli import main
+from footzoo.core.conventions import quat_conj, quat_from_euler, quat_rotate, quat_to_euler
 from footzoo.detectors import SHOE, HuangStance
-from footzoo.metrics import step_detection
+from footzoo.evaluation.metrics import step_detection
 from footzoo.orientation import Madgwick
 from footzoo.sim import NoiseModel, simulate, simulate_calibration
 
@@ -117,13 +117,13 @@ def test_fpa_and_stride_length_in_the_nine_treadmill_conditions(speed, gait, foo
 
 @pytest.mark.parametrize("foot", ["left", "right"])
 def test_gaitmap_stride_length_and_fpa_against_motion_capture(foot):
+    from footzoo.evaluation.metrics import match_strides
     from footzoo.io import load
     from footzoo.io.gaitmap_reference import reference_strides
-    from footzoo.metrics import match_strides
 
     folder = data_file("gaitmap_example", "imu_sample.csv").parent
     rec = load(folder / "imu_sample.csv", foot=foot)
-    steps = Pipeline.from_yaml("configs/huang2016.yaml").run(rec).steps
+    steps = Pipeline.from_yaml("huang2016").run(rec).steps
     ref = reference_strides(folder, foot)
     m = match_strides(steps, ref)
     straight = m[~m["turn"]]

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from footzoo import FormatError, Pipeline, RecordingError
+from footzoo.evaluation.metrics import armse, rotate_about_vertical
 from footzoo.io import builtin_sample, detect_format, load
 from footzoo.io.canonical import write
-from footzoo.metrics import armse, rotate_about_vertical
 
 from .conftest import data_file
 
@@ -37,7 +37,7 @@ def test_pyshoe_reads_frd_si_and_a_mirrored_reference():
 
 def test_pyshoe_reference_and_estimate_agree_in_handedness():
     rec = load(data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat"))
-    res = Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
+    res = Pipeline.from_yaml("yun2012").run(rec)
     est, ref = res.pos[:, :2], rec.truth.pos[:, :2]
     z = np.zeros((len(est), 1))
     proper = armse(np.hstack([est, z]), np.hstack([ref, z]))
@@ -69,12 +69,12 @@ def test_gaitmap_feet_convert_to_frd(foot):
 @pytest.mark.parametrize("foot", ["left", "right"])
 def test_gaitmap_feet_turn_like_the_markers(foot):
     """Handedness: the estimated walk turns the same way as the motion-capture heel marker."""
+    from footzoo.evaluation.metrics import match_strides
     from footzoo.io.gaitmap_reference import reference_strides
-    from footzoo.metrics import match_strides
 
     folder = data_file("gaitmap_example", "imu_sample.csv").parent
     rec = load(folder / "imu_sample.csv", foot=foot)
-    res = Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
+    res = Pipeline.from_yaml("yun2012").run(rec)
     m = match_strides(res.steps, reference_strides(folder, foot))
     ref_turn = np.unwrap(m["heading_rad"].to_numpy())  # lab frame, z up: counter-clockwise positive
     est_turn = np.unwrap(m["est_heading_rad"].to_numpy())  # NED: clockwise seen from above positive

@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from footzoo import _jit
-from footzoo.cli import main as cli_main
+from footzoo.apps.cli import main as cli_main
+from footzoo.kernels import jit as _jit
 
 ROOT = Path(__file__).resolve().parents[1]
-CONFIG = str(ROOT / "configs" / "yun2012.yaml")
+CONFIG = str(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml")
 pytestmark = pytest.mark.skipif(not _jit.HAVE_NUMBA, reason="needs numba")
 
 # run the config on a simulated walk; print the footzoo kernels numba compiled and the end position
@@ -122,7 +122,7 @@ def test_compile_without_ship_fills_numbas_cache(tmp_path):
 
 
 def test_ship_refuses_a_process_that_already_compiled(monkeypatch, tmp_path):
-    from footzoo.precompile import compile_kernels
+    from footzoo.apps.compile import compile_kernels
 
     monkeypatch.setattr(_jit, "_materialised", True)
     with pytest.raises(RuntimeError, match="new process"):
@@ -130,7 +130,7 @@ def test_ship_refuses_a_process_that_already_compiled(monkeypatch, tmp_path):
 
 
 def test_compile_takes_a_study_file_for_every_config_of_its_grid(capsys):
-    assert cli_main(["compile", str(ROOT / "configs" / "study_quick.yaml")]) == 0
+    assert cli_main(["compile", str(ROOT / "footzoo" / "config" / "builtin" / "study_quick.yaml")]) == 0
     lines = capsys.readouterr().out.splitlines()
     # 2 detectors x 2 corrections on one base: four distinct pipelines, whatever the recordings
     assert len(lines) == 4

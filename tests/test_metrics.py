@@ -3,7 +3,14 @@
 import numpy as np
 import pytest
 
-from footzoo.metrics import armse, loop_closure, path_length, pyshoe_error, rotate_about_vertical, yaw_alignment
+from footzoo.evaluation.metrics import (
+    armse,
+    loop_closure,
+    path_length,
+    pyshoe_error,
+    rotate_about_vertical,
+    yaw_alignment,
+)
 
 
 def square(n=400, side=10.0):
@@ -61,7 +68,7 @@ def test_shape_mismatch_is_an_error():
 
 
 def test_stance_metrics_on_a_hand_made_case():
-    from footzoo.metrics import intervals, stance_scores, step_detection
+    from footzoo.evaluation.metrics import intervals, stance_scores, step_detection
 
     t = np.arange(40) * 0.01
     truth = np.zeros(40, bool)
@@ -87,7 +94,7 @@ def test_stance_metrics_on_a_hand_made_case():
 
 
 def test_a_merged_detection_counts_both_true_phases_wrong():
-    from footzoo.metrics import step_detection
+    from footzoo.evaluation.metrics import step_detection
 
     t = np.arange(20) * 0.01
     truth = np.zeros(20, bool)

@@ -8,10 +8,10 @@ A simulated walk is re-expressed in a sensor turned on the foot by a fixed rotat
 import numpy as np
 import pytest
 
-from footzoo.alignment import initial_attitude
-from footzoo.conventions import GRAVITY, quat_conj, quat_from_euler, quat_mul, quat_rotate, quat_to_euler
-from footzoo.data import Recording, Truth
-from footzoo.pipeline import Pipeline
+from footzoo.core.conventions import GRAVITY, quat_conj, quat_from_euler, quat_mul, quat_rotate, quat_to_euler
+from footzoo.core.data import Recording, Truth
+from footzoo.runtime.alignment import initial_attitude
+from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import simulate
 
 MOUNTINGS = {
@@ -70,7 +70,7 @@ def test_the_inverted_sensor_reads_plus_g_at_rest(walk):
 @pytest.mark.parametrize("mounting", ["inverted", "on_its_side", "arbitrary"])
 def test_every_orientation_filter_starts_right_on_a_turned_sensor(walk, config, mounting):
     rec = remount(walk, *MOUNTINGS[mounting])
-    res = Pipeline.from_yaml(f"configs/{config}.yaml").run(rec)
+    res = Pipeline.from_yaml(config).run(rec)
     quat = res.samples[["qw", "qx", "qy", "qz"]].to_numpy()
     still = rec.t < 1.5  # the walk starts with 2 s of standing
     tilt_est = quat_to_euler(quat[still])[:, :2]
@@ -85,6 +85,6 @@ def test_every_orientation_filter_starts_right_on_a_turned_sensor(walk, config, 
 @pytest.mark.parametrize("config", ["nguyen2016", "nguyen2016_ins_zvu", "duong2015_zupt", "yun2012"])
 def test_trajectory_does_not_depend_on_the_mounting(walk, config):
     """INS and FQA-based pipelines are equivariant: an upside-down sensor gives the same track."""
-    up = Pipeline.from_yaml(f"configs/{config}.yaml").run(walk)
-    down = Pipeline.from_yaml(f"configs/{config}.yaml").run(remount(walk, *MOUNTINGS["inverted"]))
+    up = Pipeline.from_yaml(config).run(walk)
+    down = Pipeline.from_yaml(config).run(remount(walk, *MOUNTINGS["inverted"]))
     np.testing.assert_allclose(down.pos, up.pos, atol=1e-6)

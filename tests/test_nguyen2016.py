@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline, Recording
-from footzoo.conventions import quat_from_euler, quat_to_matrix
+from footzoo.core.conventions import quat_from_euler, quat_to_matrix
 from footzoo.corrections.hdr import HDR, heading_bias
 from footzoo.detectors import DGP, AngularRateFSM
+from footzoo.evaluation.metrics import loop_closure, step_detection
 from footzoo.filters.eskf import Layout, skew, transition
-from footzoo.metrics import loop_closure, step_detection
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
@@ -140,7 +140,7 @@ def test_hallway_loop_with_magnetic_disturbance_ekf_is_best_and_below_paper():
                    disturbance=MagneticDisturbance(field=(0.0, 0.1, 0.0), north=(10.0, 30.0), east=(-1.0, 1.0)))
     errors = {}
     for name in ("nguyen2016_ins_zvu", "nguyen2016_ins_zvu_hdr", "nguyen2016"):
-        res = Pipeline.from_yaml(f"configs/{name}.yaml").run(rec)
+        res = Pipeline.from_yaml(name).run(rec)
         errors[name] = loop_closure(res.pos)["loop_closure_xy_pct"]
     assert min(errors, key=errors.get) == "nguyen2016"
     assert errors["nguyen2016"] < 0.375  # measured 0.13 %

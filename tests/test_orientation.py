@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from ahrs.filters import FQA as AhrsFQA
 
-from footzoo.conventions import quat_conj, quat_from_rotvec, quat_mul, quat_normalize, quat_rotate, quat_to_euler
+from footzoo.core.conventions import quat_conj, quat_from_rotvec, quat_mul, quat_normalize, quat_rotate, quat_to_euler
 from footzoo.orientation import FQAComplementary
 from footzoo.orientation.fqa import fqa, fqa_tilt
 
@@ -15,7 +15,7 @@ M_REF = np.array([np.cos(INCLINATION), 0.0, np.sin(INCLINATION)])  # NED: north 
 
 def random_attitudes(n, max_pitch=1.3):
     rpy = np.column_stack([rng.uniform(-3, 3, n), rng.uniform(-max_pitch, max_pitch, n), rng.uniform(-3, 3, n)])
-    from footzoo.conventions import quat_from_euler
+    from footzoo.core.conventions import quat_from_euler
 
     return quat_from_euler(*rpy.T)
 

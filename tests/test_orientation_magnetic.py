@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import footzoo
-from footzoo.conventions import GRAVITY
-from footzoo.metrics import loop_closure
+from footzoo.core.conventions import GRAVITY
+from footzoo.evaluation.metrics import loop_closure
 from footzoo.orientation.magnetic import field_norm_and_dip, magnetometer_valid
 from footzoo.sim import MagneticDisturbance, simulate
 

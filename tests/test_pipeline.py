@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from footzoo import Pipeline
-from footzoo.cli import main
+from footzoo.apps.cli import main
+from footzoo.evaluation.metrics import loop_closure, pyshoe_error
 from footzoo.io import builtin_sample, load
-from footzoo.metrics import loop_closure, pyshoe_error
 
 from .conftest import data_file
 
-CONFIG = "configs/yun2012.yaml"
+CONFIG = "yun2012"
 
 
 @pytest.fixture(scope="module")
@@ -68,8 +68,8 @@ def test_pyshoe_walking_trials_median():
 
 def test_recording_without_rest_is_rejected_and_a_late_rest_is_carried_back():
     from footzoo import Recording, RecordingError
-    from footzoo.alignment import initial_attitude
-    from footzoo.conventions import quat_to_euler
+    from footzoo.core.conventions import quat_to_euler
+    from footzoo.runtime.alignment import initial_attitude
 
     rec = builtin_sample()
     k = np.searchsorted(rec.t, [20.0, 24.0])

@@ -13,9 +13,7 @@ import pandas as pd
 import pytest
 
 import footzoo
-from footzoo.ablation.report import level_labels, metric_figure, metric_label, plot_study, roc_figure, run_labels
-from footzoo.ablation.report import trajectories_figure as study_trajectories
-from footzoo.plots import (
+from footzoo.evaluation.plots import (
     aligned_reference,
     errors_figure,
     fpa_figure,
@@ -27,6 +25,8 @@ from footzoo.plots import (
     trajectory_figure,
 )
 from footzoo.sim import NoiseModel, simulate
+from footzoo.studies.report import level_labels, metric_figure, metric_label, plot_study, roc_figure, run_labels
+from footzoo.studies.report import trajectories_figure as study_trajectories
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +34,7 @@ def walk():
     """A short simulated walk with truth and the yun2012 pipeline's result on it."""
     rec = simulate(n_strides=8, rate=100.0, profile="physical", noise=NoiseModel(seed=0), seed=0,
                    fpa=np.radians(8.0))
-    res = footzoo.Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
+    res = footzoo.Pipeline.from_yaml("yun2012").run(rec)
     return rec, res
 
 
@@ -74,7 +74,7 @@ def test_reference_is_aligned_onto_the_estimate(walk):
     turned = np.column_stack([c * truth[:, 0] - s * truth[:, 1], s * truth[:, 0] + c * truth[:, 1], truth[:, 2]])
     samples = res.samples.copy()
     samples[["pos_n", "pos_e", "pos_d"]] = turned + [5.0, -2.0, 0.3]
-    fake = footzoo.data.Result(samples=samples, steps=res.steps, config=res.config, versions=res.versions)
+    fake = footzoo.core.data.Result(samples=samples, steps=res.steps, config=res.config, versions=res.versions)
     assert np.allclose(aligned_reference(fake, rec), fake.pos, atol=1e-9)
     fig = trajectory_figure(res, rec)
     assert "reference (yaw-aligned)" in legend_texts(fig)
@@ -93,7 +93,7 @@ def test_errors_figure_reports_the_rms_of_the_plotted_error(walk):
 
 def test_no_truth_gives_no_error_figure_and_no_reference(walk, tmp_path):
     rec, res = walk
-    bare = footzoo.data.Recording(t=rec.t, acc=rec.acc, gyr=rec.gyr, meta={"name": "bare"})
+    bare = footzoo.core.data.Recording(t=rec.t, acc=rec.acc, gyr=rec.gyr, meta={"name": "bare"})
     assert errors_figure(res, bare) is None
     assert aligned_reference(res, bare) is None
     fig = trajectory_figure(res, bare)
@@ -121,7 +121,7 @@ def test_strides_figure_uses_gait_event_columns_and_reference(walk):
     rec, res = walk
     steps = res.steps.copy()
     steps["fpa_deg"] = 8.0  # as the huang_fpa analysis adds it
-    res2 = footzoo.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
+    res2 = footzoo.core.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
                                diagnostics=res.diagnostics)
     fig = strides_figure(res2, rec)
     titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_visible()]
@@ -151,7 +151,7 @@ def test_stride_table_without_units_in_its_names(walk):
     legacy = pd.DataFrame({"start": st["start_s"], "end": st["end_s"], "stride_time": st["stride_time_s"],
                            "stride_length": st["stride_length_m"], "speed": st["speed_m_s"],
                            "heading": st["heading_rad"], "max_clearance": st["max_clearance_m"], "fpa": 0.1})
-    res2 = footzoo.data.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
+    res2 = footzoo.core.data.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
                                diagnostics=res.diagnostics)
     fig = strides_figure(res2, rec)
     titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
@@ -186,7 +186,7 @@ def test_robust_limits_keep_a_precise_series_and_drop_a_standing_stride():
 
 def test_no_strides(walk):
     rec, res = walk
-    empty = footzoo.data.Result(samples=res.samples, steps=res.steps.iloc[:0], config=res.config,
+    empty = footzoo.core.data.Result(samples=res.samples, steps=res.steps.iloc[:0], config=res.config,
                                 versions=res.versions)
     assert strides_figure(empty, rec) is None
     assert fpa_figure(empty, rec) is None
@@ -344,8 +344,8 @@ def test_one_config_without_reference(tmp_path):
 
 def _reference_plot_study(table, runs, factors, out):
     """The previous plot_study, all figures in one call (the parallel report split it by factor only)."""
-    from footzoo.ablation.report import _safe, trajectories_figure
-    from footzoo.plots import save
+    from footzoo.evaluation.plots import save
+    from footzoo.studies.report import _safe, trajectories_figure
 
     written = []
     labels = run_labels(runs, factors)
@@ -367,7 +367,7 @@ def _reference_plot_study(table, runs, factors, out):
 
 def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
     """The report's one-figure tasks (shared out to workers) give the previous plot_study's files, byte for byte."""
-    from footzoo.ablation.report import draw_figure, figure_tasks
+    from footzoo.studies.report import draw_figure, figure_tasks
 
     runs = fake_runs(4, n_recordings=3)
     table = table_of(runs, FACTORS)
@@ -380,7 +380,7 @@ def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
     for p in old:
         assert (tmp_path / "new" / p.name).read_bytes() == p.read_bytes()
     assert [p.name for p in plot_study(table, runs, FACTORS, tmp_path / "again")] == [p.name for p in old]
-    from footzoo.ablation.report import render_figure
+    from footzoo.studies.report import render_figure
 
     drawn = [d for d in (render_figure(t) for t in tasks) if d is not None]  # in memory, as on a Dask worker
     assert [name for name, _ in drawn] == [p.name for p in old]
@@ -393,7 +393,7 @@ def test_saved_figures_keep_a_legend_placed_below_the_axes(tmp_path, layout):
     import matplotlib.pyplot as plt
     from PIL import Image
 
-    from footzoo.plots import STYLE, save
+    from footzoo.evaluation.plots import STYLE, save
 
     fig, ax = plt.subplots(figsize=(4, 3), layout=layout)
     ax.plot([0, 1], [0, 1], label="a long legend entry that reaches far to the side")

@@ -1,13 +1,13 @@
-"""Every built-in plug-in follows the plug-in contract (footzoo.testing.check_plugin)."""
+"""Every built-in plug-in follows the plug-in contract (footzoo.apps.testing.check_plugin)."""
 
 import numpy as np
 import pytest
 
 import footzoo
-from footzoo.errors import RecordingError
-from footzoo.plugin import Detector
-from footzoo.registry import KINDS, available
-from footzoo.testing import check_plugin
+from footzoo.apps.testing import check_plugin
+from footzoo.core.errors import RecordingError
+from footzoo.plugins.base import Detector
+from footzoo.plugins.registry import KINDS, available
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -77,11 +77,11 @@ def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
     with pytest.raises(TypeError, match="plug-in class"):
         footzoo.register(NotAPlugin)
 
-    class Stray(footzoo.plugin.Plugin):
+    class Stray(footzoo.plugins.base.Plugin):
         kind = "detector"
         name = "test_stray"
 
-    with pytest.raises(TypeError, match="derives from footzoo.plugin.Detector"):
+    with pytest.raises(TypeError, match="derives from footzoo.plugins.base.Detector"):
         footzoo.register(Stray)
 
     class Shoe2(Detector):
@@ -94,11 +94,12 @@ def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
 
 
 def test_the_engine_pipeline_and_stream_name_no_plugin():
-    """The engine knows no plug-in by name: adding one touches none of these files."""
+    """The engine, the runtime and the kernels know no plug-in by name: adding one touches none of their files."""
     from pathlib import Path
 
     root = Path(footzoo.__file__).parent
-    files = [*sorted((root / "filters").glob("*.py")), root / "pipeline.py", root / "stream.py"]
+    files = [*sorted((root / "filters").glob("*.py")), *sorted((root / "runtime").glob("*.py")),
+             *sorted((root / "kernels").glob("*.py"))]
     names = {name for kind in KINDS for name in available(kind) if not name.startswith("test_")}
     for f in files:
         text = f.read_text()

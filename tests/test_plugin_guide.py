@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from footzoo import Pipeline
-from footzoo.errors import FootzooWarning
-from footzoo.extensions import load_plugins
-from footzoo.metrics import stance_scores
+from footzoo.apps.testing import check_plugin
+from footzoo.core.errors import FootzooWarning
+from footzoo.evaluation.metrics import stance_scores
+from footzoo.plugins.extensions import load_plugins
+from footzoo.runtime.stream import Stream
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
-from footzoo.stream import Stream
-from footzoo.testing import check_plugin
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "plugins"
 

@@ -3,16 +3,16 @@
 import numpy as np
 import pytest
 
+from footzoo.evaluation.metrics import pyshoe_error
 from footzoo.io import load
-from footzoo.metrics import pyshoe_error
-from footzoo.pipeline import Pipeline
+from footzoo.runtime.pipeline import Pipeline
 from tests.conftest import data_file
 
 
 def test_pyshoe_sensor_is_on_the_right_foot_so_huang2016_runs():
     rec = load(data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat"))
     assert rec.meta["foot"] == "right"
-    res = Pipeline.from_yaml("configs/huang2016.yaml").run(rec)
+    res = Pipeline.from_yaml("huang2016").run(rec)
     # one foot progression angle per stride (their values need the foot vector of a calibration trial,
     # which PyShoe does not have: the sensor's x axis is about 30° off the walking direction)
     assert res.steps["fpa_rad"].notna().sum() >= len(res.steps) - 1 > 10
@@ -23,7 +23,7 @@ def test_pyshoe_sensor_is_on_the_right_foot_so_huang2016_runs():
 def test_upside_down_trial_is_aligned_from_gravity():
     rec = load(data_file("pyshoe_vicon", "2018-02-22-10-09-36.mat"))
     assert rec.acc[:50, 2].mean() > 9.0  # mounted upside down: +g on z at rest
-    res = Pipeline.from_yaml("configs/duong2015_zupt.yaml").run(rec)
+    res = Pipeline.from_yaml("duong2015_zupt").run(rec)
     quat = res.samples[["qw", "qx", "qy", "qz"]].to_numpy()
     roll = np.degrees(np.abs(res.samples["roll"].to_numpy()[:50]))
     assert np.all(roll > 170)  # the estimate knows the sensor is upside down

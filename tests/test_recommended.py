@@ -1,9 +1,9 @@
-"""configs/recommended.yaml: one setting that finds every stance walking, running and on stairs (simulated)."""
+"""The recommended config: one setting that finds every stance walking, running and on stairs (simulated)."""
 
 import pytest
 
-from footzoo.metrics import armse, step_detection
-from footzoo.pipeline import Pipeline
+from footzoo.evaluation.metrics import armse, step_detection
+from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import simulate
 
 SCENARIOS = {
@@ -17,7 +17,7 @@ SCENARIOS = {
 def test_recommended_finds_every_stance_and_tracks_the_truth(scenario):
     spec, bound = SCENARIOS[scenario]
     rec = simulate(**spec, profile="physical", noise={"scale": 1.0, "seed": 0})
-    res = Pipeline.from_yaml("configs/recommended.yaml").run(rec)
+    res = Pipeline.from_yaml("recommended").run(rec)
     sd = step_detection(res.stance, rec.truth.stance, rec.t)
     assert sd["error_rate"] == 0.0
     assert len(res.steps) == len(rec.truth.steps)

@@ -11,9 +11,9 @@ import pytest
 
 from footzoo import Pipeline
 from footzoo.analysis.foot_vector import FootVector
-from footzoo.cli import main
+from footzoo.apps.cli import main
+from footzoo.core.data import Recording
 from footzoo.corrections.height import load_calibration, save_calibration
-from footzoo.data import Recording
 from footzoo.io import load
 from footzoo.io.canonical import EXACT_CSV, write
 from footzoo.sim import NoiseModel, simulate
@@ -72,8 +72,8 @@ def test_run_outputs_round_trip(walk, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(ROOT)
     data = write(_epoch(walk), tmp_path / "walk.csv")
     out = tmp_path / "out"
-    assert main(["run", "configs/yun2012.yaml", "--data", str(data), "--out", str(out)]) == 0
-    expected = Pipeline.from_yaml(ROOT / "configs" / "yun2012.yaml").run(load(data))
+    assert main(["run", "yun2012", "--data", str(data), "--out", str(out)]) == 0
+    expected = Pipeline.from_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml").run(load(data))
     samples = pd.read_csv(out / "samples.csv", **EXACT_CSV)
     steps = pd.read_csv(out / "steps.csv", **EXACT_CSV)
     pd.testing.assert_frame_equal(samples, expected.samples, check_exact=True, check_dtype=False)

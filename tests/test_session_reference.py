@@ -9,17 +9,17 @@ import pandas as pd
 import pytest
 
 from footzoo import Pipeline, Session
-from footzoo.cli import main
-from footzoo.errors import FormatError
+from footzoo.apps.cli import main
+from footzoo.core.errors import FormatError
+from footzoo.evaluation.metrics import footprint_errors, rigid_align_2d
 from footzoo.io import load
 from footzoo.io.canonical import write
-from footzoo.metrics import footprint_errors, rigid_align_2d
-from footzoo.session import step_times
+from footzoo.runtime.session import step_times
 from footzoo.sim import NoiseModel, simulate
 
 from .conftest import data_file
 
-YUN = "configs/yun2012.yaml"
+YUN = "yun2012"
 
 
 def test_step_time_and_symmetry_index_by_hand():
@@ -78,7 +78,7 @@ def test_a_one_foot_file_is_not_a_session(tmp_path, capsys):
 
 
 def test_gaitmap_stride_paths_against_motion_capture(gaitmap_session):
-    from footzoo.metrics import stride_path_errors
+    from footzoo.evaluation.metrics import stride_path_errors
 
     session, res = gaitmap_session
     for foot in ("left", "right"):

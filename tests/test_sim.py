@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from footzoo.conventions import quat_conj, quat_mul, quat_rotate, quat_to_euler
+from footzoo.core.conventions import quat_conj, quat_mul, quat_rotate, quat_to_euler
 from footzoo.filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from footzoo.orientation import FQAComplementary
 from footzoo.sim import DistanceSensors, MagneticDisturbance, NoiseModel, simulate, simulate_pendulum
@@ -185,7 +185,7 @@ def test_quaternion_helpers_used_here():
 
 
 def test_cli_simulate_then_run_prints_metrics_against_the_truth(tmp_path, capsys):
-    from footzoo.cli import main
+    from footzoo.apps.cli import main
     from footzoo.io import load
 
     out = tmp_path / "walk.csv"
@@ -194,7 +194,7 @@ def test_cli_simulate_then_run_prints_metrics_against_the_truth(tmp_path, capsys
     assert rec.truth.closed_loop and rec.truth.steps is not None and rec.dist.shape[1] == 2
     assert rec.truth.dist is not None
     capsys.readouterr()
-    assert main(["run", "configs/yun2012.yaml", "--data", str(out)]) == 0
+    assert main(["run", "yun2012", "--data", str(out)]) == 0
     text = capsys.readouterr().out
     assert "loop_closure_xy_m" in text and "armse_3d_m" in text
 

@@ -13,7 +13,7 @@ def walk():
 
 
 def _pipeline(name, smoother):
-    d = Pipeline.from_yaml(f"configs/{name}.yaml").to_dict()
+    d = Pipeline.from_yaml(name).to_dict()
     return Pipeline.from_dict({**d, "smoother": smoother})
 
 

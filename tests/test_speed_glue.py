@@ -9,12 +9,12 @@ import pandas as pd
 import pytest
 
 from footzoo import Pipeline
-from footzoo._table import samples_frame
 from footzoo.analysis.fpa import HuangFPA
-from footzoo.conventions import gravity_ned, quat_mul, quat_normalize, quat_rotate, quat_to_euler, wrap_angle
+from footzoo.core.conventions import gravity_ned, quat_mul, quat_normalize, quat_rotate, quat_to_euler, wrap_angle
+from footzoo.core.table import samples_frame
 from footzoo.corrections.zvu_dedrift import swing_segments, zvu_dedrift
+from footzoo.evaluation.metrics import intervals
 from footzoo.filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
-from footzoo.metrics import intervals
 from footzoo.sim import NoiseModel, simulate
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
@@ -226,8 +226,8 @@ def _reference_first_still_window(t, gyr, duration, max_gyr):
 
 @pytest.mark.parametrize("still_from", [0, 4090, 5000, 20000, None])
 def test_first_still_window_reads_chunks_but_finds_the_same_window(still_from):
-    from footzoo.alignment import first_still_window
-    from footzoo.errors import RecordingError
+    from footzoo.core.errors import RecordingError
+    from footzoo.runtime.alignment import first_still_window
 
     rng = np.random.default_rng(0)
     n = 30000
@@ -249,7 +249,7 @@ def _reference_hdr(quat, acc_nav, stance, threshold):
     """The previous per-stride loop of HDR without a Kalman filter (eqs. 23–27)."""
     import math
 
-    from footzoo.conventions import quat_yaw
+    from footzoo.core.conventions import quat_yaw
 
     yaw = quat_yaw(quat)
     out = acc_nav.copy()
@@ -275,7 +275,7 @@ def _reference_hdr(quat, acc_nav, stance, threshold):
 
 
 def test_hdr_swing_rotation_equals_the_stride_loop(walk):
-    from footzoo.conventions import quat_from_euler
+    from footzoo.core.conventions import quat_from_euler
     from footzoo.corrections.hdr import HDR
 
     rng = np.random.default_rng(4)

@@ -8,7 +8,7 @@ Speed itself: benchmarks/.
 import numpy as np
 import pytest
 
-from footzoo.conventions import GRAVITY
+from footzoo.core.conventions import GRAVITY
 from footzoo.orientation.magnetic import REFERENCE_DURATION, field_norm_and_dip, magnetometer_valid
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
@@ -40,7 +40,7 @@ def disturbed_walk():
 @pytest.mark.parametrize("tolerances", [(0.1, np.radians(5.0)), (0.02, np.radians(1.0)), (0.3, 0.2)])
 def test_magnetometer_check_equals_the_numpy_code(disturbed_walk, lead, tolerances):
     r = disturbed_walk
-    from footzoo.registry import build
+    from footzoo.plugins.registry import build
 
     still = build("detector", {"type": "windowed"}).detect(r.t, r.acc, r.gyr).stance_.copy()
     still[:lead] = True  # leading still runs of several lengths, also none and all
@@ -70,9 +70,9 @@ def test_magnetometer_check_equals_the_numpy_code_on_random_fields():
 @pytest.mark.parametrize("rate", [100.0, 200.0])
 def test_skog_statistics_in_the_window_pass_equal_the_tests_on_the_moments(name, rate):
     """The fused window pass gives the statistic of ``test(window_moments(...))``, the previous path, to the bit."""
-    from footzoo.conventions import GRAVITY as G
+    from footzoo.core.conventions import GRAVITY as G
     from footzoo.detectors.windows import window_moments
-    from footzoo.registry import build
+    from footzoo.plugins.registry import build
 
     r = simulate(n_strides=20, rate=rate, profile="physical", path="mixed_speed", noise=NoiseModel(seed=5))
     det = build("detector", {"type": name, "window": 0.04}).detect(r.t, r.acc, r.gyr)
@@ -93,7 +93,7 @@ def test_a_subclass_with_its_own_test_gets_the_moments():
 
 
 def test_the_finite_check_without_a_temporary_equals_isfinite_all():
-    from footzoo.plugin import _all_finite
+    from footzoo.plugins.base import _all_finite
 
     rng = np.random.default_rng(0)
     big = np.finfo(float).max
@@ -105,7 +105,7 @@ def test_the_finite_check_without_a_temporary_equals_isfinite_all():
 
 
 def test_the_sample_table_wraps_the_outputs_and_copies_time_and_stance():
-    from footzoo._table import samples_frame
+    from footzoo.core.table import samples_frame
 
     r = simulate(n_strides=5, rate=100.0, profile="physical", noise=NoiseModel(seed=2))
     q, pos, vel = r.truth.quat.copy(), r.truth.pos.copy(), r.truth.vel.copy()
@@ -187,7 +187,7 @@ def test_gait_events_equal_the_vectorised_code(scenario, flip):
     """The compiled searches and the mid-interval times of the event samples give the previous events to the bit."""
     from footzoo.analysis.gait_events import detect_gait_events
     from footzoo.analysis.strides import real_stances
-    from footzoo.registry import build
+    from footzoo.plugins.registry import build
 
     r = simulate(profile="physical", noise=NoiseModel(seed=6), n_strides=30, **scenario)
     t = r.t + np.cumsum(np.random.default_rng(1).uniform(0.0, 1e-4, len(r.t)))  # uneven intervals

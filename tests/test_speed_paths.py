@@ -26,7 +26,7 @@ def walk():
 
 @pytest.mark.parametrize("name", KALMAN)
 def test_compiled_kalman_loop_equals_the_filterpy_reference(walk, name):
-    p = Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
+    p = Pipeline.from_yaml(ROOT / "footzoo" / "config" / "builtin" / f"{name}.yaml")
     ref = p.run(walk, engine="reference", covariance=True)
     fast = p.run(walk, engine="fast", covariance=True)
     for col in ("pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "qw", "qx", "qy", "qz"):
@@ -52,9 +52,9 @@ def test_without_a_compiler_the_same_code_gives_the_same_numbers(tmp_path):
         "import json, sys, numpy as np, footzoo;"
         "from footzoo.sim import simulate, NoiseModel;"
         "rec = simulate(n_strides=4, profile='physical', rate=100.0, noise=NoiseModel(seed=2));"
-        "out = {c: footzoo.Pipeline.from_yaml(f'configs/{c}.yaml').run(rec).pos[-1].tolist()"
+        "out = {c: footzoo.Pipeline.from_yaml(c).run(rec).pos[-1].tolist()"
         " for c in ('yun2012', 'huang2016', 'nguyen2016', 'duong2015_zupt')};"
-        "out['jit'] = footzoo._jit.HAVE_NUMBA; print(json.dumps(out))"
+        "out['jit'] = footzoo.kernels.jit.HAVE_NUMBA; print(json.dumps(out))"
     )
     results = []
     for disable in ("0", "1"):
@@ -79,7 +79,7 @@ def test_import_footzoo_loads_no_heavy_dependency():
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["before"] == {"pandas": False, "scipy": False, "numba": False}
-    assert out["pipeline"] == "footzoo.pipeline"
+    assert out["pipeline"] == "footzoo.runtime.pipeline"
     assert "Pipeline" in out["all"] and "load" in out["all"]
 
 
@@ -92,10 +92,11 @@ def test_pipeline_and_readers_load_no_compiler_until_a_kernel_runs():
     script = (
         "import sys, json; from footzoo import Pipeline, load; heavy = ('numba', 'scipy', 'filterpy');"
         "out = {'import': [m for m in heavy if m in sys.modules]};"
-        "from footzoo.registry import available; [available(k) for k in ('orientation', 'detector', 'correction')];"
-        "p = Pipeline.from_yaml('configs/nguyen2016.yaml'); out['build'] = [m for m in heavy if m in sys.modules];"
+        "from footzoo.plugins.registry import available;"
+        "[available(k) for k in ('orientation', 'detector', 'correction')];"
+        "p = Pipeline.from_yaml('nguyen2016'); out['build'] = [m for m in heavy if m in sys.modules];"
         "from footzoo.sim import simulate; p.run(simulate(n_strides=3, rate=100.0, profile='physical'));"
-        "import footzoo._jit as j; out['run'] = 'numba' in sys.modules; out['jit'] = j.HAVE_NUMBA;"
+        "import footzoo.kernels.jit as j; out['run'] = 'numba' in sys.modules; out['jit'] = j.HAVE_NUMBA;"
         "print(json.dumps(out))"
     )
     proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True, text=True, cwd=ROOT,
@@ -109,7 +110,7 @@ def test_pipeline_and_readers_load_no_compiler_until_a_kernel_runs():
 def test_kernels_are_compiled_at_first_call_and_callers_see_the_compiled_callees():
     """After the first kernel call every footzoo module attribute naming a kernel is numba's dispatcher."""
     script = (
-        "import sys, json, numpy as np, footzoo, footzoo._jit as j;"
+        "import sys, json, numpy as np, footzoo, footzoo.kernels.jit as j;"
         "from footzoo.orientation import fqa_complementary as fc; fqa = sys.modules['footzoo.orientation.fqa'];"
         "lazy = type(fc.complementary_kernel).__name__;"
         "q = fc.complementary_kernel(np.array([1.0, 0, 0, 0]), np.zeros((3, 3)), np.full(3, 0.01),"
@@ -163,7 +164,7 @@ def _dense_engine(engine):
 
 def test_rows_taken_one_at_a_time_equal_the_stacked_update(walk):
     """Rows with several nonzero entries each, updated in turn (fast) and stacked (filterpy): the same filter."""
-    stance = np.asarray(Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml").detect(walk).stance_)
+    stance = np.asarray(Pipeline.from_yaml("nguyen2016").detect(walk).stance_)
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
     ref = _dense_engine("reference").run(walk.t, walk.acc, walk.gyr, stance, q0)
     fast = _dense_engine("fast").run(walk.t, walk.acc, walk.gyr, stance, q0)
@@ -175,7 +176,7 @@ def test_rows_taken_one_at_a_time_equal_the_stacked_update(walk):
 
 def test_compiled_loop_keeps_the_covariance_exactly_symmetric(walk):
     eng = _dense_engine("fast")
-    stance = np.asarray(Pipeline.from_yaml(ROOT / "configs" / "nguyen2016.yaml").detect(walk).stance_)
+    stance = np.asarray(Pipeline.from_yaml("nguyen2016").detect(walk).stance_)
     state = eng.start(np.array([1.0] + [0.0] * 15))
     eng.advance(state, walk.t, walk.acc, walk.gyr, stance, None, [None], 0)
     assert np.array_equal(state.P, state.P.T)
@@ -209,8 +210,8 @@ def _allocating_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m
 
 
 def test_measurement_functions_compile_without_reference_counting_and_allocating_ones_still_work():
-    from footzoo import _jit
     from footzoo.corrections.ekf_zupt import zero_velocity_measure
+    from footzoo.kernels import jit as _jit
 
     if not _jit.HAVE_NUMBA:
         pytest.skip("numba not installed")

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from footzoo import ConfigError, Pipeline, Recording, RecordingError
+from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
-from footzoo.stream import Stream
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -17,7 +17,7 @@ def walk():
 
 
 @pytest.mark.parametrize("config", [
-    "configs/nguyen2016.yaml",
+    "nguyen2016",
     {"orientation": {"type": "ins"}, "detector": {"type": "dgp"},
      "corrections": [{"type": "zupt"}, {"type": "height_distance"}]},
 ])
@@ -33,7 +33,7 @@ def test_streamed_results_equal_the_batch_results(walk, config):
 
 
 def test_push_returns_none_until_the_still_start_is_seen(walk):
-    s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
+    s = Stream(Pipeline.from_yaml("nguyen2016"))
     assert s.push(walk.t[0], walk.acc[0], walk.gyr[0], walk.mag[0]) is None
     outs = [s.push(walk.t[k], walk.acc[k], walk.gyr[k], walk.mag[k]) for k in range(1, 80)]
     est = outs[-1]
@@ -43,31 +43,31 @@ def test_push_returns_none_until_the_still_start_is_seen(walk):
 
 def test_non_causal_pipelines_are_rejected_with_the_reason():
     with pytest.raises(ConfigError, match=r"detector 'angular_rate_fsm' looks ahead or dates switches back"):
-        Stream(Pipeline.from_yaml("configs/yun2012.yaml"))
+        Stream(Pipeline.from_yaml("yun2012"))
     with pytest.raises(ConfigError, match=r"detector 'windowed'"):
-        Stream(Pipeline.from_yaml("configs/duong2015_zupt.yaml"))
+        Stream(Pipeline.from_yaml("duong2015_zupt"))
     # a smoother runs backwards: a stream would silently give the forward filter's estimate instead
-    d = Pipeline.from_yaml("configs/nguyen2016.yaml").to_dict()
+    d = Pipeline.from_yaml("nguyen2016").to_dict()
     d["smoother"] = "rts"
     with pytest.raises(ConfigError, match=r"smoother 'rts' runs backwards .*live: smoother: none"):
         Stream(Pipeline.from_dict(d))
 
 
 def test_bad_live_input_is_reported(walk):
-    s = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"))
+    s = Stream(Pipeline.from_yaml("nguyen2016"))
     s.push(walk.t[0], walk.acc[0], walk.gyr[0])
     with pytest.raises(RecordingError, match="samples must arrive in order"):
         s.push(walk.t[0], walk.acc[0], walk.gyr[0])
     with pytest.raises(RecordingError, match="non-finite sample"):
         s.push(walk.t[1], [np.nan, 0, 0], walk.gyr[1])
-    spinning = Stream(Pipeline.from_yaml("configs/nguyen2016.yaml"), rate=100.0, max_wait=3.0)
+    spinning = Stream(Pipeline.from_yaml("nguyen2016"), rate=100.0, max_wait=3.0)
     with pytest.raises(RecordingError, match="found no still period.*first 3.0 s"):
         for k in range(400):  # turning at 1 rad/s: never still
             spinning.push(k / 100.0, [0.0, 0.0, -9.81], [0.0, 0.0, 1.0])
 
 
 def test_a_stream_that_starts_moving_waits_for_the_first_still_period_and_equals_the_batch(walk):
-    p = Pipeline.from_yaml("configs/nguyen2016.yaml")
+    p = Pipeline.from_yaml("nguyen2016")
     k0 = int(np.searchsorted(walk.t, 3.0))  # start mid-walk: the batch carries the attitude back
     rec = Recording(t=walk.t[k0:] - walk.t[k0], acc=walk.acc[k0:], gyr=walk.gyr[k0:], mag=walk.mag[k0:])
     batch = p.run(rec)
@@ -101,7 +101,7 @@ def test_stream_equals_batch_on_real_walking_trials(trial):
 
     rec = load(data_file("pyshoe_vicon", f"{trial}.mat"), format="pyshoe")
     causal = []
-    for path in sorted(glob.glob("configs/*.yaml")):
+    for path in sorted(glob.glob("footzoo/config/builtin/*.yaml")):
         if "study" in path:
             continue
         p = Pipeline.from_yaml(path)

@@ -13,10 +13,10 @@ import sys
 from pathlib import Path
 
 import footzoo
-from footzoo.plots import plot_run
+from footzoo.evaluation.plots import plot_run
 from footzoo.sim import NoiseModel, simulate
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 rec = simulate(path="figure_eight", rate=100.0, profile="physical", noise=NoiseModel(seed=3), seed=3)
-result = footzoo.Pipeline.from_yaml("configs/duong2015_zupt.yaml").run(rec)
+result = footzoo.Pipeline.from_yaml("duong2015_zupt").run(rec)
 plot_run(result, out, rec, window=(4.0, 8.0))

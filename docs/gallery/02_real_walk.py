@@ -12,10 +12,10 @@ import sys
 from pathlib import Path
 
 import footzoo
+from footzoo.evaluation.plots import plot_run
 from footzoo.io import builtin_sample
-from footzoo.plots import plot_run
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 rec = builtin_sample()
-result = footzoo.Pipeline.from_yaml("configs/yun2012.yaml").run(rec)
+result = footzoo.Pipeline.from_yaml("yun2012").run(rec)
 plot_run(result, out, rec, window=(18.0, 23.0))

@@ -14,14 +14,14 @@ import numpy as np
 
 import footzoo
 from footzoo.analysis import calibrate_foot_vector
-from footzoo.plots import fpa_figure, save
+from footzoo.evaluation.plots import fpa_figure, save
 from footzoo.sim import NoiseModel, simulate, simulate_calibration
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 mount_yaw = np.radians(15.0)
 foot_yaml = Path(tempfile.mkdtemp()) / "foot.yaml"
 calibrate_foot_vector(simulate_calibration(mount_yaw=mount_yaw, noise=NoiseModel(seed=5))).save(foot_yaml)
-config = footzoo.config.load_yaml("configs/huang2016.yaml")
+config = footzoo.config.load_yaml("huang2016")
 config["analysis"][0]["calibration"] = str(foot_yaml)
 rec = simulate(n_strides=30, rate=100.0, profile="physical", fpa=np.radians(12.0), mount_yaw=mount_yaw,
                noise=NoiseModel(seed=1), seed=1, clearance=0.12)

@@ -11,7 +11,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from footzoo.ablation import Study, run_study
+from footzoo.studies import Study, run_study
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
 study = Study.from_dict({

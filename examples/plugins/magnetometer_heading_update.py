@@ -23,7 +23,7 @@ import numpy as np
 
 import footzoo
 from footzoo.filters.measurement import ATT, MeasurementModel, measurement_function
-from footzoo.plugin import KalmanCorrection, Samples
+from footzoo.plugins.base import KalmanCorrection, Samples
 
 
 @measurement_function

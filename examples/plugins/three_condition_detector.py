@@ -22,7 +22,7 @@ import numpy as np
 from scipy.ndimage import median_filter, uniform_filter1d
 
 import footzoo
-from footzoo.plugin import Detector
+from footzoo.plugins.base import Detector
 
 
 @footzoo.register

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..checks import check_vector
-from ..data import Recording
-from ..errors import ConfigError, RecordingError
-from ..metrics import intervals
-from ..yamlsafe import load_file
+from ..core.checks import check_vector
+from ..core.data import Recording
+from ..core.errors import ConfigError, RecordingError
+from ..core.yamlsafe import load_file
+from ..evaluation.metrics import intervals
 
 
 @dataclass

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pandas as pd
 
-from .._jit import njit
-from ..checks import check_range, check_vector
-from ..errors import ConfigError
-from ..metrics import intervals, nearest_index
-from ..plugin import Analysis
-from ..registry import check_positive, register
+from ..core.checks import check_range, check_vector
+from ..core.errors import ConfigError
+from ..evaluation.metrics import intervals, nearest_index
+from ..kernels.jit import njit
+from ..plugins.base import Analysis
+from ..plugins.registry import check_positive, register
 from .foot_vector import FootVector
 
 

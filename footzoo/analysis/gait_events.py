@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit
+from ..kernels.jit import njit
 
 
 @dataclass

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..metrics import intervals
+from ..evaluation.metrics import intervals
 from .gait_events import detect_gait_events, segment_argext
 
 #: Columns of :func:`segment_steps`, units in the names.

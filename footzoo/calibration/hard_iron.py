@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_range, check_vector
-from ..errors import CalibrationWarning
-from ..plugin import Calibration
-from ..registry import register
+from ..core.checks import check_range, check_vector
+from ..core.errors import CalibrationWarning
+from ..plugins.base import Calibration
+from ..plugins.registry import register
 
 
 @dataclass(frozen=True)
@@ -131,7 +131,7 @@ class HardIron(Calibration):
     magnetic disturbances nearby make an ellipsoid or a cloud, which an offset does not
     calibrate; Köroğlu's indoor walks give 20–30 %, the simulator 0.2 %) and the offset is
     smaller than the field; otherwise the magnetometer is left as it is, with a
-    :class:`~footzoo.errors.CalibrationWarning` and the reason in ``report_``. Recordings without
+    :class:`~footzoo.core.errors.CalibrationWarning` and the reason in ``report_``. Recordings without
     a magnetometer pass through unchanged.
 
     Parameters

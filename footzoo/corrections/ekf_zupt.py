@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_bool, check_range
+from ..core.checks import check_bool, check_range
 from ..filters.measurement import ACC_BIAS, BA, BG, GYRO_BIAS, VEL, MeasurementModel, StateBlock, measurement_function
-from ..plugin import KalmanCorrection, Samples
-from ..registry import register
+from ..plugins.base import KalmanCorrection, Samples
+from ..plugins.registry import register
 
 
 @measurement_function

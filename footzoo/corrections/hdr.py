@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..checks import check_range
-from ..conventions import quat_yaw
+from ..core.checks import check_range
+from ..core.conventions import quat_yaw
+from ..evaluation.metrics import intervals
 from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
-from ..metrics import intervals
-from ..plugin import AccelerationCorrection, KalmanCorrection, Samples
-from ..registry import register
+from ..kernels.jit import njit
+from ..plugins.base import AccelerationCorrection, KalmanCorrection, Samples
+from ..plugins.registry import register
 
 
 def heading_bias(yaw: float, previous: list[float], threshold: float) -> float | None:

@@ -29,12 +29,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..checks import check_bool, check_range
-from ..errors import ConfigError, RecordingError
+from ..core.checks import check_bool, check_range
+from ..core.errors import ConfigError, RecordingError
+from ..core.yamlsafe import load_file
 from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
-from ..plugin import KalmanCorrection, Samples
-from ..registry import register
-from ..yamlsafe import load_file
+from ..plugins.base import KalmanCorrection, Samples
+from ..plugins.registry import register
 
 #: Duong & Suh Table 1 in their IMU frame (x toward the floor), mapped to FRD: (x, y, z)_DS -> (y, z, x).
 TABLE1_POSITIONS = [[0.080, 0.0, -0.008], [-0.062, 0.0, -0.006]]

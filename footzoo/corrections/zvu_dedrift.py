@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit
 from ..filters.strapdown import integrate_position, sample_intervals
-from ..plugin import VelocityCorrection
-from ..registry import register
+from ..kernels.jit import njit
+from ..plugins.base import VelocityCorrection
+from ..plugins.registry import register
 
 
 def swing_segments(stance: np.ndarray) -> list[tuple[int, int]]:

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..registry import check_positive, register
+from ..kernels.jit import njit
+from ..plugins.registry import check_positive, register
 from .runs import close_short_swings
 from .shoe import SHOE
 

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from ..checks import check_range
-from ..plugin import Detector
-from ..registry import register
+from ..core.checks import check_range
+from ..plugins.base import Detector
+from ..plugins.registry import register
 from .runs import dated_and_online_states
 
 

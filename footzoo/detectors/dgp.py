@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..checks import check_range
-from ..conventions import GRAVITY
+from ..core.checks import check_range
+from ..core.conventions import GRAVITY
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
-from ..plugin import Detector
-from ..registry import check_positive, register
+from ..kernels.jit import njit
+from ..plugins.base import Detector
+from ..plugins.registry import check_positive, register
 
 
 def _count(x: float) -> int:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..registry import register
+from ..plugins.registry import register
 from .skog import FUSED_TESTS, SkogTest
 from .windows import MAG_TEST
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import RecordingError
-from ..plugin import Detector
-from ..registry import register
+from ..core.errors import RecordingError
+from ..plugins.base import Detector
+from ..plugins.registry import register
 
 
 @register

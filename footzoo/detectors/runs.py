@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit
+from ..kernels.jit import njit
 
 
 def dated_and_online_states(

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from ..checks import check_range
-from ..conventions import GRAVITY
-from ..registry import register
+from ..core.checks import check_range
+from ..core.conventions import GRAVITY
+from ..plugins.registry import register
 from .runs import dated_and_online_states
 from .skog import FUSED_TESTS, SkogTest
 from .windows import SHOE_TEST

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_range
-from ..conventions import GRAVITY
-from ..plugin import Detector
-from ..registry import check_positive
+from ..core.checks import check_range
+from ..core.conventions import GRAVITY
+from ..plugins.base import Detector
+from ..plugins.registry import check_positive
 from .windows import window_moments, window_statistic
 
 #: Built-in ``test`` methods that :func:`~footzoo.detectors.windows.window_statistic` evaluates in its window pass,

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..checks import check_range
+from ..core.checks import check_range
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
-from ..registry import register
+from ..kernels.jit import njit
+from ..plugins.registry import register
 from .adaptive_shoe import AdaptiveSHOE, adaptive_threshold_kernel
 from .runs import close_short_swings
 

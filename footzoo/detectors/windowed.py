@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_range
-from ..plugin import Detector
-from ..registry import register
+from ..core.checks import check_range
+from ..plugins.base import Detector
+from ..plugins.registry import register
 from .windows import row_norms, window_max
 
 

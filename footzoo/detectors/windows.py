@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from ..kernels.jit import njit
 
 
 @njit

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import _jit
-from ..checks import Settings
-from ..errors import ConfigError, FootzooWarning
+from ..core.checks import Settings
+from ..core.errors import ConfigError, FootzooWarning
+from ..kernels import jit as _jit
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
 

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import _jit
-from .._jit import njit
+from ..kernels import jit as _jit
+from ..kernels.jit import njit
 from .smoother import feed_back_attitude
 from .strapdown import quat_product, rotvec_quat
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import quat_from_rotvec, quat_mul, quat_to_matrix
+from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
 from .measurement import MeasurementModel
 from .smoother import smoother_gain

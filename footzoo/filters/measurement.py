@@ -68,8 +68,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import _jit
-from .._jit import njit
+from ..kernels import jit as _jit
+from ..kernels.jit import njit
 
 #: Offsets in ``nav``: quaternion, position, velocity, gyro bias, accelerometer bias.
 Q, P, V, BG, BA = 0, 4, 7, 10, 13

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from ..kernels.jit import njit
 from .strapdown import quat_product, rotvec_quat
 
 JITTER = 1e-12

@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..conventions import GRAVITY
+from ..core.conventions import GRAVITY
+from ..kernels.jit import njit
 
 
 @njit(inline=True)

@@ -1,4 +1,4 @@
-"""Readers: every supported format converted once to a :class:`~footzoo.data.Recording` (FRD, SI).
+"""Readers: every supported format converted once to a :class:`~footzoo.core.data.Recording` (FRD, SI).
 
 ``load(path, format=None, **options)`` picks the reader from ``format`` or, when
 ``format`` is None, from the file's extension and header.
@@ -25,8 +25,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..data import Recording
-from ..errors import FootzooError, FormatError, did_you_mean
+from ..core.data import Recording
+from ..core.errors import FootzooError, FormatError, did_you_mean
 from . import canonical, gaitmap, pyshoe, sensorconnect, xio
 
 READERS: dict[str, Callable[..., Recording]] = {

@@ -15,10 +15,10 @@ from typing import Any
 import pandas as pd
 import yaml
 
-from ..checks import check_bool
-from ..data import Recording
-from ..errors import FormatError
-from ..yamlsafe import load_file
+from ..core.checks import check_bool
+from ..core.data import Recording
+from ..core.errors import FormatError
+from ..core.yamlsafe import load_file
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"

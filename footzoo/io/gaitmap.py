@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..checks import check_range
-from ..data import Recording, Truth
-from ..errors import FormatError
+from ..core.checks import check_range
+from ..core.data import Recording, Truth
+from ..core.errors import FormatError
 from .gaitmap_reference import has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8

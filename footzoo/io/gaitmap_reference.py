@@ -18,7 +18,7 @@ distance between the first and the last position of the stride) of the heel
 marker, and agrees with gaitmap's own per-stride heel trajectories
 (``position_sample.csv``) to 0.6 mm. The events make one stride of the left
 foot's 180° turn from 16.40 s to 18.68 s although the heel stands still for
-0.7 s between two steps in it; :func:`footzoo.metrics.match_strides` leaves
+0.7 s between two steps in it; :func:`footzoo.evaluation.metrics.match_strides` leaves
 such a stride unpaired (its borders do not match any one estimated stride).
 """
 
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import FormatError
+from ..core.errors import FormatError
 
 IMU_RATE = 204.8
 MOCAP_RATE = 100.0

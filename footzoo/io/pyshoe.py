@@ -4,7 +4,7 @@
 z down (already FRD); ``ts`` (s); ``gt`` (N×3, VICON position, z up). The
 reference is mirrored with respect to the IMU frame: a right-handed NED
 estimate matches ``gt · [1, 1, −1]`` (negate z only), which is what the
-:class:`~footzoo.data.Truth` holds (z down, horizontal axes VICON's, so compare
+:class:`~footzoo.core.data.Truth` holds (z down, horizontal axes VICON's, so compare
 after a rotation about the vertical). ``zv_vicon_opt`` becomes the stance truth.
 The sensor is on the right shoe: ``meta["foot"] = "right"``. When the folder
 holds the dataset's ``trials.csv``, the trial's hand-counted strides
@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from ..data import Recording, Truth
-from ..errors import FormatError
+from ..core.data import Recording, Truth
+from ..core.errors import FormatError
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")

@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..data import Recording, Truth
-from ..errors import FormatError
+from ..core.data import Recording, Truth
+from ..core.errors import FormatError
 
 SIGNALS = {
     "scaledAccelX": "acc_x", "scaledAccelY": "acc_y", "scaledAccelZ": "acc_z",

@@ -19,9 +19,9 @@ from typing import Any
 
 import pandas as pd
 
-from ..checks import check_bool
-from ..data import Recording, Truth
-from ..errors import FormatError
+from ..core.checks import check_bool
+from ..core.data import Recording, Truth
+from ..core.errors import FormatError
 
 COLUMNS = {
     "Time (s)": "t",
@@ -49,7 +49,7 @@ def read(
     duplicates : {"drop", "error"}
         Repeated time stamps (the file has about 1 % exact duplicates).
     max_gap : float, optional
-        Largest gap bridged (s); default :data:`footzoo.data.DEFAULT_MAX_GAP`.
+        Largest gap bridged (s); default :data:`footzoo.core.data.DEFAULT_MAX_GAP`.
     closed_loop : bool
         Whether the walk ends where it started (true for ``short_walk.csv``).
     """

@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..checks import check_bool, check_range
+from ..core.checks import check_bool, check_range
 from ..filters.strapdown import quat_product, rotvec_quat, sample_intervals
-from ..plugin import Orientation
-from ..registry import register
+from ..kernels.jit import njit
+from ..plugins.base import Orientation
+from ..plugins.registry import register
 from .fqa import fqa_sample
 from .magnetic import magnetometer_valid, rejection_parameters
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..filters.strapdown import sample_intervals
-from ..plugin import Orientation
-from ..registry import register
+from ..plugins.base import Orientation
+from ..plugins.registry import register
 from .fqa_complementary import complementary_kernel
 
 

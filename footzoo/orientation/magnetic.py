@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..checks import check_bool, check_range
-from ..conventions import GRAVITY
+from ..core.checks import check_bool, check_range
+from ..core.conventions import GRAVITY
+from ..kernels.jit import njit
 
 #: Longest stretch of the still start used to learn the reference (s).
 REFERENCE_DURATION = 1.0

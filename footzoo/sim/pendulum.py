@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..conventions import GRAVITY, quat_conj, quat_from_euler, quat_rotate
-from ..data import Recording, Truth
+from ..core.conventions import GRAVITY, quat_conj, quat_from_euler, quat_rotate
+from ..core.data import Recording, Truth
 from .sensors import NoiseModel, magnetic_field_ned, sample_imu
 
 

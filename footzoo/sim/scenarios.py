@@ -1,7 +1,7 @@
 """Composable simulated recordings with ground truth.
 
-``simulate(path=..., ...)`` builds a :class:`~footzoo.data.Recording` whose
-:class:`~footzoo.data.Truth` holds, for every sample, the sensor's position,
+``simulate(path=..., ...)`` builds a :class:`~footzoo.core.data.Recording` whose
+:class:`~footzoo.core.data.Truth` holds, for every sample, the sensor's position,
 velocity, attitude and stance flag (stance = the sensor's velocity is zero
 over the whole sample interval), and per step the start and end, stride
 length, heading and foot progression angle; with distance sensors, the true
@@ -15,8 +15,8 @@ from dataclasses import asdict
 import numpy as np
 import pandas as pd
 
-from ..conventions import GRAVITY, quat_conj, quat_rotate
-from ..data import Recording, Truth
+from ..core.conventions import GRAVITY, quat_conj, quat_rotate
+from ..core.data import Recording, Truth
 from . import paths
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..conventions import GRAVITY, gravity_ned, quat_conj, quat_mul, quat_normalize, quat_rotate
+from ..core.conventions import GRAVITY, gravity_ned, quat_conj, quat_mul, quat_normalize, quat_rotate
 
 #: Named magnetic field locations: total intensity (Gauss) and inclination (deg, down positive).
 MAGNETIC_FIELDS = {

@@ -1,0 +1,518 @@
+"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``.
+
+Bad input never prints a Python traceback: the message names the input, the
+problem and the fix, and the exit code says which kind of problem it was
+(``--debug`` adds the traceback):
+
+====  ==============================================================================
+code  meaning
+====  ==============================================================================
+0     success
+1     internal error: a bug in footzoo (rerun with ``--debug`` and report it)
+2     usage or configuration error: bad arguments, config, study or calibration file
+3     data error: unreadable, malformed or implausible recording; unwritable output
+130   interrupted (Ctrl-C)
+====  ==============================================================================
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import traceback
+import warnings
+from pathlib import Path
+from typing import Any
+
+from ..core.conventions import ACC_UNITS, GYR_UNITS
+from ..core.errors import ConfigError, FootzooError, FormatError, RecordingError
+from ..io.canonical import FLOAT_FORMAT
+
+
+def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
+    options: dict[str, Any] = {}
+    if getattr(args, "foot", None) and args.foot != "both":
+        options["foot"] = args.foot
+    for key in ("acc_unit", "gyr_unit"):
+        if getattr(args, key, None):
+            options[key] = getattr(args, key)
+    return options
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_USAGE = 2
+EXIT_DATA = 3
+EXIT_INTERRUPTED = 130
+
+EXIT_CODES_HELP = """exit codes:
+  0    success
+  1    internal error (a bug in footzoo: rerun with --debug and report it)
+  2    usage or configuration error (arguments, config, study or calibration file)
+  3    data error (unreadable, malformed or implausible recording; unwritable output)
+  130  interrupted
+"""
+
+
+class OutputError(FootzooError, OSError):
+    """An output location cannot be written (exit code 3)."""
+
+
+def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
+    """An argparse ``type``: a finite number in [lo, hi] (a usage error, exit code 2, otherwise)."""
+
+    def parse(text: str) -> float | int:
+        try:
+            value = int(text) if integer else float(text)
+        except ValueError:
+            kind = "a whole number" if integer else "a number"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
+        if not (lo <= value <= hi):  # also rejects nan
+            u = f" {unit}" if unit else ""
+            raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must lie in [{lo:g}, {hi:g}]{u}")
+        return value
+
+    return parse
+
+
+def _writable_dir(path: str, option: str = "--out") -> Path:
+    """Create ``path`` if needed and check it is a writable directory, before any work is done."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{option} {path!r} exists and is not a directory; choose a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except PermissionError:
+        raise OutputError(f"{option} {path!r} cannot be created (permission denied); choose a writable place") from None
+    except OSError as err:
+        raise OutputError(f"{option} {path!r} cannot be created: {err.strerror or err}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable directory")
+    return out
+
+
+def _writable_file(path: str, option: str = "--out") -> Path:
+    """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
+    p = Path(path)
+    if p.is_dir():
+        raise OutputError(f"{option} {path!r} is a directory; give a file name")
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"{option} {path!r}: the folder {str(folder)!r} does not exist; create it first")
+    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable place")
+    return p
+
+
+def _load_recording(args: argparse.Namespace):
+    from ..io import builtin_sample, load
+
+    if args.data is None:
+        rec = builtin_sample()
+        if getattr(args, "foot", None) in ("left", "right"):
+            rec.meta["foot"] = args.foot  # the sample does not say which foot it is from
+        return rec
+    return load(args.data, format=args.format, **_reader_options(args))
+
+
+def _two_feet(args: argparse.Namespace) -> bool:
+    """Run both feet: ``--foot both``, or a gaitmap file with both sensors and no ``--foot``."""
+    if args.data is None:
+        if args.foot == "both":
+            raise FormatError("--foot both needs --data with a two-foot file (gaitmap)")
+        return False
+    if args.foot not in (None, "both"):
+        return False
+    from ..io import check_input_file, detect_format
+    from ..io.gaitmap import feet
+
+    fmt = args.format or detect_format(check_input_file(args.data))
+    if fmt != "gaitmap":
+        if args.foot == "both":
+            raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file")
+        return False
+    return len(feet(Path(args.data))) == 2 or args.foot == "both"
+
+
+def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
+    print(title)
+    for key, value in metrics.items():
+        print(f"  {key:32s} {value:.4f}" if isinstance(value, float) else f"  {key:32s} {value}")
+
+
+def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
+    """samples.csv, steps.csv (units in the column names), metrics.json and optionally the run's figures."""
+    out.mkdir(parents=True, exist_ok=True)
+    result.samples.to_csv(out / "samples.csv", index=False, float_format=FLOAT_FORMAT)
+    result.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
+    payload = {"metrics": result.metrics, "config": result.config, "versions": result.versions,
+               "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
+    (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
+    written = ["samples.csv", "steps.csv", "metrics.json"]
+    if plot:
+        from ..evaluation.plots import plot_run
+
+        written += [p.name for p in plot_run(result, out, rec)]
+    return written
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """Run a pipeline on a recording (or both feet of a session); print metrics; optionally write outputs."""
+    from ..runtime.pipeline import Pipeline
+
+    pipeline = Pipeline.from_yaml(args.config)
+    out = _writable_dir(args.out) if args.out else None
+    if args.plot and not args.out:
+        print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
+        return 2
+    if _two_feet(args):
+        return _run_session(args, pipeline)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rec = _load_recording(args)
+    for w in caught:
+        print(f"note: {w.message}", file=sys.stderr)
+    result = pipeline.run(rec)
+    metrics = result.metrics
+    if "pyshoe_trial_error" in rec.meta:
+        metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
+    ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
+    _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
+    if out is not None:
+        written = _write_result(result, rec, out, args.plot)
+        print(f"wrote {', '.join(written)} to {args.out}")
+    return 0
+
+
+def _run_session(args: argparse.Namespace, pipeline) -> int:
+    """Both feet of a gaitmap file: per-foot metrics, the bilateral table, per-foot outputs."""
+    from ..runtime.session import Session
+
+    options = _reader_options(args)
+    session = Session.load(args.data, format=args.format, **options)
+    res = session.run(pipeline)
+    for foot, r in res.results.items():
+        rec = session.recordings[foot]
+        ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
+        _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})",
+                       r.metrics)
+    print("bilateral (medians; symmetry index = 100 |L - R| / mean, %)")
+    print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
+    if args.out:
+        out = Path(args.out)
+        for foot, r in res.results.items():
+            written = _write_result(r, session.recordings[foot], out / foot, args.plot)
+        res.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
+        res.bilateral.to_csv(out / "bilateral.csv", float_format=FLOAT_FORMAT)
+        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out}")
+    return 0
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    """Print every plug-in with its parameters, defaults, units and paper."""
+    from ..plugins.registry import describe
+
+    print(describe(args.kind), end="")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """Check a config without running it."""
+    from ..config.schema import load_yaml
+    from ..runtime.pipeline import Pipeline
+    from ..runtime.validate import config_errors
+
+    errors = config_errors(load_yaml(args.config))
+    if errors:
+        print(f"{args.config}: {len(errors)} problem(s)", file=sys.stderr)
+        for e in errors:
+            print(f"  - {e}", file=sys.stderr)
+        return 2
+    pipeline = Pipeline.from_yaml(args.config)
+    print(f"{args.config}: valid")
+    print(json.dumps(pipeline.to_dict(), indent=2))
+    return 0
+
+
+def cmd_compile(args: argparse.Namespace) -> int:
+    """Compile and cache the kernels of pipeline configs (or write them into a wheel's folder with --ship)."""
+    from .compile import compile_kernels
+
+    for config, seconds in compile_kernels(args.configs, ship=args.ship):
+        print(f"{config}: {seconds:.1f} s")
+    return 0
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """Simulate a recording with ground truth and write it as canonical CSV/Parquet."""
+    import numpy as np
+
+    from ..io.canonical import write
+    from ..sim import (
+        DistanceSensors,
+        MagneticDisturbance,
+        NoiseModel,
+        simulate,
+        simulate_calibration,
+        simulate_pendulum,
+    )
+
+    _writable_file(args.out)
+    biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
+    noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
+    if args.scenario == "pendulum":
+        rec = simulate_pendulum(rate=args.rate, noise=noise, sampling=args.sampling)
+    elif args.scenario == "calibration":
+        rec = simulate_calibration(mount_yaw=np.radians(args.mount_yaw), foot=args.foot, rate=args.rate, noise=noise)
+    else:
+        rec = simulate(
+            path=args.scenario, n_strides=args.strides, stride_length=args.stride_length, rate=args.rate,
+            profile=args.profile, sampling=args.sampling, noise=noise, seed=args.seed,
+            fpa=np.radians(args.fpa), mount_yaw=np.radians(args.mount_yaw), foot=args.foot,
+            distance_sensors=DistanceSensors() if args.distance_sensors else False,
+            disturbance=MagneticDisturbance() if args.disturbance else None,
+        )
+    out = write(rec, args.out)
+    closed = "closed loop" if rec.truth.closed_loop else "open path"
+    print(f"wrote {out} ({rec.n} samples at {rec.rate:.0f} Hz, {rec.t[-1]:.1f} s, {closed}, "
+          f"{0 if rec.truth.steps is None else len(rec.truth.steps)} strides)")
+    return 0
+
+
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    """Foot vector from a calibration recording (Huang et al. 2016, eq. 11), saved as YAML."""
+    import numpy as np
+
+    from ..analysis.foot_vector import calibrate_foot_vector
+
+    _writable_file(args.out)
+    rec = _load_recording(args)
+    fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
+                               flex=tuple(args.flex) if args.flex else None)
+    fv.save(args.out)
+    yaw = np.degrees(np.arctan2(-fv.vector[1], fv.vector[0]))
+    print(f"foot vector (sensor frame, FRD): {np.round(fv.vector, 4).tolist()}  "
+          f"(sensor yawed {yaw:.2f}° on the foot)")
+    print(f"still {fv.still[0]:.2f}-{fv.still[1]:.2f} s, flexions {fv.flex[0]:.2f}-{fv.flex[1]:.2f} s")
+    print(f"wrote {args.out}; use it with analysis: [{{type: huang_fpa, calibration: {args.out}}}]")
+    return 0
+
+
+def cmd_ablate(args: argparse.Namespace) -> int:
+    """Run a study: every config × recording cell, in parallel, cached, with tables and plots."""
+    from ..studies import run_study
+    from ..studies.report import summarise, to_markdown
+
+    out = args.out or f"ablation_{Path(args.study).stem}"
+    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
+    a = table.attrs
+    notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
+             if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
+    notes = "".join(f", {n}" for n in notes if n)
+    print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
+          f"{a['failed']} failed{notes}); results in {out}/")
+    factors = [c for c in table.columns if c not in ("run", "base", "recording", "metric", "value", "error")]
+    for f in factors[:3]:
+        s = summarise(table, f)
+        keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
+        print(f"\n{f}:")
+        print(to_markdown(keep), end="")
+    return 0
+
+
+def cmd_list_compat(args: argparse.Namespace) -> int:
+    """Print which orientation × correction combinations validate, with the reasons for the others."""
+    from .compat import compatibility_matrix
+
+    print(compatibility_matrix(), end="")
+    return 0
+
+
+def cmd_configs(args: argparse.Namespace) -> int:
+    """List the shipped configs with the first line of their description, or copy one (``--copy``)."""
+    from ..config import library
+
+    if args.copy:
+        target = library.copy(args.copy, args.to, overwrite=args.force)
+        print(f"wrote {target} (a copy of the shipped {library.path(args.copy).stem}); edit it and run "
+              f"footzoo run {target}")
+        return EXIT_OK
+    for kind in ("pipeline", "study"):
+        print(f"{kind} configs ({'footzoo ablate NAME' if kind == 'study' else 'footzoo run NAME'}):")
+        for name in library.names(kind):
+            print(f"  {name:<24} {_first_comment(library.path(name))}")
+    print("copy one to edit it: footzoo configs --copy NAME [--to FOLDER]")
+    return EXIT_OK
+
+
+def _first_comment(path: Path) -> str:
+    """The first comment line of a YAML file, without the ``#``."""
+    for line in path.read_text().splitlines():
+        if line.startswith("#"):
+            return line.lstrip("# ").strip()
+    return ""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``footzoo`` command."""
+    parser = argparse.ArgumentParser(
+        prog="footzoo", description="Foot-mounted IMU motion estimation: a zoo of published building blocks.",
+        epilog=EXIT_CODES_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the Python traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
+
+    run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
+    run.add_argument("config", help="pipeline YAML, e.g. yun2012")
+    run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
+    run.add_argument("--format", help="canonical, xio, pyshoe, gaitmap or sensorconnect (default: detect)")
+    run.add_argument("--foot", choices=["left", "right", "both"],
+                     help="foot to read from a two-foot file (gaitmap; default: both when the file has both), "
+                          "or the foot a one-foot recording is from")
+    run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
+    run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
+    run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
+    run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
+                     "errors (with a reference), strides, fpa (.png, needs --out)")
+    run.set_defaults(func=cmd_run)
+
+    comp = sub.add_parser("compile", help="compile the kernels of pipeline configs now, so that their first "
+                          "run loads them from numba's cache (e.g. before a study on a new machine)")
+    comp.add_argument("configs", nargs="+", help="pipeline YAML files or study files (every config of the "
+                      "grid), e.g. footzoo/config/builtin/*.yaml")
+    comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
+                      "(what setup.py does for a wheel's footzoo/_compiled)")
+    comp.set_defaults(func=cmd_compile)
+
+    sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
+    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
+                                          "calibration"])
+    sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
+    sim.add_argument("--strides", type=_number(1, 100_000, integer=True), default=100,
+                     help="strides of a straight walk (default 100)")
+    sim.add_argument("--stride-length", type=_number(0.05, 5.0, "m"), default=1.2,
+                     help="stride length in m (default 1.2)")
+    sim.add_argument("--rate", type=_number(10.0, 20_000.0, "Hz"), default=50.0,
+                     help="sampling rate in Hz (default 50)")
+    sim.add_argument("--profile", choices=["paper", "physical"], default="paper", help="stance kinematics")
+    sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
+    sim.add_argument("--noise-scale", type=_number(0.0, 1000.0), default=1.0,
+                     help="factor on Table II noise σ (default 1)")
+    sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
+    sim.add_argument("--seed", type=int, default=0)
+    sim.add_argument("--fpa", type=_number(-90.0, 90.0, "deg"), default=0.0,
+                     help="foot progression angle in deg (toe-out +)")
+    sim.add_argument("--mount-yaw", type=_number(-180.0, 180.0, "deg"), default=0.0,
+                     help="sensor yaw on the foot in deg")
+    sim.add_argument("--foot", choices=["right", "left"], default="right")
+    sim.add_argument("--distance-sensors", action="store_true", help="add two VL6180-like range sensors")
+    sim.add_argument("--disturbance", action="store_true", help="add a magnetic disturbance (first 10 m north)")
+    sim.set_defaults(func=cmd_simulate)
+
+    cal = sub.add_parser("calibrate", help="foot vector from a still period and slow dorsi-/plantar-flexions")
+    cal.add_argument("--data", required=True, help="calibration recording")
+    cal.add_argument("--format", help="reader format (default: detect)")
+    cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
+    cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
+    cal.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
+    cal.add_argument("--still", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="still period (s); default: found")
+    cal.add_argument("--flex", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
+                     help="flexion period (s); default: found")
+    cal.add_argument("--out", required=True, help="YAML file to write")
+    cal.set_defaults(func=cmd_calibrate)
+
+    abl = sub.add_parser("ablate", help="run an ablation study (configs x recordings) and write tables and plots")
+    abl.add_argument("study", help="study YAML, e.g. study_quick")
+    abl.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib); -1 = all cores")
+    abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
+    abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
+    abl.add_argument("--quiet", action="store_true", help="no progress bar")
+    abl.set_defaults(func=cmd_ablate)
+
+    lst = sub.add_parser("list", help="list plug-ins with their parameters, defaults, units and papers")
+    lst.add_argument("--kind", choices=["orientation", "detector", "correction", "analysis"], help="only this kind")
+    lst.add_argument("--compatibility", action="store_true",
+                     help="print which orientation x correction combinations validate, and why not")
+    lst.set_defaults(func=lambda a: cmd_list_compat(a) if a.compatibility else cmd_list(a))
+
+    cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
+    cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")
+    cfg.add_argument("--to", default=".", metavar="DEST", help="folder or file name of the copy (default: here)")
+    cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
+    cfg.set_defaults(func=cmd_configs)
+
+    val = sub.add_parser("validate", help="check a pipeline config without running it")
+    val.add_argument("config", help="pipeline YAML")
+    val.set_defaults(func=cmd_validate)
+    return parser
+
+
+def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]:
+    """Sub-command parsers that also take ``--debug`` and list the exit codes in their help."""
+
+    class SubParser(argparse.ArgumentParser):
+        def __init__(self, **kwargs: Any):
+            kwargs.setdefault("parents", [common])
+            kwargs.setdefault("epilog", EXIT_CODES_HELP)
+            kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+            super().__init__(**kwargs)
+
+    return SubParser
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"footzoo: warning: {message}", file=sys.stderr)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help (0) or a usage error (2, message already printed)
+        return int(stop.code) if isinstance(stop.code, int) else EXIT_USAGE
+    debug = bool(getattr(args, "debug", False))
+    if not debug:
+        warnings.showwarning = _show_warning
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        print("footzoo: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: not an error
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_OK
+    except Exception as err:  # the command line's last line of defence: no traceback unless --debug
+        if debug:
+            traceback.print_exc()
+        code, text = _classify(err)
+        print(f"footzoo: {text}", file=sys.stderr)
+        return code
+
+
+def _classify(err: Exception) -> tuple[int, str]:
+    """Exit code and message for an exception leaving a command."""
+    if isinstance(err, (RecordingError, FormatError, OutputError)):
+        return EXIT_DATA, f"error: {err}"
+    if isinstance(err, (ConfigError, FootzooError)):
+        return EXIT_USAGE, f"error: {err}"
+    if isinstance(err, PermissionError):
+        return EXIT_DATA, (f"error: permission denied: {err.filename!r}; check the file's permissions or choose "
+                           "another location")
+    if isinstance(err, OSError):
+        where = f" {err.filename!r}" if err.filename else ""
+        return EXIT_DATA, f"error: cannot access{where}: {err.strerror or err}"
+    if isinstance(err, MemoryError):
+        return EXIT_DATA, "error: out of memory; use a smaller recording or study"
+    return EXIT_INTERNAL, (f"internal error: {type(err).__name__}: {err}. This is a bug in footzoo: rerun with "
+                           "--debug and report the traceback")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,312 @@
+"""Conformance checks for plug-ins, like scikit-learn's ``check_estimator``.
+
+``check_plugin(cls)`` runs a plug-in class through the contract of :mod:`footzoo.plugins.base` on a
+short simulated walk (with magnetometer, distance sensors and truth) and raises
+``AssertionError`` naming the first broken rule. Use it in your plug-in's tests::
+
+    from footzoo.apps.testing import check_plugin
+    def test_my_detector_follows_the_contract():
+        check_plugin(MyDetector)
+
+The checks:
+
+* registered under its kind and name, derived from the kind's base class, with a docstring
+  and a ``paper``;
+* every constructor parameter has a default; every numeric one has a unit in ``units``;
+  parameters are stored as attributes under their own names (``get_params``), constructing
+  from ``get_params()`` gives the same parameters (idempotent), ``set_params`` works and
+  rejects unknown names;
+* YAML round trip: ``spec()`` dumps with ``yaml.safe_dump`` and builds back to the same
+  parameters; ``clone()`` gives an equal, unfitted, independent copy;
+* the action method leaves its inputs untouched, returns results of the documented shapes,
+  finite, and refuses NaN input with a footzoo error;
+* a calibration returns corrected copies shaped like its inputs and a ``report_`` dict, and
+  passes a recording without a magnetometer through;
+* a ``causal`` detector gives the same stance fed chunk by chunk as in one batch;
+* a Kalman correction gives the same trajectory (1e-9) on the compiled and the reference
+  engine (or runs on the reference one, with a warning, when its model does not compile), and
+  live in :class:`~footzoo.runtime.stream.Stream` the same as in a batch run.
+"""
+
+from __future__ import annotations
+
+import copy
+import inspect
+import warnings
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..core.errors import FootzooError
+from ..plugins.base import (
+    AccelerationCorrection,
+    Analysis,
+    Calibration,
+    Detector,
+    KalmanCorrection,
+    Orientation,
+    Plugin,
+    VelocityCorrection,
+)
+from ..plugins.registry import available, build
+
+_WALK: Any = None
+
+
+def _walk():
+    """A short simulated walk with magnetometer, two distance sensors and truth (cached)."""
+    global _WALK
+    if _WALK is None:
+        from ..sim import NoiseModel, simulate
+
+        _WALK = simulate(n_strides=5, profile="physical", rate=100.0, noise=NoiseModel(seed=7),
+                         distance_sensors=True, clearance=0.1)
+    return _WALK
+
+
+def check_plugin(cls: type[Plugin]) -> None:
+    """Run every conformance check on a plug-in class (see the module docstring)."""
+    _check_declaration(cls)
+    instance = cls()
+    _check_params(cls, instance)
+    _check_round_trip(cls, instance)
+    if isinstance(instance, Calibration):
+        _check_calibration(instance)
+    elif isinstance(instance, Detector):
+        _check_detector(instance)
+    elif isinstance(instance, Orientation):
+        _check_orientation(instance)
+    elif isinstance(instance, KalmanCorrection) and not isinstance(instance, (VelocityCorrection,
+                                                                              AccelerationCorrection)):
+        _check_kalman(instance)
+    elif isinstance(instance, (VelocityCorrection, AccelerationCorrection)):
+        _check_batch_correction(instance)
+        if isinstance(instance, KalmanCorrection):
+            _check_kalman(instance)
+    elif isinstance(instance, Analysis):
+        _check_analysis(instance)
+
+
+# --------------------------------------------------------------------------- declaration
+def _check_declaration(cls: type[Plugin]) -> None:
+    assert isinstance(cls, type) and issubclass(cls, Plugin), f"{cls!r} is not a footzoo plug-in class"
+    assert cls.name, f"{cls.__name__}: class attribute 'name' is empty"
+    registered = available(cls.kind).get(cls.name)
+    assert registered is cls, (f"{cls.__name__}: not registered as {cls.kind} {cls.name!r} "
+                               f"(decorate it with @footzoo.register; found {registered!r})")
+    assert (cls.__doc__ or "").strip(), f"{cls.__name__}: no docstring (cite the paper and its equations)"
+    assert cls.paper, f"{cls.__name__}: class attribute 'paper' is empty (cite the source)"
+
+
+def _check_params(cls: type[Plugin], p: Plugin) -> None:
+    defaults = cls.defaults()
+    for name, default in defaults.items():
+        assert default is not inspect.Parameter.empty, f"{cls.__name__}: parameter {name!r} has no default"
+        numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
+        assert not numeric or name in cls.units, f"{cls.__name__}: numeric parameter {name!r} has no unit in 'units'"
+        assert hasattr(p, name), f"{cls.__name__}: parameter {name!r} is not stored as attribute self.{name}"
+    stray = sorted(set(cls.units) - set(defaults))
+    assert not stray, f"{cls.__name__}: 'units' names no parameter {stray}"
+    params = p.get_params()
+    again = cls(**copy.deepcopy(params)).get_params()
+    assert _equal(params, again), f"{cls.__name__}: constructing from get_params() changes them: {params} -> {again}"
+    q = p.clone()
+    if params:
+        name = next(iter(params))
+        assert q.set_params(**{name: copy.deepcopy(params[name])}) is q, f"{cls.__name__}: set_params must return self"
+        assert _equal(q.get_params(), params), f"{cls.__name__}: set_params to the same value changed parameters"
+    try:
+        q.set_params(no_such_parameter_xyz=1)
+    except (ValueError, FootzooError):
+        pass
+    else:
+        raise AssertionError(f"{cls.__name__}: set_params accepted an unknown parameter")
+
+
+def _check_round_trip(cls: type[Plugin], p: Plugin) -> None:
+    spec = p.spec()
+    text = yaml.safe_dump(spec)
+    back = build(cls.kind, yaml.safe_load(text), where="check_plugin")
+    assert type(back) is cls, f"{cls.__name__}: YAML round trip built {type(back).__name__}"
+    assert _equal(back.get_params(), p.get_params()), f"{cls.__name__}: YAML round trip changed the parameters"
+    c = p.clone()
+    assert c is not p and _equal(c.get_params(), p.get_params()), f"{cls.__name__}: clone() differs"
+    fitted = [k for k in vars(c) if k.endswith("_") and not k.startswith("_")]
+    assert not fitted, f"{cls.__name__}: a fresh instance already has results {fitted} (set them in the action method)"
+
+
+def _equal(a: Any, b: Any) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple, np.ndarray)) or isinstance(b, (list, tuple, np.ndarray)):
+        try:
+            return bool(np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object)))
+        except Exception:
+            return False
+    return a == b or (isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b))
+
+
+# --------------------------------------------------------------------------- behaviour
+def _signals(rec) -> tuple[np.ndarray, ...]:
+    return rec.t.copy(), rec.acc.copy(), rec.gyr.copy(), rec.mag.copy()
+
+
+def _unchanged(before: tuple[np.ndarray, ...], after: tuple[np.ndarray, ...], who: str) -> None:
+    for a, b in zip(before, after, strict=True):
+        assert np.array_equal(a, b), f"{who}: the action method modified its input arrays"
+
+
+def _expect_nan_error(fn, who: str) -> None:
+    try:
+        fn()
+    except FootzooError:
+        return
+    except Exception as err:  # noqa: BLE001 - the check reports what it got
+        raise AssertionError(f"{who}: NaN input raised {type(err).__name__} ({err}), not a footzoo error") from None
+    raise AssertionError(f"{who}: NaN input was accepted silently")
+
+
+def _nan(a: np.ndarray) -> np.ndarray:
+    b = a.copy()
+    b[len(b) // 2] = np.nan
+    return b
+
+
+def _stance(rec) -> np.ndarray:
+    return rec.truth.stance.copy()
+
+
+def _check_detector(d: Detector) -> None:
+    rec = _walk()
+    t, acc, gyr, mag = _signals(rec)
+    who = f"detector {d.name!r}"
+    args = (t, acc, gyr, rec.truth) if d.needs_truth else (t, acc, gyr)
+    out = d.clone().detect(*args)
+    assert out is not None, f"{who}: detect() must return self"
+    _unchanged((rec.t, rec.acc, rec.gyr), (t, acc, gyr), who)
+    stance = np.asarray(out.stance_)
+    assert stance.shape == t.shape and stance.dtype == bool, f"{who}: stance_ must be (N,) bool, got {stance.dtype}"
+    assert np.asarray(out.statistic_).shape == t.shape, f"{who}: statistic_ must be (N,)"
+    assert stance.any() and not stance.all(), f"{who}: found no stance or no swing in a simulated walk"
+    if not d.needs_truth:
+        _expect_nan_error(lambda: d.clone().detect(t, _nan(acc), gyr), who)
+    if d.causal:
+        live = d.clone()
+        live.begin(rec.rate)
+        chunks = [live.step(t[i:i + 7], acc[i:i + 7], gyr[i:i + 7]) for i in range(0, len(t), 7)]
+        streamed = np.concatenate([np.asarray(c, dtype=bool) for c in chunks])
+        assert np.array_equal(streamed, stance), f"{who}: causal, but chunk-by-chunk stance differs from the batch"
+
+
+def _check_calibration(c: Calibration) -> None:
+    rec = _walk()
+    t, acc, gyr, mag = _signals(rec)
+    who = f"calibration {c.name!r}"
+    for m in (mag, None):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = c.clone().calibrate(t, acc, gyr, m)
+        _unchanged((rec.t, rec.acc, rec.gyr, rec.mag), (t, acc, gyr, mag), who)
+        for name, before in (("acc", acc), ("gyr", gyr), ("mag", m)):
+            after = getattr(out, f"{name}_", "missing")
+            if before is None:
+                assert after is None, f"{who}: without a magnetometer, mag_ must be None"
+                continue
+            assert isinstance(after, np.ndarray) and after.shape == before.shape and np.isfinite(after).all(), (
+                f"{who}: {name}_ must be a finite array shaped like the input {before.shape}")
+        assert isinstance(out.report_, dict), f"{who}: report_ must be a dict"
+        try:
+            yaml.safe_dump(out.report_)
+        except yaml.YAMLError as err:
+            raise AssertionError(f"{who}: report_ must hold plain values (numbers, text, lists): {err}") from None
+    _expect_nan_error(lambda: c.clone().calibrate(t, _nan(acc), gyr, mag), who)
+
+
+def _check_orientation(o: Orientation) -> None:
+    rec = _walk()
+    t, acc, gyr, mag = _signals(rec)
+    who = f"orientation {o.name!r}"
+    q0 = rec.truth.quat[0].copy()
+    out = o.clone().estimate(t, acc, gyr, mag, _stance(rec), q0)
+    _unchanged((rec.t, rec.acc, rec.gyr, rec.mag), (t, acc, gyr, mag), who)
+    quat = np.asarray(out.quat_)
+    assert quat.shape == (len(t), 4) and np.isfinite(quat).all(), f"{who}: quat_ must be finite (N, 4)"
+    assert np.allclose(np.linalg.norm(quat, axis=1), 1.0, atol=1e-6), f"{who}: quat_ must be unit quaternions"
+    _expect_nan_error(lambda: o.clone().estimate(t, acc, _nan(gyr), mag, _stance(rec), q0), who)
+
+
+def _check_batch_correction(c: Plugin) -> None:
+    from ..filters.strapdown import motion_acceleration
+
+    rec = _walk()
+    who = f"correction {c.name!r}"
+    t = rec.t.copy()
+    acc_nav = motion_acceleration(rec.truth.quat, rec.acc, 9.81)
+    before = acc_nav.copy()
+    stance = _stance(rec)
+    if isinstance(c, VelocityCorrection):
+        out = c.clone().apply(t, acc_nav, stance)
+        _unchanged((before,), (acc_nav,), who)
+        assert out.vel_.shape == acc_nav.shape and out.pos_.shape == acc_nav.shape, f"{who}: vel_/pos_ must be (N, 3)"
+        assert np.isfinite(out.pos_).all(), f"{who}: non-finite positions"
+        _expect_nan_error(lambda: c.clone().apply(t, _nan(acc_nav), stance), who)
+    if isinstance(c, AccelerationCorrection):
+        new = c.clone().apply_acceleration(rec.truth.quat.copy(), acc_nav, stance)
+        _unchanged((before,), (acc_nav,), who)
+        assert np.shape(new) == acc_nav.shape and np.isfinite(new).all(), f"{who}: must return a finite (N, 3) array"
+        _expect_nan_error(lambda: c.clone().apply_acceleration(rec.truth.quat, _nan(acc_nav), stance), who)
+
+
+def _check_kalman(c: KalmanCorrection) -> None:
+    from ..runtime.pipeline import Pipeline
+    from ..runtime.stream import Stream
+
+    rec = _walk()
+    who = f"correction {c.name!r}"
+    base = {"orientation": {"type": "ins"}, "detector": {"type": "dgp", "min_swing": 0.2}}
+    host = [] if any(q in c.observes for q in ("velocity",)) else [{"type": "zupt"}]
+    if "heading" in c.observes:
+        host = [{"type": "ekf_zupt"}]
+    spec = c.spec()
+    try:
+        pipe = Pipeline.from_dict({**base, "corrections": host + [spec]})
+    except FootzooError as err:
+        raise AssertionError(f"{who}: cannot be used with orientation ins, detector dgp and {host}: {err}") from None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        auto = pipe.run(rec, engine="auto")
+    ref = pipe.run(rec, engine="reference")
+    assert np.isfinite(ref.pos).all(), f"{who}: non-finite trajectory on the reference engine"
+    _close(auto, ref, who, "engine='auto'")
+    if auto.config["engine"] == "fast":
+        _close(pipe.run(rec, engine="fast"), ref, who, "engine='fast'")
+    else:
+        assert any(c.name in str(w.message) for w in caught), f"{who}: fell back to the reference engine silently"
+    if c.causal:
+        live = Stream(pipe, rate=rec.rate).run(rec)
+        assert np.array_equal(live["stance"], auto.stance), f"{who}: live stance differs from the batch"
+        scale = max(float(np.abs(auto.pos).max()), 1.0)
+        err = float(np.abs(live["pos"] - auto.pos).max())
+        assert err <= 1e-9 * scale, f"{who}: live trajectory differs from the batch by {err:.3g} m"
+
+
+def _close(a, b, who: str, what: str) -> None:
+    scale = max(float(np.abs(b.pos).max()), 1.0)
+    err = max(float(np.abs(a.pos - b.pos).max()), float(np.abs(a.quat - b.quat).max()) * scale)
+    assert err <= 1e-9 * scale, f"{who}: {what} differs from the reference engine by {err:.3g}"
+
+
+def _check_analysis(a: Analysis) -> None:
+    from ..runtime.pipeline import Pipeline
+
+    rec = _walk()
+    who = f"analysis {a.name!r}"
+    res = Pipeline.from_dict({"orientation": {"type": "madgwick"}, "detector": {"type": "shoe"},
+                              "corrections": [{"type": "zvu_dedrift"}]}).run(rec)
+    t, quat, pos, stance = rec.t.copy(), res.quat.copy(), res.pos.copy(), res.stance.copy()
+    out = a.clone().analyze(t, quat, pos, stance, dict(rec.meta, foot="right"))
+    _unchanged((rec.t, res.quat, res.pos), (t, quat, pos), who)
+    steps = out.annotate(res.steps.copy(), t)
+    assert len(steps) == len(res.steps), f"{who}: annotate() must keep one row per step"
+    _expect_nan_error(lambda: a.clone().analyze(t, _nan(quat), pos, stance, dict(rec.meta, foot="right")), who)

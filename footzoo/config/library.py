@@ -1,0 +1,84 @@
+"""The configs shipped with footzoo, by name: ``Pipeline.from_yaml("recommended")`` from anywhere.
+
+The YAML files live in this package's ``builtin`` folder and are installed with it. A name
+is a file stem (``yun2012``), with or without ``.yaml``; a path to an existing file always
+wins over a name, so a user's edited copy next to their data is read instead.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from ..core.errors import ConfigError, did_you_mean
+
+#: Folder of the shipped YAML files.
+BUILTIN = Path(__file__).resolve().parent / "builtin"
+
+
+def names(kind: str | None = None) -> list[str]:
+    """Names of the shipped configs: ``kind`` ``"pipeline"``, ``"study"`` or None for both."""
+    out = []
+    for p in sorted(BUILTIN.glob("*.yaml")):
+        study = p.stem.startswith("study_")
+        if kind is None or (kind == "study") == study:
+            out.append(p.stem)
+    if kind not in (None, "pipeline", "study"):
+        raise ConfigError(f"kind must be 'pipeline', 'study' or None, got {kind!r}")
+    return out
+
+
+def is_name(spec: str | Path) -> bool:
+    """Whether ``spec`` names a shipped config rather than a file path."""
+    s = str(spec)
+    stem = s[:-5] if s.endswith(".yaml") else s
+    return "/" not in s and "\\" not in s and (BUILTIN / f"{stem}.yaml").is_file()
+
+
+def path(name: str) -> Path:
+    """The file of the shipped config ``name`` (``recommended`` or ``recommended.yaml``)."""
+    stem = name[:-5] if name.endswith(".yaml") else name
+    p = BUILTIN / f"{stem}.yaml"
+    if not p.is_file():
+        known = names()
+        raise ConfigError(f"no shipped config named {name!r}{did_you_mean(stem, known)}; shipped configs: {known} "
+                          "(or give the path of a YAML file)")
+    return p
+
+
+def resolve(spec: str | Path) -> Path:
+    """A config's file: ``spec`` itself when it exists, else the shipped config of that name.
+
+    Raises
+    ------
+    ConfigError
+        When ``spec`` is neither an existing file nor a shipped config's name.
+    """
+    p = Path(spec)
+    if p.exists() or not is_name(spec):
+        if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml"):
+            path(str(spec))  # a name that is not shipped: the error lists the shipped ones
+        return p
+    return path(str(spec))
+
+
+def copy(name: str, dest: str | Path = ".", overwrite: bool = False) -> Path:
+    """Copy the shipped config ``name`` to ``dest`` (a folder, or a file name) to edit it; returns the new file.
+
+    Raises
+    ------
+    ConfigError
+        When the target exists (unless ``overwrite``) or ``name`` is not shipped.
+    """
+    src = path(name)
+    d = Path(dest)
+    target = d / src.name if d.is_dir() else d
+    if target.exists() and not overwrite:
+        raise ConfigError(f"{target} exists; choose another destination, or overwrite it (--force; overwrite=True)")
+    if target.resolve() == src.resolve():
+        raise ConfigError(f"{target} is the shipped file itself; copy it elsewhere")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = target.with_name(f".{target.name}.tmp")
+    shutil.copyfile(src, tmp)
+    tmp.replace(target)
+    return target

@@ -1,0 +1,110 @@
+"""YAML pipeline configurations: parsing and validation with did-you-mean errors.
+
+A configuration::
+
+    name: yun2012
+    gravity: 9.81                 # m/s²
+    init: {duration: 0.5}         # still period at the start used for alignment (s)
+    orientation: {type: fqa_complementary, static_gain: 1.05, dynamic_gain: 0.0}
+    detector:    {type: angular_rate_fsm, threshold: 0.6, min_duration: 0.1}
+    corrections:
+      - {type: zvu_dedrift}
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..core.checks import check_positive, check_range
+from ..core.errors import ConfigError, did_you_mean
+from ..core.yamlsafe import load_file
+from .library import resolve
+
+TOP_LEVEL_KEYS: dict[str, str] = {
+    "name": "pipeline name (text)",
+    "description": "free text",
+    "gravity": "gravity magnitude g (m/s²), default 9.81",
+    "init": "initial alignment: {duration: s of stillness at the start (default 0.5)}",
+    "calibration": "list of in-situ sensor calibrations applied first [{type: hard_iron}, ...]",
+    "orientation": "orientation plug-in {type: ..., params}",
+    "detector": "stance detector plug-in {type: ..., params}",
+    "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
+    "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
+    "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
+    "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
+                  "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
+                  "initial_position_std: m, impact_noise: s (velocity noise per squared acceleration)}",
+    "guards": "what happens when the detector misses stances: {max_swing: s (default 1.5, 0 = off), still_rate: "
+              "rad/s, min_step: s, half_width: s, window: s, max_speed: m/s (default 50, 0 = off)}",
+    "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",
+}
+INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
+REQUIRED = ("orientation", "detector")
+
+
+def load_yaml(path: str | Path) -> dict[str, Any]:
+    """Read a YAML config (a path, or a shipped config's name) with the strict, bounded loader.
+
+    See :mod:`footzoo.core.yamlsafe` for the loader and :func:`footzoo.config.library.resolve` for names.
+    """
+    p = resolve(path)
+    data = load_file(p, ConfigError, "config file")
+    if data is None:
+        raise ConfigError(f"{p}: the file is empty; a config needs at least 'orientation' and 'detector'")
+    if not isinstance(data, dict):
+        raise ConfigError(f"{p}: the top level must be a mapping, got {type(data).__name__}")
+    data.setdefault("name", p.stem)
+    return data
+
+
+def top_level_errors(d: dict[str, Any]) -> list[str]:
+    """Every problem with the top-level keys of a config (unknown, missing, badly typed), as messages."""
+    if not isinstance(d, dict):
+        return [f"a config must be a mapping, got {type(d).__name__}"]
+    errors = []
+    valid = list(TOP_LEVEL_KEYS)
+    for key in d:
+        if key not in TOP_LEVEL_KEYS:
+            errors.append(f"unknown config key {key!r}{did_you_mean(key, valid)}; valid keys: {valid}")
+    for key in REQUIRED:
+        if key not in d:
+            errors.append(f"config is missing {key!r} ({TOP_LEVEL_KEYS[key]})")
+    init = d.get("init", {}) or {}
+    if not isinstance(init, dict):
+        errors.append(f"init must be a mapping like {{duration: 0.5}}, got {init!r}")
+    else:
+        for key in init:
+            if key not in INIT_KEYS:
+                errors.append(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; "
+                              f"valid: {list(INIT_KEYS)}")
+    for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]"),
+                         ("calibration", "[{type: hard_iron}]")):
+        if not isinstance(d.get(key, []) or [], list):
+            errors.append(f"{key} must be a list, e.g. {example}")
+    return errors
+
+
+def check_top_level(d: dict[str, Any]) -> None:
+    """Reject unknown or missing top-level keys, listing the valid ones (every problem in one message)."""
+    errors = top_level_errors(d)
+    if errors:
+        raise ConfigError("; ".join(errors))
+
+
+#: Longest accepted ``init.duration`` (s): the still start used for the initial alignment.
+INIT_DURATION_MAX = 60.0
+
+
+def check_init(init: dict[str, Any]) -> dict[str, float]:
+    """Validate ``init`` (``duration`` in s, ``max_gyr`` in rad/s) and fill in the defaults."""
+    if not isinstance(init, dict):
+        raise ConfigError(f"init must be a mapping like {{duration: 0.5, max_gyr: 0.6}}, got {init!r}")
+    unknown = [k for k in init if k not in INIT_KEYS]
+    if unknown:
+        raise ConfigError(f"unknown init key {unknown[0]!r}{did_you_mean(str(unknown[0]), list(INIT_KEYS))}; "
+                          f"valid: {list(INIT_KEYS)}")
+    out = {**INIT_KEYS, **init}
+    out["duration"] = check_range("init.duration", out["duration"], 0.0, INIT_DURATION_MAX, "s", lo_open=True)
+    out["max_gyr"] = check_positive("init.max_gyr", out["max_gyr"], unit="rad/s")
+    return out

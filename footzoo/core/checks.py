@@ -1,0 +1,241 @@
+"""Typed, bounded validation of parameters and live samples (bottom layer: footzoo.core.errors and numpy only).
+
+Every check returns the value converted to its Python type, or raises a footzoo
+error whose message names the input, the problem and the fix. Plug-in
+constructors use :func:`check_positive`, :func:`check_range` and
+:func:`check_bool`; :func:`validate_sample` guards ``Stream.push``.
+
+Physical bounds (SI units) shared by the recording checks and the stream:
+
+* :data:`GRAVITY_RANGE` — 9.7 to 9.9 m/s²: Earth's surface gravity lies between
+  about 9.76 m/s² (high mountains near the equator) and 9.834 m/s² (poles), so a
+  value outside this range is a unit or typing error (``98.1``, ``1.0``).
+* :data:`ACC_MAX` — 2000 m/s² (≈ 204 g): above the full range of any body-worn
+  IMU (high-g parts end at ±200 g); a larger value is a corrupt sample.
+* :data:`GYR_MAX` — 50 rad/s (≈ 2900 °/s): above any foot's angular rate
+  (≲ 20 rad/s when sprinting) and the ±2000 °/s range of common gyroscopes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+from .errors import ConfigError, RecordingError, did_you_mean
+
+#: Plausible gravity magnitude g on the Earth's surface (m/s²), inclusive bounds.
+GRAVITY_RANGE = (9.7, 9.9)
+#: Largest plausible |specific force| component of a body-worn IMU (m/s²).
+ACC_MAX = 2000.0
+#: Largest plausible |angular rate| component (rad/s).
+GYR_MAX = 50.0
+#: Default largest gap between two pushed samples of a live stream (s).
+STREAM_MAX_GAP = 0.1
+
+
+def _number(name: str, value: Any, error: type[Exception]) -> float:
+    if isinstance(value, bool) or isinstance(value, str) or value is None:
+        hint = " (write the number without quotes)" if isinstance(value, str) else ""
+        raise error(f"{name} must be a number, got {type(value).__name__} {value!r}{hint}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise error(f"{name} must be a number, got {type(value).__name__} {value!r}") from None
+    if not math.isfinite(v):
+        raise error(f"{name} must be a finite number, got {value!r}; give a finite value in its unit")
+    return v
+
+
+def check_positive(name: str, value: Any, allow_zero: bool = False, unit: str = "") -> float:
+    """A finite number ``> 0`` (or ``>= 0`` with ``allow_zero``), as float.
+
+    Raises
+    ------
+    ConfigError
+        For a non-number (strings, booleans, None), NaN, ±inf or a value out of bounds.
+    """
+    v = _number(name, value, ConfigError)
+    if v < 0 if allow_zero else v <= 0:
+        bound = ">= 0" if allow_zero else "> 0"
+        u = f" {unit}" if unit else ""
+        raise ConfigError(f"{name} must be {bound}{u}, got {value!r}")
+    return v
+
+
+def check_range(
+    name: str, value: Any, lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False
+) -> float:
+    """A finite number in ``[lo, hi]`` (ends open with ``lo_open`` / ``hi_open``), as float.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name, as the user wrote it (e.g. ``init.duration``).
+    value : any
+        The value to check.
+    lo, hi : float
+        Bounds, in ``unit``.
+    unit : str
+        Unit of the value, shown in the message (e.g. ``"m/s^2"``).
+    """
+    v = _number(name, value, ConfigError)
+    below = v <= lo if lo_open else v < lo
+    above = v >= hi if hi_open else v > hi
+    if below or above:
+        u = f" {unit}" if unit else ""
+        interval = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+        raise ConfigError(f"{name} = {value!r}{u} is out of range: it must lie in {interval}{u}")
+    return v
+
+
+def check_bool(name: str, value: Any) -> bool:
+    """A real boolean; strings such as ``'no'`` or ``'false'`` (truthy in Python) are rejected."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ConfigError(
+        f"{name} must be true or false, got {type(value).__name__} {value!r}; "
+        "write true or false without quotes"
+    )
+
+
+def check_vector(name: str, value: Any, size: int = 3, nonzero: bool = False, unit: str = "") -> list[float]:
+    """A list of ``size`` finite numbers (and not all zero with ``nonzero``)."""
+    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") or len(value) != size:
+        raise ConfigError(f"{name} must be a list of {size} numbers like [1, 0, 0], got {value!r}")
+    out = [_number(f"{name}[{i}]", v, ConfigError) for i, v in enumerate(value)]
+    if nonzero and not any(out):
+        u = f" ({unit})" if unit else ""
+        raise ConfigError(f"{name}{u} must not be all zeros, got {value!r}: its direction is undefined")
+    return out
+
+
+def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: str) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise RecordingError(f"{name} at t = {t!r} must be 3 numbers ({unit}), got {value!r}") from None
+    if arr.shape != (3,):
+        extra = ""
+        if arr.ndim == 2 and arr.shape[-1] == 3:
+            extra = (f": that is {arr.shape[0]} samples; push them one at a time "
+                     "(for k in range(n): stream.push(t[k], acc[k], gyr[k])) or use Stream.run(recording)")
+        raise RecordingError(f"{name} at t = {t!r} must have shape (3,), got {arr.shape}{extra}")
+    if not np.isfinite(arr).all():
+        raise RecordingError(f"non-finite sample at t = {t!r}: {name} = {arr.tolist()}; repair or drop the sample")
+    if bound is not None and np.abs(arr).max() > bound:
+        raise RecordingError(
+            f"{name} at t = {t!r} is {arr.tolist()} {unit}: beyond any body-worn IMU (|value| <= {bound:g} {unit}); "
+            "the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)"
+        )
+    return arr
+
+
+def validate_sample(
+    t: Any,
+    acc: Any,
+    gyr: Any,
+    mag: Any = None,
+    dist: Any = None,
+    previous_t: float | None = None,
+    max_gap: float | None = None,
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Check one live sample; return it as ``(t, acc, gyr, mag, dist)`` floats/arrays.
+
+    Parameters
+    ----------
+    t : float
+        Time stamp (s); finite and later than ``previous_t``.
+    acc : (3,) array_like
+        Specific force, FRD (m/s²), each component within ±:data:`ACC_MAX`.
+    gyr : (3,) array_like
+        Angular rate, FRD (rad/s), each component within ±:data:`GYR_MAX`.
+    mag : (3,) array_like, optional
+        Magnetic field (any unit), finite.
+    dist : (k,) array_like, optional
+        Ranges (m); NaN means "no reading", ±inf is rejected.
+    previous_t : float, optional
+        Time stamp of the previous sample (s).
+    max_gap : float, optional
+        Largest accepted interval to the previous sample (s); default :data:`STREAM_MAX_GAP`.
+
+    Raises
+    ------
+    RecordingError
+        Naming the sample's time, the problem and the fix. One sample per call:
+        a block of samples (shape ``(n, 3)``) is rejected with how to push it.
+    """
+    if isinstance(t, (bool, str)) or np.ndim(t) != 0:
+        raise RecordingError(f"t must be one time stamp in s (a number), got {t!r}; push one sample per call")
+    try:
+        tf = float(t)
+    except (TypeError, ValueError):
+        raise RecordingError(f"t must be a time stamp in s, got {t!r}") from None
+    if not math.isfinite(tf):
+        raise RecordingError(f"time stamp t = {t!r} is not finite; give each sample its real time in s")
+    if previous_t is not None:
+        if tf <= previous_t:
+            raise RecordingError(
+                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in order (increasing time)"
+            )
+        gap = STREAM_MAX_GAP if max_gap is None else max_gap
+        if tf - previous_t > gap:
+            raise RecordingError(
+                f"gap of {tf - previous_t:.6g} s before t = {tf!r} s exceeds the stream's limit of {gap:g} s: "
+                "the filter cannot bridge it; start a new Stream after the gap"
+            )
+    a = _sample_vector("acc", acc, tf, ACC_MAX, "m/s^2")
+    g = _sample_vector("gyr", gyr, tf, GYR_MAX, "rad/s")
+    m = None if mag is None else _sample_vector("mag", mag, tf, None, "")
+    d = None
+    if dist is not None:
+        try:
+            d = np.asarray(dist, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise RecordingError(
+                f"dist at t = {tf!r} must be numbers in m (NaN for no reading), got {dist!r}"
+            ) from None
+        if np.isinf(d).any():
+            raise RecordingError(f"dist at t = {tf!r} is infinite ({d.tolist()}); use NaN where there is no reading")
+    return tf, a, g, m, d
+
+
+class Settings:
+    """Base of a config's settings blocks (``navigation:``, ``guards:``): a dataclass of numbers.
+
+    A subclass is a ``@dataclass`` whose fields are the keys (with their defaults) and sets
+    ``section`` (the config key), ``units`` and ``ranges`` (per field) and ``example`` (a valid
+    mapping, for the error message). Values are checked against their ranges on construction;
+    :meth:`from_dict` refuses unknown keys with the valid ones; :meth:`to_dict` gives every value.
+    """
+
+    section: ClassVar[str] = ""
+    example: ClassVar[str] = ""
+    units: ClassVar[dict[str, str]] = {}
+    ranges: ClassVar[dict[str, tuple[float, float]]] = {}
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            lo, hi = self.ranges[f.name]
+            setattr(self, f.name, check_range(f"{self.section}.{f.name}", getattr(self, f.name), lo, hi,
+                                              self.units[f.name]))
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any] | None) -> Any:
+        """Build from the config's mapping (None or missing keys: the defaults)."""
+        if d is None:
+            return cls()
+        if not isinstance(d, dict):
+            raise ConfigError(f"{cls.section} must be a mapping like {cls.example}, got {d!r}")
+        valid = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        for key in d:
+            if key not in valid:
+                raise ConfigError(f"unknown {cls.section} key {key!r}{did_you_mean(str(key), valid)}; "
+                                  f"valid: {valid}")
+        return cls(**d)
+
+    def to_dict(self) -> dict[str, float]:
+        """Every value, explicit (for ``Result.config``)."""
+        return asdict(self)  # type: ignore[call-overload]

@@ -1,0 +1,618 @@
+"""Data model: :class:`Recording`, :class:`Truth` and :class:`Result`.
+
+A :class:`Recording` holds signals already converted to footzoo's conventions
+(FRD body frame, SI units, see :mod:`footzoo.core.conventions`). It is validated on
+construction; every problem raises :class:`~footzoo.core.errors.RecordingError`
+with a message that names the column and the fix.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .checks import check_positive
+from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
+from .errors import FootzooWarning, RecordingError
+from .sanity import check_impossible, scan
+
+ACC_COLS = ["acc_x", "acc_y", "acc_z"]
+GYR_COLS = ["gyr_x", "gyr_y", "gyr_z"]
+MAG_COLS = ["mag_x", "mag_y", "mag_z"]
+TRUTH_POS_COLS = ["true_pos_n", "true_pos_e", "true_pos_d"]
+TRUTH_VEL_COLS = ["true_vel_n", "true_vel_e", "true_vel_d"]
+TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
+
+#: Shortest recording footzoo accepts (s): the initial alignment needs still samples.
+MIN_DURATION = 1.0
+#: Default largest gap between samples that is bridged (s); longer gaps are refused.
+DEFAULT_MAX_GAP = 0.1
+#: ... or this many median sample periods, when that is longer (slow loggers).
+DEFAULT_MAX_GAP_PERIODS = 5.0
+#: Plausible median sampling rate of a foot-mounted IMU (Hz); outside it the time stamps are not in seconds.
+RATE_RANGE = (10.0, 20_000.0)
+#: An interval longer than this many median periods is a gap (at least one sample missing).
+GAP_PERIODS = 1.5
+#: Gyro peak (in the declared unit rad/s) above which the data must be in deg/s.
+GYRO_DEG_S_SUSPICION = 50.0
+
+
+@dataclass
+class Truth:
+    """Reference values that no estimator produced (simulator or dataset).
+
+    Attributes
+    ----------
+    pos : (N, 3) ndarray or None
+        Sensor position in NED (m); the horizontal axes may be rotated about
+        the vertical with respect to the estimate (compare after alignment).
+    vel : (N, 3) ndarray or None
+        Sensor velocity in NED (m/s).
+    quat : (N, 4) ndarray or None
+        Body -> NED attitude, scalar first.
+    stance : (N,) bool ndarray or None
+        True where the sensor's velocity is zero.
+    steps : DataFrame or None
+        Reference strides, one row per stride, columns as in
+        :func:`footzoo.analysis.strides.segment_steps` where known: ``start_s``,
+        ``to_s``, ``end_s`` (IC, toe-off, next IC; s), ``stride_length_m``,
+        ``heading_rad``, ``fpa_rad``, ``turn`` (bool). Simulator files written
+        before the unit names (``swing_start``/``swing_end``, ``stride_length``,
+        ``heading``, ``fpa``) are read too (:func:`footzoo.evaluation.metrics.reference_steps`).
+    closed_loop : bool
+        The walk ends where it started (loop-closure metrics apply).
+    dist : (N, k) ndarray or None
+        True range of each distance sensor (m), NaN where it has no sample.
+    stride_count : int or None
+        Strides counted by hand (PyShoe's trials, Köroğlu's ``numberOfStrides``).
+    footprints : (K, 2) ndarray or None
+        Horizontal position of every footprint (m), first one included, in the
+        dataset's own floor axes (compare after a 2-D rigid alignment, reflection
+        allowed), e.g. Köroğlu's ground control points ``GCP_meters``.
+    stride_positions : DataFrame or None
+        Per-stride trajectories (e.g. gaitmap's ``position_sample.csv``):
+        ``stride`` (row of ``steps``), ``t_s`` (s), ``pos_x_m``, ``pos_y_m``,
+        ``pos_up_m`` (m, zeroed at the stride's start, right-handed with z up;
+        compare after a rotation about the vertical).
+    source : str
+        What the reference is (e.g. "VICON", "motion capture", "simulator").
+    """
+
+    pos: np.ndarray | None = None
+    vel: np.ndarray | None = None
+    quat: np.ndarray | None = None
+    stance: np.ndarray | None = None
+    steps: pd.DataFrame | None = None
+    closed_loop: bool = False
+    dist: np.ndarray | None = None
+    stride_count: int | None = None
+    footprints: np.ndarray | None = None
+    stride_positions: pd.DataFrame | None = None
+    source: str = ""
+
+    def __repr__(self) -> str:
+        have = [k for k in ("pos", "vel", "quat", "stance", "steps", "dist", "footprints", "stride_positions")
+                if getattr(self, k) is not None]
+        extra = f", stride_count={self.stride_count}" if self.stride_count is not None else ""
+        src = f"{self.source!r}, " if self.source else ""
+        return f"Truth({src}{', '.join(have) or 'nothing'}{extra}, closed_loop={self.closed_loop})"
+
+
+@dataclass
+class Recording:
+    """IMU signals in FRD/SI, validated.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Sample times (s), strictly increasing.
+    acc : (N, 3) ndarray
+        Specific force in the FRD body frame (m/s²); at rest ≈ ``[0, 0, -g]``.
+    gyr : (N, 3) ndarray
+        Angular rate in FRD (rad/s).
+    mag : (N, 3) ndarray, optional
+        Magnetic field in FRD (any unit).
+    dist : (N, k) ndarray, optional
+        Distance-sensor ranges (m); NaN where the slower sensor has no sample.
+    meta : dict
+        ``name``, ``source``, ``rate`` (Hz, derived), ``placement`` …
+    truth : Truth, optional
+        Reference values, if any.
+    max_gap : float, optional
+        Largest gap between two samples that is bridged (s); default
+        ``max(DEFAULT_MAX_GAP, 5 median periods)`` = 0.1 s above 50 Hz. Shorter
+        gaps are kept as they are (no samples invented: every filter integrates
+        over each sample's own interval, which is what the sensor measured) and
+        reported with a :class:`~footzoo.core.errors.FootzooWarning` and in
+        ``meta["diagnostics"]["gaps"]``; longer gaps are refused.
+    """
+
+    t: np.ndarray
+    acc: np.ndarray
+    gyr: np.ndarray
+    mag: np.ndarray | None = None
+    dist: np.ndarray | None = None
+    meta: dict[str, Any] = field(default_factory=dict)
+    truth: Truth | None = None
+    max_gap: float | None = None
+
+    def __post_init__(self) -> None:
+        self.t = _floats("t", self.t)
+        self.acc = _floats("acc", self.acc)
+        self.gyr = _floats("gyr", self.gyr)
+        if self.mag is not None:
+            self.mag = _floats("mag", self.mag)
+        if self.dist is not None:
+            self.dist = _floats("dist", self.dist)
+            if self.dist.ndim == 1:
+                self.dist = self.dist[:, None]
+        if not isinstance(self.meta, dict):
+            raise RecordingError(f"meta must be a dict, got {type(self.meta).__name__}")
+        if self.truth is not None and not isinstance(self.truth, Truth):
+            raise RecordingError(f"truth must be a footzoo Truth, got {type(self.truth).__name__}")
+        validate_recording(self)
+        self.meta = dict(self.meta)
+        _report_gaps(self)
+        self.meta.setdefault("name", "recording")
+        self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
+        findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]))
+        if findings:
+            self.meta["sanity"] = findings
+
+    def __repr__(self) -> str:
+        channels = ["acc", "gyr"] + [k for k in ("mag", "dist") if getattr(self, k) is not None]
+        truth = "" if self.truth is None else f", truth={self.truth!r}"
+        return (f"Recording({self.name!r}, n={self.n}, rate={self.rate:.1f} Hz, "
+                f"duration={self.t[-1] - self.t[0]:.2f} s, channels={channels}{truth})")
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return self.t.shape[0]
+
+    @property
+    def rate(self) -> float:
+        """Median sampling rate (Hz)."""
+        return self.meta["rate"]
+
+    @property
+    def name(self) -> str:
+        """The recording's name (file stem or given)."""
+        return str(self.meta.get("name", "recording"))
+
+    @classmethod
+    def from_dataframe(
+        cls,
+        df: pd.DataFrame,
+        *,
+        acc_unit: str = "m/s^2",
+        gyr_unit: str = "rad/s",
+        dist_unit: str = "m",
+        time_col: str = "t",
+        duplicates: str = "error",
+        nan_policy: str = "error",
+        max_gap: float | None = None,
+        meta: dict[str, Any] | None = None,
+        truth: Truth | None = None,
+    ) -> Recording:
+        """Build a recording from a DataFrame with canonical column names.
+
+        Columns: ``t`` (s), ``acc_x..acc_z``, ``gyr_x..gyr_z``, optionally
+        ``mag_x..mag_z`` and ``dist_a``, ``dist_b``, …, all already in the FRD
+        body frame. ``true_pos_n..d``, ``true_vel_n..d``, ``true_qw..qz`` and
+        ``true_stance`` columns, when present, become the :class:`Truth`.
+
+        Parameters
+        ----------
+        acc_unit : {"m/s^2", "g", "mg"}
+            Unit of the acc columns.
+        gyr_unit : {"rad/s", "deg/s"}
+            Unit of the gyr columns.
+        dist_unit : {"m", "cm", "mm"}
+            Unit of the dist columns.
+        duplicates : {"error", "drop"}
+            What to do with rows whose time stamp repeats the previous one.
+            ``"drop"`` keeps the first and warns with the count.
+        nan_policy : {"error", "interpolate"}
+            What to do with non-finite IMU values (``dist`` may always be NaN).
+        max_gap : float, optional
+            Largest gap bridged (s); default 0.1 s (or 5 median periods if longer).
+        """
+        if not isinstance(df, pd.DataFrame):
+            raise RecordingError(f"from_dataframe expects a pandas DataFrame, got {type(df).__name__}")
+        _check_choice("acc_unit", acc_unit, ACC_UNITS)
+        _check_choice("gyr_unit", gyr_unit, GYR_UNITS)
+        _check_choice("dist_unit", dist_unit, DIST_UNITS)
+        _check_choice("duplicates", duplicates, ("error", "drop"))
+        _check_choice("nan_policy", nan_policy, ("error", "interpolate"))
+        if len(df) == 0:
+            raise RecordingError("the recording is empty (0 rows); check the file and its header")
+        required = [time_col, *ACC_COLS, *GYR_COLS]
+        missing = [c for c in required if c not in df.columns]
+        if missing:
+            raise RecordingError(
+                f"missing column(s) {missing}; a recording needs {required} "
+                f"(found {list(df.columns)[:12]}). Rename the columns or use a reader from footzoo.io"
+            )
+        has_mag = all(c in df.columns for c in MAG_COLS)
+        partial_mag = [c for c in MAG_COLS if c in df.columns]
+        if partial_mag and not has_mag:
+            raise RecordingError(f"magnetometer columns incomplete: found {partial_mag}, need {MAG_COLS}")
+        dist_cols = sorted(c for c in df.columns if c.startswith("dist_"))
+
+        df = df.reset_index(drop=True)
+        t = pd.to_numeric(df[time_col], errors="coerce").to_numpy(dtype=float)
+        meta = dict(meta or {})
+        if duplicates == "drop":
+            dup = np.zeros(len(t), dtype=bool)
+            dup[1:] = np.diff(t) == 0
+            meta["dropped_duplicates"] = int(dup.sum())
+            if dup.any():
+                warnings.warn(
+                    f"dropped {int(dup.sum())} row(s) whose time stamp repeats the previous one",
+                    stacklevel=2,
+                )
+                df = df.loc[~dup].reset_index(drop=True)
+                t = t[~dup]
+
+        def block(cols: list[str], scale: float, allow_nan: bool = False) -> np.ndarray:
+            values = df[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float) * scale
+            if allow_nan:
+                return values
+            bad = ~np.isfinite(values)
+            if bad.any():
+                if nan_policy == "interpolate":
+                    frame = pd.DataFrame(values).interpolate(limit_direction="both")
+                    return frame.to_numpy(dtype=float)
+                row, col = np.argwhere(bad)[0]
+                if bad[:, col].all():
+                    raise RecordingError(
+                        f"column {cols[col]!r} holds no numbers (first value {df[cols[col]].iloc[0]!r}); check the "
+                        "file's delimiter and decimal separator (footzoo reads ',' between values and '.' in numbers)"
+                    )
+                raise RecordingError(
+                    f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
+                    f"first at row {row} (t = {t[row]!r}); drop or repair those rows, "
+                    "or pass nan_policy='interpolate'"
+                )
+            return values
+
+        acc = block(ACC_COLS, ACC_UNITS[acc_unit])
+        gyr = block(GYR_COLS, GYR_UNITS[gyr_unit])
+        mag = block(MAG_COLS, 1.0) if has_mag else None
+        dist = block(dist_cols, DIST_UNITS[dist_unit], allow_nan=True) if dist_cols else None
+        if truth is None:
+            truth = _truth_from_columns(df)
+        meta.setdefault("units_declared", {"acc": acc_unit, "gyr": gyr_unit})
+        if dist_cols:
+            meta.setdefault("dist_columns", dist_cols)
+        return cls(t=t, acc=acc, gyr=gyr, mag=mag, dist=dist, meta=meta, truth=truth, max_gap=max_gap)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Canonical DataFrame (SI, FRD) with truth columns where known."""
+        cols: dict[str, np.ndarray] = {"t": self.t}
+        cols.update(zip(ACC_COLS, self.acc.T, strict=True))
+        cols.update(zip(GYR_COLS, self.gyr.T, strict=True))
+        if self.mag is not None:
+            cols.update(zip(MAG_COLS, self.mag.T, strict=True))
+        if self.dist is not None:
+            names = self.meta.get("dist_columns") or [f"dist_{chr(97 + i)}" for i in range(self.dist.shape[1])]
+            cols.update(zip(names, self.dist.T, strict=True))
+        tr = self.truth
+        if tr is not None:
+            if tr.pos is not None:
+                cols.update(zip(TRUTH_POS_COLS, tr.pos.T, strict=True))
+            if tr.vel is not None:
+                cols.update(zip(TRUTH_VEL_COLS, tr.vel.T, strict=True))
+            if tr.quat is not None:
+                cols.update(zip(TRUTH_QUAT_COLS, tr.quat.T, strict=True))
+            if tr.stance is not None:
+                cols["true_stance"] = tr.stance.astype(int)
+            if tr.dist is not None:
+                cols.update({f"true_dist_{chr(97 + i)}": d for i, d in enumerate(tr.dist.T)})
+        return pd.DataFrame(cols)
+
+
+def _floats(name: str, value: Any) -> np.ndarray:
+    """``value`` as a contiguous, writable float array, or a RecordingError naming the input.
+
+    Writable always (a copy of a read-only input, such as pandas' copy-on-write views): the
+    compiled kernels then see one array type whatever the reader, and compile once.
+    """
+    try:
+        array = np.ascontiguousarray(value, dtype=float)
+        return array if array.flags.writeable else array.copy()
+    except (TypeError, ValueError) as err:
+        raise RecordingError(
+            f"{name} must be numbers (an array of floats), got {type(value).__name__}: {err}"
+        ) from None
+
+
+def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
+    def get(cols: list[str]) -> np.ndarray | None:
+        return df[cols].to_numpy(dtype=float) if all(c in df.columns for c in cols) else None
+
+    pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
+    stance = None
+    if "true_stance" in df.columns:
+        flags = pd.to_numeric(df["true_stance"], errors="coerce").to_numpy(dtype=float)
+        if not np.isin(flags, (0.0, 1.0)).all():
+            k = int(np.argmax(~np.isin(flags, (0.0, 1.0))))
+            raise RecordingError(
+                f"column 'true_stance' must hold 0 or 1 in every row, got {df['true_stance'].iloc[k]!r} at row {k}; "
+                "fix the column or drop it"
+            )
+        stance = flags.astype(bool)
+    dist_cols = sorted(c for c in df.columns if c.startswith("true_dist_"))
+    dist = df[dist_cols].to_numpy(dtype=float) if dist_cols else None
+    if pos is None and vel is None and quat is None and stance is None:
+        return None
+    return Truth(pos=pos, vel=vel, quat=quat, stance=stance, dist=dist)
+
+
+def _check_choice(name: str, value: str, allowed) -> None:
+    if not isinstance(value, str) or value not in allowed:
+        raise RecordingError(f"{name}={value!r} is not supported; use one of {list(allowed)}")
+
+
+def validate_recording(rec: Recording) -> None:
+    """Check shapes, time stamps, finiteness and plausible units of a recording.
+
+    Raises
+    ------
+    RecordingError
+        With a message naming the problem and how to fix it.
+    """
+    t, acc, gyr = rec.t, rec.acc, rec.gyr
+    n = t.shape[0] if t.ndim == 1 else -1
+    if t.ndim != 1:
+        raise RecordingError(f"t must be one-dimensional, got shape {t.shape}")
+    if n == 0:
+        raise RecordingError("the recording is empty (0 samples)")
+    for name, arr in (("acc", acc), ("gyr", gyr), ("mag", rec.mag)):
+        if arr is not None and arr.shape != (n, 3):
+            raise RecordingError(f"{name} must have shape ({n}, 3) to match t, got {arr.shape}")
+    if rec.dist is not None and rec.dist.shape[0] != n:
+        raise RecordingError(f"dist must have {n} rows to match t, got {rec.dist.shape[0]}")
+    if n < 3:
+        raise RecordingError(f"the recording has only {n} sample(s); at least {MIN_DURATION} s is needed")
+    if rec.truth is not None:
+        _check_truth(rec.truth, n)
+    if rec.max_gap is not None:
+        rec.max_gap = check_positive("max_gap", rec.max_gap, unit="s")
+    for name, arr in (("t", t), ("acc", acc), ("gyr", gyr), ("mag", rec.mag)):
+        if arr is None:
+            continue
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            idx = int(np.argwhere(bad)[0][0])
+            raise RecordingError(
+                f"{name} has {int(bad.sum())} non-finite value(s), first at sample {idx}; "
+                "drop or repair those samples (Recording.from_dataframe(..., nan_policy='interpolate'))"
+            )
+    dt = np.diff(t)
+    if np.any(dt < 0):
+        k = int(np.argmax(dt < 0))
+        raise RecordingError(
+            f"time stamps go backwards at sample {k + 1} (t = {t[k]:.6f} s -> {t[k + 1]:.6f} s); "
+            "sort the rows by time or fix the clock"
+        )
+    if np.any(dt == 0):
+        k = int(np.argmax(dt == 0))
+        raise RecordingError(
+            f"{int(np.sum(dt == 0))} duplicate time stamp(s), first at sample {k + 1} (t = {t[k]:.6f} s); "
+            "remove them, or pass duplicates='drop' to drop repeated rows (a warning gives the count)"
+        )
+    period = float(np.median(dt))
+    if not RATE_RANGE[0] <= 1.0 / period <= RATE_RANGE[1]:
+        raise RecordingError(
+            f"the median sampling rate is {1.0 / period:.6g} Hz (period {period:.6g}), outside the plausible "
+            f"{RATE_RANGE[0]:g}-{RATE_RANGE[1]:g} Hz of a foot-mounted IMU: are the time stamps in ms, µs or ns? "
+            "footzoo needs t in seconds (divide by 1e3, 1e6 or 1e9)"
+        )
+    max_gap = _max_gap(rec, period)
+    if np.any(dt > max_gap):
+        k = int(np.argmax(dt > max_gap))
+        raise RecordingError(
+            f"{int(np.sum(dt > max_gap))} gap(s) longer than {max_gap * 1e3:.1f} ms, the first "
+            f"{dt[k] * 1e3:.1f} ms at t = {t[k]:.3f} s (median period {period * 1e3:.2f} ms); "
+            "split the recording there, or raise max_gap if the filters may bridge it"
+        )
+    duration = t[-1] - t[0]
+    if duration < MIN_DURATION:
+        raise RecordingError(
+            f"the recording is too short to align: {duration:.3f} s; footzoo needs at least "
+            f"{MIN_DURATION} s, starting with the foot still"
+        )
+    _check_units(rec)
+    check_impossible(t, acc, gyr)
+
+
+def _check_truth(truth: Truth, n: int) -> None:
+    """Ground truth must cover the IMU samples one to one (checked at load, not after a run)."""
+    for name, arr, width in (("pos", truth.pos, 3), ("vel", truth.vel, 3), ("quat", truth.quat, 4),
+                             ("stance", truth.stance, None), ("dist", truth.dist, None)):
+        if arr is None:
+            continue
+        shape = np.shape(arr)
+        if len(shape) == 0 or shape[0] != n:
+            rows = shape[0] if len(shape) else 0
+            raise RecordingError(
+                f"ground truth {name} has {rows} rows but the IMU has {n} samples: truth must have one row per "
+                f"IMU sample. {'Shorter: the reference stops early' if rows < n else 'Longer'}; trim both to the "
+                "common time span, or drop the truth"
+            )
+        if width is not None and (len(shape) != 2 or shape[1] != width):
+            raise RecordingError(f"ground truth {name} must have shape ({n}, {width}), got {shape}")
+        if width is not None:
+            bad = ~np.isfinite(np.asarray(arr, dtype=float)).all(axis=1)
+            if bad.any():
+                k = int(np.argmax(bad))
+                where = (f"the reference stops at sample {k} while the IMU has {n} samples" if bad[k:].all()
+                         else f"{int(bad.sum())} row(s) are not finite, the first at sample {k}")
+                raise RecordingError(
+                    f"ground truth {name}: {where}; truth must cover every IMU sample: trim the recording to the "
+                    "reference's time span, or drop the truth columns"
+                )
+
+
+def _max_gap(rec: Recording, period: float) -> float:
+    """Largest gap bridged (s): the recording's ``max_gap`` or the default."""
+    return rec.max_gap if rec.max_gap is not None else max(DEFAULT_MAX_GAP, DEFAULT_MAX_GAP_PERIODS * period)
+
+
+def _report_gaps(rec: Recording) -> None:
+    """Warn about the short gaps that are bridged and list them in ``meta["diagnostics"]["gaps"]``.
+
+    A gap is an interval longer than ``GAP_PERIODS`` median periods. The
+    samples are kept as they are: the filters integrate each sample over its
+    own interval (the sensor's last reading held across the gap), which adds
+    no invented data; interpolating would invent a motion the sensor did not
+    measure and hide the gap from the detectors' windows. A gap in a stance
+    costs nothing; a gap in a swing loses the motion in it, which neither
+    holding nor interpolating recovers (on a simulated 30 m loop, 1–3 lost
+    samples mid-swing at 100 Hz cost 1–40 cm of loop closure either way).
+    """
+    dt = np.diff(rec.t)
+    period = float(np.median(dt))
+    k = np.flatnonzero(dt > GAP_PERIODS * period)
+    if k.size == 0:
+        return
+    longest = int(k[np.argmax(dt[k])])
+    diag = rec.meta.setdefault("diagnostics", {})
+    diag["gaps"] = {
+        "count": int(k.size),
+        "start_s": rec.t[k].tolist(),
+        "duration_s": dt[k].tolist(),
+        "longest_s": float(dt[longest]),
+        "max_gap_s": float(_max_gap(rec, period)),
+    }
+    warnings.warn(
+        FootzooWarning(
+            f"{rec.name}: bridged {k.size} gap(s) in the time stamps (intervals over {GAP_PERIODS:g} median periods "
+            f"of {period * 1e3:.2f} ms), the longest {dt[longest] * 1e3:.1f} ms at t = {rec.t[longest]:.3f} s; "
+            "the filters integrate over each sample's real interval. The list is in meta['diagnostics']['gaps']; "
+            "pass a smaller max_gap to refuse them"
+        ),
+        stacklevel=4,
+    )
+
+
+def _check_units(rec: Recording) -> None:
+    acc_norm = np.linalg.norm(rec.acc, axis=1)
+    gyr_norm = np.linalg.norm(rec.gyr, axis=1)
+    # the stillest tenth of the samples tells the unit of the accelerometer
+    still = gyr_norm <= np.quantile(gyr_norm, 0.1)
+    rest = float(np.median(acc_norm[still]))
+    if 0.5 < rest < 2.0:
+        raise RecordingError(
+            f"accelerometer magnitude at rest is {rest:.3f}: this looks like g, not m/s²; "
+            "declare acc_unit: g (Recording.from_dataframe(..., acc_unit='g'))"
+        )
+    if 500.0 < rest < 2000.0:
+        raise RecordingError(
+            f"accelerometer magnitude at rest is {rest:.1f}: this looks like mg; declare acc_unit: mg"
+        )
+    if not 0.5 * GRAVITY < rest < 1.5 * GRAVITY:
+        raise RecordingError(
+            f"accelerometer magnitude at rest is {rest:.3f} m/s², far from g = {GRAVITY}; "
+            "check the unit (acc_unit) and the sensor's calibration"
+        )
+    # 99th percentile, not the maximum: a few corrupt samples are reported as such (sanity.check_impossible)
+    peak = float(np.quantile(gyr_norm, 0.99))
+    if peak > GYRO_DEG_S_SUSPICION:
+        raise RecordingError(
+            f"gyroscope 99th-percentile rate is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
+            "this looks like deg/s; declare gyr_unit: deg/s"
+        )
+
+
+@dataclass
+class Result:
+    """What a pipeline produced for one recording.
+
+    Attributes
+    ----------
+    samples : DataFrame
+        Per sample: ``t`` (s), ``qw..qz`` (body -> NED), ``roll, pitch, yaw``
+        (rad, Z-Y-X), ``pos_n, pos_e, pos_d`` (m), ``vel_n, vel_e, vel_d`` (m/s),
+        ``acc_n, acc_e, acc_d`` (motion acceleration, gravity removed, m/s²),
+        ``stance`` (bool).
+    steps : DataFrame
+        Per stride, units in the column names (see
+        :func:`footzoo.analysis.strides.segment_steps`): ``start_s``, ``to_s``,
+        ``end_s`` (initial contact, toe-off, next initial contact), stride, stance
+        and swing time (s), ``cadence_steps_min``, ``stride_length_m``,
+        ``speed_m_s``, ``heading_rad``, mid-stance positions (m),
+        ``max_clearance_m``; ``fpa_rad`` with an FPA analysis.
+    config : dict
+        The resolved configuration (every parameter, defaults filled in).
+    versions : dict
+        Versions of footzoo and its numerical dependencies.
+    recording : dict
+        The recording's metadata.
+    diagnostics : dict
+        Plug-in statistics (e.g. detector test statistic), arrays by name.
+    reference : Truth or None
+        The recording's reference (simulator truth, VICON, motion-capture events,
+        footprints, hand-counted strides), used by :attr:`metrics`.
+    """
+
+    samples: pd.DataFrame
+    steps: pd.DataFrame
+    config: dict[str, Any]
+    versions: dict[str, str]
+    recording: dict[str, Any] = field(default_factory=dict)
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+    reference: Truth | None = None
+
+    def __repr__(self) -> str:
+        name = self.recording.get("name", "recording")
+        return (f"Result({self.config.get('name', 'pipeline')!r} on {name!r}, {len(self.samples)} samples, "
+                f"{len(self.steps)} strides, reference={'yes' if self.reference is not None else 'no'})")
+
+    @property
+    def metrics(self) -> dict[str, float]:
+        """Summary and errors against the recording's reference, one number per key (units in the keys).
+
+        Always: ``duration_s``, ``path_length_m`` (horizontal), ``strides``,
+        median ``stride_time_s``, ``cadence_steps_min``, ``stride_length_m``,
+        ``stance_time_s``, ``swing_time_s``. With a closed-loop reference: loop
+        closure. With reference positions: ``armse_3d_m`` (after a least-squares
+        yaw alignment) and ``pyshoe_error_m``. With a hand count:
+        ``stride_count_ref``, ``stride_count_error``. With reference strides: the
+        matched count and the median absolute IC/TO errors (s), stride-length
+        RMS and mean error (m) over every matched stride and over the straight
+        ones (``..._straight_m``), stride-time and FPA errors
+        (:func:`footzoo.evaluation.metrics.stride_errors`). With footprints: per-footprint
+        error after a 2-D rigid alignment. With per-stride trajectories: the
+        median per-stride 3-D path RMS after a yaw alignment. See :func:`footzoo.evaluation.metrics.result_metrics`.
+        """
+        from ..evaluation.metrics import result_metrics
+
+        t = self.samples["t"].to_numpy()
+        return result_metrics(t, self.pos, self.steps, self.reference)
+
+    @property
+    def pos(self) -> np.ndarray:
+        """Position (N, 3) in NED (m)."""
+        return self.samples[["pos_n", "pos_e", "pos_d"]].to_numpy()
+
+    @property
+    def vel(self) -> np.ndarray:
+        """Velocity (N, 3) in NED (m/s)."""
+        return self.samples[["vel_n", "vel_e", "vel_d"]].to_numpy()
+
+    @property
+    def quat(self) -> np.ndarray:
+        """Attitude (N, 4), body -> NED, scalar first."""
+        return self.samples[["qw", "qx", "qy", "qz"]].to_numpy()
+
+    @property
+    def stance(self) -> np.ndarray:
+        """Stance flag (N,), bool."""
+        return self.samples["stance"].to_numpy(dtype=bool)

@@ -1,0 +1,41 @@
+"""Exceptions footzoo raises; every message names the problem and the fix."""
+
+import difflib
+
+
+class FootzooError(Exception):
+    """Base class of footzoo's own errors."""
+
+
+class RecordingError(FootzooError, ValueError):
+    """A recording is malformed: missing columns, bad time stamps, wrong units, …"""
+
+
+class ConfigError(FootzooError, ValueError):
+    """A pipeline configuration is invalid: unknown keys, types or values."""
+
+
+class FormatError(FootzooError, ValueError):
+    """A file cannot be read in the requested (or detected) format."""
+
+
+class FootzooWarning(UserWarning):
+    """A warning from footzoo: the result is computed but something in the input deserves a look."""
+
+
+class SensorWarning(FootzooWarning):
+    """Suspicious sensor data: saturated (clipped) axes, isolated spikes (glitches)."""
+
+
+class CalibrationWarning(FootzooWarning):
+    """An in-situ calibration could not be fitted reliably and was not applied (:mod:`footzoo.calibration`)."""
+
+
+class GuardWarning(FootzooWarning):
+    """A pipeline guard fired: the detector missed stances, or the estimate diverged (:mod:`footzoo.runtime.guards`)."""
+
+
+def did_you_mean(word: str, options: list[str]) -> str:
+    """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
+    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""

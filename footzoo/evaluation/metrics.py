@@ -1,0 +1,465 @@
+"""Trajectory metrics: path length, loop closure, ARMSE after yaw alignment, PyShoe's error.
+
+All positions are (N, 3) arrays in NED (m). Horizontal means north-east.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+
+def path_length(pos: np.ndarray, horizontal: bool = True) -> float:
+    """Length (m) of the travelled path: sum of distances between samples.
+
+    ``horizontal`` uses north and east only (the walked distance on a floor).
+    """
+    p = np.asarray(pos, dtype=float)[:, : 2 if horizontal else 3]
+    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
+
+
+def loop_closure(pos: np.ndarray) -> dict[str, float]:
+    """End-to-start distance of a walk that should end where it started.
+
+    Returns
+    -------
+    dict
+        ``loop_closure_3d_m``, ``loop_closure_xy_m`` (m), ``path_length_m``
+        (horizontal, m) and ``loop_closure_xy_pct`` / ``loop_closure_3d_pct`` (%
+        of the horizontal path length).
+    """
+    p = np.asarray(pos, dtype=float)
+    d = p[-1] - p[0]
+    length = path_length(p)
+    e3, exy = float(np.linalg.norm(d)), float(np.linalg.norm(d[:2]))
+    def pct(e):
+        return (100.0 * e / length if length > 0 else float("nan"))
+    return {
+        "loop_closure_3d_m": e3,
+        "loop_closure_xy_m": exy,
+        "path_length_m": length,
+        "loop_closure_3d_pct": pct(e3),
+        "loop_closure_xy_pct": pct(exy),
+    }
+
+
+def yaw_alignment(est: np.ndarray, ref: np.ndarray) -> float:
+    """Rotation ψ (rad) about the vertical that best maps ``est`` onto ``ref``.
+
+    Both start at the origin; ψ minimises ``Σ |R_z(ψ) e_i − r_i|²`` over the
+    horizontal components, whose closed form is
+    ``ψ = atan2(Σ (e_n r_e − e_e r_n), Σ (e_n r_n + e_e r_e))``.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    num = np.sum(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0])
+    den = np.sum(e[:, 0] * r[:, 0] + e[:, 1] * r[:, 1])
+    return float(np.arctan2(num, den))
+
+
+def rotate_about_vertical(pos: np.ndarray, psi: float) -> np.ndarray:
+    """Rotate positions (N, 3) by ψ (rad) about the NED z axis (north toward east)."""
+    c, s = np.cos(psi), np.sin(psi)
+    p = np.asarray(pos, dtype=float).copy()
+    n, e = p[:, 0].copy(), p[:, 1].copy()
+    p[:, 0] = c * n - s * e
+    p[:, 1] = s * n + c * e
+    return p
+
+
+def armse(est: np.ndarray, ref: np.ndarray) -> float:
+    """3-D RMS position error (m) after both start at the origin and a least-squares yaw alignment.
+
+    ``sqrt(mean_i |R_z(ψ*) (e_i − e_0) − (r_i − r_0)|²)`` with ψ* from
+    :func:`yaw_alignment`. Vertical axes are not rotated.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    _check_same_length(e, r)
+    e = rotate_about_vertical(e, yaw_alignment(e, r))
+    return float(np.sqrt(np.mean(np.sum((e - r) ** 2, axis=1))))
+
+
+def pyshoe_error(est: np.ndarray, ref: np.ndarray, align_distance: float = 0.8) -> float:
+    """PyShoe's 2-D trial error (m), as defined by Wagstaff et al.'s evaluation code.
+
+    Both trajectories start at the origin. The estimate is rotated about the
+    vertical once, so that its position at the first sample whose horizontal
+    straight-line distance from the start reaches ``align_distance`` (0.8 m)
+    points in the same direction as the reference at that sample (sample 300
+    when it never gets that far, as PyShoe does). The error is the mean over
+    samples of ``sqrt((dn² + de²) / 2)``.
+    """
+    e = np.asarray(est, dtype=float) - est[0]
+    r = np.asarray(ref, dtype=float) - ref[0]
+    _check_same_length(e, r)
+    dist = np.linalg.norm(e[:, :2], axis=1)
+    far = np.flatnonzero(dist >= align_distance)
+    k = int(far[0]) if far.size else min(300, len(e) - 1)
+    psi = np.arctan2(r[k, 1], r[k, 0]) - np.arctan2(e[k, 1], e[k, 0])
+    e = rotate_about_vertical(e, psi)
+    d = e[:, :2] - r[:, :2]
+    return float(np.mean(np.sqrt(np.mean(d**2, axis=1))))
+
+
+def _check_same_length(e: np.ndarray, r: np.ndarray) -> None:
+    if e.shape != r.shape:
+        raise ValueError(f"estimate {e.shape} and reference {r.shape} must have the same shape")
+
+
+def trajectory_metrics(pos: np.ndarray, truth_pos: np.ndarray | None, closed_loop: bool) -> dict[str, float]:
+    """The metrics a run can compute: loop closure (closed walks) and ARMSE/PyShoe error (with a reference)."""
+    out: dict[str, float] = {"path_length_m": path_length(pos)}
+    if closed_loop:
+        out.update(loop_closure(pos))
+    if truth_pos is not None:
+        out["armse_3d_m"] = armse(pos, truth_pos)
+        out["pyshoe_error_m"] = pyshoe_error(pos, truth_pos)
+    return out
+
+
+# --------------------------------------------------------------------------- stance detection
+
+
+def intervals(mask: np.ndarray) -> np.ndarray:
+    """``(start, stop)`` index pairs (stop exclusive) of the True runs of a boolean mask, (K, 2)."""
+    m = np.asarray(mask, dtype=bool).astype(np.int8)
+    d = np.diff(np.concatenate([[0], m, [0]]))
+    return np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)])
+
+
+def stance_scores(stance: np.ndarray, truth: np.ndarray) -> dict[str, float]:
+    """Per-sample precision, recall and F1 of a stance mask (stance = positive class)."""
+    s, r = np.asarray(stance, bool), np.asarray(truth, bool)
+    tp = float(np.sum(s & r))
+    precision = tp / max(float(s.sum()), 1.0)
+    recall = tp / max(float(r.sum()), 1.0)
+    f1 = 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
+    return {"precision": precision, "recall": recall, "f1": f1, "accuracy": float(np.mean(s == r))}
+
+
+def step_detection(stance: np.ndarray, truth: np.ndarray, t: np.ndarray) -> dict[str, float]:
+    """Step-level comparison of detected and true stance phases (the gait-phase error rate).
+
+    Matching rule: a true stance phase is detected correctly when exactly one
+    detected stance phase overlaps it and that detected phase overlaps no other
+    true stance phase. Every other true phase is an error (missed: no overlap;
+    split: two or more overlap; merged: its detected phase spans two true
+    phases), and so is every detected phase that overlaps no true phase
+    (false step). ``error_rate = (wrong true phases + false steps) / true phases``,
+    the measure of Nguyen & La's "1 wrong in 36 steps". Timing errors are over
+    the correct matches (detected − true, s): onset at the phase's first sample,
+    offset at its last.
+    """
+    det, ref = intervals(stance), intervals(truth)
+    overlap = (det[:, None, 0] < ref[None, :, 1]) & (ref[None, :, 0] < det[:, None, 1])
+    per_ref = overlap.sum(axis=0)
+    per_det = overlap.sum(axis=1)
+    correct, onset, offset = 0, [], []
+    for j in range(len(ref)):
+        if per_ref[j] == 1:
+            i = int(np.flatnonzero(overlap[:, j])[0])
+            if per_det[i] == 1:
+                correct += 1
+                onset.append(t[det[i, 0]] - t[ref[j, 0]])
+                offset.append(t[det[i, 1] - 1] - t[ref[j, 1] - 1])
+    false_steps = int(np.sum(per_det == 0))
+    n = len(ref)
+    return {
+        "true_steps": n,
+        "detected_steps": len(det),
+        "correct": correct,
+        "missed": int(np.sum(per_ref == 0)),
+        "split": int(np.sum(per_ref > 1)),
+        "false_steps": false_steps,
+        "step_count_error": len(det) - n,
+        "error_rate": (n - correct + false_steps) / n if n else float("nan"),
+        "onset_error_mean_s": float(np.mean(onset)) if onset else float("nan"),
+        "offset_error_mean_s": float(np.mean(offset)) if offset else float("nan"),
+        "onset_error_abs_max_s": float(np.max(np.abs(onset))) if onset else float("nan"),
+        "offset_error_abs_max_s": float(np.max(np.abs(offset))) if offset else float("nan"),
+    }
+
+
+# --------------------------------------------------------------------------- strides
+
+
+#: Older simulator step tables (before unit names) -> reference column names.
+_LEGACY_STEP_NAMES = {"swing_start": "to_s", "swing_end": "end_s", "stride_length": "stride_length_m",
+                      "heading": "heading_rad", "fpa": "fpa_rad"}
+
+
+def reference_steps(steps: pd.DataFrame) -> pd.DataFrame:
+    """A reference stride table with footzoo's column names (see :class:`footzoo.core.data.Truth`).
+
+    The simulator's step table (``swing_start`` = toe-off, ``swing_end`` =
+    initial contact, ``stride_length``, ``heading``, ``fpa``) is renamed and given
+    ``start_s``, the previous stride's initial contact (NaN for the first).
+    """
+    out = steps.rename(columns={k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns
+                                and v not in steps.columns})
+    if "swing_end" in steps.columns:  # simulator table: its own start/end are heel-off and foot-flat
+        out = out.drop(columns=[c for c in ("start", "end") if c in out.columns])
+        ic = out["end_s"].to_numpy(dtype=float)
+        out.insert(0, "start_s", np.concatenate([[np.nan], ic[:-1]]))
+    return out
+
+
+def nearest_index(sorted_values: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """Index of the nearest element of the non-empty ascending ``sorted_values`` for each query (vectorised)."""
+    v = np.asarray(sorted_values, dtype=float)
+    q = np.asarray(queries, dtype=float)
+    if len(v) == 1:
+        return np.zeros(len(q), dtype=np.int64)
+    k = np.clip(np.searchsorted(v, q), 1, len(v) - 1)
+    return np.where(np.abs(v[k - 1] - q) <= np.abs(v[k] - q), k - 1, k)
+
+
+#: Events that must agree for two strides to pair: the borders of the swing (toe-off, initial contact).
+MATCH_ON = ("to_s", "end_s")
+
+
+def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str | tuple[str, ...] = MATCH_ON,
+                  tolerance: float = 0.3) -> pd.DataFrame:
+    """Pair the estimated and reference strides that cover the same swing, one to one.
+
+    Each reference stride is paired with the estimated stride nearest in time on
+    the first column of ``on``; the pair counts only when every column of ``on``
+    that both tables have (by default the toe-off ``to_s`` and the initial
+    contact ``end_s`` that border the swing) differs by at most ``tolerance``
+    (s), as gaitmap's stride matching requires of both borders
+    (``gaitmap.evaluation_utils.match_stride_lists``). So a reference stride
+    that spans two estimated ones (a stance the reference missed, or a swing
+    the estimate split) stays unpaired instead of being compared with one of
+    them, and an estimated stride pairs with one reference stride at most (the
+    nearest). A border missing (NaN) on either side is not checked. Vectorised.
+
+    Parameters
+    ----------
+    estimated, reference : DataFrame
+        Stride tables (:func:`footzoo.analysis.strides.segment_steps`; the
+        reference with footzoo's column names or the simulator's, see
+        :func:`reference_steps`).
+    on : str or tuple of str
+        Event columns (s) that must agree; the first one pairs the strides. A
+        reference without the first column pairs on ``end_s``.
+    tolerance : float
+        Largest time difference (s) of each event of a pair.
+
+    Returns
+    -------
+    DataFrame
+        The paired reference rows, in the reference's order, with the
+        estimate's columns added as ``est_<column>``.
+    """
+    est = estimated.reset_index(drop=True)
+    ref = reference_steps(reference).reset_index(drop=True)
+    cols = [on] if isinstance(on, str) else list(on)
+    if cols[0] not in ref.columns and "end_s" in ref.columns:
+        cols[0] = "end_s"
+    cols = list(dict.fromkeys(c for c in cols if c in ref.columns and c in est.columns))
+    if not cols or len(est) == 0 or len(ref) == 0:
+        return pd.DataFrame(columns=[*ref.columns, *(f"est_{c}" for c in est.columns)])
+    e = est[cols[0]].to_numpy(dtype=float)
+    r = ref[cols[0]].to_numpy(dtype=float)
+    order = np.argsort(e)
+    pick = order[nearest_index(e[order], r)]  # row of est paired with each reference stride
+    gap = np.abs(e[pick] - r)
+    ok = gap <= tolerance
+    for c in cols[1:]:
+        d = np.abs(est[c].to_numpy(dtype=float)[pick] - ref[c].to_numpy(dtype=float))
+        ok &= ~(d > tolerance)  # NaN: not checked
+    # one to one: an estimated stride taken by several reference strides keeps the nearest
+    cand = np.flatnonzero(ok)
+    first = cand[np.lexsort((gap[cand], pick[cand]))]
+    keep = first[np.concatenate([[True], pick[first][1:] != pick[first][:-1]])] if len(first) else first
+    ok = np.zeros(len(ref), bool)
+    ok[keep] = True
+    matched = est.iloc[pick[ok]].reset_index(drop=True).add_prefix("est_")
+    return pd.concat([ref[ok].reset_index(drop=True), matched], axis=1)
+
+
+def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: float = 0.3) -> dict[str, float]:
+    """Per-stride errors (estimate − reference) of the matched strides (:func:`match_strides`).
+
+    The one implementation of the stride comparison: :attr:`footzoo.core.data.Result.metrics`,
+    :class:`footzoo.Session` and the accuracy benchmark all report these values.
+
+    Parameters
+    ----------
+    estimated : DataFrame
+        Estimated stride table (:func:`footzoo.analysis.strides.segment_steps`).
+    reference : DataFrame
+        Reference stride table (see :class:`footzoo.core.data.Truth`); an optional
+        boolean ``turn`` column flags the strides that change direction.
+    tolerance : float
+        Largest time difference (s) of a pair (:func:`match_strides`).
+
+    Returns
+    -------
+    dict
+        The count of reference and matched strides, and where both sides have
+        the column: median absolute error of the initial contact
+        (``ic_error_median_abs_s``, on ``end_s``) and toe-off
+        (``to_error_median_abs_s``), mean signed errors, stride-time error;
+        stride-length RMS and mean error (m) over every matched stride
+        (``stride_length_rms_error_m``, ``stride_length_mean_error_m``) and over
+        the straight ones only (``stride_length_rms_error_straight_m``,
+        ``stride_length_mean_error_straight_m``, all strides when the reference
+        flags no turns); FPA mean and RMS error (deg) over the straight strides
+        (the line of progression of a turn stride is not defined).
+    """
+    m = match_strides(estimated, reference, tolerance=tolerance)
+    out: dict[str, float] = {"ref_strides": float(len(reference)), "matched_strides": float(len(m))}
+    if len(m) == 0:
+        return out
+    straight = ~m["turn"].to_numpy(dtype=bool) if "turn" in m.columns else np.ones(len(m), bool)
+
+    def diff(col: str, mask=None) -> np.ndarray | None:
+        if col not in m.columns or f"est_{col}" not in m.columns:
+            return None
+        d = m[f"est_{col}"].to_numpy(dtype=float) - m[col].to_numpy(dtype=float)
+        d = d[mask] if mask is not None else d
+        return d[np.isfinite(d)]
+
+    for col, name in (("end_s", "ic"), ("to_s", "to")):
+        d = diff(col)
+        if d is not None and d.size:
+            out[f"{name}_error_median_abs_s"] = float(np.median(np.abs(d)))
+            out[f"{name}_error_mean_s"] = float(np.mean(d))
+    if "end_s" in m.columns and "start_s" in m.columns:
+        ref_time = m["end_s"].to_numpy(float) - m["start_s"].to_numpy(float)
+        d = m["est_stride_time_s"].to_numpy(float) - ref_time
+        d = d[np.isfinite(d)]
+        if d.size:
+            out["stride_time_error_median_abs_s"] = float(np.median(np.abs(d)))
+    for suffix, mask in (("", None), ("_straight", straight)):
+        d = diff("stride_length_m", mask)
+        if d is not None and d.size:
+            out[f"stride_length_rms_error{suffix}_m"] = float(np.sqrt(np.mean(d**2)))
+            out[f"stride_length_mean_error{suffix}_m"] = float(np.mean(d))
+    d = diff("fpa_rad", straight)
+    if d is not None and d.size:
+        d = np.degrees(d)
+        out["fpa_mean_error_deg"] = float(np.mean(d))
+        out["fpa_rms_error_deg"] = float(np.sqrt(np.mean(d**2)))
+    return out
+
+
+def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> tuple[np.ndarray, bool]:
+    """Least-squares 2-D rotation + translation of ``est`` onto ``ref`` (Kabsch), optionally a reflection.
+
+    Returns the aligned points and whether a reflection was used (it is taken
+    only when it fits better: datasets such as Köroğlu's flip an axis).
+    """
+    e = np.asarray(est, float)[:, :2]
+    r = np.asarray(ref, float)[:, :2]
+    best = None
+    for mirror in ((False, True) if reflection else (False,)):
+        ee = e * np.array([1.0, -1.0]) if mirror else e
+        ce, cr = ee.mean(axis=0), r.mean(axis=0)
+        h = (ee - ce).T @ (r - cr)
+        u, _, vt = np.linalg.svd(h)
+        d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+        rot = vt.T @ np.diag([1.0, d]) @ u.T
+        aligned = (ee - ce) @ rot.T + cr
+        err = float(np.sum((aligned - r) ** 2))
+        if best is None or err < best[0]:
+            best = (err, aligned, mirror)
+    return best[1], best[2]
+
+
+def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, float]:
+    """Error of every footprint (mid-stance position) against measured footprints, e.g. Köroğlu's GCPs.
+
+    The estimated footprints are the first stride's start and every stride's
+    end (K + 1 points for K strides). Compared only when the counts agree;
+    after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
+    the mean and RMS distances (m) and the end-point distance are returned.
+    """
+    fp = np.asarray(footprints, float)
+    out: dict[str, float] = {"footprints_ref": float(len(fp))}
+    if len(steps) == 0:
+        return out
+    est = np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
+    out["footprints_est"] = float(len(est))
+    if len(est) != len(fp):
+        return out
+    aligned, _ = rigid_align_2d(est, fp)
+    d = np.linalg.norm(aligned - fp, axis=1)
+    out.update(footprint_error_mean_m=float(d.mean()), footprint_error_rms_m=float(np.sqrt(np.mean(d**2))),
+               footprint_error_end_m=float(d[-1]))
+    return out
+
+
+def stride_path_errors(t: np.ndarray, pos: np.ndarray, stride_positions: pd.DataFrame,
+                       turn: np.ndarray | None = None) -> dict[str, float]:
+    """3-D RMS error (m) of the estimated trajectory over each reference stride, after a yaw alignment.
+
+    Per stride the estimate (NED, interpolated at the reference times) is turned
+    into a right-handed z-up frame (east, north, up), both are zeroed at the
+    stride's first sample, the estimate is rotated about the vertical
+    (:func:`yaw_alignment`) and the RMS of the 3-D difference is taken.
+    Returns the median over the strides (``stride_path_rms_error_median_m``),
+    over the strides not flagged in ``turn`` when it is given.
+    """
+    enu = np.column_stack([pos[:, 1], pos[:, 0], -pos[:, 2]])
+    rms = []
+    for k, g in stride_positions.groupby("stride"):
+        if turn is not None and bool(turn[int(k)]):
+            continue
+        tt = g["t_s"].to_numpy(dtype=float)
+        if tt[0] < t[0] or tt[-1] > t[-1] or len(tt) < 2:
+            continue
+        e = np.column_stack([np.interp(tt, t, enu[:, i]) for i in range(3)])
+        r = g[["pos_x_m", "pos_y_m", "pos_up_m"]].to_numpy(dtype=float)
+        e, r = e - e[0], r - r[0]
+        e = rotate_about_vertical(e, yaw_alignment(e, r))
+        rms.append(float(np.sqrt(np.mean(np.sum((e - r) ** 2, axis=1)))))
+    if not rms:
+        return {}
+    return {"stride_path_rms_error_median_m": float(np.median(rms)), "stride_paths": float(len(rms))}
+
+
+def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, reference=None) -> dict[str, float]:
+    """The numbers ``footzoo run`` prints: a summary of the run and its errors against the reference.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Time (s).
+    pos : (N, 3) ndarray
+        Estimated position, NED (m).
+    steps : DataFrame
+        The stride table (:func:`footzoo.analysis.strides.segment_steps`).
+    reference : Truth, optional
+        The recording's reference.
+
+    Returns
+    -------
+    dict
+        Keys carry their unit; see :attr:`footzoo.core.data.Result.metrics`.
+    """
+    ref = reference
+    closed = bool(ref is not None and ref.closed_loop)
+    out: dict[str, float] = {"duration_s": float(t[-1] - t[0])}
+    out.update(trajectory_metrics(pos, ref.pos if ref is not None else None, closed))
+    out["strides"] = float(len(steps))
+    for col in ("stride_time_s", "cadence_steps_min", "stride_length_m", "stance_time_s", "swing_time_s"):
+        if col in steps.columns:
+            v = steps[col].to_numpy(dtype=float)
+            v = v[np.isfinite(v)]
+            out[f"median_{col}"] = float(np.median(v)) if v.size else float("nan")
+    if ref is None:
+        return out
+    if ref.stride_count is not None:
+        out["stride_count_ref"] = float(ref.stride_count)
+        out["stride_count_error"] = float(len(steps) - ref.stride_count)
+    if ref.steps is not None and len(ref.steps):
+        out.update(stride_errors(steps, ref.steps))
+    if ref.footprints is not None:
+        out.update(footprint_errors(steps, ref.footprints))
+    if ref.stride_positions is not None:
+        turn = ref.steps["turn"].to_numpy(dtype=bool) if ref.steps is not None and "turn" in ref.steps else None
+        out.update(stride_path_errors(t, pos, ref.stride_positions, turn))
+    return out

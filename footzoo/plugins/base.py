@@ -1,0 +1,314 @@
+"""Plug-in kinds as base classes: what each kind takes, does, returns and declares.
+
+Every plug-in (built-in or yours) derives from one of :class:`Orientation`, :class:`Detector`,
+:class:`VelocityCorrection`, :class:`AccelerationCorrection`, :class:`KalmanCorrection`,
+:class:`Analysis` or :class:`Calibration`, and is made available by name with :func:`footzoo.register`. The rules, as in
+scikit-learn:
+
+* ``__init__`` takes every parameter as a keyword with its paper's default, stores it under the
+  same name (validated, converted to plain numbers), and does nothing else that depends on data;
+* ``units`` gives the unit of every numeric parameter, ``paper`` the reference, the class
+  docstring the equations;
+* the one action method (``calibrate``, ``estimate``, ``detect``, ``apply``, ``apply_acceleration``,
+  ``analyze``; a Kalman correction's ``model``) sets results as attributes ending in ``_`` and
+  returns ``self`` (or the corrected array);
+* capabilities are class attributes the pipeline reads instead of names: ``needs_magnetometer``,
+  ``needs_truth``, ``needs_distance``, ``causal`` (the output at a sample depends only on samples
+  up to it, so it can run live in :class:`footzoo.runtime.stream.Stream`).
+
+``footzoo.apps.testing.check_plugin`` runs a plug-in through this contract.
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..core.errors import RecordingError
+from ..filters.measurement import MeasurementModel, StateBlock
+
+#: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
+ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
+
+
+def _all_finite(value: np.ndarray) -> bool:
+    """``np.isfinite(value).all()`` without its (N,) temporary: a sum is finite only if every term is.
+
+    A NaN or an infinity makes the sum non-finite; a finite sum therefore proves the array
+    finite. Only a non-finite sum (a bad sample, or an overflow of huge values) needs the exact check.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(value.sum()):
+            return True
+    return bool(np.isfinite(value).all())
+
+
+def _checked(method: Callable[..., Any]) -> Callable[..., Any]:
+    """Wrap an action method: a non-finite or non-numeric array argument raises a clear RecordingError."""
+    names = [p for p in inspect.signature(method).parameters if p != "self"]
+
+    @functools.wraps(method)
+    def action(self, *args, **kwargs):
+        for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
+            if isinstance(value, np.ndarray) and value.dtype.kind in "fc" and not _all_finite(value):
+                bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
+                raise RecordingError(
+                    f"{self.kind} {self.name!r}: input {name!r} has {len(bad)} non-finite sample(s) (NaN or inf), "
+                    f"first at index {int(bad[0])}; repair or drop them before running (footzoo.Recording does)"
+                )
+            if isinstance(value, np.ndarray) and value.dtype.kind not in "fcbiu":
+                raise RecordingError(f"{self.kind} {self.name!r}: input {name!r} must be numeric, got dtype "
+                                     f"{value.dtype}")
+        return method(self, *args, **kwargs)
+
+    action.__footzoo_checked__ = True
+    return action
+
+
+class Plugin:
+    """Base of every plug-in: parameters in ``__init__``, estimates in attributes ending in ``_``."""
+
+    kind: ClassVar[str] = ""
+    name: ClassVar[str] = ""
+    paper: ClassVar[str] = ""
+    units: ClassVar[dict[str, str]] = {}
+    needs_magnetometer: ClassVar[bool] = False
+    needs_truth: ClassVar[bool] = False
+    needs_distance: ClassVar[bool] = False
+    causal: ClassVar[bool] = False
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for action in ACTIONS:
+            method = cls.__dict__.get(action)
+            if callable(method) and not getattr(method, "__footzoo_checked__", False):
+                setattr(cls, action, _checked(method))
+
+    @classmethod
+    def param_names(cls) -> list[str]:
+        """The constructor's parameter names, in order."""
+        sig = inspect.signature(cls.__init__)
+        return [p for p, v in sig.parameters.items() if p != "self" and v.kind not in (v.VAR_POSITIONAL, v.VAR_KEYWORD)]
+
+    @classmethod
+    def defaults(cls) -> dict[str, Any]:
+        """The constructor's defaults (the paper's values)."""
+        sig = inspect.signature(cls.__init__)
+        return {p: sig.parameters[p].default for p in cls.param_names()}
+
+    def get_params(self) -> dict[str, Any]:
+        """Current parameter values (scikit-learn style)."""
+        return {p: getattr(self, p) for p in self.param_names()}
+
+    def set_params(self, **params: Any) -> Plugin:
+        """Change parameters, validated as the constructor validates them; returns ``self``."""
+        unknown = [k for k in params if k not in self.param_names()]
+        if unknown:
+            raise ValueError(f"{self.kind} {self.name!r}: unknown parameter(s) {unknown}; "
+                             f"valid parameters: {self.param_names()}")
+        fresh = type(self)(**{**self.get_params(), **params})
+        self.__dict__.clear()
+        self.__dict__.update(fresh.__dict__)
+        return self
+
+    def clone(self) -> Plugin:
+        """An unfitted copy with the same parameters."""
+        return type(self)(**copy.deepcopy(self.get_params()))
+
+    def spec(self) -> dict[str, Any]:
+        """``{"type": name, **params}``: the YAML form."""
+        return {"type": self.name, **_plain(self.get_params())}
+
+    @classmethod
+    def capabilities(cls) -> dict[str, Any]:
+        """The declared capabilities, for listings and checks."""
+        return {k: getattr(cls, k) for k in ("needs_magnetometer", "needs_truth", "needs_distance", "causal")}
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        return f"{type(self).__name__}({args})"
+
+
+def _plain(value: Any) -> Any:
+    """Parameters as YAML-safe plain values."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+class Calibration(Plugin):
+    """In-situ sensor calibration: fitted on the recording itself, applied before every other stage.
+
+    ``calibrate(t, acc, gyr, mag)`` takes time (s), specific force (m/s², FRD), angular rate
+    (rad/s, FRD) and the magnetometer (any unit, or None) and sets ``acc_``, ``gyr_`` and ``mag_``
+    (corrected copies in the same units; ``mag_`` None without a magnetometer; the inputs are not
+    changed) and ``report_`` (a dict of plain numbers, text and lists: what was fitted or why
+    nothing was, shown in ``Result.diagnostics["calibration"]``). A calibration that cannot be
+    fitted reliably on a recording leaves the signals as they are and says so (warning and
+    ``report_``); it never guesses. It sees the whole recording, so :class:`footzoo.runtime.stream.Stream` runs none.
+    """
+
+    kind: ClassVar[str] = "calibration"
+
+    def calibrate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> Calibration:
+        """Set ``acc_``, ``gyr_``, ``mag_`` and ``report_``; returns ``self``."""
+        raise NotImplementedError
+
+
+class Orientation(Plugin):
+    """Attitude of the sensor (body → NED quaternion per sample).
+
+    ``estimate(t, acc, gyr, mag, stance, q0)`` sets ``quat_`` ((N, 4), scalar first) from time
+    (s), specific force (m/s², FRD), angular rate (rad/s), magnetometer (any unit, or None), the
+    detector's stance mask and the initial attitude ``q0`` from the still start.
+    ``carried_by_filter``: the attitude is a state of the error-state Kalman filter (the INS);
+    the filter then propagates and corrects it and ``estimate`` is only used without a filter.
+    ``use_magnetometer``: read the magnetometer (parameter or class attribute).
+    """
+
+    kind: ClassVar[str] = "orientation"
+    carried_by_filter: ClassVar[bool] = False
+    needs_stance: ClassVar[bool] = False
+    use_magnetometer: bool = False
+
+    def estimate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None,
+                 stance: np.ndarray, q0: np.ndarray) -> Orientation:
+        """Set ``quat_``; returns ``self``."""
+        raise NotImplementedError
+
+
+class Detector(Plugin):
+    """Stance (zero-velocity) detection.
+
+    ``detect(t, acc, gyr)`` (with ``needs_truth``: ``detect(t, acc, gyr, truth)``) sets
+    ``stance_`` ((N,) bool) and ``statistic_`` ((N,) float, the test statistic, NaN if none).
+    A ``causal`` detector also implements ``begin(rate)`` (fresh state for a sampling rate in Hz)
+    and ``step(t, acc, gyr) -> (n,) bool`` (the stance of the next chunk of samples, from the
+    carried state), giving the same mask live as in a batch.
+    """
+
+    kind: ClassVar[str] = "detector"
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Detector:
+        """Set ``stance_`` and ``statistic_``; returns ``self``."""
+        raise NotImplementedError
+
+
+class Correction(Plugin):
+    """Base of the corrections; use one of the three subclasses."""
+
+    kind: ClassVar[str] = "correction"
+
+
+class VelocityCorrection(Correction):
+    """Batch velocity/position from the NED motion acceleration (e.g. zero-velocity dedrift).
+
+    ``apply(t, acc_nav, stance)`` sets ``vel_`` and ``pos_`` ((N, 3), m/s and m). At most one per
+    pipeline, and not together with Kalman corrections (both would set the velocity).
+    """
+
+    def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> VelocityCorrection:
+        """Set ``vel_`` and ``pos_``; returns ``self``."""
+        raise NotImplementedError
+
+
+class AccelerationCorrection(Correction):
+    """Batch change of the NED motion acceleration before integration (e.g. heading reduction).
+
+    ``apply_acceleration(quat, acc_nav, stance)`` returns the corrected (N, 3) acceleration (m/s²).
+    A class that is also a :class:`KalmanCorrection` acts inside the filter when the pipeline has
+    one, and in this batch form otherwise.
+    """
+
+    def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:
+        """The corrected motion acceleration (m/s², NED)."""
+        raise NotImplementedError
+
+
+@dataclass
+class Samples:
+    """Signals a Kalman correction builds its model and per-sample inputs from.
+
+    ``t`` (N,) s; ``acc``, ``gyr`` (N, 3) m/s², rad/s; ``mag`` (N, 3) or None; ``dist`` (N, k)
+    m or None; ``init_window`` (N,) bool: the still start used for the initial alignment. In a
+    batch run these are the whole recording; live, :meth:`KalmanCorrection.model` sees the still
+    start and :meth:`KalmanCorrection.sample_data` each new chunk.
+    """
+
+    t: np.ndarray
+    acc: np.ndarray
+    gyr: np.ndarray
+    mag: np.ndarray | None
+    dist: np.ndarray | None
+    init_window: np.ndarray
+
+
+class KalmanCorrection(Correction):
+    """A measurement of the error-state Kalman filter, owning its model.
+
+    Implement :meth:`model` (and :meth:`state_blocks` / :meth:`sample_data` when needed). The
+    model's functions follow :mod:`footzoo.filters.measurement`; compile them with its
+    decorators and the correction runs in the compiled engine and live, else on the reference
+    engine (with a warning). ``observes`` names the measured quantities: two corrections that
+    observe the same quantity cannot be combined.
+    """
+
+    observes: ClassVar[tuple[str, ...]] = ()
+    causal: ClassVar[bool] = True
+
+    def state_blocks(self) -> list[StateBlock]:
+        """Error-state blocks this correction adds or switches on (``gyro_bias``, ``acc_bias``)."""
+        return []
+
+    def requires_attitude_state(self) -> bool:
+        """Whether the model needs the attitude error as a state (``orientation: ins``)."""
+        return False
+
+    def sample_data(self, samples: Samples) -> np.ndarray:
+        """Per-sample inputs of the model, (N, d); default: none."""
+        return np.zeros((len(samples.t), 0))
+
+    def model(self, samples: Samples) -> MeasurementModel:
+        """The measurement model for a run that starts with ``samples`` (see :class:`Samples`)."""
+        raise NotImplementedError
+
+
+class Analysis(Plugin):
+    """Analysis of a finished trajectory (e.g. foot progression angle per stride).
+
+    ``analyze(t, quat, pos, stance, meta)`` sets its results; ``annotate(steps, t)`` returns the
+    steps table with its columns added.
+    """
+
+    kind: ClassVar[str] = "analysis"
+
+    def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
+                meta: dict[str, Any]) -> Analysis:
+        """Analyse a trajectory; returns ``self``."""
+        raise NotImplementedError
+
+    def annotate(self, steps: Any, t: np.ndarray) -> Any:
+        """The steps table with this analysis' columns."""
+        raise NotImplementedError
+
+
+#: Base class of each kind.
+BASES: dict[str, tuple[type[Plugin], ...]] = {
+    "calibration": (Calibration,),
+    "orientation": (Orientation,),
+    "detector": (Detector,),
+    "correction": (VelocityCorrection, AccelerationCorrection, KalmanCorrection),
+    "analysis": (Analysis,),
+}

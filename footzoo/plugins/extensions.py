@@ -1,0 +1,253 @@
+"""External plug-ins: modules or ``.py`` files named in a config's or a study's ``plugins:`` list, and
+installed packages that declare the entry-point group ``footzoo.plugins``.
+
+Importing a plug-in module registers its plug-ins (they use ``footzoo.plugins.registry.register``). A ``.py`` file is
+imported under a stable module name derived from its resolved path and kept in ``sys.modules``, so
+objects defined in it pickle by reference and every worker process that loads the same file gets the
+same module name. Loading is idempotent: a file or module already loaded with the same source is not
+executed again; an edited file is executed again and its plug-ins replace the old ones.
+
+This module sits at the bottom of the layers: it imports only :mod:`footzoo.core.errors` at module level.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.util
+import sys
+import threading
+import traceback
+from pathlib import Path
+from typing import Any
+
+from ..core.errors import ConfigError
+
+ENTRY_POINT_GROUP = "footzoo.plugins"
+
+_LOCK = threading.RLock()
+_LOADED: dict[str, str] = {}  # module name -> sha256 of the source it was executed from
+_ENTRY_POINTS: list[dict[str, Any]] | None = None
+
+
+def is_path_spec(spec: str) -> bool:
+    """True when a ``plugins:`` entry names a file (ends in ``.py`` or contains a path separator)."""
+    return spec.endswith(".py") or "/" in spec or "\\" in spec
+
+
+def resolve_specs(specs: Any, base_dir: str | Path | None = None, where: str = "plugins") -> list[str]:
+    """Check a ``plugins:`` value and make its file paths absolute (module names are kept as given).
+
+    Parameters
+    ----------
+    specs : list of str
+        Module names (``mypackage.detectors``) or paths to ``.py`` files.
+    base_dir : path, optional
+        Folder relative paths are resolved against (the YAML file's folder); default: the working directory.
+    where : str
+        Name of the input, for error messages.
+
+    Returns
+    -------
+    list of str
+        The specs, file paths resolved to absolute paths.
+    """
+    if specs is None:
+        return []
+    if isinstance(specs, str):
+        specs = [specs]
+    if not isinstance(specs, (list, tuple)):
+        raise ConfigError(f"{where} must be a list of module names or .py paths, e.g. [my_detector.py], "
+                          f"got {type(specs).__name__} {specs!r}")
+    out = []
+    for i, spec in enumerate(specs):
+        if not isinstance(spec, str) or not spec.strip():
+            raise ConfigError(f"{where}[{i}] must be a module name or a path to a .py file, got {spec!r}")
+        spec = spec.strip()
+        if is_path_spec(spec):
+            p = Path(spec).expanduser()
+            if not p.is_absolute():
+                p = Path(base_dir if base_dir is not None else ".") / p
+            out.append(str(p.resolve()))
+        else:
+            out.append(spec)
+    return out
+
+
+def load_plugins(specs: list[str] | None, base_dir: str | Path | None = None,
+                 where: str = "plugins") -> list[dict[str, Any]]:
+    """Import plug-in modules or files; importing them registers their plug-ins.
+
+    Parameters
+    ----------
+    specs : list of str
+        Module names (imported with :func:`importlib.import_module`) or paths to ``.py`` files
+        (relative to ``base_dir``).
+    base_dir : path, optional
+        Folder of the YAML file that lists them; default: the working directory.
+    where : str
+        Name of the input, for error messages.
+
+    Returns
+    -------
+    list of dict
+        Per spec: ``spec`` (as resolved), ``module`` (module name), ``path`` (source file) and
+        ``sha256`` (of the source).
+
+    Raises
+    ------
+    ConfigError
+        A missing file or module, a syntax error (with file and line) or an error while importing.
+    """
+    out = []
+    with _LOCK:
+        for i, spec in enumerate(resolve_specs(specs, base_dir, where)):
+            label = f"{where}[{i}]"
+            if is_path_spec(spec):
+                out.append(_load_file(Path(spec), label))
+            else:
+                out.append(_load_module(spec, label))
+    return out
+
+
+def source_hash(specs: list[str] | None, base_dir: str | Path | None = None) -> str:
+    """SHA-256 over the source of every plug-in (files, or the files of named modules), in order.
+
+    Editing a plug-in changes the hash, which is part of every ablation cache key.
+    """
+    h = hashlib.sha256()
+    for i, spec in enumerate(resolve_specs(specs, base_dir)):
+        h.update(spec.encode())
+        for f in _source_files(spec, f"plugins[{i}]"):
+            h.update(str(f).encode())
+            h.update(hashlib.sha256(f.read_bytes()).digest())
+    return h.hexdigest()
+
+
+def load_entry_points() -> list[dict[str, Any]]:
+    """Load, once per process, every installed package's entry points in the group ``footzoo.plugins``.
+
+    Returns
+    -------
+    list of dict
+        Per entry point: ``name``, ``value`` (``module:attr``) and ``distribution``.
+
+    Raises
+    ------
+    ConfigError
+        An entry point that fails to load, naming its distribution and the fix.
+    """
+    global _ENTRY_POINTS
+    with _LOCK:
+        if _ENTRY_POINTS is not None:
+            return list(_ENTRY_POINTS)
+        from importlib.metadata import entry_points
+
+        loaded = []
+        for ep in entry_points(group=ENTRY_POINT_GROUP):
+            dist = getattr(getattr(ep, "dist", None), "name", None) or "an installed package"
+            try:
+                ep.load()
+            except Exception as err:  # any failure of third-party code becomes a named footzoo error
+                raise ConfigError(
+                    f"the plug-in entry point {ep.name!r} ({ep.value}) of {dist} failed to load: "
+                    f"{type(err).__name__}: {err}; fix or uninstall {dist}") from None
+            loaded.append({"name": ep.name, "value": ep.value, "distribution": dist})
+        _ENTRY_POINTS = loaded
+        return list(loaded)
+
+
+# --------------------------------------------------------------------------- internals
+
+
+def module_name_for(path: Path) -> str:
+    """The stable module name a plug-in file is imported under (same path, same name, in every process)."""
+    resolved = Path(path).resolve()
+    stem = "".join(c if c.isalnum() else "_" for c in resolved.stem)
+    return f"footzoo_plugin_{hashlib.sha256(str(resolved).encode()).hexdigest()[:12]}_{stem}"
+
+
+def _source_files(spec: str, label: str) -> list[Path]:
+    if is_path_spec(spec):
+        p = Path(spec)
+        _check_file(p, label)
+        return [p]
+    try:
+        found = importlib.util.find_spec(spec)
+    except (ImportError, ValueError) as err:
+        raise ConfigError(f"{label}: cannot find the plug-in module {spec!r} ({err}); install it or give "
+                          f"the path to a .py file") from None
+    if found is None or not found.origin or not found.has_location:
+        raise ConfigError(f"{label}: no plug-in module named {spec!r}; install it or give the path to a .py file")
+    origin = Path(found.origin)
+    if found.submodule_search_locations:  # a package: every .py file under it
+        return sorted(origin.parent.rglob("*.py"))
+    return [origin]
+
+
+def _check_file(p: Path, label: str) -> None:
+    if not p.exists():
+        raise ConfigError(f"{label}: plug-in file {str(p)!r} does not exist; paths are relative to the "
+                          f"YAML file's folder")
+    if not p.is_file():
+        raise ConfigError(f"{label}: plug-in path {str(p)!r} is not a file; give the path to a .py file")
+
+
+def _load_file(path: Path, label: str) -> dict[str, Any]:
+    _check_file(path, label)
+    try:
+        source = path.read_bytes()
+    except OSError as err:
+        raise ConfigError(f"{label}: cannot read plug-in file {str(path)!r}: {err.strerror or err}") from None
+    digest = hashlib.sha256(source).hexdigest()
+    name = module_name_for(path)
+    info = {"spec": str(path), "module": name, "path": str(path), "sha256": digest}
+    if _LOADED.get(name) == digest and name in sys.modules:
+        return info
+    try:
+        code = compile(source, str(path), "exec")
+    except SyntaxError as err:
+        raise ConfigError(f"{label}: syntax error in plug-in file {err.filename or path}, line {err.lineno}: "
+                          f"{err.msg}; fix the file") from None
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    previous = sys.modules.get(name)
+    sys.modules[name] = module  # before executing: dataclasses, pickling and registration look it up
+    try:
+        exec(code, module.__dict__)
+    except Exception as err:  # a plug-in's import failure becomes a named footzoo error
+        if previous is None:
+            sys.modules.pop(name, None)
+        else:
+            sys.modules[name] = previous
+        raise ConfigError(f"{label}: importing plug-in file {str(path)!r} failed{_where(err, path)}: "
+                          f"{type(err).__name__}: {err}") from None
+    _LOADED[name] = digest
+    return info
+
+
+def _load_module(name: str, label: str) -> dict[str, Any]:
+    try:
+        module = importlib.import_module(name)
+    except ModuleNotFoundError as err:
+        if err.name and (name == err.name or name.startswith(err.name + ".")):
+            raise ConfigError(f"{label}: no plug-in module named {name!r}; install it, put it on PYTHONPATH or "
+                              f"give the path to a .py file") from None
+        raise ConfigError(f"{label}: importing plug-in module {name!r} failed: {type(err).__name__}: {err}") from None
+    except SyntaxError as err:
+        raise ConfigError(f"{label}: syntax error in plug-in module {name!r}, file {err.filename}, line {err.lineno}: "
+                          f"{err.msg}; fix the file") from None
+    except Exception as err:  # a plug-in's import failure becomes a named footzoo error
+        raise ConfigError(f"{label}: importing plug-in module {name!r} failed: {type(err).__name__}: {err}") from None
+    path = getattr(module, "__file__", None)
+    files = _source_files(name, label)
+    h = hashlib.sha256()
+    for f in files:
+        h.update(f.read_bytes())
+    return {"spec": name, "module": module.__name__, "path": path, "sha256": h.hexdigest()}
+
+
+def _where(err: BaseException, path: Path) -> str:
+    """`` at line N`` of the plug-in file where the exception was raised, when the traceback passes through it."""
+    lines = [f.lineno for f in traceback.extract_tb(err.__traceback__) if Path(f.filename) == path]
+    return f" at line {lines[-1]}" if lines else ""

@@ -1,0 +1,395 @@
+"""Compose plug-ins into a pipeline and run it on a recording.
+
+``Pipeline.run`` is five named stages: :meth:`~Pipeline.calibrate` (in-situ sensor calibration,
+if any), :meth:`~Pipeline.detect` (gait phase),
+:meth:`~Pipeline.orient` (attitude, unless the Kalman filter carries it),
+:meth:`~Pipeline.navigate` (velocity and position: the error-state Kalman engine, or batch
+corrections and integration) and :meth:`~Pipeline.analyse` (strides and analysis plug-ins).
+The stages read the plug-ins' base classes and declared capabilities, never their names.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .._version import __version__
+from ..analysis.strides import segment_steps
+from ..config.library import resolve
+from ..config.schema import check_init, check_top_level, load_yaml
+from ..core.checks import GRAVITY_RANGE, check_range
+from ..core.conventions import GRAVITY
+from ..core.data import Recording, Result
+from ..core.errors import ConfigError, RecordingError
+from ..core.table import samples_frame
+from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
+from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
+from ..plugins.base import (
+    AccelerationCorrection,
+    Analysis,
+    Calibration,
+    Detector,
+    KalmanCorrection,
+    Orientation,
+    Plugin,
+    Samples,
+    VelocityCorrection,
+)
+from ..plugins.extensions import load_plugins
+from ..plugins.registry import build
+from .alignment import initial_attitude
+from .guards import StanceGuard, check_speed
+
+
+class Pipeline:
+    """An orientation filter, a stance detector, corrections and analyses.
+
+    Parameters
+    ----------
+    orientation : Orientation
+        Attitude source.
+    detector : Detector
+        Stance detector.
+    corrections : list of corrections
+        Applied in order; Kalman corrections stack their rows in this order.
+    name : str
+        Pipeline name.
+    gravity : float
+        g (m/s²), within :data:`footzoo.core.checks.GRAVITY_RANGE` (9.7–9.9).
+    init : dict
+        ``duration`` (s) and ``max_gyr`` (rad/s) of the still start used for alignment.
+    analysis : list of Analysis
+        Run on the finished trajectory.
+    navigation : NavigationNoise or dict, optional
+        Process noise and initial uncertainty of the INS core of the Kalman filter.
+    smoother : {"none", "rts"}
+        ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
+        (:mod:`footzoo.filters.smoother`; offline only). The forward trajectory stays in
+        ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
+    plugins : list of str, optional
+        External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
+        :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.plugins.extensions`).
+    guards : StanceGuard or dict, optional
+        What a run does when the detector misses stances (stance at the stillest instants of a
+        swing longer than ``max_swing``) and the speed bound of the estimate; see
+        :mod:`footzoo.runtime.guards`. On by default.
+    calibration : list of Calibration, optional
+        In-situ sensor calibrations (:mod:`footzoo.calibration`), fitted on each recording and
+        applied in order before every other stage; their reports are in
+        ``Result.diagnostics["calibration"]``.
+    """
+
+    SMOOTHERS = ("none", "rts")
+
+    def __init__(
+        self,
+        orientation: Orientation,
+        detector: Detector,
+        corrections: list[Plugin] | None = None,
+        name: str = "pipeline",
+        gravity: float = GRAVITY,
+        init: dict[str, float] | None = None,
+        analysis: list[Analysis] | None = None,
+        navigation: NavigationNoise | dict[str, Any] | None = None,
+        smoother: str = "none",
+        plugins: list[str] | None = None,
+        guards: StanceGuard | dict[str, Any] | None = None,
+        calibration: list[Calibration] | None = None,
+    ):
+        self.calibration = list(calibration or [])
+        for i, c in enumerate(self.calibration):
+            if not isinstance(c, Calibration):
+                raise ConfigError(f"calibration[{i}] must be a footzoo.plugins.Calibration, got {type(c).__name__}")
+        self.orientation = orientation
+        self.detector = detector
+        self.corrections = list(corrections or [])
+        self.analysis = list(analysis or [])
+        self.name = name
+        self.gravity = check_range("gravity", gravity, *GRAVITY_RANGE, "m/s^2")
+        self.init = check_init(init or {})
+        self.navigation = (navigation if isinstance(navigation, NavigationNoise)
+                           else NavigationNoise.from_dict(navigation))
+        self.plugins = list(plugins or [])
+        self.guards = guards if isinstance(guards, StanceGuard) else StanceGuard.from_dict(guards)
+        check_compatibility(orientation, detector, self.corrections)
+        if smoother not in self.SMOOTHERS:
+            raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
+        if smoother != "none" and not self.filter_corrections:
+            raise ConfigError(f"smoother: {smoother} smooths the Kalman filter, and this pipeline has none; "
+                              "add a Kalman correction (e.g. zupt) or remove smoother")
+        self.smoother = smoother
+
+    # ----------------------------------------------------------------- build
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], base_dir: str | Path | None = None) -> Pipeline:
+        """Build and validate a pipeline from a config mapping (see :mod:`footzoo.config`).
+
+        A ``plugins:`` list (module names or ``.py`` paths, relative to ``base_dir``, default the
+        working directory) is loaded first, so the config can use the plug-ins it registers.
+        """
+        check_top_level(d)
+        plugins = [p["spec"] for p in load_plugins(d.get("plugins"), base_dir)]
+        calibration = [build("calibration", c, f"calibration[{i}]") for i, c in enumerate(d.get("calibration") or [])]
+        orientation = build("orientation", d["orientation"], "orientation")
+        detector = build("detector", d["detector"], "detector")
+        corrections = [
+            build("correction", c, f"corrections[{i}]") for i, c in enumerate(d.get("corrections") or [])
+        ]
+        analysis = [build("analysis", a, f"analysis[{i}]") for i, a in enumerate(d.get("analysis") or [])]
+        return cls(
+            orientation,
+            detector,
+            corrections,
+            name=str(d.get("name", "pipeline")),
+            gravity=d.get("gravity", GRAVITY),
+            init=d.get("init") or {},
+            analysis=analysis,
+            navigation=d.get("navigation"),
+            smoother=d.get("smoother", "none"),
+            plugins=plugins,
+            guards=d.get("guards"),
+            calibration=calibration,
+        )
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> Pipeline:
+        """Build a pipeline from a YAML file, or a shipped config by name (``"recommended"``, see ``footzoo configs``).
+
+        Plug-in paths in the file are relative to its folder.
+        """
+        path = resolve(path)
+        d = load_yaml(path)
+        try:
+            return cls.from_dict(d, base_dir=path.parent)
+        except ConfigError as err:
+            raise ConfigError(f"{path}: {err}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The resolved configuration, every parameter explicit."""
+        out = {
+            "name": self.name,
+            "gravity": self.gravity,
+            "init": dict(self.init),
+            "navigation": self.navigation.to_dict(),
+            "smoother": self.smoother,
+            "guards": self.guards.to_dict(),
+            "calibration": [c.spec() for c in self.calibration],
+            "orientation": self.orientation.spec(),
+            "detector": self.detector.spec(),
+            "corrections": [c.spec() for c in self.corrections],
+            "analysis": [a.spec() for a in self.analysis],
+        }
+        if self.plugins:
+            out["plugins"] = list(self.plugins)
+        return out
+
+    # ------------------------------------------------------------ structure
+    @property
+    def filter_corrections(self) -> list[KalmanCorrection]:
+        """The corrections acting inside the Kalman filter (empty: no filter).
+
+        A filter runs when a correction can only act inside one; corrections that have both a
+        filter and a batch form (heading reduction) then act inside it too.
+        """
+        kalman = [c for c in self.corrections if isinstance(c, KalmanCorrection)]
+        needs_filter = any(not isinstance(c, (AccelerationCorrection, VelocityCorrection)) for c in kalman)
+        return kalman if needs_filter else []
+
+    # ------------------------------------------------------------------- run
+    def run(self, rec: Recording, engine: str = "auto", covariance: bool = False) -> Result:
+        """Estimate attitude, velocity, position and steps for one recording.
+
+        Parameters
+        ----------
+        rec : Recording
+            The input.
+        engine : {"auto", "fast", "reference"}
+            For Kalman-filter pipelines: the compiled loop (:mod:`footzoo.filters.kalman_fast`)
+            or the reference loop on filterpy's ``KalmanFilter``; ``auto`` takes the compiled
+            one when every correction's measurement model compiles, else the reference with a
+            warning. Both give the same numbers.
+        covariance : bool
+            Keep the Kalman filter's variances per sample in ``Result.diagnostics['P_diag']``
+            ((N, n), n × 8 bytes per sample; off by default).
+        """
+        if engine not in ENGINES:
+            raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+        if not isinstance(rec, Recording):
+            raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
+        self._check_inputs(rec)
+        rec, calibration = self.calibrate(rec)
+        detector = self.detect(rec)
+        stance, guard_report = self.guard(rec, detector)
+        q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
+        quat = self.orient(rec, stance, q0)
+        nav = self.navigate(rec, stance, q0, quat, engine, covariance)
+        steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
+        guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
+        diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
+                       "guards": guard_report, **nav["diagnostics"]}
+        if self.calibration:
+            diagnostics["calibration"] = calibration
+        config = self.to_dict()
+        config["engine"] = nav["engine"]
+        samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
+        return Result(samples=samples, steps=steps, config=config, versions=versions(),
+                      recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
+
+    def _use_mag(self, rec: Recording) -> bool:
+        return rec.mag is not None and bool(getattr(self.orientation, "use_magnetometer", False))
+
+    def _check_inputs(self, rec: Recording) -> None:
+        for p in [*self.calibration, self.orientation, self.detector, *self.corrections, *self.analysis]:
+            if p.needs_magnetometer and rec.mag is None:
+                raise RecordingError(f"{p.kind} {p.name!r} needs a magnetometer; the recording {rec.name!r} has none: "
+                                     f"load one with mag_x, mag_y, mag_z or choose another {p.kind}")
+
+    def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
+        """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""
+        if not self.calibration:
+            return rec, []
+        out = copy.copy(rec)
+        reports = []
+        for c in self.calibration:
+            fitted = c.clone().calibrate(out.t, out.acc, out.gyr, out.mag)
+            out.acc, out.gyr, out.mag = _calibrated(c, out, fitted)
+            reports.append({"type": c.name, **fitted.report_})
+        return out, reports
+
+    def detect(self, rec: Recording) -> Detector:
+        """Stage 1: the fitted detector (``stance_``, ``statistic_``)."""
+        detector = self.detector.clone()
+        if detector.needs_truth:
+            return detector.detect(rec.t, rec.acc, rec.gyr, rec.truth)
+        return detector.detect(rec.t, rec.acc, rec.gyr)
+
+    def guard(self, rec: Recording, detector: Detector) -> tuple[np.ndarray, dict[str, Any]]:
+        """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report."""
+        stance, report = self.guards.apply(rec.t, rec.gyr, detector.stance_)
+        self.guards.warn(report, detector.name, rec.name)
+        return stance, report
+
+    def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+        """Stage 2: the attitude (N, 4), or None when the Kalman filter carries it."""
+        if self.orientation.carried_by_filter and self.filter_corrections:
+            return None
+        mag = rec.mag if self._use_mag(rec) else None
+        return self.orientation.clone().estimate(rec.t, rec.acc, rec.gyr, mag, stance, q0).quat_
+
+    def navigate(self, rec: Recording, stance: np.ndarray, q0: np.ndarray, quat: np.ndarray | None,
+                 engine: str = "auto", covariance: bool = False) -> dict[str, Any]:
+        """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections."""
+        kalman = [c.clone() for c in self.filter_corrections]
+        if kalman:
+            samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
+            eng = self.kalman_engine(kalman, samples, engine)
+            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother == "rts")
+            out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
+            if covariance:
+                out["diagnostics"]["P_diag"] = out["P_diag"]
+            out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
+            out["engine"] = eng.engine
+            return out
+        acc_nav = motion_acceleration(quat, rec.acc, self.gravity)
+        for c in self.corrections:
+            if isinstance(c, AccelerationCorrection):
+                acc_nav = c.clone().apply_acceleration(quat, acc_nav, stance)
+        velocity = [c for c in self.corrections if isinstance(c, VelocityCorrection)]
+        if velocity:
+            corr = velocity[0].clone().apply(rec.t, acc_nav, stance)
+            vel, pos = corr.vel_, corr.pos_
+        else:
+            dt = sample_intervals(rec.t)
+            vel = integrate_velocity(acc_nav, dt)
+            pos = integrate_position(vel, dt)
+        return {"quat": quat, "vel": vel, "pos": pos, "acc_nav": acc_nav, "diagnostics": {}, "engine": "none"}
+
+    def kalman_engine(self, kalman: list[KalmanCorrection], samples: Samples, engine: str = "auto") -> KalmanEngine:
+        """The error-state engine for these (fresh) corrections, with their models built from ``samples``."""
+        models = []
+        for c in kalman:
+            m = c.model(samples)
+            m.data = np.ascontiguousarray(c.sample_data(samples), dtype=float)
+            models.append(m)
+        blocks = [b for c in kalman for b in c.state_blocks()]
+        return KalmanEngine(self.orientation.carried_by_filter, blocks, models, self.navigation, self.gravity, engine,
+                            names=[f"correction {c.name!r}" for c in kalman])
+
+    def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
+        """Stage 4: the steps table, with the analysis plug-ins' columns."""
+        steps = segment_steps(rec.t, stance, pos, rec.gyr)
+        for a in self.analysis:
+            steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
+        return steps
+
+
+def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np.ndarray, ...]:
+    """The calibrated signals, checked: same shapes as the input, finite (a plug-in error names the plug-in)."""
+    out = []
+    for name, before in (("acc", rec.acc), ("gyr", rec.gyr), ("mag", rec.mag)):
+        after = getattr(fitted, f"{name}_", None)
+        if before is None and after is None:
+            out.append(None)
+            continue
+        after = None if after is None else np.asarray(after, dtype=float)
+        if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
+            what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
+                    else "NaN/inf")
+            raise RecordingError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
+                                 f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)")
+        out.append(after)
+    return tuple(out)
+
+
+def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:
+    """Reject plug-in combinations that cannot work together, with the reason and the fix."""
+    names = [c.name for c in corrections]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        raise ConfigError(f"corrections: {dupes} listed more than once; keep one of each")
+    velocity = [c.name for c in corrections if isinstance(c, VelocityCorrection)]
+    if len(velocity) > 1:
+        raise ConfigError(f"corrections {velocity}: only one velocity correction can be applied")
+    kalman = [c for c in corrections if isinstance(c, KalmanCorrection)]
+    filter_only = [c.name for c in kalman if not isinstance(c, (AccelerationCorrection, VelocityCorrection))]
+    if filter_only and velocity:
+        raise ConfigError(
+            f"corrections: {velocity} and the Kalman filter {filter_only} both correct the velocity; choose one"
+        )
+    if not filter_only:
+        return
+    seen: dict[str, str] = {}
+    for c in kalman:
+        for quantity in c.observes:
+            if quantity in seen:
+                raise ConfigError(f"corrections {[seen[quantity], c.name]}: both measure the {quantity} in the same "
+                                  "filter; keep one")
+            seen[quantity] = c.name
+    if not orientation.carried_by_filter:
+        for c in kalman:
+            if c.requires_attitude_state():
+                raise ConfigError(
+                    f"{c.name}: inside the Kalman filter {filter_only} it observes the attitude error, which is a "
+                    f"filter state only with an orientation the filter carries (orientation: ins); got "
+                    f"{orientation.name!r}: use orientation: {{type: ins}}"
+                    + (" or set gyro_bias: false and zero_rate: false" if "gyro_bias" in c.param_names() else "")
+                )
+
+
+def versions() -> dict[str, str]:
+    """Versions of footzoo and its numerical dependencies (for reproducibility)."""
+    import platform
+
+    import scipy
+
+    return {
+        "footzoo": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+    }

@@ -1,0 +1,152 @@
+"""Both feet of one walk: each foot through the same pipeline, per-foot and bilateral tables.
+
+A layer above :class:`~footzoo.runtime.pipeline.Pipeline`: :meth:`Session.run` calls
+``Pipeline.run`` once per foot and combines the stride tables. Bilateral
+parameters follow the usual gait-lab definitions (e.g. gaitmap's
+``TemporalParameterCalculation`` and the symmetry index of Robinson et al. 1987,
+``SI = 100 · |L − R| / (0.5 · (L + R))``): the **step time** of a foot is the
+time from the other foot's initial contact to this foot's next initial contact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..core.data import Recording, Result
+from ..core.errors import FormatError
+from .pipeline import Pipeline
+
+FEET = ("left", "right")
+#: Parameters of the bilateral table: median per foot of these stride-table columns.
+BILATERAL_COLUMNS = ["stride_time_s", "step_time_s", "stance_time_s", "swing_time_s", "cadence_steps_min",
+                     "stride_length_m", "speed_m_s", "max_clearance_m"]
+
+
+class Session:
+    """Recordings of both feet of one walk, on one clock.
+
+    Parameters
+    ----------
+    recordings : dict
+        ``{"left": Recording, "right": Recording}`` (one foot alone is allowed;
+        the bilateral table then stays empty).
+    name : str
+        Session name.
+    """
+
+    def __init__(self, recordings: dict[str, Recording], name: str = "session"):
+        bad = [k for k in recordings if k not in FEET]
+        if bad or not recordings:
+            raise FormatError(f"a session holds recordings keyed 'left' and/or 'right', got {list(recordings)}")
+        for foot, rec in recordings.items():
+            if not isinstance(rec, Recording):
+                raise FormatError(f"session[{foot!r}] must be a footzoo Recording, got {type(rec).__name__}")
+        self.recordings = dict(recordings)
+        self.name = name
+
+    def __repr__(self) -> str:
+        return f"Session({self.name!r}, feet={list(self.recordings)})"
+
+    @classmethod
+    def load(cls, path: str | Path, format: str | None = None, **options: Any) -> Session:
+        """Read every foot a file holds (gaitmap: ``left_sensor`` and ``right_sensor``).
+
+        Raises
+        ------
+        FormatError
+            When the file holds one foot only (use :func:`footzoo.io.load`).
+        """
+        from ..io import detect_format, load
+        from ..io.gaitmap import feet
+
+        p = Path(path)
+        fmt = format or detect_format(p)
+        if fmt != "gaitmap":
+            raise FormatError(f"{p}: a {fmt} file holds one foot; load it with footzoo.load (command line: "
+                              "--foot left or --foot right), or build Session({'left': ..., 'right': ...})")
+        found = feet(p)
+        if not found:
+            raise FormatError(f"{p}: no left_sensor or right_sensor columns")
+        recs = {f: load(p, format=fmt, foot=f, **options) for f in found}
+        return cls(recs, name=p.stem)
+
+    def run(self, pipeline: Pipeline, engine: str = "auto") -> SessionResult:
+        """Run ``pipeline`` on each foot (``Pipeline.run``) and combine the stride tables."""
+        results = {foot: pipeline.run(rec, engine=engine) for foot, rec in self.recordings.items()}
+        return SessionResult(results=results, name=self.name)
+
+
+def step_times(steps: dict[str, pd.DataFrame]) -> dict[str, np.ndarray]:
+    """Step time (s) of each stride of each foot: its ``end_s`` minus the other foot's latest IC before it.
+
+    NaN where the other foot has no earlier contact in the stride (the first
+    step, or when the other foot's IC is older than this foot's previous one).
+    """
+    out: dict[str, np.ndarray] = {}
+    for foot, table in steps.items():
+        ic = table["end_s"].to_numpy(dtype=float)
+        other = [f for f in steps if f != foot]
+        if not other:
+            out[foot] = np.full(len(ic), np.nan)
+            continue
+        o = np.sort(steps[other[0]]["end_s"].to_numpy(dtype=float))
+        k = np.searchsorted(o, ic) - 1
+        prev = np.where(k >= 0, o[np.maximum(k, 0)], np.nan)
+        own_prev = table["start_s"].to_numpy(dtype=float)
+        st = ic - prev
+        st[~(prev > own_prev)] = np.nan  # the other foot must land within this stride
+        out[foot] = st
+    return out
+
+
+@dataclass
+class SessionResult:
+    """Results of both feet.
+
+    Attributes
+    ----------
+    results : dict
+        ``{"left": Result, "right": Result}``.
+    name : str
+        Session name.
+    """
+
+    results: dict[str, Result]
+    name: str = "session"
+
+    @cached_property
+    def steps(self) -> pd.DataFrame:
+        """Stride tables of both feet, one after the other, with ``foot`` and ``step_time_s`` (s)."""
+        per = {f: r.steps for f, r in self.results.items()}
+        st = step_times(per)
+        frames = [t.assign(step_time_s=st[f]).assign(foot=f) for f, t in per.items()]
+        cols = ["foot", *frames[0].columns.drop("foot")]
+        return pd.concat(frames, ignore_index=True)[cols]
+
+    @property
+    def per_foot(self) -> pd.DataFrame:
+        """One row per foot: :attr:`footzoo.core.data.Result.metrics` (errors against each foot's reference)."""
+        return pd.DataFrame({f: r.metrics for f, r in self.results.items()}).T.rename_axis("foot")
+
+    @property
+    def bilateral(self) -> pd.DataFrame:
+        """Median of each parameter per foot and the symmetry index ``100 · |L − R| / (0.5 · (L + R))`` (%)."""
+        steps = self.steps
+        rows = {}
+        for col in BILATERAL_COLUMNS:
+            if col not in steps.columns:
+                continue
+            med = {}
+            for f in FEET:
+                v = steps.loc[steps["foot"] == f, col].to_numpy(dtype=float)
+                v = v[np.isfinite(v)]
+                med[f] = float(np.median(v)) if v.size else np.nan
+            si = 100.0 * abs(med["left"] - med["right"]) / (0.5 * (med["left"] + med["right"]))
+            rows[col] = {"left": med["left"], "right": med["right"], "symmetry_index_pct": si}
+        return pd.DataFrame(rows).T.rename_axis("parameter")

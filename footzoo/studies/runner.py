@@ -1,0 +1,572 @@
+"""Run a study's cells serially, on local cores (joblib) or on a Dask cluster, with a checked, resumable cache.
+
+How a study runs:
+
+1. the study is parsed, its plug-ins loaded, each recording identified once (content hash of a file,
+   or the simulator spec and seed) and every cell keyed by the hash of its resolved config, the data's
+   identity, footzoo's version and the plug-ins' source hash;
+2. cached cells are read back after checking their checksum; a damaged, truncated, edited or foreign
+   entry is reported (warning, ``table.attrs["recomputed"]``, ``cache_report.log``) and run again; a
+   cell that failed is run again once footzoo's source changed (a changed config, plug-in, version or
+   recording changes its key anyway);
+3. the remaining cells are grouped by recording and sent in chunks to the workers: each worker loads
+   the study's plug-ins, then loads or simulates each recording once and runs every config of the chunk
+   on it (a small per-process cache shares a recording between chunks);
+4. the tidy table is built from the run records; trajectories and threshold sweeps stay in the run
+   records and in ``trajectories.parquet`` / ``roc.parquet``, never in ``table.attrs``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import math
+import os
+import threading
+import time
+import traceback
+import warnings
+from collections import OrderedDict
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .study import Cell, Study, code_fingerprint
+
+TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
+CACHE_FORMAT = "footzoo-ablation-cache/2"
+RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
+CHUNKS_PER_WORKER = 4  # aim for this many chunks per worker (load balance vs. loading a recording again)
+
+
+class CacheWarning(UserWarning):
+    """A cache entry was damaged, truncated, edited or foreign; its cell was run again."""
+
+
+# --------------------------------------------------------------------------- metrics of one run
+
+
+def _metrics(rec, res, metric_names: list[str] | None) -> dict[str, float]:
+    from ..evaluation.metrics import stance_scores, step_detection, trajectory_metrics
+
+    truth = rec.truth
+    closed = bool(truth is not None and truth.closed_loop)
+    m = trajectory_metrics(res.pos, truth.pos if truth is not None else None, closed)
+    m["steps"] = float(len(res.steps))
+    if truth is not None and truth.stance is not None:
+        m.update({f"stance_{k}": v for k, v in stance_scores(res.stance, truth.stance).items()})
+        sd = step_detection(res.stance, truth.stance, rec.t)
+        m["gait_phase_error_rate"] = sd["error_rate"]
+        m["step_count_error"] = float(sd["step_count_error"])
+    if "fpa_rad" in res.steps:
+        fpa = res.steps["fpa_rad"].dropna()
+        if len(fpa):
+            m["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
+    if metric_names:
+        m = {k: v for k, v in m.items() if k in metric_names}
+    return {k: float(v) for k, v in m.items()}
+
+
+def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
+    """Threshold sweep from the detector's statistic (stance where the statistic is below the threshold)."""
+    from ..plugins.registry import build
+
+    if rec.truth is None or rec.truth.stance is None:
+        return []
+    det = build("detector", dict(detector_spec))
+    if getattr(det, "needs_truth", False):
+        return []
+    det.detect(rec.t, rec.acc, rec.gyr)
+    stat, truth = np.asarray(det.statistic_, float), rec.truth.stance
+    out = []
+    for th in np.quantile(stat, np.linspace(0.0, 1.0, points)):
+        pred = stat <= th
+        tpr = float(np.sum(pred & truth) / max(truth.sum(), 1))
+        fpr = float(np.sum(pred & ~truth) / max((~truth).sum(), 1))
+        out.append([float(th), tpr, fpr])
+    return out
+
+
+# --------------------------------------------------------------------------- cache entries
+
+
+def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:
+    """Write one cache entry atomically: a header line (format, key, checksum, size) then the JSON record."""
+    payload = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
+    header = {"format": CACHE_FORMAT, "key": key, "sha256": hashlib.sha256(payload).hexdigest(),
+              "bytes": len(payload)}
+    tmp = path.with_suffix(f".{os.getpid()}.{time.monotonic_ns()}.tmp")
+    tmp.write_bytes(json.dumps(header).encode() + b"\n" + payload)
+    tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
+
+
+def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]:
+    """``(record, None)`` for a sound entry of this cell, ``(None, problem)`` otherwise; never raises."""
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        return None, f"unreadable ({err.strerror or err})"
+    line, _, payload = raw.partition(b"\n")
+    try:
+        header = json.loads(line)
+    except ValueError:
+        header = None
+    if not isinstance(header, dict) or header.get("format") != CACHE_FORMAT:
+        return None, "not a footzoo cache entry of this version (foreign file or older format)"
+    if header.get("key") != key:
+        return None, f"belongs to another cell (key {str(header.get('key'))[:24]!r})"
+    if len(payload) != header.get("bytes"):
+        return None, f"truncated or extended ({len(payload)} of {header.get('bytes')} bytes)"
+    if hashlib.sha256(payload).hexdigest() != header.get("sha256"):
+        return None, "checksum mismatch (edited or damaged)"
+    try:
+        record = json.loads(payload)
+    except ValueError:
+        return None, "checksum matches but the content is not JSON"
+    if not isinstance(record, dict) or record.get("key") != key:
+        return None, "checksum matches but the record is not this cell's"
+    return record, None
+
+
+# --------------------------------------------------------------------------- one cell, one chunk
+
+_RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
+_RECORDINGS_LOCK = threading.Lock()
+
+
+def _recording(cell: Cell, identity: str):
+    """The cell's recording, loaded or simulated once per process and shared by the configs that use it."""
+    with _RECORDINGS_LOCK:  # Dask workers may run several chunks in threads of one process
+        rec = _RECORDINGS.get(identity)
+        if rec is not None:
+            _RECORDINGS.move_to_end(identity)
+            return rec
+    rec = _read_only(cell.recording.load())
+    with _RECORDINGS_LOCK:
+        _RECORDINGS[identity] = rec
+        while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
+            _RECORDINGS.popitem(last=False)
+    return rec
+
+
+def _read_only(rec):
+    """Freeze a shared recording's arrays: a plug-in writing into its input fails loudly instead of
+    silently changing the input of the configs that run after it."""
+    for obj in (rec, rec.truth):
+        for value in vars(obj).values() if obj is not None else ():
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+    return rec
+
+
+def _new_record(cell: Cell, key: str) -> dict[str, Any]:
+    return {"key": key, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+            "error": None, "metrics": {}, "trajectory": [], "roc": [], "code_fingerprint": code_fingerprint()}
+
+
+def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
+    out["error"] = f"{type(err).__name__}: {err}"
+    if isinstance(err, ValueError) and "read-only" in str(err):
+        out["error"] += ("; a plug-in wrote into the recording's arrays, which a study shares between configs: "
+                         "the plug-in must copy its input before changing it")
+    out["traceback"] = "".join(traceback.format_exception(type(err), err, err.__traceback__, limit=3))
+    return out
+
+
+def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_points: int) -> dict[str, Any]:
+    out = _new_record(cell, key)
+    try:
+        from ..runtime.pipeline import Pipeline
+
+        res = Pipeline.from_dict(cell.config).run(rec)
+        out["metrics"] = _metrics(rec, res, metric_names)
+        step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
+        out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
+        if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
+            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4).tolist()
+        if sweep_points:
+            out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
+    except Exception as err:  # one failing run is reported, not fatal
+        _fail(out, err)
+    return out
+
+
+def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[str], cache_dir: str | None,
+              metric_names: list[str] | None = None, sweep_points: int = 0,
+              on_cell: Callable[[], None] | None = None) -> list[dict[str, Any]]:
+    """Run cells that share one recording (in a worker): load the plug-ins, the recording once, run each config.
+
+    Never raises: a plug-in, recording or run failure is recorded in the cells it concerns. Each
+    finished cell is written to the cache at once, so an interrupted study keeps it.
+    """
+    from ..plugins.extensions import load_plugins
+
+    setup_error: BaseException | None = None
+    rec = None
+    start = time.process_time()
+    try:
+        load_plugins(plugins)
+        rec = _recording(cells[0], identity)
+    except Exception as err:  # a plug-in, reader or simulator failure fails this recording's cells only
+        setup_error = err
+    out = []
+    for cell, key in zip(cells, keys, strict=True):
+        if setup_error is not None:
+            record = _fail(_new_record(cell, key), setup_error)
+        else:
+            record = _compute(cell, key, rec, metric_names, sweep_points)
+        # CPU seconds of this run in its worker (the first run of a chunk includes loading the recording)
+        record["cpu_s"] = round(time.process_time() - start, 6)
+        start = time.process_time()
+        if cache_dir is not None:
+            try:
+                write_entry(Path(cache_dir) / f"{key}.json", key, record)
+            except OSError as err:  # a full or read-only cache costs the resume, not the result
+                warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning, stacklevel=2)
+        record["cached"] = False
+        out.append(record)
+        if on_cell is not None:
+            on_cell()
+    return out
+
+
+def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] | None = None,
+             sweep_points: int = 0) -> dict[str, Any]:
+    """Run one cell, or read it from the cache when a sound entry exists; never raises: errors are recorded."""
+    identity = cell.recording.identity()
+    key = cell.key(identity)
+    if cache_dir is not None and (Path(cache_dir) / f"{key}.json").exists():
+        record, problem = read_entry(Path(cache_dir) / f"{key}.json", key)
+        if record is not None:
+            return {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                    "cached": True}
+        warnings.warn(f"cache entry {key} {problem}; running it again", CacheWarning, stacklevel=2)
+    plugins = [p for p in cell.config.get("plugins") or []]
+    return run_chunk([cell], [key], identity, plugins, cache_dir, metric_names, sweep_points)[0]
+
+
+# --------------------------------------------------------------------------- the study
+
+
+def run_study(
+    study: Study | str | Path,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    out: str | Path | None = None,
+    progress: bool = False,
+    max_runs: int | None = None,
+) -> pd.DataFrame:
+    """Run every cell of a study and return the tidy table (one row per run × metric).
+
+    Parameters
+    ----------
+    study : Study or path
+        The study (or its YAML file).
+    jobs : int
+        Local worker processes (joblib); 1 runs serially, -1 uses every core.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``); the runs go
+        to its workers through ``dask.distributed``.
+    out : path, optional
+        Output folder: ``cache/`` (one checked file per run, keyed by the hash of the
+        resolved config, the data, footzoo's version and the plug-ins' source, so a rerun
+        resumes), ``results.parquet``, ``results.csv``, ``trajectories.parquet``,
+        ``roc.parquet``, ``summary.md``, ``summary.tex`` and plots. A rerun whose table,
+        runs and footzoo source are unchanged, and whose outputs are all present and
+        intact (``outputs.json`` records their checksums), leaves them as they are.
+    progress : bool
+        Show one progress bar over the whole command (loading, runs, report).
+    max_runs : int, optional
+        Stop after this many new runs (what an interruption leaves behind).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``run``, ``base``, one per factor, ``recording``, ``metric``, ``value``,
+        ``error``. ``attrs`` holds counts only: ``computed``, ``cached``, ``failed``, and
+        ``recomputed`` (damaged cache entries: key -> problem) and ``retried`` (failed
+        cells run again because footzoo's source changed: keys). Trajectories and
+        threshold sweeps are in ``out`` (see :func:`read_trajectories`).
+    """
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
+        from ..core.errors import ConfigError
+
+        raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+    bar = _Progress(progress, "study")
+    try:
+        if scheduler is None:
+            return _run_study(study, jobs, None, out, max_runs, bar)
+        cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
+        try:
+            return _run_study(study, jobs, cluster, out, max_runs, bar)
+        finally:
+            cluster.close()
+    finally:
+        bar.close()
+
+
+def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.DataFrame:
+    bar.phase("loading")
+    if not isinstance(study, Study):
+        study = Study.from_yaml(study)
+    bar.set_description(study.name)
+    cells = study.cells()
+    report_steps = 4 if out is not None else 0
+    bar.add(len(study.recordings) + len(cells) + report_steps)
+    bar.update(1)
+
+    bar.phase("hashing data")
+    identity: dict[int, str] = {}
+    for rec in study.recordings:
+        identity[id(rec)] = rec.identity()
+        bar.update(1)
+    keys = [c.key(identity[id(c.recording)]) for c in cells]
+
+    cache_dir = None
+    if out is not None:
+        cache = Path(out) / "cache"
+        cache.mkdir(parents=True, exist_ok=True)
+        cache_dir = str(cache)
+
+    bar.phase("reading cache")
+    results: dict[int, dict[str, Any]] = {}
+    todo: list[int] = []
+    recomputed: dict[str, str] = {}
+    retried: list[str] = []
+    for i, key in enumerate(keys):
+        path = Path(cache_dir) / f"{key}.json" if cache_dir else None
+        if path is None or not (path.exists() or path.is_symlink()):
+            todo.append(i)
+            continue
+        record, problem = read_entry(path, key)
+        if record is None:
+            recomputed[key] = problem
+            todo.append(i)
+        elif record.get("error") and record.get("code_fingerprint") != code_fingerprint():
+            retried.append(key)
+            todo.append(i)
+        else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
+            cell = cells[i]
+            results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                          "cached": True}
+            bar.update(1)
+    if recomputed:
+        warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
+                      f"(e.g. {next(iter(recomputed))}: {next(iter(recomputed.values()))}) will be run again"
+                      + (f"; see {Path(out) / 'cache_report.log'}" if out is not None else ""),
+                      CacheWarning, stacklevel=3)
+    if max_runs is not None:
+        bar.add(-(len(todo) - min(len(todo), max_runs)))
+        todo = todo[:max_runs]
+
+    bar.phase("running")
+    args = (study.plugins, cache_dir, study.metrics, study.sweep_points)
+    for idx, records in _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
+        for i, r in zip(idx, records, strict=True):
+            results[i] = r
+    runs = [results[i] for i in sorted(results)]
+    table = tidy(runs, list(study.factors))
+    table.attrs["computed"] = sum(1 for r in runs if not r.get("cached"))
+    table.attrs["cached"] = sum(1 for r in runs if r.get("cached"))
+    table.attrs["failed"] = sum(1 for r in runs if r.get("error"))
+    table.attrs["recomputed"] = dict(recomputed)
+    table.attrs["retried"] = list(retried)
+    if out is not None:
+        from .report import write_outputs
+
+        if recomputed:
+            _log_damaged(Path(out), recomputed)
+        bar.phase("report")
+        digest = _outputs_digest(table, runs, list(study.factors))
+        if _outputs_current(Path(out), digest):
+            bar.update(report_steps)  # nothing changed since the outputs were written: keep them
+        else:
+            # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
+            write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
+                          jobs=jobs if scheduler is None else 1,
+                          scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler)
+            _write_manifest(Path(out), digest)
+    return table
+
+
+MANIFEST = "outputs.json"
+
+
+def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> str:
+    """What the report depends on: the table, the runs (keys and labels), the factors and footzoo's source."""
+    h = hashlib.sha256(json.dumps([[r["key"], r["base"], r["recording"]] for r in runs]).encode())
+    h.update(json.dumps([factors, code_fingerprint()]).encode())
+    h.update(pd.util.hash_pandas_object(table.astype(str), index=True).to_numpy().tobytes())
+    return h.hexdigest()
+
+
+def _outputs_current(out: Path, digest: str) -> bool:
+    """True when ``out`` holds every output of a report with this digest, each with its recorded content."""
+    try:
+        manifest = json.loads((out / MANIFEST).read_text())
+        return manifest["digest"] == digest and all(
+            _file_sha256(out / name) == sha for name, sha in manifest["files"].items())
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return False
+
+
+def _write_manifest(out: Path, digest: str) -> None:
+    skip = {MANIFEST, "cache_report.log"}
+    files = {f.name: _file_sha256(f) for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
+    tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps({"digest": digest, "files": files}, indent=1))
+    tmp.replace(out / MANIFEST)
+
+
+def _file_sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _chunks(todo: list[int], cells: list[Cell], identity: dict[int, str], workers: int) -> list[list[int]]:
+    """Group the cells to run by recording, then split each group so every worker gets several chunks."""
+    groups: dict[str, list[int]] = {}
+    for i in todo:
+        groups.setdefault(identity[id(cells[i].recording)], []).append(i)
+    if workers <= 1:
+        return list(groups.values())
+    want = CHUNKS_PER_WORKER * workers
+    per_group = max(1, math.ceil(want / max(len(groups), 1)))
+    chunks = []
+    for idx in groups.values():
+        n = min(per_group, len(idx))
+        size = math.ceil(len(idx) / n)
+        chunks += [idx[k:k + size] for k in range(0, len(idx), size)]
+    return chunks
+
+
+def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
+    """Yield ``(indices, records)`` per finished chunk, from the chosen back end."""
+    def task(idx):
+        first = cells[idx[0]]
+        return ([cells[i] for i in idx], [keys[i] for i in idx], identity[id(first.recording)], *args)
+
+    if not todo:
+        return
+    if scheduler is not None:
+        from dask.distributed import as_completed
+
+        with _connected(scheduler) as client:
+            workers = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+            chunks = _chunks(todo, cells, identity, max(workers, 1))
+            futures = {client.submit(run_chunk, *task(idx), pure=False): idx for idx in chunks}
+            for fut in as_completed(futures):
+                records = fut.result()
+                bar.update(len(records))
+                yield futures[fut], records
+    elif jobs != 1:
+        from joblib import Parallel, delayed
+
+        chunks = _chunks(todo, cells, identity, (os.cpu_count() or 1) if jobs < 0 else int(jobs))
+        gen = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
+            delayed(_indexed)(k, *task(idx)) for k, idx in enumerate(chunks))
+        for k, records in gen:
+            bar.update(len(records))
+            yield chunks[k], records
+    else:
+        for idx in _chunks(todo, cells, identity, 1):
+            yield idx, run_chunk(*task(idx), on_cell=lambda: bar.update(1))
+
+
+class _Cluster:
+    """A Dask scheduler's address and the client connected to it at the first use, closed by :meth:`close`."""
+
+    def __init__(self, address: str):
+        self.address = address
+        self._client: Any = None
+
+    @property
+    def client(self) -> Any:
+        if self._client is None:
+            from dask.distributed import Client
+
+            self._client = Client(self.address)
+        return self._client
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+
+def _connected(scheduler: Any) -> Any:
+    """A context giving a Dask client: the study's (left open) for a :class:`_Cluster`, else a new one."""
+    from dask.distributed import Client
+
+    return contextlib.nullcontext(scheduler.client) if isinstance(scheduler, _Cluster) else Client(scheduler)
+
+
+def _indexed(k: int, *args: Any) -> tuple[int, list[dict[str, Any]]]:
+    return k, run_chunk(*args)
+
+
+def _log_damaged(out: Path, recomputed: dict[str, str]) -> None:
+    stamp = time.strftime("%Y-%m-%dT%H:%M:%S")
+    with open(out / "cache_report.log", "a") as f:
+        for key, problem in recomputed.items():
+            f.write(f"{stamp} cache entry {key}.json {problem}: run again\n")
+
+
+def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
+    """One row per run × metric (a failed run gives one row with its error)."""
+    rows = []
+    for r in runs:
+        base = {"run": r["key"], "base": r["base"], **{f: _cell_value(r["levels"].get(f)) for f in factors},
+                "recording": r["recording"]}
+        if r["error"]:
+            rows.append({**base, "metric": None, "value": np.nan, "error": r["error"]})
+        for name, value in sorted(r["metrics"].items()):
+            rows.append({**base, "metric": name, "value": value, "error": None})
+    cols = ["run", "base", *factors, "recording", "metric", "value", "error"]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def read_trajectories(out: str | Path) -> pd.DataFrame:
+    """The stored trajectories of a study's runs (``out/trajectories.parquet``): one row per stored point."""
+    return pd.read_parquet(Path(out) / "trajectories.parquet")
+
+
+def _cell_value(v: Any) -> Any:
+    return v if isinstance(v, (str, int, float, bool)) or v is None else json.dumps(v, sort_keys=True)
+
+
+class _Progress:
+    """One tqdm bar over the whole command; its total grows as the work becomes known."""
+
+    def __init__(self, show: bool, name: str):
+        self.bar = None
+        if show:
+            try:
+                from tqdm import tqdm
+            except ImportError:  # tqdm is a dependency, but a bar is not worth failing for
+                return
+            self.bar = tqdm(total=1, desc=name, unit="step")
+        self.name = name
+
+    def set_description(self, name: str) -> None:
+        self.name = name
+
+    def phase(self, what: str) -> None:
+        if self.bar is not None:
+            self.bar.set_description(f"{self.name}: {what}")
+
+    def add(self, n: int) -> None:
+        if self.bar is not None:
+            self.bar.total += n
+            self.bar.refresh()
+
+    def update(self, n: int = 1) -> None:
+        if self.bar is not None:
+            self.bar.update(n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

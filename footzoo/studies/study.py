@@ -1,0 +1,338 @@
+"""Study files: base configs × factors (dotted-path overrides, grids) × recordings × metrics."""
+
+from __future__ import annotations
+
+import copy
+import functools
+import glob
+import hashlib
+import itertools
+import json
+import os
+import stat
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..config.library import is_name, resolve
+from ..config.library import path as library_path
+from ..config.schema import load_yaml
+from ..core.errors import ConfigError, did_you_mean
+from ..core.yamlsafe import load_file
+from ..plugins.extensions import load_plugins, resolve_specs, source_hash
+
+STUDY_KEYS = {
+    "name": "study name",
+    "description": "free text",
+    "base": "a config path, an inline config, or a list of them",
+    "factors": "mapping of dotted paths to lists of values (all combinations are run)",
+    "recordings": "list of {path: glob, format: ...} or {simulate: {...}, seeds: [...]}",
+    "metrics": "list of metric names to keep (default: all)",
+    "sweep": "threshold sweep of the detectors: {points: 25}",
+    "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
+}
+
+# what a run can measure (footzoo.studies.runner computes them); a study's ``metrics`` picks among them
+METRICS: dict[str, str] = {
+    "path_length_m": "horizontal path length (m)",
+    "loop_closure_xy_m": "horizontal end-to-start distance of a closed walk (m)",
+    "loop_closure_3d_m": "3-D end-to-start distance of a closed walk (m)",
+    "loop_closure_xy_pct": "horizontal end-to-start distance, % of the path length",
+    "loop_closure_3d_pct": "3-D end-to-start distance, % of the path length",
+    "armse_3d_m": "RMS position error after yaw alignment, against the reference (m)",
+    "pyshoe_error_m": "PyShoe's position error against the reference (m)",
+    "steps": "number of detected steps",
+    "stance_precision": "per-sample stance precision against the true stance",
+    "stance_recall": "per-sample stance recall against the true stance",
+    "stance_f1": "per-sample stance F1 against the true stance",
+    "stance_accuracy": "per-sample stance accuracy against the true stance",
+    "gait_phase_error_rate": "wrong or missed steps per true step",
+    "step_count_error": "detected minus true steps",
+    "fpa_mean_deg": "mean foot progression angle (deg)",
+}
+
+_FILE_DIGESTS: dict[tuple[str, int, int], str] = {}  # (path, size, mtime_ns) -> sha256 of the content
+
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """SHA-256 over footzoo's own source files (part of every cache key)."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+@dataclass
+class RecordingSpec:
+    """One recording of a study: a file or a simulator scenario with a seed."""
+
+    label: str
+    path: str | None = None
+    format: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+    simulate: dict[str, Any] | None = None
+    seed: int | None = None
+
+    def identity(self) -> str:
+        """What the cache key depends on: the file's content hash, or the simulator spec and seed.
+
+        A path that is not a readable file (a dangling link, a directory, a vanished or unreadable
+        file) gets an identity describing the problem, so its cells fail on their own and are run
+        again once the file changes.
+        """
+        if self.path is not None:
+            problem = self.problem()
+            data = {"problem": problem, "path": self.path} if problem else {"file": _file_digest(self.path)}
+            return json.dumps({**data, "format": self.format, "options": self.options}, sort_keys=True, default=str)
+        from .._version import __version__
+
+        return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": __version__}, sort_keys=True,
+                          default=str)
+
+    def problem(self) -> str | None:
+        """Why the recording's file cannot be read (None for a simulated recording or a readable file)."""
+        if self.path is None:
+            return None
+        p = Path(self.path)
+        try:
+            st = p.stat()
+        except FileNotFoundError:
+            if p.is_symlink():
+                return f"{self.path!r} is a dangling link (its target {os.readlink(p)!r} does not exist)"
+            return f"{self.path!r} does not exist (any more)"
+        except OSError as err:
+            return f"{self.path!r} cannot be accessed: {err.strerror or err}"
+        if stat.S_ISDIR(st.st_mode):
+            return f"{self.path!r} is a directory, not a recording file; narrow the study's glob"
+        if not stat.S_ISREG(st.st_mode):
+            return f"{self.path!r} is not a regular file"
+        if not os.access(p, os.R_OK):
+            return f"{self.path!r} is not readable (permission denied)"
+        return None
+
+    def load(self):
+        """The recording."""
+        if self.path is not None:
+            problem = self.problem()
+            if problem:
+                from ..core.errors import RecordingError
+
+                raise RecordingError(f"recording {problem}")
+            from ..io import load
+
+            return load(self.path, format=self.format, **self.options)
+        from ..sim import NoiseModel, simulate
+
+        spec = copy.deepcopy(self.simulate)
+        noise = spec.pop("noise", None)
+        if isinstance(noise, dict):
+            noise = NoiseModel(**{**noise, "seed": self.seed or 0})
+        return simulate(**spec, noise=noise, seed=self.seed or 0)
+
+
+@dataclass
+class Cell:
+    """One run: a resolved config on one recording."""
+
+    config: dict[str, Any]
+    recording: RecordingSpec
+    levels: dict[str, Any]
+    base: str
+    code: str = ""  # footzoo's version and the plug-ins' source hash (Study.code_identity)
+
+    def key(self, data: str | None = None) -> str:
+        """Cache key: hash of the resolved config, the code identity and the data's identity."""
+        data = self.recording.identity() if data is None else data
+        payload = json.dumps({"config": self.config, "data": data, "code": self.code}, sort_keys=True, default=str)
+        return hashlib.sha256(payload.encode()).hexdigest()[:24]
+
+
+@dataclass
+class Study:
+    """A parsed study file."""
+
+    name: str
+    bases: list[tuple[str, dict[str, Any]]]
+    factors: dict[str, list[Any]]
+    recordings: list[RecordingSpec]
+    metrics: list[str] | None = None
+    sweep_points: int = 0
+    plugins: list[str] = field(default_factory=list)
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> Study:
+        """Read and check a study file; paths in it are relative to the file."""
+        p = resolve(path)
+        data = load_file(p, ConfigError, "study file")
+        if not isinstance(data, dict):
+            raise ConfigError(f"{p}: a study must be a mapping with base, factors, recordings")
+        try:
+            return cls.from_dict(data, root=p.parent)
+        except ConfigError as err:
+            raise ConfigError(f"{p}: {err}") from None
+
+    def code_identity(self) -> str:
+        """footzoo's version and source, and every plug-in's source (SHA-256): part of every cache key.
+
+        With footzoo's own source in the key, a result computed before an edit of a built-in
+        plug-in (an editable install, a benchmark) is never read back as if it were current.
+        """
+        from .._version import __version__
+
+        return json.dumps({"footzoo": __version__, "source": code_fingerprint(),
+                           "plugins": source_hash(self.plugins)}, sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
+        """Build from a mapping (see :data:`STUDY_KEYS`)."""
+        root = Path(root)
+        for key in d:
+            if key not in STUDY_KEYS:
+                raise ConfigError(f"unknown study key {key!r}{did_you_mean(key, list(STUDY_KEYS))}; "
+                                  f"valid keys: {list(STUDY_KEYS)}")
+        if "base" not in d or "recordings" not in d:
+            raise ConfigError("a study needs 'base' (config path(s)) and 'recordings'")
+        plugins = resolve_specs(d.get("plugins"), root, "plugins")
+        bases = []
+        for b in d["base"] if isinstance(d["base"], list) else [d["base"]]:
+            if isinstance(b, str):
+                path = _resolve(root, b)
+                cfg, folder = load_yaml(path), Path(path).parent
+                name = Path(path).stem
+            elif isinstance(b, dict):
+                cfg, folder = copy.deepcopy(b), root
+                name = str(b.get("name", f"base{len(bases)}"))
+            else:
+                raise ConfigError(f"base entries must be config paths or mappings, got {b!r}")
+            if cfg.get("plugins"):  # the base's own plug-ins, made absolute so any worker finds them
+                cfg["plugins"] = resolve_specs(cfg["plugins"], folder, f"base {name}: plugins")
+                plugins += [p for p in cfg["plugins"] if p not in plugins]
+            bases.append((name, cfg))
+        load_plugins(plugins)  # here too: errors surface before any run, and factors may name the plug-ins
+        factors = d.get("factors") or {}
+        if not isinstance(factors, dict):
+            raise ConfigError("factors must map dotted paths to lists of values, e.g. {detector.type: [dgp, shoe]}")
+        for k in factors:
+            if not isinstance(k, str) or not k:
+                raise ConfigError(f"factor names must be dotted paths like detector.threshold, got {k!r}")
+        factors = {k: (v if isinstance(v, list) else [v]) for k, v in factors.items()}
+        recordings = []
+        if not isinstance(d["recordings"] or [], list):
+            raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
+        for i, r in enumerate(d["recordings"] or []):
+            recordings += _expand_recording(r, root, i)
+        if not recordings:
+            raise ConfigError("the study has no recordings (check the globs)")
+        metrics = d.get("metrics")
+        if metrics is not None:
+            if isinstance(metrics, str):
+                metrics = [metrics]
+            if not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics):
+                raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}; valid: {list(METRICS)}")
+            for m in metrics:
+                if m not in METRICS:
+                    raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}; "
+                                      f"valid metrics: {list(METRICS)}")
+        sweep = d.get("sweep") or {}
+        if not isinstance(sweep, dict) or set(sweep) - {"points"}:
+            raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
+        points = sweep.get("points", 0)
+        if isinstance(points, bool) or not isinstance(points, int) or points < 0:
+            raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
+        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins)
+
+    def cells(self) -> list[Cell]:
+        """Every base × factor combination × recording."""
+        # type changes first: they reset the plug-in's parameters, which other factors may then set
+        names = sorted(self.factors, key=lambda n: not n.endswith(".type"))
+        code = self.code_identity()
+        out = []
+        for base_name, base in self.bases:
+            for values in itertools.product(*(self.factors[n] for n in names)):
+                cfg = copy.deepcopy(base)
+                for n, v in zip(names, values, strict=True):
+                    set_dotted(cfg, n, v)
+                levels = {"base": base_name, **dict(zip(names, values, strict=True))}
+                for rec in self.recordings:
+                    out.append(Cell(cfg, rec, levels, base_name, code))
+        return out
+
+
+def _resolve(root: Path, path: str) -> str:
+    """A path of the study file: as written, relative to the study's folder, or a shipped config's name."""
+    p = Path(path)
+    if p.is_absolute() or p.exists():
+        return str(p)
+    if not (root / p).exists() and is_name(path):
+        return str(library_path(path))
+    return str(root / p)
+
+
+def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
+    if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
+        raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
+    if "path" in r:
+        pattern = r["path"]
+        if not isinstance(pattern, str) or not pattern:
+            raise ConfigError(f"recordings[{i}].path must be a file path or glob (text), got {pattern!r}")
+        if r.get("format") is not None and not isinstance(r["format"], str):
+            raise ConfigError(f"recordings[{i}].format must be a format name, got {r['format']!r}")
+        matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
+        if not matches:
+            raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
+        opts = {k: v for k, v in r.items() if k not in ("path", "format")}
+        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts) for m in matches]
+    if not isinstance(r["simulate"], dict):
+        raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
+    sim = dict(r["simulate"])
+    seeds = r.get("seeds", [0])
+    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) for s in seeds):
+        raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers, got {seeds!r}")
+    repeats = r.get("repeats", 1)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
+    seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
+    label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
+    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s)) for s in seeds]
+
+
+def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``a.b.0.c`` in nested dicts/lists; setting ``X.type`` drops X's other parameters.
+
+    Changing a plug-in's type keeps only the new type (its parameters take their
+    defaults) unless other factors set them.
+    """
+    parts = path.split(".")
+    node: Any = d
+    for part in parts[:-1]:
+        key: Any = int(part) if isinstance(node, list) else part
+        if isinstance(node, list):
+            if key >= len(node):
+                raise ConfigError(f"factor {path!r}: index {key} is out of range ({len(node)} entries)")
+        elif key not in node or node[key] is None:
+            node[key] = {}
+        node = node[key]
+    last = parts[-1]
+    if isinstance(node, list):
+        node[int(last)] = value
+    elif last == "type" and isinstance(node, dict) and node.get("type") != value:
+        node.clear()
+        node["type"] = value
+    else:
+        node[last] = value
+
+
+def _file_digest(path: str) -> str:
+    """SHA-256 of a file's content, remembered per (path, size, modification time) within the process."""
+    st = os.stat(path)
+    memo = (os.path.realpath(path), st.st_size, st.st_mtime_ns)
+    if memo not in _FILE_DIGESTS:
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        _FILE_DIGESTS[memo] = h.hexdigest()
+    return _FILE_DIGESTS[memo]

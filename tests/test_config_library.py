@@ -1,0 +1,66 @@
+"""Shipped configs by name, from any folder; the moved modules' old names still import."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import warnings
+
+import pytest
+
+import footzoo
+from footzoo import ConfigError, Pipeline
+from footzoo.apps.cli import main
+from footzoo.config import library
+
+
+def test_every_shipped_config_builds_by_name_from_another_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    names = library.names("pipeline")
+    assert {"recommended", "yun2012", "nguyen2016", "duong2015", "huang2016"} <= set(names)
+    for name in names:
+        assert Pipeline.from_yaml(name).name == name
+        assert Pipeline.from_yaml(f"{name}.yaml").name == name
+
+
+def test_a_file_next_to_the_data_wins_over_the_shipped_config_of_that_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    copy = library.copy("yun2012", tmp_path)
+    copy.write_text(copy.read_text().replace("name: yun2012", "name: mine"))
+    assert Pipeline.from_yaml("yun2012.yaml").name == "mine"  # the file here
+    assert Pipeline.from_yaml("yun2012").name == "yun2012"  # a bare name is the shipped config
+
+
+def test_an_unknown_name_lists_the_shipped_configs_with_a_suggestion():
+    with pytest.raises(ConfigError, match=r"no shipped config named 'recomended'.*did you mean 'recommended'"):
+        Pipeline.from_yaml("recomended")
+
+
+def test_the_configs_command_lists_and_copies(tmp_path, capsys):
+    assert main(["configs"]) == 0
+    out = capsys.readouterr().out
+    assert "recommended" in out and "study_quick" in out
+    assert main(["configs", "--copy", "recommended", "--to", str(tmp_path)]) == 0
+    assert (tmp_path / "recommended.yaml").read_text() == library.path("recommended").read_text()
+    assert main(["configs", "--copy", "recommended", "--to", str(tmp_path)]) == 2  # exists: refused
+    assert "--force" in capsys.readouterr().err
+    assert main(["configs", "--copy", "recommended", "--to", str(tmp_path), "--force"]) == 0
+
+
+def test_a_study_names_its_base_config_by_name(tmp_path):
+    from footzoo.studies import Study
+
+    study = Study.from_dict({"base": "yun2012", "recordings": [{"simulate": {"n_strides": 3}, "seeds": [0]}]},
+                            root=tmp_path)
+    assert study.bases[0][0] == "yun2012"
+
+
+@pytest.mark.parametrize("old, new", sorted(footzoo.MOVED.items()))
+def test_a_moved_module_still_imports_under_its_old_name_with_a_warning(old, new):
+    sys.modules.pop(old, None)  # imported by an earlier test: import it afresh
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        module = importlib.import_module(old)
+    assert module is importlib.import_module(new)
+    assert module.__spec__.name == new  # the module keeps its own identity
+    assert any(issubclass(w.category, DeprecationWarning) and new in str(w.message) for w in caught)
