@@ -38,6 +38,7 @@ _EXPORTS = {
     "FootzooError": "core.errors",
     "FootzooWarning": "core.errors",
     "FormatError": "core.errors",
+    "PluginError": "core.errors",
     "RecordingError": "core.errors",
     "SensorWarning": "core.errors",
     "Pipeline": "runtime.pipeline",
@@ -58,6 +59,7 @@ __all__ = [
     "FootzooWarning",
     "FormatError",
     "Pipeline",
+    "PluginError",
     "Recording",
     "RecordingError",
     "Result",
@@ -139,7 +141,15 @@ if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
 if TYPE_CHECKING:
     from .apps.testing import check_plugin
     from .core.data import Recording, Result, Truth
-    from .core.errors import ConfigError, FootzooError, FootzooWarning, FormatError, RecordingError, SensorWarning
+    from .core.errors import (
+        ConfigError,
+        FootzooError,
+        FootzooWarning,
+        FormatError,
+        PluginError,
+        RecordingError,
+        SensorWarning,
+    )
     from .io import load
     from .plugins.registry import register
     from .runtime.pipeline import Pipeline

@@ -19,6 +19,23 @@ class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
 
 
+class PluginError(FootzooError):
+    """A plug-in broke its contract or raised: the fault is the plug-in's, not footzoo's nor the data's.
+
+    Attributes
+    ----------
+    plugin : str
+        ``"<kind> '<name>'"`` of the plug-in (e.g. ``"correction 'my_update'"``).
+    method : str
+        The method that failed (``detect``, ``measure``, ...).
+    """
+
+    def __init__(self, message: str, plugin: str = "", method: str = ""):
+        super().__init__(message)
+        self.plugin = plugin
+        self.method = method
+
+
 class FootzooWarning(UserWarning):
     """A warning from footzoo: the result is computed but something in the input deserves a look."""
 
