@@ -231,8 +231,19 @@ def cmd_validate(args: argparse.Namespace) -> int:
         return 2
     pipeline = Pipeline.from_yaml(args.config)
     print(f"{args.config}: valid")
+    print(live_summary(pipeline))
     print(json.dumps(pipeline.to_dict(), indent=2))
     return 0
+
+
+def live_summary(pipeline: Any) -> str:
+    """One line: the pipeline's latency live (at 100 Hz), or why it cannot run live."""
+    from ..core.context import RunContext
+
+    problems = pipeline.live_problems()
+    if problems:
+        return "live: no — " + "; ".join(problems)
+    return f"live: yes, latency {pipeline.latency(RunContext(rate=100.0, gravity=pipeline.gravity))} (at 100 Hz)"
 
 
 def cmd_compile(args: argparse.Namespace) -> int:

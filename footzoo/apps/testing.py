@@ -22,7 +22,10 @@ The checks:
   finite, and refuses NaN input with a footzoo error;
 * a calibration returns corrected copies shaped like its inputs and a ``report_`` dict, and
   passes a recording without a magnetometer through;
-* a ``causal`` detector gives the same stance fed chunk by chunk as in one batch;
+* a block that implements the incremental protocol (``begin``/``step``/``finish``, see
+  :mod:`footzoo.plugins.incremental`) gives the same final outputs fed in chunks of random
+  sizes (and one sample at a time) as in one batch, declares a :class:`~footzoo.plugins.incremental.Latency`,
+  and its ``provisional()`` guesses are shaped like its outputs;
 * a Kalman correction gives the same trajectory (1e-9) on the compiled and the reference
   engine (or runs on the reference one, with a warning, when its model does not compile), and
   live in :class:`~footzoo.runtime.stream.Stream` the same as in a batch run.
@@ -38,6 +41,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ..core.context import RunContext
 from ..core.errors import FootzooError
 from ..plugins.base import (
     AccelerationCorrection,
@@ -49,6 +53,7 @@ from ..plugins.base import (
     Plugin,
     VelocityCorrection,
 )
+from ..plugins.incremental import Latency, concat
 from ..plugins.registry import available, build
 
 _WALK: Any = None
@@ -191,12 +196,42 @@ def _check_detector(d: Detector) -> None:
     assert stance.any() and not stance.all(), f"{who}: found no stance or no swing in a simulated walk"
     if not d.needs_truth:
         _expect_nan_error(lambda: d.clone().detect(t, _nan(acc), gyr), who)
-    if d.causal:
-        live = d.clone()
-        live.begin(rec.rate)
-        chunks = [live.step(t[i:i + 7], acc[i:i + 7], gyr[i:i + 7]) for i in range(0, len(t), 7)]
-        streamed = np.concatenate([np.asarray(c, dtype=bool) for c in chunks])
-        assert np.array_equal(streamed, stance), f"{who}: causal, but chunk-by-chunk stance differs from the batch"
+    if d.incremental() and not d.needs_truth:
+        _check_live(who, d, (RunContext.of(rec),), {"t": t, "acc": acc, "gyr": gyr}, {"stance": stance})
+
+
+def _check_live(who: str, block: Plugin, begin: tuple, inputs: dict[str, np.ndarray],
+                expected: dict[str, np.ndarray], step: str = "step") -> None:
+    """The incremental protocol against the batch outputs: chunks of random sizes, then one sample at a time."""
+    lat = block.latency(begin[0])
+    assert isinstance(lat, Latency), f"{who}: latency(ctx) must return a footzoo.plugins.incremental.Latency"
+    n = len(next(iter(inputs.values())))
+    rng = np.random.default_rng(0)
+    for sizes in (rng.integers(1, 40, size=64), np.ones(1, dtype=int)):
+        live = block.clone()
+        live.begin(*begin)
+        parts, k, i = [], 0, 0
+        stop = n if sizes.size > 1 else min(n, 300)  # one sample at a time: the first 3 s
+        while k < stop:
+            m = min(int(sizes[i % sizes.size]), stop - k)
+            parts.append(getattr(live, step)(*(v[k:k + m] for v in inputs.values())))
+            k, i = k + m, i + 1
+            if i % 9 == 0:  # a guess for (at most) the samples pushed but not final
+                pending = k - len(concat(parts).get(next(iter(expected)), ()))
+                for key, value in live.provisional().items():
+                    assert len(value) <= pending, (f"{who}: provisional() gives {len(value)} {key!r} for "
+                                                   f"{pending} pending samples")
+        parts.append(live.finish())
+        out = concat(parts)
+        for key, want in expected.items():
+            got = np.asarray(out.get(key, np.zeros(0)))
+            assert got.shape == np.asarray(want[:stop]).shape, (
+                f"{who}: fed in chunks, {step}() and finish() gave {key!r} for {got.shape[0]} of {stop} samples")
+            same = np.array_equal(got, want[:stop]) if got.dtype == bool else np.allclose(got, want[:stop], rtol=0,
+                                                                                          atol=1e-9)
+            if not same and sizes.size == 1 and stop < n:
+                continue  # the first seconds alone: the batch saw what followed them (a look-ahead)
+            assert same, f"{who}: fed in chunks, its final {key!r} differs from the batch (check latency and restart)"
 
 
 def _check_calibration(c: Calibration) -> None:
@@ -234,6 +269,9 @@ def _check_orientation(o: Orientation) -> None:
     assert quat.shape == (len(t), 4) and np.isfinite(quat).all(), f"{who}: quat_ must be finite (N, 4)"
     assert np.allclose(np.linalg.norm(quat, axis=1), 1.0, atol=1e-6), f"{who}: quat_ must be unit quaternions"
     _expect_nan_error(lambda: o.clone().estimate(t, acc, _nan(gyr), mag, _stance(rec), q0), who)
+    if o.incremental():
+        _check_live(who, o, (RunContext.of(rec), q0), {"t": t, "acc": acc, "gyr": gyr, "mag": mag,
+                                                       "stance": _stance(rec)}, {"quat": quat})
 
 
 def _check_batch_correction(c: Plugin) -> None:
@@ -251,11 +289,17 @@ def _check_batch_correction(c: Plugin) -> None:
         assert out.vel_.shape == acc_nav.shape and out.pos_.shape == acc_nav.shape, f"{who}: vel_/pos_ must be (N, 3)"
         assert np.isfinite(out.pos_).all(), f"{who}: non-finite positions"
         _expect_nan_error(lambda: c.clone().apply(t, _nan(acc_nav), stance), who)
+        if c.incremental():
+            _check_live(who, c, (RunContext.of(rec),), {"t": t, "acc_nav": acc_nav, "stance": stance},
+                        {"vel": out.vel_, "pos": out.pos_})
     if isinstance(c, AccelerationCorrection):
         new = c.clone().apply_acceleration(rec.truth.quat.copy(), acc_nav, stance)
         _unchanged((before,), (acc_nav,), who)
         assert np.shape(new) == acc_nav.shape and np.isfinite(new).all(), f"{who}: must return a finite (N, 3) array"
         _expect_nan_error(lambda: c.clone().apply_acceleration(rec.truth.quat, _nan(acc_nav), stance), who)
+        if c.incremental():
+            _check_live(who, c, (RunContext.of(rec),), {"quat": rec.truth.quat, "acc_nav": acc_nav,
+                                                        "stance": stance}, {"acc_nav": new}, step="step_acceleration")
 
 
 def _check_kalman(c: KalmanCorrection) -> None:
@@ -284,7 +328,7 @@ def _check_kalman(c: KalmanCorrection) -> None:
     else:
         assert any(c.name in str(w.message) for w in caught), f"{who}: fell back to the reference engine silently"
     if c.causal:
-        live = Stream(pipe, rate=rec.rate).run(rec)
+        live = Stream(pipe, rate=rec.rate, guess=False).run(rec, chunk=np.array([1, 5, 17, 3]))
         assert np.array_equal(live["stance"], auto.stance), f"{who}: live stance differs from the batch"
         scale = max(float(np.abs(auto.pos).max()), 1.0)
         err = float(np.abs(live["pos"] - auto.pos).max())

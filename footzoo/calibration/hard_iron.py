@@ -174,6 +174,23 @@ class HardIron(Calibration):
         self.outlier_mads = check_range("outlier_mads", outlier_mads, 0.0, 100.0, "1", lo_open=True)
         self.max_residual = check_range("max_residual", max_residual, 0.0, 1.0, "1", lo_open=True)
 
+    fits_on = ("mag",)
+
+    def is_fitted(self) -> bool:
+        """With ``offset`` given there is nothing to fit: it runs live as it is."""
+        return self.offset is not None
+
+    def fixed(self, report: dict) -> HardIron:
+        """This calibration with the offset of an earlier fit (``report_``), for a live stream.
+
+        A fit that was not applied (too little turning, disturbances) gives a zero offset: the
+        magnetometer passes unchanged, as in the run the report comes from.
+        """
+        applied = bool(report.get("applied")) and report.get("offset") is not None
+        offset = [float(v) for v in report["offset"]] if applied else [0.0, 0.0, 0.0]
+        return HardIron(offset=offset, min_spread=self.min_spread, outlier_mads=self.outlier_mads,
+                        max_residual=self.max_residual)
+
     def calibrate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> HardIron:
         """Fit (or take) the offset and remove it from ``mag``."""
         self.acc_, self.gyr_, self.mag_, self.fit_ = acc, gyr, mag, None

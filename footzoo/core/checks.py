@@ -202,6 +202,79 @@ def validate_sample(
     return tf, a, g, m, d
 
 
+def validate_block(
+    t: Any,
+    acc: Any,
+    gyr: Any,
+    mag: Any = None,
+    dist: Any = None,
+    previous_t: float | None = None,
+    max_gap: float | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Check a block of live samples at once, as :func:`validate_sample` checks one: ``(t, acc, gyr, mag, dist)``.
+
+    ``t`` (n,) s, ``acc`` (n, 3) m/s², ``gyr`` (n, 3) rad/s, ``mag`` (n, 3) or None, ``dist`` (n, k) m or None.
+
+    Raises
+    ------
+    RecordingError
+        Naming the first bad sample's time, the problem and the fix.
+    """
+    try:
+        tf = np.asarray(t, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise RecordingError(f"t must be time stamps in s (numbers), got {t!r:.80}") from None
+    n = tf.shape[0]
+    if n == 0:
+        raise RecordingError("an empty block: give at least one sample")
+    arrays = []
+    for name, value, bound, unit in (("acc", acc, ACC_MAX, "m/s^2"), ("gyr", gyr, GYR_MAX, "rad/s"),
+                                     ("mag", mag, None, "")):
+        if value is None:
+            arrays.append(None)
+            continue
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise RecordingError(f"{name} must be numbers ({unit}), got {value!r:.80}") from None
+        if arr.shape != (n, 3):
+            raise RecordingError(f"{name} must have shape ({n}, 3) for {n} time stamps, got {arr.shape}")
+        bad = ~np.isfinite(arr).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise RecordingError(f"non-finite sample at t = {tf[k]!r}: {name} = {arr[k].tolist()}; repair or drop it")
+        if bound is not None and (np.abs(arr) > bound).any():
+            k = int(np.argmax((np.abs(arr) > bound).any(axis=1)))
+            raise RecordingError(
+                f"{name} at t = {tf[k]!r} is {arr[k].tolist()} {unit}: beyond any body-worn IMU (|value| <= "
+                f"{bound:g} {unit}); the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)")
+        arrays.append(arr)
+    if not np.isfinite(tf).all():
+        k = int(np.argmax(~np.isfinite(tf)))
+        raise RecordingError(f"time stamp {k} of the block is {tf[k]!r}: give each sample its real time in s")
+    steps = np.diff(np.concatenate([[previous_t], tf])) if previous_t is not None else np.diff(tf)
+    first = tf[0] if previous_t is None else previous_t
+    if (steps <= 0).any():
+        k = int(np.argmax(steps <= 0))
+        before = (np.concatenate([[first], tf]) if previous_t is not None else tf)[k]
+        raise RecordingError(f"time went from {before!r} s to {before + steps[k]!r} s: samples must arrive in order "
+                             "(increasing time)")
+    gap = STREAM_MAX_GAP if max_gap is None else max_gap
+    if (steps > gap).any():
+        k = int(np.argmax(steps > gap))
+        raise RecordingError(f"gap of {steps[k]:.6g} s in the block exceeds the stream's limit of {gap:g} s: the "
+                             "filter cannot bridge it; start a new Stream after the gap")
+    d = None
+    if dist is not None:
+        try:
+            d = np.asarray(dist, dtype=float).reshape(n, -1)
+        except (TypeError, ValueError):
+            raise RecordingError(f"dist must be ({n}, k) numbers in m (NaN for no reading), got {dist!r:.80}") from None
+        if np.isinf(d).any():
+            raise RecordingError("dist holds infinite values; use NaN where there is no reading")
+    return tf, arrays[0], arrays[1], arrays[2], d
+
+
 class Settings:
     """Base of a config's settings blocks (``navigation:``, ``guards:``): a dataclass of numbers.
 

@@ -7,11 +7,12 @@ import math
 import numpy as np
 
 from ..core.checks import check_range
+from ..core.context import RunContext
 from ..core.conventions import quat_yaw
-from ..evaluation.metrics import intervals
 from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
 from ..kernels.jit import njit
 from ..plugins.base import AccelerationCorrection, KalmanCorrection, Samples
+from ..plugins.incremental import Chunk, Latency
 from ..plugins.registry import register
 
 
@@ -35,22 +36,33 @@ def _bias(yaw: float, a: float, b: float, threshold: float) -> float:
 
 
 @njit
-def _turn_swings(out: np.ndarray, onsets: np.ndarray, ends: np.ndarray, yaw_end: np.ndarray,
-                 threshold: float) -> np.ndarray:
-    """Eqs. 25–27 in place on ``out`` (N, 3): the samples after stance j turned by −δψ_j; returns δψ (NaN: none)."""
-    m = onsets.shape[0]
-    bias = np.empty(m)
-    for j in range(m):
-        bias[j] = _bias(yaw_end[j], yaw_end[j - 1], yaw_end[j - 2], threshold) if j >= 2 else math.nan
-        if math.isnan(bias[j]):
+def _turn_swings(out: np.ndarray, stance: np.ndarray, ends: np.ndarray, yaw_end: np.ndarray, history: np.ndarray,
+                 bias: np.ndarray, threshold: float) -> None:
+    """Eqs. 25–27 in place on a chunk ``out`` (n, 3): each swing turned by −δψ of the stance before it.
+
+    ``ends``: chunk indices of the first swing sample after each stance that ends in the chunk,
+    ``yaw_end`` the yaw (rad) of that stance's last sample (γ^{T_i}), ``bias`` receives their δψ
+    (NaN: none, or rejected). ``history`` carries from chunk to chunk: the last two final yaws,
+    the number of stances ended so far and the δψ in force (NaN outside a swing after a stance).
+    """
+    e = 0
+    for k in range(out.shape[0]):
+        if e < ends.shape[0] and ends[e] == k:
+            count = history[2]
+            d = _bias(yaw_end[e], history[0], history[1], threshold) if count >= 2 else math.nan
+            history[1], history[0], history[2] = history[0], yaw_end[e], count + 1
+            bias[e] = d
+            history[3] = d
+            e += 1
+        if stance[k]:
+            history[3] = math.nan
             continue
-        stop = onsets[j + 1] if j + 1 < m else out.shape[0]
-        c, s = math.cos(-bias[j]), math.sin(-bias[j])
-        for k in range(ends[j], stop):
-            n, e = out[k, 0], out[k, 1]
-            out[k, 0] = c * n - s * e
-            out[k, 1] = s * n + c * e
-    return bias
+        d = history[3]
+        if not math.isnan(d):
+            c, s = math.cos(-d), math.sin(-d)
+            n, east = out[k, 0], out[k, 1]
+            out[k, 0] = c * n - s * east
+            out[k, 1] = s * n + c * east
 
 
 @measurement_function
@@ -133,14 +145,52 @@ class HDR(AccelerationCorrection, KalmanCorrection):
         self.yaw_std = check_range("yaw_std", yaw_std, 1e-9, 3.1416, "rad")
 
     # ------------------------------------------------------------- no EKF: eqs. 25-27
-    def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:
-        """NED motion acceleration with each swing turned by −δψ about the vertical."""
-        out = np.array(acc_nav, dtype=float)
-        st = intervals(stance)
-        yaw_end = np.ascontiguousarray(quat_yaw(quat[st[:, 1] - 1]))  # γ at the end of each stance
-        self.bias_ = _turn_swings(out, np.ascontiguousarray(st[:, 0], dtype=np.int64),
-                                  np.ascontiguousarray(st[:, 1], dtype=np.int64), yaw_end, float(self.threshold))
+    def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,
+                           ctx: RunContext | None = None) -> np.ndarray:
+        """NED motion acceleration (m/s²) with each swing turned by −δψ about the vertical."""
+        out = super().apply_acceleration(quat, acc_nav, stance, ctx)
+        self.bias_ = np.concatenate(self._biases) if self._biases else np.zeros(0)
         return out
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """None: a swing's δψ is known when the stance before it ends (given the final stance)."""
+        return Latency()
+
+    def begin(self, ctx: RunContext) -> HDR:
+        """Fresh state: no stance ended yet."""
+        super().begin(ctx)
+        self._history = np.array([0.0, 0.0, 0.0, math.nan])  # γ^{T_{i−1}}, γ^{T_{i−2}}, stances ended, δψ in force
+        self._last: tuple[bool, float] | None = None  # stance and yaw of the previous sample
+        self._biases: list[np.ndarray] = []
+        return self
+
+    def step_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> Chunk:
+        """The next samples' acceleration, each swing turned by the δψ of the stance that ended before it."""
+        out = np.array(acc_nav, dtype=float).reshape(-1, 3)
+        s = np.ascontiguousarray(stance, dtype=np.bool_).reshape(-1)
+        if not s.size:
+            return {"acc_nav": out}
+        q = np.asarray(quat, dtype=float).reshape(-1, 4)
+        before = np.concatenate([[self._last[0] if self._last else False], s[:-1]])
+        ends = np.flatnonzero(before & ~s)  # the first swing sample after each stance
+        # γ^{T_i}: the yaw of each stance's last sample (the previous chunk's last one for a stance ending there)
+        last = [s.size - 1] if s[-1] else []
+        yaws = quat_yaw(q[np.concatenate([ends[ends > 0] - 1, last]).astype(np.int64)])
+        yaw_end = np.concatenate([[self._last[1]] if ends.size and ends[0] == 0 else [], yaws[:yaws.size - len(last)]])
+        bias = np.empty(ends.size)
+        _turn_swings(out, s, ends.astype(np.int64), np.ascontiguousarray(yaw_end, dtype=float), self._history, bias,
+                     float(self.threshold))
+        self._biases.append(bias)
+        self._last = (bool(s[-1]), float(yaws[-1]) if last else math.nan)
+        return {"acc_nav": out}
+
+    def finish(self) -> Chunk:
+        """The δψ of a stance that lasts to the end of the data (for ``bias_``; no swing follows it)."""
+        if self._last and self._last[0]:
+            d = (_bias(self._last[1], self._history[0], self._history[1], float(self.threshold))
+                 if self._history[2] >= 2 else math.nan)
+            self._biases.append(np.array([d]))
+        return {}
 
     # ------------------------------------------------------------- with the EKF: eq. 28
     def requires_attitude_state(self) -> bool:

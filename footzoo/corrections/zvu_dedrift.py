@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.strapdown import integrate_position, sample_intervals
+from ..core.context import RunContext
+from ..filters.strapdown import Integrator, integrate_position, sample_intervals
 from ..kernels.jit import njit
-from ..plugins.base import VelocityCorrection
+from ..plugins.base import VelocityCorrection, run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave, after_stance, run_starts
 from ..plugins.registry import register
 
 
@@ -20,6 +22,17 @@ def swing_segments(stance: np.ndarray) -> list[tuple[int, int]]:
     edges = np.flatnonzero(s[1:] != s[:-1]) + 1
     bounds = np.concatenate([[0], edges, [s.shape[0]]])
     return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if not s[a] and a > 0]
+
+
+def dedrifted_velocity(t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The velocity of :func:`zvu_dedrift` (m/s, (N, 3)) and the ε of each closed swing (m/s², (M, 3))."""
+    t = np.ascontiguousarray(t, dtype=float)
+    a = np.ascontiguousarray(acc_nav, dtype=float)
+    s = np.ascontiguousarray(stance, dtype=np.bool_)
+    vel = np.empty((t.shape[0], 3))
+    bias = np.empty((int(np.count_nonzero(s[1:] & ~s[:-1])) + 1, 3))
+    m = _dedrift_kernel(t, sample_intervals(t), a, s, vel, bias)
+    return vel, bias[:m].copy()
 
 
 def zvu_dedrift(t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -50,15 +63,8 @@ def zvu_dedrift(t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> tuple
     bias : (M, 3) ndarray
         ε of each closed swing (m/s²).
     """
-    t = np.ascontiguousarray(t, dtype=float)
-    a = np.ascontiguousarray(acc_nav, dtype=float)
-    s = np.ascontiguousarray(stance, dtype=np.bool_)
-    dt = sample_intervals(t)
-    vel = np.empty((t.shape[0], 3))
-    bias = np.empty((int(np.count_nonzero(s[1:] & ~s[:-1])) + 1, 3))
-    m = _dedrift_kernel(t, dt, a, s, vel, bias)
-    pos = integrate_position(vel, dt)
-    return vel, pos, bias[:m].copy()
+    vel, bias = dedrifted_velocity(t, acc_nav, stance)
+    return vel, integrate_position(vel, sample_intervals(np.asarray(t, dtype=float))), bias
 
 
 @njit
@@ -133,7 +139,53 @@ class ZVUDedrift(VelocityCorrection):
     def __init__(self) -> None:
         pass
 
-    def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> ZVUDedrift:
+    def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,
+              ctx: RunContext | None = None) -> ZVUDedrift:
         """Correct velocity and position over a recording (see :func:`zvu_dedrift`)."""
+        self.begin(run_context(ctx, t))
         self.vel_, self.pos_, self.bias_ = zvu_dedrift(t, acc_nav, stance)
         return self
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """A swing is corrected once the stance that ends it has been seen."""
+        return Latency(until=("the end of the swing",))
+
+    def begin(self, ctx: RunContext) -> ZVUDedrift:
+        """Fresh state: the open swing's samples, and the position integration."""
+        super().begin(ctx)
+
+        def ready(inp: Chunk, start: int) -> int:
+            s = inp["stance"]
+            return start + (s.size if s[-1] else int(run_starts(s)[-1]))  # up to the open swing
+
+        self._velocity = OverlapSave(lambda t, acc_nav, stance: {"vel": dedrifted_velocity(t, acc_nav, stance)[0],
+                                                                 "t": t},
+                                     lookahead=ready,
+                                     restart=lambda out, inp, start, final: after_stance(inp["stance"], start, final))
+        self._integrator = Integrator()
+        return self
+
+    def step(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> Chunk:
+        """Velocity and position of the samples up to the last stance sample."""
+        return self._positions(self._velocity.step(t=np.asarray(t, float), acc_nav=np.asarray(acc_nav, float),
+                                                   stance=np.asarray(stance, bool)))
+
+    def finish(self) -> Chunk:
+        """The open swing at the end, integrated as measured (it cannot be dedrifted)."""
+        return self._positions(self._velocity.finish())
+
+    def provisional(self) -> Chunk:
+        """The open swing's velocity and position as measured so far (not dedrifted yet)."""
+        out = self._velocity.provisional()
+        if not out:
+            return {}
+        live = Integrator()
+        live.t_prev, live.v_last, live.p_last = self._integrator.t_prev, self._integrator.v_last, \
+            self._integrator.p_last
+        return {"vel": out["vel"], "pos": live.position(out["vel"], out["t"])}
+
+    def _positions(self, out: Chunk) -> Chunk:
+        if not out:
+            return {}
+        return {"vel": out["vel"], "pos": self._integrator.position(out["vel"], out["t"])}

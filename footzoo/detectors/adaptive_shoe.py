@@ -6,7 +6,10 @@ import math
 
 import numpy as np
 
+from ..core.context import RunContext
 from ..kernels.jit import njit
+from ..plugins.base import run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave, after_stance
 from ..plugins.registry import check_positive, register
 from .runs import close_short_swings
 from .shoe import SHOE
@@ -14,17 +17,16 @@ from .shoe import SHOE
 
 @njit
 def adaptive_threshold_kernel(t: np.ndarray, statistic: np.ndarray, gamma0: float, tau: float,
-                              gamma_max: float) -> tuple[np.ndarray, np.ndarray]:
+                              gamma_max: float, t_last: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Causal test ``T_k < γ_k`` with ``γ_k = min(γ_0 exp((t_k − t_last)/τ), γ_max)``.
 
-    ``t_last`` is the time of the last sample declared stationary (the start of
-    the recording before the first). Returns the stance flag and γ_k.
+    ``t_last`` is the time of the last sample declared stationary (s; the start of the recording
+    before the first). Returns the stance flag, γ_k and ``t_last`` after the samples (to resume).
     """
     n = t.shape[0]
     stance = np.empty(n, dtype=np.bool_)
     gamma = np.empty(n)
     log_max = math.log(gamma_max)
-    t_last = t[0]
     for k in range(n):
         g = math.exp(min(math.log(gamma0) + (t[k] - t_last) / tau, log_max))
         gamma[k] = g
@@ -32,7 +34,36 @@ def adaptive_threshold_kernel(t: np.ndarray, statistic: np.ndarray, gamma0: floa
         stance[k] = s
         if s:
             t_last = t[k]
-    return stance, gamma
+    return stance, gamma, t_last
+
+
+class AdaptiveThreshold:
+    """The live form of :func:`adaptive_threshold_kernel`: it carries ``t_last`` from chunk to chunk.
+
+    Takes ``t`` (s) and ``statistic``; gives ``test`` (stance flag) and ``threshold`` (γ_k), plus the
+    inputs named in ``keep``.
+    """
+
+    wants = ("t", "statistic", "acc", "gyr")
+
+    def __init__(self, gamma0: float, tau: float, gamma_max: float, keep: tuple[str, ...] = ()):
+        self.gamma0, self.tau, self.gamma_max, self.keep = gamma0, tau, gamma_max, keep
+        self.t_last: float | None = None
+
+    def step(self, t: np.ndarray, statistic: np.ndarray, **given: np.ndarray) -> dict[str, np.ndarray]:
+        t = np.ascontiguousarray(t, dtype=float)
+        if self.t_last is None:
+            self.t_last = float(t[0])
+        test, gamma, self.t_last = adaptive_threshold_kernel(t, np.ascontiguousarray(statistic, dtype=float),
+                                                             self.gamma0, self.tau, self.gamma_max, self.t_last)
+        return {"test": test, "threshold": gamma, "statistic": statistic, "t": t,
+                **{k: given[k] for k in self.keep}}
+
+    def finish(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def provisional(self) -> dict[str, np.ndarray]:
+        return {}
 
 
 @register
@@ -105,13 +136,42 @@ class AdaptiveSHOE(SHOE):
         self.max_threshold = check_positive("max_threshold", max_threshold)
         self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> AdaptiveSHOE:
+    def min_swing_samples(self, ctx: RunContext) -> int:
+        """``min_swing`` in samples at the run's rate."""
+        return int(math.floor(self.min_swing * ctx.rate + 0.5))
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> AdaptiveSHOE:
         """Evaluate SHOE, then the adaptive test sample by sample."""
+        self.begin(run_context(ctx, t))
         self.statistic_ = self._statistic(t, acc, gyr)
-        test, self.threshold_ = adaptive_threshold_kernel(
-            np.ascontiguousarray(t, dtype=float), self.statistic_, self.threshold, self.time_constant,
-            max(self.max_threshold, self.threshold))
-        rate = 1.0 / float(np.median(np.diff(t)))
-        self.stance_ = close_short_swings(test, int(math.floor(self.min_swing * rate + 0.5)))
+        t = np.ascontiguousarray(t, dtype=float)
+        test, self.threshold_, _ = adaptive_threshold_kernel(t, self.statistic_, self.threshold, self.time_constant,
+                                                             max(self.max_threshold, self.threshold), float(t[0]))
+        self.stance_ = close_short_swings(test, self.min_swing_samples(self.ctx_))
         self.stance_online_ = self.stance_.copy()
+        return self
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """SHOE's half window, then ``min_swing`` (a short swing is filled once it has ended)."""
+        return super().latency(ctx) + Latency(ctx.seconds(self.min_swing_samples(ctx)))
+
+    def threshold_stage(self, keep: tuple[str, ...] = ()) -> AdaptiveThreshold:
+        """The adaptive test, carrying the time of the last stance sample."""
+        return AdaptiveThreshold(self.threshold, self.time_constant, max(self.max_threshold, self.threshold), keep)
+
+    def gap_stage(self, keep: tuple[str, ...] = ()) -> OverlapSave:
+        """:func:`close_short_swings` over the recent test, restarted at a stance sample."""
+        m = self.min_swing_samples(self.ctx_)
+
+        def compute(test: np.ndarray, **given: np.ndarray) -> Chunk:
+            return {"stance": close_short_swings(test, m), **{k: given[k] for k in ("statistic", "threshold", *keep)}}
+
+        return OverlapSave(compute, lookahead=m, wants=("test", "statistic", "threshold", *keep),
+                           restart=lambda out, inp, start, final: after_stance(inp["test"], start, final))
+
+    def begin(self, ctx: RunContext) -> AdaptiveSHOE:
+        """Fresh state: SHOE's window, the adaptive test, the closing of short swings."""
+        super().begin(ctx)
+        self._stages = [self.window_stage(keep=("t",)), self.threshold_stage(), self.gap_stage()]
         return self

@@ -7,9 +7,11 @@ import math
 import numpy as np
 
 from ..core.checks import check_range
-from ..plugins.base import Detector
+from ..core.context import RunContext
+from ..plugins.base import Detector, run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
-from .runs import dated_and_online_states
+from .runs import after_long_stance, dated_and_online_states
 
 
 def below_over_interval(rate: np.ndarray, threshold: float) -> np.ndarray:
@@ -117,7 +119,17 @@ class AngularRateFSM(Detector):
         self.threshold = check_range("threshold", threshold, 0.0, 50.0, "rad/s", lo_open=True)
         self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> AngularRateFSM:
+    def min_samples(self, ctx: RunContext) -> int:
+        """Γ_th in samples at the run's rate: ``max(1, round(min_duration · rate))``."""
+        return max(1, int(math.floor(self.min_duration * ctx.rate + 0.5)))
+
+    def _compute(self, statistic: np.ndarray) -> Chunk:
+        """The machine over |ω| (rad/s): ``stance`` (dated back, edges tested), ``online``, ``statistic``."""
+        dated, online = dated_and_online_states(statistic < self.threshold, self.min_samples_, initial=True)
+        stance = trim_stance_edges(dated, below_over_interval(statistic, self.threshold))
+        return {"stance": stance, "online": online, "statistic": statistic}
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> AngularRateFSM:
         """Detect stance over a whole recording (vectorised).
 
         Parameters
@@ -128,12 +140,35 @@ class AngularRateFSM(Detector):
             Specific force (m/s²), unused.
         gyr : (N, 3) ndarray
             Angular rate (rad/s).
+        ctx : RunContext, optional
+            The run's context (rate); default: from ``t``.
         """
-        rate = 1.0 / float(np.median(np.diff(t)))
-        self.min_samples_ = max(1, int(math.floor(self.min_duration * rate + 0.5)))
-        self.statistic_ = np.linalg.norm(gyr, axis=1)
-        dated, self.stance_online_ = dated_and_online_states(
-            self.statistic_ < self.threshold, self.min_samples_, initial=True
-        )
-        self.stance_ = trim_stance_edges(dated, below_over_interval(self.statistic_, self.threshold))
+        self.begin(run_context(ctx, t))
+        out = self._compute(np.linalg.norm(gyr, axis=1))
+        self.statistic_, self.stance_, self.stance_online_ = out["statistic"], out["stance"], out["online"]
         return self
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """Twice Γ_th (a run decided, then the run of the dated state decided) and one sample for the edge test."""
+        return Latency(ctx.seconds(2 * self.min_samples(ctx)))
+
+    def begin(self, ctx: RunContext) -> AngularRateFSM:
+        """Fresh state: the machine restarts at the end of every stance (overlap-save)."""
+        super().begin(ctx)
+        self.min_samples_ = g = self.min_samples(self.ctx_)
+        self._live = OverlapSave(self._compute, lookahead=2 * g, restart=lambda out, inp, start, final:
+                                 after_long_stance(inp["statistic"] < self.threshold, start, final, g))
+        return self
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """The stance of the samples whose machine state is now decided."""
+        return self._live.step(statistic=np.linalg.norm(np.asarray(gyr, dtype=float).reshape(-1, 3), axis=1))
+
+    def provisional(self) -> Chunk:
+        """The machine's current reading of the undecided samples."""
+        return self._live.provisional()
+
+    def finish(self) -> Chunk:
+        """The last samples, decided with the end of the data."""
+        return self._live.finish()

@@ -7,10 +7,12 @@ import math
 import numpy as np
 
 from ..core.checks import check_range
+from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
-from ..plugins.base import Detector
+from ..plugins.base import Detector, run_context
+from ..plugins.incremental import Chunk, Latency
 from ..plugins.registry import check_positive, register
 
 
@@ -311,8 +313,10 @@ class DGP(Detector):
         self.max_swing = check_range("max_swing", max_swing, 0.0, 100.0, "s")
         self.max_stance_rate = check_range("max_stance_rate", max_stance_rate, 0.0, 50.0, "rad/s")
 
-    def begin(self, rate: float) -> None:
-        """Fresh state for a recording sampled at ``rate`` (Hz)."""
+    def begin(self, ctx: RunContext) -> DGP:
+        """Fresh state for a run at the context's rate (Hz)."""
+        super().begin(ctx)
+        rate = self.ctx_.rate
         f = max(_count((self.window * rate - 1) / 2), 1)
         self._n_c = max(_count(self.condition_window * rate), 1)
         self._w = 2 * f + 1
@@ -323,6 +327,11 @@ class DGP(Detector):
         self._stat_state = dgp_statistic_state(f, self._n_c, self._lag)
         delay = max(_count(2 * rate / self.reference_rate), 1)
         self._state = dgp_initial_state(self.initial_delay, self.initial_threshold, delay)
+        return self
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """None: each sample's phase is decided with it (Algorithm 1 is causal)."""
+        return Latency()
 
     def _advance(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
         s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
@@ -332,18 +341,17 @@ class DGP(Detector):
         s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing, self._max_swing, moving)
         return s_c, d_g, s_d, max_cd, th, stance
 
-    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
-        """Stance of the next samples (one live sample, or a chunk) from the carried state (after :meth:`begin`)."""
-        return self._advance(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
-                             np.ascontiguousarray(gyr, dtype=float))[-1]
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """The stance (and ``max_cd``, the threshold) of the next samples, from the carried state."""
+        s_c, d_g, s_d, max_cd, th, stance = self._advance(
+            np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float).reshape(-1, 3),
+            np.ascontiguousarray(gyr, dtype=float).reshape(-1, 3))
+        return {"stance": stance, "statistic": max_cd, "threshold": th, "s_c": s_c, "d_g": d_g, "s_d": s_d}
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> DGP:
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> DGP:
         """Detect stance over a recording (eqs. 3–15)."""
-        rate = 1.0 / float(np.median(np.diff(t)))
-        self.begin(rate)
-        self.s_c_, self.d_g_, self.s_d_, self.statistic_, self.threshold_, stance = self._advance(
-            np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
-            np.ascontiguousarray(gyr, dtype=float))
-        self.stance_ = stance
-        self.stance_online_ = stance.copy()
+        out = self.begin(run_context(ctx, t)).step(t, acc, gyr)
+        self.s_c_, self.d_g_, self.s_d_ = out["s_c"], out["d_g"], out["s_d"]
+        self.statistic_, self.threshold_, self.stance_ = out["statistic"], out["threshold"], out["stance"]
+        self.stance_online_ = self.stance_.copy()
         return self

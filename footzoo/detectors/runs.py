@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import njit
+from ..plugins.incremental import run_starts
 
 
 def dated_and_online_states(
@@ -96,3 +97,23 @@ def close_short_swings(stance: np.ndarray, min_samples: int) -> np.ndarray:
     lengths = np.diff(np.concatenate([starts, [n]]))
     short_gap = ~s[starts] & (lengths < min_samples) & (starts > 0) & (starts + lengths < n)
     return s | np.repeat(short_gap, lengths)
+
+
+def after_long_stance(candidate: np.ndarray, start: int, final: int, min_samples: int) -> int:
+    """Restart point of :func:`dated_and_online_states` (see :class:`~footzoo.plugins.incremental.OverlapSave`).
+
+    The latest sample ``r ≤ final`` (absolute; ``candidate`` starts at absolute ``start``) that starts
+    a run of ``candidate == False`` right after a run of True at least ``min_samples`` long. There
+    the three passes of the state machine are in a state that does not depend on anything before:
+    the True run is kept (long enough), the machine is in stance, and the new run starts afresh.
+    Returns ``start`` when there is none in the window.
+    """
+    c = np.asarray(candidate[: final - start + 1], dtype=bool)
+    starts = run_starts(c)
+    if starts.size < 2:
+        return start
+    lengths = np.diff(np.append(starts, c.size))
+    # runs i >= 1 of False whose preceding run (i - 1) is True and long, and did not begin the window
+    ok = ~c[starts[1:]] & (lengths[:-1] >= max(int(min_samples), 1)) & (starts[:-1] > 0)
+    hits = np.flatnonzero(ok)
+    return start + int(starts[1:][hits[-1]]) if hits.size else start

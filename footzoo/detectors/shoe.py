@@ -7,9 +7,12 @@ import math
 import numpy as np
 
 from ..core.checks import check_range
+from ..core.context import RunContext
 from ..core.conventions import GRAVITY
+from ..plugins.base import run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
-from .runs import dated_and_online_states
+from .runs import after_long_stance, dated_and_online_states
 from .skog import FUSED_TESTS, SkogTest
 from .windows import SHOE_TEST
 
@@ -98,12 +101,34 @@ class HuangStance(SHOE):
         super().__init__(threshold, window, sigma_a, sigma_g)
         self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> HuangStance:
+    def min_samples(self, ctx: RunContext) -> int:
+        """Γ_th in samples at the run's rate."""
+        return max(1, int(math.floor(self.min_duration * ctx.rate + 0.5)))
+
+    def _machine(self, statistic: np.ndarray) -> Chunk:
+        stance, online = dated_and_online_states(statistic < self.threshold, self.min_samples(self.ctx_))
+        return {"stance": stance, "online": online, "statistic": statistic}
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> HuangStance:
         """SHOE, then the state machine (dated back)."""
-        rate = 1.0 / float(np.median(np.diff(t)))
-        self.statistic_ = self._statistic(t, acc, gyr)
-        n_min = max(1, int(math.floor(self.min_duration * rate + 0.5)))
-        self.stance_, self.stance_online_ = dated_and_online_states(self.statistic_ < self.threshold, n_min)
+        self.begin(run_context(ctx, t))
+        out = self._machine(self._statistic(t, acc, gyr))
+        self.statistic_, self.stance_, self.stance_online_ = out["statistic"], out["stance"], out["online"]
         onsets = np.flatnonzero(self.stance_[1:] & ~self.stance_[:-1]) + 1
         self.heel_strikes_ = onsets
+        return self
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """SHOE's half window, then twice Γ_th for the state machine."""
+        return super().latency(ctx) + Latency(ctx.seconds(2 * self.min_samples(ctx)))
+
+    def begin(self, ctx: RunContext) -> HuangStance:
+        """Fresh state: SHOE's window, then the machine, restarted at the end of every stance."""
+        super().begin(ctx)
+        g = self.min_samples(self.ctx_)
+        machine = OverlapSave(self._machine, lookahead=2 * g, wants=("statistic",),
+                              restart=lambda out, inp, start, final: after_long_stance(
+                                  inp["statistic"] < self.threshold, start, final, g))
+        self._stages = [*self._stages, machine]
         return self

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.checks import check_range
+from ..core.context import RunContext
 from ..core.conventions import GRAVITY
-from ..plugins.base import Detector
+from ..plugins.base import Detector, run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave, feed
 from ..plugins.registry import check_positive
 from .windows import window_moments, window_statistic
 
@@ -63,9 +65,12 @@ class SkogTest(Detector):
         """T_k from the (N, 6) window moments (see ``window_moments``)."""
         raise NotImplementedError
 
+    def window_samples(self, ctx: RunContext) -> int:
+        """W in samples at the run's rate: ``max(2, round(window · rate))``."""
+        return max(int(round(self.window * ctx.rate)), 2)
+
     def _statistic(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
-        rate = 1.0 / float(np.median(np.diff(t)))
-        self.window_samples_ = max(int(round(self.window * rate)), 2)
+        self.window_samples_ = self.window_samples(self.ctx_)
         acc = np.ascontiguousarray(acc, dtype=float)
         gyr = np.ascontiguousarray(gyr, dtype=float)
         fused = FUSED_TESTS.get(type(self).test)
@@ -74,7 +79,12 @@ class SkogTest(Detector):
                                     self.sigma_g**2)
         return self.test(window_moments(acc, gyr, self.window_samples_, GRAVITY))
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> SkogTest:
+    def _compute(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """The batch test over arrays: ``stance`` and ``statistic``."""
+        statistic = self._statistic(t, acc, gyr)
+        return {"stance": statistic < self.threshold, "statistic": statistic}
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> SkogTest:
         """Evaluate the test over the whole recording.
 
         Parameters
@@ -85,8 +95,55 @@ class SkogTest(Detector):
             Specific force (m/s²).
         gyr : (N, 3) ndarray
             Angular rate (rad/s).
+        ctx : RunContext, optional
+            The run's context (rate); default: from ``t``.
         """
-        self.statistic_ = self._statistic(t, acc, gyr)
-        self.stance_ = self.statistic_ < self.threshold
+        self.begin(run_context(ctx, t))
+        out = self._compute(t, acc, gyr)
+        self.statistic_, self.stance_ = out["statistic"], out["stance"]
         self.stance_online_ = self.stance_.copy()
         return self
+
+    # ------------------------------------------------------------------ live
+    def _window_reach(self, ctx: RunContext) -> tuple[int, int]:
+        """Samples of the centred window before and after its sample (``W//2`` and ``W − 1 − W//2``)."""
+        w = self.window_samples(ctx)
+        return w // 2, w - 1 - w // 2
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """The window's half after the sample (s)."""
+        return Latency(ctx.seconds(self._window_reach(ctx)[1]))
+
+    def begin(self, ctx: RunContext) -> SkogTest:
+        """Fresh state: a window of the last W samples (overlap-save, see :mod:`footzoo.plugins.incremental`)."""
+        super().begin(ctx)
+        self._stages = [self.window_stage()]
+        return self
+
+    def window_stage(self, keep: tuple[str, ...] = ()) -> OverlapSave:
+        """The test over a window of the recent samples; its outputs also carry the inputs named in ``keep``.
+
+        For a detector built on the test (a later stage takes the statistic and, e.g., ``t``).
+        """
+        before, after = self._window_reach(self.ctx_)
+
+        def compute(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+            given = {"t": t, "acc": acc, "gyr": gyr}
+            return {**self._compute(t, acc, gyr), **{k: given[k] for k in keep}}
+
+        return OverlapSave(compute, lookahead=after, restart=before, wants=("t", "acc", "gyr"))
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """The stance (and statistic) of the samples whose outputs are now final.
+
+        The test's window, then any stage a subclass adds (``_stages``, fed one into the next).
+        """
+        return feed(self._stages, {"t": t, "acc": acc, "gyr": gyr})
+
+    def provisional(self) -> Chunk:
+        """The last stage's current outputs for the samples it has seen but not finalised."""
+        return self._stages[-1].provisional()
+
+    def finish(self) -> Chunk:
+        """The last samples, with the window clipped at the end of the data (as in the batch test)."""
+        return feed(self._stages, {}, finish=True)

@@ -7,8 +7,11 @@ import math
 import numpy as np
 
 from ..core.checks import check_range
+from ..core.context import RunContext
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
+from ..plugins.base import run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave, run_starts
 from ..plugins.registry import register
 from .adaptive_shoe import AdaptiveSHOE, adaptive_threshold_kernel
 from .runs import close_short_swings
@@ -282,23 +285,86 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         self.speed_scale = check_range("speed_scale", speed_scale, 1e-3, 100.0, "m/s")
         self.still_speed = check_range("still_speed", still_speed, 0.0, 100.0, "m/s")
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> SpeedAdaptiveSHOE:
+    def _speed_test(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, statistic: np.ndarray,
+                    provisional: np.ndarray) -> dict[str, np.ndarray]:
+        """Steps 2–3 over arrays: the swings' speeds, the speed-dependent test, the closing of gaps and pauses."""
+        m = self.min_swing_samples(self.ctx_)
+        g_max = max(self.max_threshold, self.threshold)
+        starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
+        speed_k = speed_per_sample(t, starts, ends, peaks, self.REACH)
+        threshold = np.minimum(self.threshold * np.exp(speed_k / self.speed_scale), g_max)
+        # a sample the strapdown sees moving faster than still_speed is no stance, whatever the test says
+        candidate = (statistic < threshold) & (speed <= self.still_speed)
+        closed = close_still_gaps(candidate, m, speed, self.still_speed)
+        return {"stance": drop_pauses(closed, m), "speed": speed_k, "threshold": threshold, "statistic": statistic}
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray,
+               ctx: RunContext | None = None) -> SpeedAdaptiveSHOE:
         """Provisional adaptive SHOE, swing speeds, then the speed-dependent test."""
         t = np.ascontiguousarray(t, dtype=float)
         acc = np.ascontiguousarray(acc, dtype=float)
         gyr = np.ascontiguousarray(gyr, dtype=float)
+        self.begin(run_context(ctx, t))
         self.statistic_ = self._statistic(t, acc, gyr)
-        rate = 1.0 / float(np.median(np.diff(t)))
-        min_swing = int(math.floor(self.min_swing * rate + 0.5))
         g_max = max(self.max_threshold, self.threshold)
-        provisional, _ = adaptive_threshold_kernel(t, self.statistic_, self.threshold, self.time_constant, g_max)
-        provisional = close_short_swings(provisional, min_swing)
-        starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
-        self.speed_ = speed_per_sample(t, starts, ends, peaks, self.REACH)
-        self.threshold_ = np.minimum(self.threshold * np.exp(self.speed_ / self.speed_scale), g_max)
-        # a sample the strapdown sees moving faster than still_speed is no stance, whatever the test says
-        candidate = (self.statistic_ < self.threshold_) & (speed <= self.still_speed)
-        closed = close_still_gaps(candidate, min_swing, speed, self.still_speed)
-        self.stance_ = drop_pauses(closed, min_swing)
+        provisional, _, _ = adaptive_threshold_kernel(t, self.statistic_, self.threshold, self.time_constant, g_max,
+                                                      float(t[0]))
+        provisional = close_short_swings(provisional, self.min_swing_samples(self.ctx_))
+        out = self._speed_test(t, acc, gyr, self.statistic_, provisional)
+        self.speed_, self.threshold_, self.stance_ = out["speed"], out["threshold"], out["stance"]
         self.stance_online_ = self.stance_.copy()
         return self
+
+    # ------------------------------------------------------------------ live
+    def _margins(self, ctx: RunContext) -> tuple[int, int, int]:
+        """Samples of REACH, of LEVELLING and of the gap and pause filters' reach (three shortest swings)."""
+        return (int(math.ceil(self.REACH * ctx.rate)) + 1, int(math.ceil(self.LEVELLING * ctx.rate)) + 1,
+                3 * self.min_swing_samples(ctx) + 2)
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """The adaptive pass's latency, then the swings within REACH after a sample must have ended."""
+        reach, _, gaps = self._margins(ctx)
+        return super().latency(ctx) + Latency(ctx.seconds(reach + gaps), ("the end of the next swing",))
+
+    def begin(self, ctx: RunContext) -> SpeedAdaptiveSHOE:
+        """Fresh state: SHOE's window, the adaptive pass, then the speed test over the recent strides."""
+        super().begin(ctx)
+        reach, lead, gaps = self._margins(self.ctx_)
+
+        def ready(inp: Chunk, start: int) -> int:
+            prov = inp["provisional"]
+            open_swing = start + (int(run_starts(prov)[-1]) if prov.size and not prov[-1] else prov.size)
+            return open_swing - reach - gaps
+
+        def restart(out: Chunk, inp: Chunk, start: int, final: int) -> int:
+            # two whole provisional strides of context before the first sample a swing can still reach
+            prov = inp["provisional"]
+            starts = run_starts(prov)
+            stance_starts = start + starts[prov[starts]] if prov.size else np.zeros(0, int)
+            before = stance_starts[stance_starts < final - reach - gaps - lead]
+            return int(before[-3]) if before.size >= 3 else start
+
+        speed = OverlapSave(self._speed_test, lookahead=ready, restart=restart,
+                            wants=("t", "acc", "gyr", "statistic", "provisional"))
+        self._stages = [self.window_stage(keep=("t", "acc", "gyr")), self.threshold_stage(keep=("acc", "gyr")),
+                        _Renamed(self.gap_stage(keep=("t", "acc", "gyr")), {"stance": "provisional"}), speed]
+        return self
+
+
+class _Renamed:
+    """A stage whose output ``stance`` is the next stage's ``provisional``."""
+
+    def __init__(self, stage: OverlapSave, names: dict[str, str]):
+        self.stage, self.names, self.wants = stage, names, stage.wants
+
+    def _rename(self, chunk: Chunk) -> Chunk:
+        return {self.names.get(k, k): v for k, v in chunk.items()}
+
+    def step(self, **chunk: np.ndarray) -> Chunk:
+        return self._rename(self.stage.step(**chunk))
+
+    def finish(self) -> Chunk:
+        return self._rename(self.stage.finish())
+
+    def provisional(self) -> Chunk:
+        return self._rename(self.stage.provisional())

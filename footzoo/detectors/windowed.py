@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.checks import check_range
-from ..plugins.base import Detector
+from ..core.context import RunContext
+from ..plugins.base import Detector, run_context
+from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
 from .windows import row_norms, window_max
 
@@ -74,20 +76,55 @@ class Windowed(Detector):
         self.acc_window = check_range("acc_window", acc_window, 0.0, 10.0, "s")
         self.reference_rate = check_range("reference_rate", reference_rate, 0.0, 100000.0, "Hz", lo_open=True)
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Windowed:
-        """Evaluate eq. 21 over the whole recording (vectorised)."""
-        rate = 1.0 / float(np.median(np.diff(t)))
-        half_g = int(round(self.gyro_window * rate / 2))
-        half_a = int(round(self.acc_window * rate / 2))
+    def _counts(self, ctx: RunContext) -> tuple[int, int, int, float]:
+        """Half windows (samples), the lag of the accelerometer change (samples) and its scale, at the run's rate."""
+        half_g = int(round(self.gyro_window * ctx.rate / 2))
+        half_a = int(round(self.acc_window * ctx.rate / 2))
+        lag = max(int(round(ctx.rate / self.reference_rate)), 1)
+        return half_g, half_a, lag, ctx.rate / (self.reference_rate * lag)
+
+    def _compute(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """Eq. 21 over arrays: ``stance``, ``statistic``, ``gyro_statistic``, ``acc_statistic``."""
+        half_g, half_a, lag, scale = self._counts(self.ctx_)
         acc = np.ascontiguousarray(acc, dtype=float)
-        lag = max(int(round(rate / self.reference_rate)), 1)
-        scale = rate / (self.reference_rate * lag)
-        dacc = np.zeros(t.shape[0])
+        dacc = np.zeros(acc.shape[0])
         dacc[lag:] = scale * row_norms(np.ascontiguousarray(acc[lag:] - acc[:-lag]))
-        self.gyro_statistic_ = window_max(row_norms(np.ascontiguousarray(gyr, dtype=float)), half_g)
-        self.acc_statistic_ = window_max(dacc, half_a)
-        self.statistic_ = np.maximum(self.gyro_statistic_ / self.gyro_threshold,
-                                     self.acc_statistic_ / self.acc_diff_threshold)
-        self.stance_ = self.statistic_ <= 1.0
+        gyro = window_max(row_norms(np.ascontiguousarray(gyr, dtype=float)), half_g)
+        accs = window_max(dacc, half_a)
+        statistic = np.maximum(gyro / self.gyro_threshold, accs / self.acc_diff_threshold)
+        return {"stance": statistic <= 1.0, "statistic": statistic, "gyro_statistic": gyro, "acc_statistic": accs}
+
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> Windowed:
+        """Evaluate eq. 21 over the whole recording (vectorised)."""
+        self.begin(run_context(ctx, t))
+        out = self._compute(t, acc, gyr)
+        self.gyro_statistic_, self.acc_statistic_ = out["gyro_statistic"], out["acc_statistic"]
+        self.statistic_, self.stance_ = out["statistic"], out["stance"]
         self.stance_online_ = self.stance_.copy()
         return self
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """The larger half window (s)."""
+        half_g, half_a, _, _ = self._counts(ctx)
+        return Latency(ctx.seconds(max(half_g, half_a)))
+
+    def begin(self, ctx: RunContext) -> Windowed:
+        """Fresh state: the windows of the recent samples (overlap-save)."""
+        super().begin(ctx)
+        half_g, half_a, lag, _ = self._counts(self.ctx_)
+        # the accelerometer change of the window's first sample reaches lag samples further back
+        self._live = OverlapSave(self._compute, lookahead=max(half_g, half_a), restart=max(half_g, half_a + lag))
+        return self
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """The stance of the samples whose windows are now complete."""
+        return self._live.step(t=t, acc=acc, gyr=gyr)
+
+    def provisional(self) -> Chunk:
+        """The test over the windows so far."""
+        return self._live.provisional()
+
+    def finish(self) -> Chunk:
+        """The last samples, windows clipped at the end of the data."""
+        return self._live.finish()

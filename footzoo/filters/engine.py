@@ -10,6 +10,8 @@ loop, ``"reference"`` the filterpy loop, ``"auto"`` the compiled one when every 
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import functools
 import math
 import warnings
@@ -238,6 +240,12 @@ class KalmanEngine:
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
                 out[key][:] = state.nav[at:at + 3]
         return out
+
+    def fork(self, state: Any) -> Any:
+        """An independent copy of a state from :meth:`start` (a live stream's guess runs ahead on it)."""
+        if self.engine == "reference":
+            return copy.deepcopy(state)
+        return dataclasses.replace(state, nav=state.nav.copy(), P=state.P.copy(), mems=state.mems.copy())
 
     def diagnostics(self, state: Any) -> dict[str, Any]:
         """The models' results (e.g. a calibration) from their memory."""

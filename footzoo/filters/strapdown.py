@@ -106,24 +106,30 @@ def motion_acceleration(quat: np.ndarray, acc: np.ndarray, g: float = GRAVITY) -
 
 @njit
 def _integrate_velocity_kernel(a: np.ndarray, dt: np.ndarray, v0: np.ndarray, out: np.ndarray) -> None:
-    sx, sy, sz = 0.0, 0.0, 0.0
+    # the sums start at v0 (not added to each output): a chunk resumed from the last velocity
+    # continues the same sums, so a live run gives the batch numbers exactly
+    sx, sy, sz = v0[0], v0[1], v0[2]
     for k in range(a.shape[0]):
         sx += a[k, 0] * dt[k]
         sy += a[k, 1] * dt[k]
         sz += a[k, 2] * dt[k]
-        out[k, 0], out[k, 1], out[k, 2] = sx + v0[0], sy + v0[1], sz + v0[2]
+        out[k, 0], out[k, 1], out[k, 2] = sx, sy, sz
 
 
 @njit
-def _integrate_position_kernel(v: np.ndarray, dt: np.ndarray, p0: np.ndarray, out: np.ndarray) -> None:
-    sx, sy, sz = 0.0, 0.0, 0.0
+def _integrate_position_kernel(v: np.ndarray, dt: np.ndarray, p0: np.ndarray, v_before: np.ndarray,
+                               resume: bool, out: np.ndarray) -> None:
+    # as above, the sums start at p0; resumed (``resume``), sample 0 is the interval from the
+    # previous sample, whose velocity is ``v_before``
+    sx, sy, sz = p0[0], p0[1], p0[2]
     for k in range(v.shape[0]):
-        if k > 0:
+        if k > 0 or resume:
             h = dt[k]
-            sx += 0.5 * (v[k, 0] + v[k - 1, 0]) * h
-            sy += 0.5 * (v[k, 1] + v[k - 1, 1]) * h
-            sz += 0.5 * (v[k, 2] + v[k - 1, 2]) * h
-        out[k, 0], out[k, 1], out[k, 2] = sx + p0[0], sy + p0[1], sz + p0[2]
+            px, py, pz = (v[k - 1, 0], v[k - 1, 1], v[k - 1, 2]) if k > 0 else (v_before[0], v_before[1], v_before[2])
+            sx += 0.5 * (v[k, 0] + px) * h
+            sy += 0.5 * (v[k, 1] + py) * h
+            sz += 0.5 * (v[k, 2] + pz) * h
+        out[k, 0], out[k, 1], out[k, 2] = sx, sy, sz
 
 
 def integrate_velocity(acc_nav: np.ndarray, dt: np.ndarray, v0: np.ndarray | None = None) -> np.ndarray:
@@ -137,15 +143,51 @@ def integrate_velocity(acc_nav: np.ndarray, dt: np.ndarray, v0: np.ndarray | Non
     return out
 
 
-def integrate_position(vel: np.ndarray, dt: np.ndarray, p0: np.ndarray | None = None) -> np.ndarray:
+def integrate_position(vel: np.ndarray, dt: np.ndarray, p0: np.ndarray | None = None,
+                       v_before: np.ndarray | None = None) -> np.ndarray:
     """Position (m, (N, 3)) by the trapezoidal rule: ``p[k] = p[k-1] + (v[k-1] + v[k]) dt[k] / 2``.
 
-    ``vel`` (m/s, (N, 3)), ``dt`` (s, (N,)), ``p0`` (m, (3,)).
+    ``vel`` (m/s, (N, 3)), ``dt`` (s, (N,)), ``p0`` (m, (3,)): the position of sample 0. To continue
+    an earlier integration, give ``v_before`` (m/s, (3,)), the velocity of the sample before:
+    ``p0`` is then that sample's position and ``dt[0]`` the interval to it.
     """
     v = np.ascontiguousarray(vel, dtype=float)
     out = np.empty(v.shape)
-    _integrate_position_kernel(v, np.ascontiguousarray(dt, dtype=float), _start(p0), out)
+    _integrate_position_kernel(v, np.ascontiguousarray(dt, dtype=float), _start(p0), _start(v_before),
+                               v_before is not None, out)
     return out
+
+
+class Integrator:
+    """Velocity and position integration carried from chunk to chunk (the live form of the two functions above).
+
+    ``velocity(acc_nav, t)`` and ``position(vel, t)`` continue exactly where the previous chunk ended;
+    over one chunk from the start they give :func:`integrate_velocity` and :func:`integrate_position`.
+    """
+
+    def __init__(self) -> None:
+        self.t_prev: float | None = None
+        self.v_last = np.zeros(3)
+        self.p_last = np.zeros(3)
+
+    def _dt(self, t: np.ndarray) -> np.ndarray:
+        dt = sample_intervals(t)
+        if self.t_prev is not None and dt.size:
+            dt[0] = t[0] - self.t_prev
+        return dt
+
+    def velocity(self, acc_nav: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """``v[k] = v[k-1] + a[k] dt[k]`` (m/s) of the chunk's samples (``acc_nav`` m/s², ``t`` s)."""
+        return integrate_velocity(acc_nav, self._dt(t), self.v_last if self.t_prev is not None else None)
+
+    def position(self, vel: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Trapezoidal position (m) of the chunk's samples; advances the carried state (call after :meth:`velocity`)."""
+        if not len(t):
+            return np.zeros((0, 3))
+        resumed = self.t_prev is not None
+        pos = integrate_position(vel, self._dt(t), self.p_last if resumed else None, self.v_last if resumed else None)
+        self.t_prev, self.v_last, self.p_last = float(t[-1]), np.array(vel[-1], float), pos[-1].copy()
+        return pos
 
 
 def _start(x0: np.ndarray | None) -> np.ndarray:

@@ -7,12 +7,13 @@ import math
 import numpy as np
 
 from ..core.checks import check_bool, check_range
-from ..filters.strapdown import quat_product, rotvec_quat, sample_intervals
+from ..filters.strapdown import quat_product, rotvec_quat
 from ..kernels.jit import njit
-from ..plugins.base import Orientation
+from ..plugins.incremental import Chunk
 from ..plugins.registry import register
 from .fqa import fqa_sample
-from .magnetic import magnetometer_valid, rejection_parameters
+from .magnetic import rejection_parameters
+from .recursive import RecursiveFilter
 
 _NO_MAG = np.zeros((1, 3))
 
@@ -118,7 +119,7 @@ def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
 
 
 @register
-class FQAComplementary(Orientation):
+class FQAComplementary(RecursiveFilter):
     """Adaptive-gain quaternion complementary filter with an FQA static branch.
 
     Yun, Calusdian, Bachmann & McGhee, IEEE TIM 61(7), 2012, Sec. II-A, eqs. 2–4
@@ -174,6 +175,7 @@ class FQAComplementary(Orientation):
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
     units = {"static_gain": "1/s", "dynamic_gain": "1/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
     needs_stance = True
+    checks_magnetometer = True
 
     def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True,
                  mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
@@ -184,44 +186,12 @@ class FQAComplementary(Orientation):
         self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
             mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
 
-    def estimate(
-        self,
-        t: np.ndarray,
-        acc: np.ndarray,
-        gyr: np.ndarray,
-        mag: np.ndarray | None,
-        stance: np.ndarray,
-        q0: np.ndarray,
-    ) -> FQAComplementary:
-        """Run the filter over a recording.
-
-        Parameters
-        ----------
-        t : (N,) ndarray
-            Time (s).
-        acc, gyr : (N, 3) ndarray
-            Specific force (m/s²) and angular rate (rad/s) in FRD.
-        mag : (N, 3) ndarray or None
-            Magnetic field in FRD (any unit).
-        stance : (N,) bool ndarray
-            Gait phase at each sample (True = stance, gain k_s).
-        q0 : (4,) ndarray
-            Initial attitude.
-        """
-        dt = sample_intervals(t)
-        use_mag = self.use_magnetometer and mag is not None
-        self.gain_ = np.where(stance, self.static_gain, self.dynamic_gain)
-        self.mag_valid_ = None
-        mag_ok = np.zeros(t.shape[0], dtype=bool)
-        if use_mag:
-            self.mag_valid_ = np.ones(t.shape[0], dtype=bool)
-            if self.mag_rejection:
-                self.mag_valid_ = magnetometer_valid(t, acc, mag, stance, self.mag_norm_tolerance,
-                                                     self.mag_dip_tolerance)[0]
-            mag_ok = self.mag_valid_
-        self.quat_ = complementary_kernel(
-            np.asarray(q0, dtype=float), np.ascontiguousarray(gyr, dtype=float), dt,
-            np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(mag, dtype=float) if use_mag else _NO_MAG,
-            self.gain_, np.ascontiguousarray(mag_ok),
-        )
-        return self
+    def propagate(self, q_prev: np.ndarray, first: bool, t: np.ndarray, dt: np.ndarray, acc: np.ndarray,
+                  gyr: np.ndarray, mag: np.ndarray | None, stance: np.ndarray,
+                  mag_ok: np.ndarray | None) -> Chunk:
+        """Eqs. 2–4 over the chunk (:func:`complementary_kernel`): ``quat``; ``gain`` k_s in stance, k_d in swing."""
+        gain = np.where(stance, self.static_gain, self.dynamic_gain)
+        ok = np.zeros(t.shape[0], dtype=bool) if mag_ok is None else np.ascontiguousarray(mag_ok)
+        quat = complementary_kernel(np.asarray(q_prev, dtype=float), gyr, dt, acc, _NO_MAG if mag is None else mag,
+                                    gain, ok)
+        return {"quat": quat, "gain": gain}

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.strapdown import sample_intervals
-from ..plugins.base import Orientation
+from ..plugins.incremental import Chunk
 from ..plugins.registry import register
 from .fqa_complementary import complementary_kernel
+from .recursive import RecursiveFilter
 
 
 @register
-class INS(Orientation):
+class INS(RecursiveFilter):
     """Strapdown attitude from the gyro, corrected by the error-state Kalman filter.
 
     Nguyen & La 2016, eqs. 37–39 and 51–52 (attitude propagation and feedback);
@@ -46,10 +46,13 @@ class INS(Orientation):
     def __init__(self) -> None:
         pass
 
-    def estimate(self, t, acc, gyr, mag, stance, q0) -> INS:
-        """Gyro integration from ``q0`` (no Kalman filter configured)."""
-        dt = sample_intervals(t)
+    def _uses_mag(self, mag: np.ndarray | None) -> bool:
+        return False  # the magnetometer serves the initial alignment only
+
+    def propagate(self, q_prev: np.ndarray, first: bool, t: np.ndarray, dt: np.ndarray, acc: np.ndarray,
+                  gyr: np.ndarray, mag: np.ndarray | None, stance: np.ndarray,
+                  mag_ok: np.ndarray | None) -> Chunk:
+        """Gyro integration from the previous attitude (no Kalman filter configured)."""
         n = t.shape[0]
-        self.quat_ = complementary_kernel(np.asarray(q0, float), np.ascontiguousarray(gyr, dtype=float), dt,
-                                          np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(n), np.zeros(n, dtype=bool))
-        return self
+        return {"quat": complementary_kernel(np.asarray(q_prev, float), gyr, dt, np.zeros((1, 3)), np.zeros((1, 3)),
+                                             np.zeros(n), np.zeros(n, dtype=bool))}

@@ -7,17 +7,18 @@ import math
 import numpy as np
 
 from ..core.checks import check_bool, check_range
-from ..filters.strapdown import rotate, sample_intervals
+from ..filters.strapdown import rotate
 from ..kernels.jit import njit
-from ..plugins.base import Orientation
+from ..plugins.incremental import Chunk
 from ..plugins.registry import register
-from .magnetic import magnetometer_valid, rejection_parameters
+from .magnetic import rejection_parameters
+from .recursive import RecursiveFilter
 
 
 @njit
 def madgwick_kernel(
     q0: np.ndarray, gyr: np.ndarray, acc: np.ndarray, mag: np.ndarray | None, dt: np.ndarray, beta: float,
-    mag_valid: np.ndarray | None = None,
+    mag_valid: np.ndarray | None = None, start: int = 1,
 ) -> np.ndarray:
     """Per-sample core (plain arrays): gyro rate minus β times the normalised gradient.
 
@@ -33,8 +34,9 @@ def madgwick_kernel(
     n = gyr.shape[0]
     out = np.empty((n, 4))
     w, x, y, z = q0[0], q0[1], q0[2], q0[3]
-    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z  # a row from a tuple would compile a shape check
-    for k in range(1, n):
+    if start == 1:  # sample 0 is the initial attitude itself
+        out[0, 0], out[0, 1], out[0, 2], out[0, 3] = w, x, y, z  # a row from a tuple would compile a shape check
+    for k in range(start, n):
         h = dt[k]
         gx, gy, gz = gyr[k, 0], gyr[k, 1], gyr[k, 2]
         # eq. 1: q̇_ω = ½ q ⊗ ω
@@ -88,7 +90,7 @@ def _grad(w, x, y, z, dx, dy, dz, sx, sy, sz):
 
 
 @register
-class Madgwick(Orientation):
+class Madgwick(RecursiveFilter):
     """Madgwick's gradient-descent orientation filter, as used by Huang et al. 2016.
 
     Huang, Jirattigalachote, Cutkosky, Zhu & Shull, IEEE TBME 2016, Sec. II-A,
@@ -125,6 +127,7 @@ class Madgwick(Orientation):
         Magnetometer samples used (None without a magnetometer).
     """
 
+    checks_magnetometer = True
     name = "madgwick"
     paper = "Huang et al. 2016, IEEE TBME, eqs. 1-10 (Madgwick 2011)"
     units = {"gyro_error": "rad/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
@@ -137,17 +140,11 @@ class Madgwick(Orientation):
         self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
             mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
 
-    def estimate(self, t, acc, gyr, mag, stance, q0) -> Madgwick:
-        """Run the filter over a recording (``stance`` is not used)."""
-        dt = sample_intervals(t)
+    def propagate(self, q_prev: np.ndarray, first: bool, t: np.ndarray, dt: np.ndarray, acc: np.ndarray,
+                  gyr: np.ndarray, mag: np.ndarray | None, stance: np.ndarray,
+                  mag_ok: np.ndarray | None) -> Chunk:
+        """Eqs. 1–10 over the chunk (:func:`madgwick_kernel`); the first sample of a run is the initial attitude."""
         self.beta_ = math.sqrt(3.0 / 4.0) * self.gyro_error  # eq. 3
-        use_mag = self.use_magnetometer and mag is not None
-        self.mag_valid_ = None
-        if use_mag:
-            self.mag_valid_ = np.ones(t.shape[0], dtype=bool)
-            if self.mag_rejection:
-                self.mag_valid_ = magnetometer_valid(t, acc, mag, stance, self.mag_norm_tolerance,
-                                                     self.mag_dip_tolerance)[0]
-        self.quat_ = madgwick_kernel(np.asarray(q0, float), gyr, acc, mag if use_mag else None, dt, self.beta_,
-                                     self.mag_valid_)
-        return self
+        ok = None if mag_ok is None else np.ascontiguousarray(mag_ok)
+        return {"quat": madgwick_kernel(np.asarray(q_prev, float), gyr, acc, mag, dt, self.beta_, ok,
+                                        1 if first else 0)}

@@ -73,18 +73,44 @@ def magnetometer_valid(
     t = np.ascontiguousarray(t, dtype=float)
     f = np.ascontiguousarray(acc, dtype=float)
     m = np.ascontiguousarray(mag, dtype=float)
-    still = np.asarray(still, dtype=bool)
-    n_lead = int(np.argmin(still)) if not still.all() else still.size
+    norm_ref, dip_ref = reference_field(t, f, m, np.asarray(still, dtype=bool), complete=True)
+    return valid_samples(f, m, norm_ref, dip_ref, norm_tolerance, dip_tolerance), norm_ref, dip_ref
+
+
+def reference_field(t: np.ndarray, acc: np.ndarray, mag: np.ndarray, still: np.ndarray,
+                    complete: bool) -> tuple[float, float] | None:
+    """Reference magnitude and dip (rad) of the undisturbed field, from the leading still samples.
+
+    The median over the leading still run (at most :data:`REFERENCE_DURATION`), or over the first
+    0.5 s if the recording does not start still. ``t``, ``acc``, ``mag``, ``still`` are the first
+    samples of a recording; with ``complete`` False more may follow (a live stream), and the result
+    is None while they could still change the reference (its warm-up, at most 1 s).
+    """
+    n = t.shape[0]
+    if n == 0:
+        return None
+    moving = np.flatnonzero(~still)
+    n_lead = int(moving[0]) if moving.size else n
     # the reference samples are a prefix: t − t[0] <= T (t increases) and before the first moving sample
     n_ref = min(_leading_within(t, REFERENCE_DURATION), n_lead)
+    seen_1s = t[-1] - t[0] > REFERENCE_DURATION
+    if not complete and not (moving.size or seen_1s):
+        return None
     if n_ref < 2:
+        if not complete and not t[-1] - t[0] > 0.5:
+            return None
         n_ref = _leading_within(t, 0.5)
-    mn, dip = field_norm_and_dip(f[:n_ref], m[:n_ref])
-    norm_ref = float(np.median(mn))
-    dip_ref = float(np.median(dip))
-    valid = np.empty(t.shape[0], dtype=np.bool_)
-    _valid_kernel(f, m, norm_ref, dip_ref, norm_tolerance, dip_tolerance, GRAVITY, valid)
-    return valid, norm_ref, dip_ref
+    mn, dip = field_norm_and_dip(acc[:n_ref], mag[:n_ref])
+    return float(np.median(mn)), float(np.median(dip))
+
+
+def valid_samples(acc: np.ndarray, mag: np.ndarray, norm_ref: float, dip_ref: float, norm_tolerance: float,
+                  dip_tolerance: float) -> np.ndarray:
+    """Per sample: the field agrees with the reference (see :func:`_valid_kernel`)."""
+    valid = np.empty(acc.shape[0], dtype=np.bool_)
+    _valid_kernel(np.ascontiguousarray(acc, dtype=float), np.ascontiguousarray(mag, dtype=float), norm_ref, dip_ref,
+                  norm_tolerance, dip_tolerance, GRAVITY, valid)
+    return valid
 
 
 @njit

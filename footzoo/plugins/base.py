@@ -30,8 +30,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..core.errors import RecordingError
+from ..core.context import RunContext
+from ..core.errors import ConfigError, RecordingError
 from ..filters.measurement import MeasurementModel, StateBlock
+from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
 
 #: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
 ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
@@ -130,9 +132,83 @@ class Plugin:
         """The declared capabilities, for listings and checks."""
         return {k: getattr(cls, k) for k in ("needs_magnetometer", "needs_truth", "needs_distance", "causal")}
 
+    # ------------------------------------------------------------------ the incremental protocol
+    @classmethod
+    def incremental(cls) -> bool:
+        """Whether the class implements ``step`` (runs live, see :mod:`footzoo.plugins.incremental`)."""
+        step = getattr(cls, "step", None)
+        return callable(step) and not getattr(step, "__footzoo_abstract__", False)
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """How long after a sample this block's output for it is final (:class:`~footzoo.plugins.incremental.Latency`).
+
+        Default: none for a ``causal`` block, the whole recording for one without ``step``.
+        """
+        if self.causal or not self.incremental():
+            return Latency() if self.causal else Latency(until=(WHOLE_RECORDING,))
+        raise NotImplementedError(f"{type(self).__name__} implements step but not latency(ctx)")
+
+    def begin(self, ctx: RunContext) -> Plugin:
+        """Start a run (batch or live): fresh state for the recording of ``ctx``; returns ``self``."""
+        self.ctx_ = _context(ctx)
+        return self
+
+    def finish(self) -> Chunk:
+        """End of the data: the outputs of every sample not final yet (default: none pending)."""
+        return {}
+
+    def provisional(self) -> Chunk:
+        """The current guess for the samples pushed but not final yet (default: none pending)."""
+        return {}
+
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
+
+
+def _context(ctx: Any) -> RunContext:
+    """A :class:`RunContext` from a context (or, as in footzoo 0.2, a rate in Hz, with a DeprecationWarning)."""
+    if isinstance(ctx, RunContext):
+        return ctx
+    if isinstance(ctx, (int, float, np.floating)) and not isinstance(ctx, bool):
+        import warnings
+
+        warnings.warn("begin(rate) takes a footzoo.core.context.RunContext since footzoo 0.3: "
+                      "begin(RunContext(rate=...))", DeprecationWarning, stacklevel=3)
+        return RunContext(rate=float(ctx))
+    raise ConfigError(f"begin() takes a footzoo.core.context.RunContext, got {type(ctx).__name__} {ctx!r}")
+
+
+def run_context(ctx: RunContext | None, t: np.ndarray) -> RunContext:
+    """``ctx``, or the context of the time stamps alone for a plug-in called outside a pipeline."""
+    return _context(ctx) if ctx is not None else RunContext.from_time(t)
+
+
+def call(method: Callable[..., Any], *args: Any, ctx: RunContext) -> Any:
+    """``method(*args, ctx=ctx)``, or ``method(*args)`` for a plug-in written before the run context.
+
+    footzoo 0.2's action methods took no ``ctx``; such a plug-in computes its durations from the
+    time stamps itself (it still runs, in batch).
+    """
+    if _takes_context(method):
+        return method(*args, ctx=ctx)
+    return method(*args)
+
+
+@functools.lru_cache(maxsize=1024)
+def _takes_context_of(function: Callable[..., Any]) -> bool:
+    params = inspect.signature(function).parameters
+    return "ctx" in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def _takes_context(method: Callable[..., Any]) -> bool:
+    return _takes_context_of(getattr(method, "__func__", method))
+
+
+def run_whole(block: Plugin, ctx: RunContext, *arrays: Any) -> Chunk:
+    """A block's outputs over whole arrays through its incremental protocol: begin, one step, finish."""
+    block.begin(ctx)
+    return concat([block.step(*arrays), block.finish()])
 
 
 def _plain(value: Any) -> Any:
@@ -157,14 +233,47 @@ class Calibration(Plugin):
     changed) and ``report_`` (a dict of plain numbers, text and lists: what was fitted or why
     nothing was, shown in ``Result.diagnostics["calibration"]``). A calibration that cannot be
     fitted reliably on a recording leaves the signals as they are and says so (warning and
-    ``report_``); it never guesses. It sees the whole recording, so :class:`footzoo.runtime.stream.Stream` runs none.
+    ``report_``); it never guesses.
+
+    Live, a calibration cannot see the whole recording. It takes its fit from a calibration run
+    or file (:meth:`fixed`, from an earlier ``report_``; or parameters that give the fit, e.g.
+    ``hard_iron: {offset: [...]}``, for which :meth:`is_fitted` is true), or fits online on the
+    first seconds of the stream (:meth:`calibrate` on them; :class:`footzoo.Stream`'s ``warmup``).
+    Then ``step(t, acc, gyr, mag)`` applies the fit to each new chunk
+    (``{"acc", "gyr", "mag"}``). "Final = batch" means: equal to the batch run given the same fit.
     """
 
     kind: ClassVar[str] = "calibration"
+    #: The signals the fit is made from: without any of them there is nothing to fit (nor to wait for, live).
+    fits_on: ClassVar[tuple[str, ...]] = ("acc", "gyr", "mag")
 
     def calibrate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> Calibration:
         """Set ``acc_``, ``gyr_``, ``mag_`` and ``report_``; returns ``self``."""
         raise NotImplementedError
+
+    def is_fitted(self) -> bool:
+        """Whether the parameters already give the fit (nothing to fit on the data): it can run live as it is."""
+        return False
+
+    def fixed(self, report: dict[str, Any]) -> Calibration:
+        """A copy whose fit is the one ``report`` (an earlier ``report_``) describes, for live use."""
+        raise NotImplementedError(f"calibration {self.name!r} cannot take a fit from a report: give its fit as "
+                                  "parameters, or let the stream fit it online (warmup)")
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> Chunk:
+        """Apply the fit to the next samples: ``{"acc", "gyr", "mag"}`` (``mag`` absent without one)."""
+        self.calibrate(t, acc, gyr, mag)
+        out = {"acc": self.acc_, "gyr": self.gyr_}
+        if mag is not None:
+            out["mag"] = self.mag_
+        return out
+
+    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
+
+    @classmethod
+    def incremental(cls) -> bool:
+        """A calibration runs live once fitted (see the class docstring)."""
+        return True
 
 
 class Orientation(Plugin):
@@ -184,26 +293,59 @@ class Orientation(Plugin):
     use_magnetometer: bool = False
 
     def estimate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None,
-                 stance: np.ndarray, q0: np.ndarray) -> Orientation:
-        """Set ``quat_``; returns ``self``."""
-        raise NotImplementedError
+                 stance: np.ndarray, q0: np.ndarray, ctx: RunContext | None = None) -> Orientation:
+        """Set ``quat_``; returns ``self``. Default: the incremental protocol over the whole arrays."""
+        self.begin(run_context(ctx, t), q0)
+        out = concat([self.step(t, acc, gyr, mag, stance), self.finish()])
+        for key, value in out.items():
+            setattr(self, f"{key}_", value)
+        return self
+
+    def begin(self, ctx: RunContext, q0: np.ndarray | None = None) -> Orientation:  # type: ignore[override]
+        """Start a run from the attitude ``q0`` (body → NED) at the first sample; returns ``self``."""
+        super().begin(ctx)
+        self.q0_ = None if q0 is None else np.asarray(q0, dtype=float).reshape(4)
+        return self
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None,
+             stance: np.ndarray) -> Chunk:
+        """Push the next samples (with their final stance); ``{"quat": (m, 4)}`` of those now final."""
+        raise NotImplementedError(f"orientation {self.name!r} does not implement the incremental protocol (step)")
+
+    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
 
 
 class Detector(Plugin):
     """Stance (zero-velocity) detection.
 
-    ``detect(t, acc, gyr)`` (with ``needs_truth``: ``detect(t, acc, gyr, truth)``) sets
-    ``stance_`` ((N,) bool) and ``statistic_`` ((N,) float, the test statistic, NaN if none).
-    A ``causal`` detector also implements ``begin(rate)`` (fresh state for a sampling rate in Hz)
-    and ``step(t, acc, gyr) -> (n,) bool`` (the stance of the next chunk of samples, from the
-    carried state), giving the same mask live as in a batch.
+    ``detect(t, acc, gyr, ctx=None)`` (with ``needs_truth``: ``detect(t, acc, gyr, truth)``) sets
+    ``stance_`` ((N,) bool) and ``statistic_`` ((N,) float, the test statistic, NaN if none) from
+    time (s), specific force (m/s², FRD) and angular rate (rad/s, FRD); ``ctx`` is the run's
+    :class:`~footzoo.core.context.RunContext` (its rate converts the detector's durations).
+
+    Live (:mod:`footzoo.plugins.incremental`): ``begin(ctx)``, then ``step(t, acc, gyr)`` for each
+    new chunk returns ``{"stance": (m,) bool, ...}`` for the ``m`` samples whose stance became
+    final, ``provisional()`` the stance it would give the others now, ``finish()`` the rest at
+    the end, and ``latency(ctx)`` how long after a sample its stance is final. A detector that
+    implements only ``step`` gets ``detect`` for free (begin, one step, finish).
     """
 
     kind: ClassVar[str] = "detector"
 
-    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Detector:
-        """Set ``stance_`` and ``statistic_``; returns ``self``."""
-        raise NotImplementedError
+    def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> Detector:
+        """Set ``stance_`` and ``statistic_`` (and the step outputs' other arrays); returns ``self``."""
+        out = run_whole(self, run_context(ctx, t), t, acc, gyr)
+        for key, value in out.items():
+            setattr(self, f"{key}_", value)
+        if "statistic" not in out:
+            self.statistic_ = np.full(len(t), np.nan)
+        return self
+
+    def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
+        """Push the next samples; ``{"stance": ...}`` of the samples whose stance became final."""
+        raise NotImplementedError(f"detector {self.name!r} does not implement the incremental protocol (step)")
+
+    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
 
 
 class Correction(Plugin):
@@ -219,9 +361,19 @@ class VelocityCorrection(Correction):
     pipeline, and not together with Kalman corrections (both would set the velocity).
     """
 
-    def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> VelocityCorrection:
-        """Set ``vel_`` and ``pos_``; returns ``self``."""
-        raise NotImplementedError
+    def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,
+              ctx: RunContext | None = None) -> VelocityCorrection:
+        """Set ``vel_`` and ``pos_``; returns ``self``. Default: the incremental protocol over the whole arrays."""
+        out = run_whole(self, run_context(ctx, t), t, acc_nav, stance)
+        for key, value in out.items():
+            setattr(self, f"{key}_", value)
+        return self
+
+    def step(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> Chunk:
+        """Push the next samples; ``{"vel": (m, 3), "pos": (m, 3)}`` of those now final."""
+        raise NotImplementedError(f"correction {self.name!r} does not implement the incremental protocol (step)")
+
+    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
 
 
 class AccelerationCorrection(Correction):
@@ -232,9 +384,23 @@ class AccelerationCorrection(Correction):
     one, and in this batch form otherwise.
     """
 
-    def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> np.ndarray:
-        """The corrected motion acceleration (m/s², NED)."""
-        raise NotImplementedError
+    def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,
+                           ctx: RunContext | None = None) -> np.ndarray:
+        """The corrected motion acceleration (m/s², NED). Default: the incremental protocol over the whole arrays."""
+        self.begin(ctx if ctx is not None else RunContext(rate=1.0))
+        return concat([self.step_acceleration(quat, acc_nav, stance), self.finish()])["acc_nav"]
+
+    def step_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> Chunk:
+        """Push the next samples; ``{"acc_nav": (m, 3)}`` of those now final (``apply_acceleration`` live)."""
+        raise NotImplementedError(f"correction {self.name!r} does not implement the incremental protocol "
+                                  "(step_acceleration)")
+
+    step_acceleration.__footzoo_abstract__ = True  # type: ignore[attr-defined]
+
+    @classmethod
+    def incremental(cls) -> bool:
+        """Whether the class implements ``step_acceleration`` (runs live)."""
+        return not getattr(cls.step_acceleration, "__footzoo_abstract__", False)
 
 
 @dataclass

@@ -44,9 +44,11 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import Settings
+from ..core.context import RunContext
 from ..core.errors import GuardWarning
 from ..evaluation.metrics import intervals
 from ..kernels.jit import njit
+from ..plugins.incremental import Chunk, Latency, OverlapSave
 
 
 @njit
@@ -113,7 +115,8 @@ class StanceGuard(Settings):
     ranges = {"max_swing": (0.0, 3600.0), "still_rate": (0.0, 50.0), "min_step": (0.0, 10.0),
               "half_width": (0.0, 1.0), "window": (0.0, 1.0), "max_speed": (0.0, 1000.0)}
 
-    def apply(self, t: np.ndarray, gyr: np.ndarray, stance: np.ndarray) -> tuple[np.ndarray, dict[str, Any]]:
+    def apply(self, t: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+              ctx: RunContext | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         """The stance mask with the over-long swings given stances, and the report.
 
         Parameters
@@ -124,6 +127,8 @@ class StanceGuard(Settings):
             Angular rate (rad/s).
         stance : (N,) bool ndarray
             The detector's stance mask.
+        ctx : RunContext, optional
+            The run's context (its rate converts the durations); default: from ``t``.
 
         Returns
         -------
@@ -139,7 +144,7 @@ class StanceGuard(Settings):
         n = s.shape[0]
         if n < 2:
             return out, report
-        rate = 1.0 / float(np.median(np.diff(t)))
+        rate = (ctx if ctx is not None else RunContext.from_time(t)).rate
         swings = intervals(~s)
         if len(swings):
             report["longest_swing"] = float(np.max(swings[:, 1] - swings[:, 0]) / rate)
@@ -149,7 +154,7 @@ class StanceGuard(Settings):
         if not len(long):
             return out, report
         w = np.sqrt(np.einsum("ij,ij->i", gyr, gyr))
-        k = max(int(math.floor(self.window * rate / 2 + 0.5)), 0)
+        k = self._half_window(rate)
         score = np.convolve(np.pad(w, k, mode="edge"), np.full(2 * k + 1, 1.0 / (2 * k + 1)), mode="valid")
         sep = max(int(math.floor(self.min_step * rate + 0.5)), 1)
         half = int(math.floor(self.half_width * rate + 0.5))
@@ -160,6 +165,37 @@ class StanceGuard(Settings):
             report["stances_added"] += len(intervals(added))
             report["samples_added"] += int(np.count_nonzero(added))
         return out, report
+
+    def _half_window(self, rate: float) -> int:
+        return max(int(math.floor(self.window * rate / 2 + 0.5)), 0)
+
+    # ------------------------------------------------------------------ live
+    def latency(self, ctx: RunContext) -> Latency:
+        """A swing's stance is final once the swing has ended (and the score's half window after it)."""
+        if self.max_swing <= 0.0:
+            return Latency()
+        return Latency(ctx.seconds(self._half_window(ctx.rate)), ("the end of the swing",))
+
+    def stream(self, ctx: RunContext) -> OverlapSave | None:
+        """The guard live (overlap-save over :meth:`apply`): ``step(t=, gyr=, stance=)`` gives ``stance`` and
+        ``added`` (the samples it marked) of the samples now final; None when the guard is off."""
+        if self.max_swing <= 0.0:
+            return None
+        k = self._half_window(ctx.rate)
+
+        def compute(t: np.ndarray, gyr: np.ndarray, stance: np.ndarray) -> Chunk:
+            out, _ = self.apply(t, gyr, stance, ctx)
+            return {"stance": out, "added": out & ~np.asarray(stance, dtype=bool), "t": t}
+
+        def ready(inp: Chunk, start: int) -> int:
+            # every swing the guard may still change: open, or without the score's half window after it
+            s = inp["stance"]
+            swings = intervals(~s)
+            pending = swings[(swings[:, 1] == s.size) | (swings[:, 1] + k > s.size)] if len(swings) else swings
+            return start + (int(pending[0, 0]) if len(pending) else s.size)
+
+        return OverlapSave(compute, lookahead=ready, restart=lambda out, inp, start, final: final - k - 1,
+                           wants=("t", "gyr", "stance"))
 
     def warn(self, report: dict[str, Any], detector: str, recording: str) -> None:
         """A :class:`GuardWarning` when the maximum-swing guard fired."""

@@ -22,6 +22,7 @@ from ..analysis.strides import segment_steps
 from ..config.library import resolve
 from ..config.schema import check_init, check_top_level, load_yaml
 from ..core.checks import GRAVITY_RANGE, check_range
+from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
 from ..core.errors import ConfigError, RecordingError
@@ -38,11 +39,16 @@ from ..plugins.base import (
     Plugin,
     Samples,
     VelocityCorrection,
+    call,
 )
 from ..plugins.extensions import load_plugins
+from ..plugins.incremental import WHOLE_RECORDING, Latency, total
 from ..plugins.registry import build
 from .alignment import initial_attitude
 from .guards import StanceGuard, check_speed
+
+#: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
+STREAM_WARMUP = 30.0
 
 
 class Pipeline:
@@ -199,6 +205,59 @@ class Pipeline:
         needs_filter = any(not isinstance(c, (AccelerationCorrection, VelocityCorrection)) for c in kalman)
         return kalman if needs_filter else []
 
+    # ------------------------------------------------------------------ live
+    def blocks(self) -> list[Plugin]:
+        """The blocks a sample passes through, in order (calibrations, detector, orientation, corrections)."""
+        kalman = self.filter_corrections
+        orientation = [] if (kalman and self.orientation.carried_by_filter) else [self.orientation]
+        return [*self.calibration, self.detector, *orientation, *self.corrections]
+
+    def latency(self, ctx: RunContext) -> Latency:
+        """How long after a sample its final estimate comes, live (:class:`~footzoo.plugins.incremental.Latency`).
+
+        The blocks' look-aheads add up: the detector's, the guard's, the orientation filter's (a
+        warm-up at most), the corrections' and the smoother's.
+        """
+        parts = [self.detector.latency(ctx), self.guards.latency(ctx)]
+        parts += [b.latency(ctx) for b in self.blocks() if b is not self.detector and not isinstance(b, Calibration)]
+        if self.smoother == "rts":
+            parts.append(Latency(until=(WHOLE_RECORDING,)))
+        if any(not c.is_fitted() for c in self.calibration):
+            parts.append(Latency(warmup=STREAM_WARMUP))
+        return total(parts)
+
+    def live_problems(self, fits: list[dict[str, Any]] | None = None) -> list[str]:
+        """Why this pipeline cannot run live (empty: it can), each reason with the fix."""
+        reasons = []
+        for block in self.blocks():
+            if isinstance(block, Calibration):
+                continue
+            if block.needs_truth:
+                reasons.append(f"{block.kind} {block.name!r} reads the reference (truth), which a live stream does "
+                               "not have")
+            elif isinstance(block, KalmanCorrection) and block in self.filter_corrections:
+                continue
+            elif not block.incremental():
+                reasons.append(f"{block.kind} {block.name!r} does not implement the incremental protocol "
+                               "(begin/step/finish): it runs on whole recordings only (see the plug-in guide, "
+                               "'Running live')")
+        if fits is not None and len(fits) != len(self.calibration):
+            reasons.append(f"fits: {len(fits)} calibration fit(s) for {len(self.calibration)} calibration(s)")
+        if self.smoother == "rts":
+            reasons.append("smoother 'rts' runs backwards over the whole recording: use smoother: stepwise (it "
+                           "closes each stride once the next stance has been seen) or smoother: none")
+        return reasons
+
+    def with_fits(self, fits: Any) -> Pipeline:
+        """This pipeline with its calibrations' fits fixed (from ``Result.diagnostics["calibration"]`` or a Result):
+        a batch run of it equals a stream given the same fits."""
+        reports = fits.diagnostics.get("calibration") if hasattr(fits, "diagnostics") else fits
+        if reports is None or len(reports) != len(self.calibration):
+            raise ConfigError(f"with_fits: give one fit per calibration ({len(self.calibration)}), got {reports!r:.80}")
+        out = copy.copy(self)
+        out.calibration = [c.fixed(r) for c, r in zip(self.calibration, reports, strict=True)]
+        return out
+
     # ------------------------------------------------------------------- run
     def run(self, rec: Recording, engine: str = "auto", covariance: bool = False) -> Result:
         """Estimate attitude, velocity, position and steps for one recording.
@@ -221,12 +280,13 @@ class Pipeline:
         if not isinstance(rec, Recording):
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
         self._check_inputs(rec)
+        ctx = self.context(rec)
         rec, calibration = self.calibrate(rec)
-        detector = self.detect(rec)
-        stance, guard_report = self.guard(rec, detector)
+        detector = self.detect(rec, ctx)
+        stance, guard_report = self.guard(rec, detector, ctx)
         q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
-        quat = self.orient(rec, stance, q0)
-        nav = self.navigate(rec, stance, q0, quat, engine, covariance)
+        quat = self.orient(rec, stance, q0, ctx)
+        nav = self.navigate(rec, stance, q0, quat, engine, covariance, ctx)
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
@@ -238,6 +298,10 @@ class Pipeline:
         samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
         return Result(samples=samples, steps=steps, config=config, versions=versions(),
                       recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
+
+    def context(self, rec: Recording) -> RunContext:
+        """The run context of a batch run over ``rec``: its median rate, this pipeline's gravity, its start."""
+        return RunContext.of(rec, self.gravity)
 
     def _use_mag(self, rec: Recording) -> bool:
         return rec.mag is not None and bool(getattr(self.orientation, "use_magnetometer", False))
@@ -260,29 +324,34 @@ class Pipeline:
             reports.append({"type": c.name, **fitted.report_})
         return out, reports
 
-    def detect(self, rec: Recording) -> Detector:
+    def detect(self, rec: Recording, ctx: RunContext | None = None) -> Detector:
         """Stage 1: the fitted detector (``stance_``, ``statistic_``)."""
+        ctx = ctx or self.context(rec)
         detector = self.detector.clone()
         if detector.needs_truth:
             return detector.detect(rec.t, rec.acc, rec.gyr, rec.truth)
-        return detector.detect(rec.t, rec.acc, rec.gyr)
+        return call(detector.detect, rec.t, rec.acc, rec.gyr, ctx=ctx)
 
-    def guard(self, rec: Recording, detector: Detector) -> tuple[np.ndarray, dict[str, Any]]:
+    def guard(self, rec: Recording, detector: Detector,
+              ctx: RunContext | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report."""
-        stance, report = self.guards.apply(rec.t, rec.gyr, detector.stance_)
+        stance, report = self.guards.apply(rec.t, rec.gyr, detector.stance_, ctx or self.context(rec))
         self.guards.warn(report, detector.name, rec.name)
         return stance, report
 
-    def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+    def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray,
+               ctx: RunContext | None = None) -> np.ndarray | None:
         """Stage 2: the attitude (N, 4), or None when the Kalman filter carries it."""
         if self.orientation.carried_by_filter and self.filter_corrections:
             return None
         mag = rec.mag if self._use_mag(rec) else None
-        return self.orientation.clone().estimate(rec.t, rec.acc, rec.gyr, mag, stance, q0).quat_
+        return call(self.orientation.clone().estimate, rec.t, rec.acc, rec.gyr, mag, stance, q0,
+                    ctx=ctx or self.context(rec)).quat_
 
     def navigate(self, rec: Recording, stance: np.ndarray, q0: np.ndarray, quat: np.ndarray | None,
-                 engine: str = "auto", covariance: bool = False) -> dict[str, Any]:
+                 engine: str = "auto", covariance: bool = False, ctx: RunContext | None = None) -> dict[str, Any]:
         """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections."""
+        ctx = ctx or self.context(rec)
         kalman = [c.clone() for c in self.filter_corrections]
         if kalman:
             samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
@@ -297,10 +366,10 @@ class Pipeline:
         acc_nav = motion_acceleration(quat, rec.acc, self.gravity)
         for c in self.corrections:
             if isinstance(c, AccelerationCorrection):
-                acc_nav = c.clone().apply_acceleration(quat, acc_nav, stance)
+                acc_nav = call(c.clone().apply_acceleration, quat, acc_nav, stance, ctx=ctx)
         velocity = [c for c in self.corrections if isinstance(c, VelocityCorrection)]
         if velocity:
-            corr = velocity[0].clone().apply(rec.t, acc_nav, stance)
+            corr = call(velocity[0].clone().apply, rec.t, acc_nav, stance, ctx=ctx)
             vel, pos = corr.vel_, corr.pos_
         else:
             dt = sample_intervals(rec.t)

@@ -1,37 +1,55 @@
-"""Live estimation: push one sample, get the current estimate.
+"""Live estimation: push samples, get the newest sample's estimate at once and every sample's final one later.
 
-For pipelines whose output at a sample depends only on the samples up to it — an orientation
-the Kalman filter carries (the INS), a ``causal`` detector and Kalman corrections only, i.e.
-Nguyen & La's real-time system — :class:`Stream` gives exactly what :meth:`Pipeline.run` gives
-on the whole recording. It holds the filter's state between samples and advances the same
-engine (compiled, or the reference for a correction that does not compile) two samples at a
-time, with the same measurement models, built by the same :meth:`Pipeline.kalman_engine`.
+Every pipeline whose blocks implement the incremental protocol (:mod:`footzoo.plugins.incremental`;
+all of footzoo's do) runs live. :meth:`Stream.push` answers at once with a *provisional*
+estimate of the newest sample — what the pipeline knows now, its detector's current guess
+of the gait phase carried through a copy of the filters — and the *final* estimate of each
+sample comes once the pipeline's declared latency has passed (:meth:`Stream.final`): a
+centred window's half, a state machine's delay, a swing that is corrected at its end. The
+final estimates equal :meth:`footzoo.Pipeline.run` on the whole recording (to 1e-9; the
+same blocks run on the same samples), and the stream keeps only the samples still pending:
+its memory is bounded by the latency, not by the length of the recording.
 
-The filter starts from the batch run's alignment: the first still period of ``init.duration``
-seconds, the attitude carried back to the first sample. Until that period has been seen (at most
-``max_wait`` seconds), :meth:`Stream.push` buffers the samples and returns None; then it runs
-through the buffer and answers for the newest sample. A detector's windows in
-seconds become samples at the sampling ``rate``: give the sensor's nominal rate (the batch run
-uses the recording's median rate, :attr:`Recording.rate`; :meth:`Stream.run` passes it), or
-leave it out and the stream measures it over the still start, with a warning.
+The run context (:class:`~footzoo.core.context.RunContext`) is decided when the stream starts:
+the ``rate`` given (the sensor's nominal rate; a batch run uses the recording's median rate,
+:attr:`Recording.rate` — :meth:`Stream.run` passes it) or the rate measured over the still
+start, with a warning. The filter starts from the batch run's alignment: the first still
+period of ``init.duration`` seconds, the attitude carried back to the first sample; until
+it has been seen (at most ``max_wait`` seconds) :meth:`Stream.push` returns None.
 
-The maximum-swing guard of a batch run (:mod:`footzoo.runtime.guards`) looks at a whole swing once it
-has ended; live, the stream cannot, and warns (:class:`~footzoo.core.errors.GuardWarning`) when its
-detector has found no stance for ``guards.max_swing`` seconds. Where the guard does not fire in
-the batch run, the stream gives exactly its result.
+In-situ calibrations (``hard_iron``) are fitted on a whole recording in a batch run. Live, they
+take their fit from ``fits`` (the ``Result.diagnostics["calibration"]`` of an earlier run or of
+a calibration recording), from parameters that give it (``hard_iron: {offset: [...]}``), or fit
+online on the first ``warmup`` seconds; the final estimates then equal the batch run given the
+same fit (:meth:`footzoo.Pipeline.with_fits` and :attr:`Stream.fits`).
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
 import numpy as np
 
-from ..core.checks import validate_sample
+from ..core.checks import validate_block, validate_sample
+from ..core.context import RunContext
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
-from ..plugins.base import KalmanCorrection, Samples
+from ..plugins.base import Samples
+from ..plugins.incremental import Chunk, Latency, length
 from .alignment import first_still_window, initial_attitude
+from .pipeline import STREAM_WARMUP
+from .stages import (
+    BatchNavigationStage,
+    CalibrationStage,
+    DetectorStage,
+    KalmanStage,
+    OrientationStage,
+    Queue,
+)
+
+#: The per-sample columns of the final estimates.
+COLUMNS = ("t", "quat", "pos", "vel", "acc_nav", "stance")
 
 
 class Stream:
@@ -40,96 +58,304 @@ class Stream:
     Parameters
     ----------
     pipeline : Pipeline
-        A causal pipeline (see the module docstring); others are rejected with the reason.
+        Any pipeline whose blocks run live; others are refused with the reason.
     rate : float, optional
-        Nominal sampling rate (Hz) for the detector's windows; default: measured over the still start.
+        Nominal sampling rate (Hz) of the run context; default: measured over the still start.
     engine : {"auto", "fast", "reference"}
         As :meth:`Pipeline.run`.
     max_gap : float
         Longest accepted time between two pushed samples (s); a longer gap is an error.
     max_wait : float
         How long the stream waits for the first still period (s) before it gives up with an error.
+    fits : list of dict or Result, optional
+        The calibrations' fits (``Result.diagnostics["calibration"]``, or a Result that has them).
+    warmup : float
+        Seconds of data a calibration without a fit is fitted on, online, at the start.
+    guess : bool
+        Compute the provisional estimate of each new sample (``push`` returns it); off, ``push``
+        returns the newest final estimate instead (cheaper, e.g. to replay a recording).
+    max_pending : float
+        Warn when this many seconds of samples wait for their final estimate (s): a detector that
+        finds no stance keeps a dedrift or a smoother waiting, and the memory grows with it.
 
     Examples
     --------
-    >>> s = Stream(Pipeline.from_yaml("nguyen2016"), rate=100.0)   # doctest: +SKIP
-    >>> est = s.push(t, acc, gyr)          # None until the still start has been seen
+    >>> s = Stream(Pipeline.from_yaml("recommended"), rate=200.0)     # doctest: +SKIP
+    >>> est = s.push(t, acc, gyr)        # None until the still start has been seen
+    >>> done = s.final()                 # the final estimates that are ready (arrays)
+    >>> rest = s.close()                 # at the end of the data: the remaining ones
     """
 
-    def __init__(self, pipeline, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
-                 max_wait: float = 10.0):
-        self.pipeline = pipeline
-        self.rate = rate
-        self.engine = engine
-        self.max_gap = max_gap
-        self.max_wait = max_wait
-        self._dist_width: int | None = None
-        reasons = []
-        if not pipeline.orientation.carried_by_filter:
-            reasons.append(f"orientation {pipeline.orientation.name!r} is not carried by the Kalman filter "
-                           "(live: an orientation such as ins)")
-        det = pipeline.detector
-        if not (det.causal and hasattr(det, "begin") and hasattr(det, "step")):
-            reasons.append(f"detector {det.name!r} looks ahead or dates switches back (live: a causal detector "
-                           "such as dgp)")
-        for c in pipeline.corrections:
-            if not (isinstance(c, KalmanCorrection) and c.causal):
-                reasons.append(f"correction {c.name!r} corrects a swing after it ends")
-        if not pipeline.filter_corrections:
-            reasons.append("no Kalman-filter correction")
-        if pipeline.analysis:
-            reasons.append("analysis plug-ins run on whole recordings")
-        if pipeline.calibration:
-            reasons.append(f"calibration {[c.name for c in pipeline.calibration]} is fitted on the whole recording "
-                           "(live: remove it)")
-        if pipeline.smoother != "none":
-            reasons.append(f"smoother {pipeline.smoother!r} runs backwards over the whole recording "
-                           "(live: smoother: none)")
-        if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
+    def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
+                 max_wait: float = 10.0, fits: Any = None, warmup: float = STREAM_WARMUP, guess: bool = True,
+                 max_pending: float = 30.0):
+        reasons = pipeline.live_problems(fits=_fit_reports(fits))
+        if rate is not None and not (isinstance(rate, (int, float)) and not isinstance(rate, bool)
+                                     and math.isfinite(rate) and rate > 0):
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
-        for label, value in (("max_gap", max_gap), ("max_wait", max_wait)):
+        for label, value in (("max_gap", max_gap), ("max_wait", max_wait), ("warmup", warmup),
+                             ("max_pending", max_pending)):
             if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < np.inf):
                 reasons.append(f"{label} must be a positive number of seconds, got {value!r}")
         if reasons:
             raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
+        self.pipeline = pipeline
+        self.rate = rate
+        self.engine = engine
+        self.max_gap, self.max_wait, self.warmup, self.max_pending = max_gap, max_wait, warmup, max_pending
+        self.guess = guess
         self.init = dict(pipeline.init)
+        self._fits = _fit_reports(fits)
+        self.ctx: RunContext | None = None
+        self.fits: list[dict[str, Any]] | None = None  # the fits the stream's calibrations used
+        self._raw = Queue()  # samples before the start
+        self._out = Queue()  # final estimates not taken yet
+        self._last_final: dict[str, Any] | None = None
+        self._stages: list[Any] = []
+        self._k = 0
+        self._t_prev: float | None = None
+        self._dist_width: int | None = None
+        self._has_mag: bool | None = None
+        self._closed = False
+        self._warned: set[str] = set()
         self.log: list[dict[str, Any]] | None = None
-        self._buffer: list[tuple[float, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]] = []
-        self._ready = False
-        self.k = -1
 
-    def push(self, t: float, acc, gyr, mag=None, dist=None) -> dict[str, Any] | None:
-        """Add one sample (FRD, SI; ``dist`` in m with NaN where no reading) and return the estimate.
+    # ------------------------------------------------------------------ public
+    @property
+    def latency(self) -> Latency:
+        """The pipeline's declared latency at the stream's rate (at its nominal rate before the start)."""
+        return self.pipeline.latency(self.ctx or RunContext(rate=self.rate or 100.0, gravity=self.pipeline.gravity))
 
-        Returns None while the initial still period is being collected, then a
-        dict with ``t``, ``quat`` (body -> NED), ``pos``, ``vel`` (NED) and
-        ``stance`` for the newest sample.
+    def push(self, t: float, acc: Any, gyr: Any, mag: Any = None, dist: Any = None) -> dict[str, Any] | None:
+        """Add one sample (FRD, SI; ``dist`` in m with NaN where no reading); the newest sample's estimate.
+
+        Returns None while the initial still period is being collected, then a dict with ``t``,
+        ``quat`` (body → NED), ``pos``, ``vel`` (NED), ``stance`` and ``final`` (whether this
+        estimate is already the final one) for the newest sample: provisional when the pipeline
+        looks ahead (with ``guess``; else the newest final estimate).
         """
-        previous = self._buffer[-1][0] if self._buffer else None
-        t, acc, gyr, mag, dist = validate_sample(t, acc, gyr, mag, dist, previous, self.max_gap)
-        acc = np.asarray(acc, dtype=float).reshape(3)
-        gyr = np.asarray(gyr, dtype=float).reshape(3)
-        mag = None if mag is None else np.asarray(mag, dtype=float).reshape(3)
-        dist = self._distance_row(dist)
-        self._buffer.append((float(t), acc, gyr, mag, dist))
-        if not self._ready:
-            if t - self._buffer[0][0] <= self.init["duration"] or not self._start():
-                return None
-            out = None
-            for sample in self._buffer[self._n_init:]:
-                out = self._step(*sample)
-            self._buffer = self._buffer[-1:]
-            return out
-        self._buffer = self._buffer[-1:]
-        return self._step(float(t), acc, gyr, mag, dist)
+        if self._closed:
+            raise RecordingError("the stream is closed: start a new Stream for new data")
+        t, acc, gyr, mag, dist = validate_sample(t, acc, gyr, mag, dist, self._t_prev, self.max_gap)
+        row = {"k": np.array([self._k]), "t": np.array([t]), "acc": acc[None, :], "gyr": gyr[None, :]}
+        if self._has_mag is None:
+            self._has_mag = mag is not None
+        elif self._has_mag != (mag is not None):
+            raise RecordingError("mag must be pushed with every sample or with none (the first sample decides)")
+        if mag is not None:
+            row["mag"] = mag[None, :]
+        d = self._distance_row(dist)
+        if d is not None:
+            row["dist"] = d[None, :]
+        self._k += 1
+        self._t_prev = t
+        return self._take(row)
 
-    def _distance_row(self, dist) -> np.ndarray | None:
+    def extend(self, t: Any, acc: Any, gyr: Any, mag: Any = None, dist: Any = None) -> dict[str, Any] | None:
+        """Add a block of samples (``t`` (n,), ``acc``, ``gyr`` (n, 3), ...: a sensor's packet); the newest estimate.
+
+        The same final estimates as pushing the samples one by one (the blocks run chunk by chunk
+        to the same numbers); cheaper per sample.
+        """
+        if self._closed:
+            raise RecordingError("the stream is closed: start a new Stream for new data")
+        t, acc, gyr, mag, dist = validate_block(t, acc, gyr, mag, dist, self._t_prev, self.max_gap)
+        n = t.shape[0]
+        rows = {"k": np.arange(self._k, self._k + n), "t": t, "acc": acc, "gyr": gyr}
+        if self._has_mag is None:
+            self._has_mag = mag is not None
+        elif self._has_mag != (mag is not None):
+            raise RecordingError("mag must be pushed with every sample or with none (the first sample decides)")
+        if mag is not None:
+            rows["mag"] = mag
+        if dist is not None or self._dist_width is not None:
+            d = np.full((n, self._dist_width), np.nan) if dist is None else dist
+            if self._dist_width is None:
+                if self._k:
+                    raise RecordingError("distance readings started after the first sample: push dist (NaN where a "
+                                         "sensor has no reading) with every sample from the first one")
+                self._dist_width = d.shape[1]
+            elif d.shape[1] != self._dist_width:
+                raise RecordingError(f"dist has {d.shape[1]} readings, earlier samples had {self._dist_width}")
+            rows["dist"] = d
+        self._k += n
+        self._t_prev = float(t[-1])
+        return self._take(rows)
+
+    def pending(self) -> int:
+        """How many samples the stream holds because their final estimate is not known yet (its memory)."""
+        return len(self._raw) + sum(stage.held() for stage in self._stages)
+
+    def final(self) -> dict[str, np.ndarray]:
+        """The final estimates that became available since the last call: arrays ``t``, ``quat``, ``pos``,
+        ``vel``, ``acc_nav``, ``stance`` (empty arrays when none)."""
+        out = self._out.take(np.iinfo(np.int64).max)
+        return _columns(out)
+
+    def close(self) -> dict[str, np.ndarray]:
+        """End of the data: every remaining sample's final estimate (as :meth:`final`)."""
+        if not self._closed:
+            self._closed = True
+            if not self._stages and len(self._raw):
+                if not self._start(last=True):  # shorter than the still start: never aligned
+                    raise RecordingError(self._no_start_message())
+                self._feed(self._raw.take(np.iinfo(np.int64).max))
+            if self._stages:
+                self._feed({}, finish=True)
+        return self.final()
+
+    def run(self, rec: Any, chunk: int | np.ndarray = 1) -> dict[str, np.ndarray]:
+        """Push a whole recording and close: every sample's final estimate.
+
+        ``chunk`` samples at a time (1: :meth:`push`, sample by sample; more: :meth:`extend`), or
+        blocks of the sizes in an array (e.g. random ones, in the tests). Uses the recording's rate
+        (:attr:`Recording.rate`) when the stream was made without one, as the batch run does. With
+        ``log`` set to a list, each call's returned estimate is appended.
+        """
+        if self.rate is None and self.ctx is None:
+            self.rate = rec.rate
+        sizes = np.asarray(chunk, dtype=int).reshape(-1)
+        parts, k, i = [], 0, 0
+        while k < rec.n:
+            m = max(int(sizes[i % sizes.size]), 1)
+            i += 1
+            if m == 1:
+                est = self.push(rec.t[k], rec.acc[k], rec.gyr[k], None if rec.mag is None else rec.mag[k],
+                                None if rec.dist is None else rec.dist[k])
+            else:
+                sl = slice(k, k + m)
+                est = self.extend(rec.t[sl], rec.acc[sl], rec.gyr[sl], None if rec.mag is None else rec.mag[sl],
+                                  None if rec.dist is None else rec.dist[sl])
+            if self.log is not None:
+                self.log.append(est)
+            k += m
+            if i % 64 == 0:
+                parts.append(self.final())
+        parts.append(self.close())
+        return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
+
+    # ------------------------------------------------------------------ the chain
+    def _take(self, row: Chunk) -> dict[str, Any] | None:
+        if not self._stages:
+            self._raw.put(row)
+            if not self._start():
+                return None
+            self._feed(self._raw.take(np.iinfo(np.int64).max))
+        else:
+            self._feed(self._with_init(row))
+        return self._estimate()
+
+    def _with_init(self, chunk: Chunk) -> Chunk:
+        """The chunk with ``init``: its samples in the still start used for the alignment (Samples.init_window)."""
+        return {**chunk, "init": chunk["t"] <= self.ctx.t0 + self.init["duration"]}
+
+    def _feed(self, chunk: Chunk, finish: bool = False) -> None:
+        out = chunk
+        for stage in self._stages:
+            out = stage.push(out, finish=finish) if (length(out) or finish) else {}
+        if length(out):
+            self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
+            self._last_final = {k: out[k][-1] for k in ("k", "t", "quat", "pos", "vel", "stance")}
+        self._check_pending()
+
+    def _estimate(self) -> dict[str, Any] | None:
+        if self._last_final is not None and self._last_final["k"] == self._k - 1:
+            return {**_copy(self._last_final), "final": True}
+        if not self.guess:
+            return None if self._last_final is None else {**_copy(self._last_final), "final": False}
+        detector, *rest = self._stages[1:] if isinstance(self._stages[0], CalibrationStage) else self._stages
+        guess = detector.guess()
+        for stage in rest:
+            guess = stage.guess(guess)
+        if not length(guess):
+            return None if self._last_final is None else {**_copy(self._last_final), "final": False}
+        return {"t": float(guess["t"][-1]), "quat": guess["quat"][-1].copy(), "pos": guess["pos"][-1].copy(),
+                "vel": guess["vel"][-1].copy(), "stance": bool(guess["stance"][-1]), "final": False}
+
+    def _check_pending(self) -> None:
+        waiting = self._k - (int(self._last_final["k"]) + 1 if self._last_final is not None else 0)
+        if self.ctx is not None and waiting / self.ctx.rate > self.max_pending and "pending" not in self._warned:
+            self._warned.add("pending")
+            warnings.warn(f"Stream: {waiting / self.ctx.rate:.0f} s of samples wait for their final estimate "
+                          f"(max_pending = {self.max_pending:g} s): the detector finds no stance, so the dedrift or "
+                          "the smoother cannot close the swing; the stream's memory grows until it does",
+                          GuardWarning, stacklevel=4)
+
+    # ------------------------------------------------------------------ start
+    def _start(self, last: bool = False) -> bool:
+        """Start the chain once the buffer holds the still start (and a calibration's warm-up).
+
+        ``last``: the data ends here (close): a calibration's warm-up is what there is.
+        """
+        b = self._raw.peek()
+        t, gyr = b["t"], b["gyr"]
+        duration, max_gyr = self.init["duration"], self.init["max_gyr"]
+        if t[-1] - t[0] <= duration:
+            return False
+        try:  # the batch run's alignment: the first still window, the attitude carried back to sample 0
+            first_still_window(t, gyr, duration, max_gyr)
+        except RecordingError:
+            if t[-1] - t[0] <= self.max_wait:
+                return False
+            raise RecordingError(self._no_start_message()) from None
+        pipe = self.pipeline
+        channels = {"acc", "gyr", *(["mag"] if self._has_mag else []), *(["dist"] if self._dist_width else [])}
+        needs_fit = any(not c.is_fitted() and channels & set(c.fits_on) for c in self._calibrations())
+        if needs_fit and t[-1] - t[0] < self.warmup and not last:
+            return False
+        rate = self.rate
+        n_init = int(np.searchsorted(t, t[0] + duration, side="right"))
+        if rate is None:
+            rate = 1.0 / float(np.median(np.diff(t[:n_init])))
+            warnings.warn(f"Stream: no rate given; using {rate:.2f} Hz measured over the still start (a batch run "
+                          "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
+                          FootzooWarning, stacklevel=4)
+        self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
+        b = self._with_init(b)
+        self._raw.data = b
+        stages: list[Any] = []
+        calibrated = b
+        if pipe.calibration:
+            cal = CalibrationStage(self._calibrations(), self.ctx, self.warmup)
+            cal.fit(b)  # given fits, or online on the warm-up: the start's samples (fed through it again below)
+            stages.append(cal)
+            calibrated = cal.apply(b)
+            self.fits = cal.reports
+        use_mag = self._has_mag and bool(getattr(pipe.orientation, "use_magnetometer", False))
+        q0 = initial_attitude(calibrated["t"], calibrated["acc"], calibrated["gyr"],
+                              calibrated.get("mag") if use_mag else None, duration, max_gyr)
+        stages.append(DetectorStage(pipe.detector, pipe.guards, self.ctx))
+        kalman = [c.clone() for c in pipe.filter_corrections]
+        if not (kalman and pipe.orientation.carried_by_filter):
+            stages.append(OrientationStage(pipe.orientation, self.ctx, q0, use_mag))
+        if kalman:
+            samples = Samples(b["t"], calibrated["acc"], calibrated["gyr"], calibrated.get("mag"), b.get("dist"),
+                              b["init"])
+            engine = pipe.kalman_engine(kalman, samples, self.engine)
+            stages.append(KalmanStage(engine, kalman, q0, external_attitude=not pipe.orientation.carried_by_filter))
+        else:
+            stages.append(BatchNavigationStage(pipe.corrections, self.ctx, pipe.gravity))
+        self._stages = stages
+        return True
+
+    def _calibrations(self) -> list[Any]:
+        cals = [c.clone() for c in self.pipeline.calibration]
+        if self._fits:
+            cals = [c.fixed(r) for c, r in zip(cals, self._fits, strict=True)]
+        return cals
+
+    def _no_start_message(self) -> str:
+        return (f"the stream found no still period: |ω| stayed above init.max_gyr = {self.init['max_gyr']} rad/s in "
+                f"every {self.init['duration']} s of the first {self.max_wait} s; start it with the foot at rest "
+                "(or raise max_wait)")
+
+    def _distance_row(self, dist: Any) -> np.ndarray | None:
         """Readings of the distance sensors (m); NaN for a sample without them once a stream has them."""
         if dist is None:
             return None if self._dist_width is None else np.full(self._dist_width, np.nan)
         row = np.asarray(dist, dtype=float).reshape(-1)
         if self._dist_width is None:
-            if self._buffer:
+            if self._k:
                 raise RecordingError("distance readings started after the first sample: push dist (NaN where a "
                                      "sensor has no reading) with every sample from the first one")
             self._dist_width = row.size
@@ -138,98 +364,28 @@ class Stream:
                                  "same sensors every time (NaN where one has no reading)")
         return row
 
-    def _start(self) -> bool:
-        """Start the filter once the buffer holds the first still period; False while it does not yet."""
-        b = self._buffer
-        t = np.array([s[0] for s in b])
-        gyr_all = np.array([s[2] for s in b])
-        duration, max_gyr = self.init["duration"], self.init["max_gyr"]
-        try:  # the batch run's alignment: the first still window, the attitude carried back to sample 0
-            first_still_window(t, gyr_all, duration, max_gyr)
-        except RecordingError:
-            if t[-1] - t[0] <= self.max_wait:
-                return False
-            raise RecordingError(
-                f"the stream found no still period: |ω| stayed above init.max_gyr = {max_gyr} rad/s in every "
-                f"{duration} s of the first {self.max_wait} s; start it with the foot at rest (or raise max_wait)"
-            ) from None
-        acc_all = np.array([s[1] for s in b])
-        mag_all = np.array([s[3] for s in b]) if b[0][3] is not None else None
-        use_mag = mag_all is not None and bool(getattr(self.pipeline.orientation, "use_magnetometer", False))
-        q0 = initial_attitude(t, acc_all, gyr_all, mag_all if use_mag else None, duration, max_gyr)
-        self._n_init = n = int(np.sum(t <= t[0] + duration))
-        gyr, acc = gyr_all[:n], acc_all[:n]
-        mag = None if mag_all is None else mag_all[:n]
-        dist = np.array([s[4] for s in b[:n]]) if b[0][4] is not None else None
-        rate = self.rate
-        if rate is None:
-            rate = 1.0 / float(np.median(np.diff(t[:n])))
-            warnings.warn(f"Stream: no rate given; using {rate:.2f} Hz measured over the still start (a batch run "
-                          "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
-                          FootzooWarning, stacklevel=3)
-        self._detector = self.pipeline.detector.clone()
-        self._detector.begin(rate)
-        self._swing = 0
-        self._max_swing = int(round(self.pipeline.guards.max_swing * rate))
-        self._corrections = [c.clone() for c in self.pipeline.filter_corrections]
-        samples = Samples(t[:n], acc, gyr, mag, dist, np.ones(n, dtype=bool))
-        self._engine = self.pipeline.kalman_engine(self._corrections, samples, self.engine)
-        nav0 = np.zeros(16)
-        nav0[:4] = q0
-        self._state = self._engine.live(self._engine.start(nav0))
-        self._ready = True
-        self._prev = None
-        for sample in b[:n]:
-            self._step(*sample)
-        return True
 
-    def _step(self, t, acc, gyr, mag, dist) -> dict[str, Any]:
-        self.k += 1
-        stance = bool(self._detector.step(np.array([t]), acc[None, :], gyr[None, :])[0])
-        self._swing = 0 if stance else self._swing + 1
-        if self._swing == self._max_swing > 0:
-            warnings.warn(f"Stream: detector {self._detector.name!r} has found no stance for "
-                          f"{self.pipeline.guards.max_swing:g} s (guards.max_swing) at t = {t:.2f} s: it misses the "
-                          "stances of this motion and the estimate drifts until it finds one. A batch run would mark "
-                          "the swing's stillest instants as stance (footzoo.runtime.guards);"
-                          " live, they cannot be known yet",
-                          GuardWarning, stacklevel=3)
-        in_init = self.k < self._n_init
-        sample = (t, acc, gyr, mag, dist, stance, in_init)
-        if self._prev is None:
-            self._prev = sample
-            nav = self._state["nav"] if isinstance(self._state, dict) else self._state.nav
-            return self._emit({"t": t, "quat": nav[:4].copy(), "pos": np.zeros(3), "vel": np.zeros(3),
-                               "stance": stance})
-        pair = list(zip(self._prev, sample, strict=True))
-        self._prev = sample
-        ts, accs, gyrs = np.array(pair[0]), np.vstack(pair[1]), np.vstack(pair[2])
-        mags = None if mag is None else np.vstack(pair[3])
-        dists = None if dist is None else np.vstack(pair[4])
-        chunk = Samples(ts, accs, gyrs, mags, dists, np.array(pair[6], dtype=bool))
-        data = [np.ascontiguousarray(c.sample_data(chunk), dtype=float) for c in self._corrections]
-        out = self._engine.advance(self._state, ts, accs, gyrs, np.array(pair[5], dtype=bool), None, data,
-                                   self.k - 1, covariance=False)
-        return self._emit({"t": t, "quat": out["quat"][1], "pos": out["pos"][1], "vel": out["vel"][1],
-                           "stance": stance})
+def _fit_reports(fits: Any) -> list[dict[str, Any]] | None:
+    if fits is None:
+        return None
+    if hasattr(fits, "diagnostics"):
+        fits = fits.diagnostics.get("calibration")
+        if fits is None:
+            raise ConfigError("fits: the Result has no calibration fits (its pipeline has no calibration)")
+    if not isinstance(fits, (list, tuple)) or not all(isinstance(f, dict) for f in fits):
+        raise ConfigError(f"fits must be a list of calibration reports (Result.diagnostics['calibration']) or a "
+                          f"Result, got {type(fits).__name__}")
+    return list(fits)
 
-    def _emit(self, est: dict[str, Any]) -> dict[str, Any]:
-        if self.log is not None:
-            self.log.append(est)
-        return est
 
-    def run(self, rec) -> dict[str, np.ndarray]:
-        """Push a whole recording sample by sample; every sample's estimate (for tests and latency).
+def _columns(chunk: Chunk) -> dict[str, np.ndarray]:
+    shapes = {"t": (0,), "quat": (0, 4), "pos": (0, 3), "vel": (0, 3), "acc_nav": (0, 3), "stance": (0,)}
+    if not length(chunk):
+        return {k: np.zeros(s, dtype=bool if k == "stance" else float) for k, s in shapes.items()}
+    return {k: chunk[k] for k in shapes}
 
-        Uses the recording's rate (:attr:`Recording.rate`) when the stream was made without one, as
-        the batch run does.
-        """
-        if self.rate is None and not self._ready:
-            self.rate = rec.rate
-        self.log = []
-        for k in range(rec.n):
-            self.push(rec.t[k], rec.acc[k], rec.gyr[k], None if rec.mag is None else rec.mag[k],
-                      None if rec.dist is None else rec.dist[k])
-        out = {key: np.array([e[key] for e in self.log]) for key in ("t", "quat", "pos", "vel", "stance")}
-        self.log = None
-        return out
+
+def _copy(est: dict[str, Any]) -> dict[str, Any]:
+    return {k: (v.copy() if isinstance(v, np.ndarray) and v.ndim else (bool(v) if k == "stance" else float(v)))
+            for k, v in est.items() if k != "k"}
+
