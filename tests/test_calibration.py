@@ -163,11 +163,17 @@ def test_validate_lists_a_bad_calibration_with_the_other_problems():
     assert any("calibration[0]" in e and "min_spread" in e for e in errors)
 
 
-def test_a_stream_refuses_a_calibration():
+def test_a_stream_fits_a_calibration_online_and_its_fit_reproduces_the_batch(loop):
+    """Live, hard_iron is fitted on the stream's first seconds; the batch run given that fit gives the same numbers."""
     pipe = Pipeline.from_dict({"orientation": {"type": "ins"}, "detector": {"type": "dgp"},
                                "corrections": [{"type": "zupt"}], "calibration": [{"type": "hard_iron"}]})
-    with pytest.raises(ConfigError, match="calibration.*whole recording"):
-        Stream(pipe, rate=100.0)
+    s = Stream(pipe, rate=loop.rate, warmup=loop.t[-1] - loop.t[0] - 1.0)
+    live = s.run(loop, chunk=25)
+    assert s.fits[0]["type"] == "hard_iron" and s.fits[0]["applied"]
+    batch = pipe.with_fits(s.fits).run(loop)
+    np.testing.assert_allclose(live["pos"], batch.pos, rtol=0, atol=1e-9)
+    with pytest.raises(ConfigError, match="give one fit per calibration"):
+        pipe.with_fits([])
 
 
 def test_a_user_calibration_that_breaks_the_contract_is_named(loop, scratch_registry):

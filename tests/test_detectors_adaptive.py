@@ -21,7 +21,7 @@ def test_the_threshold_grows_exponentially_since_the_last_update():
     t = np.arange(0.0, 1.0, 0.01)
     stat = np.full(t.size, 5e4)
     stat[0] = 0.0
-    stance, gamma = adaptive_threshold_kernel(t, stat, 1e4, 0.2, 1e6)
+    stance, gamma, _ = adaptive_threshold_kernel(t, stat, 1e4, 0.2, 1e6, t[0])
     t_cross = 0.2 * math.log(5.0)
     first = int(np.flatnonzero(stance[1:])[0]) + 1
     assert t[first - 1] <= t_cross < t[first]
@@ -34,7 +34,7 @@ def test_the_cap_keeps_a_long_motion_from_becoming_stance():
     t = np.arange(0.0, 5.0, 0.01)
     stat = np.full(t.size, 2e5)
     stat[0] = 0.0
-    stance, gamma = adaptive_threshold_kernel(t, stat, 1e4, 0.2, 1e5)
+    stance, gamma, _ = adaptive_threshold_kernel(t, stat, 1e4, 0.2, 1e5, t[0])
     assert not stance[1:].any()
     assert gamma.max() == pytest.approx(1e5)
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from footzoo.core.context import RunContext
 from footzoo.detectors import DGP
 from footzoo.evaluation.metrics import stance_scores, step_detection
 from footzoo.sim import NoiseModel, simulate
@@ -48,14 +49,11 @@ def test_batch_equals_sample_by_sample(rate):
     rec = walk("walk_1.4", rate)
     n = min(rec.n, 1500)
     batch = DGP(min_swing=0.2).detect(rec.t[:n], rec.acc[:n], rec.gyr[:n])
-    live = DGP(min_swing=0.2)
-    live.begin(rate)
-    stance = np.concatenate([live.step(rec.t[k:k + 1], rec.acc[k:k + 1], rec.gyr[k:k + 1]) for k in range(n)])
-    np.testing.assert_array_equal(stance, batch.stance_)
-    again = DGP(min_swing=0.2)
-    again.begin(rate)
-    steps = [again._advance(rec.t[k:k + 1], rec.acc[k:k + 1], rec.gyr[k:k + 1]) for k in range(n)]
-    np.testing.assert_allclose(np.concatenate([s[3] for s in steps]), batch.statistic_, rtol=1e-12, atol=1e-12)
+    live = DGP(min_swing=0.2).begin(RunContext(rate=rate))
+    steps = [live.step(rec.t[k:k + 1], rec.acc[k:k + 1], rec.gyr[k:k + 1]) for k in range(n)]
+    np.testing.assert_array_equal(np.concatenate([s["stance"] for s in steps]), batch.stance_)
+    np.testing.assert_allclose(np.concatenate([s["statistic"] for s in steps]), batch.statistic_, rtol=1e-12,
+                               atol=1e-12)
 
 
 def test_no_collapse_on_real_walking_and_running():

@@ -24,7 +24,7 @@ from .detector_sims import GAITS, RATES, walk
 def _provisional(rec):
     d = SpeedAdaptiveSHOE()
     T = SHOE().detect(rec.t, rec.acc, rec.gyr).statistic_
-    prov, _ = adaptive_threshold_kernel(rec.t, T, d.threshold, d.time_constant, d.max_threshold)
+    prov, _, _ = adaptive_threshold_kernel(rec.t, T, d.threshold, d.time_constant, d.max_threshold, rec.t[0])
     return close_short_swings(prov, int(round(d.min_swing * rec.rate)))
 
 

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from footzoo import Pipeline
+from footzoo import ConfigError, Pipeline
 from footzoo.apps.cli import main
 from footzoo.evaluation.metrics import loop_closure, pyshoe_error
 from footzoo.io import builtin_sample, load
@@ -120,3 +120,19 @@ def test_cli_reports_bad_data_cleanly(tmp_path, capsys):
     odd.write_text("a,b\n1,2\n")
     assert main(["run", CONFIG, "--data", str(odd)]) == 3
     assert "cannot tell the format" in capsys.readouterr().err
+
+
+def test_an_analysis_refuses_a_recording_it_cannot_use_before_the_run_starts(monkeypatch):
+    """huang2016 without a known foot: refused at once, not after the whole run (issue 24)."""
+    from footzoo.sim import simulate
+
+    rec = simulate(n_strides=3, rate=100.0)
+    rec.meta.pop("foot", None)
+    pipe = Pipeline.from_yaml("huang2016")
+
+    def no_detection(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(type(pipe), "detect", no_detection)
+    with pytest.raises(ConfigError, match=r"does not say which foot the sensor is on.*set foot: right"):
+        pipe.run(rec)

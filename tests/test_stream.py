@@ -219,6 +219,19 @@ def test_the_stream_keeps_only_what_is_pending(walk):
     assert max(held[10:]) <= 2 * np.median(held[10:]) + long.rate
 
 
+def test_a_kept_stream_gives_the_batch_result_with_its_strides(walk):
+    p = Pipeline.from_yaml("nguyen2016")
+    s = Stream(p, rate=walk.rate, keep=True, guess=False)
+    s.run(walk, chunk=CHUNKS)
+    res = s.result(meta={"name": "live walk"})
+    batch = p.run(walk)
+    np.testing.assert_allclose(res.pos, batch.pos, rtol=0, atol=1e-9)
+    assert len(res.steps) == len(batch.steps) and res.recording["name"] == "live walk"
+    np.testing.assert_allclose(res.steps["stride_length_m"], batch.steps["stride_length_m"], rtol=0, atol=1e-9)
+    with pytest.raises(ConfigError, match="keep=True"):
+        Stream(p).result()
+
+
 def test_stream_is_exported_at_the_top_level():
     from footzoo.runtime.stream import Stream as S
 

@@ -98,6 +98,10 @@ class HuangFPA(Analysis):
             )
         return 1 if foot == "right" else -1
 
+    def check(self, meta: dict) -> None:
+        """The recording must say which foot the sensor is on, unless ``foot`` does."""
+        self._side(meta)
+
     def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
                 meta: dict) -> HuangFPA:
         """FPA per stance (eqs. 12–16)."""

@@ -349,10 +349,14 @@ def cmd_configs(args: argparse.Namespace) -> int:
         print(f"wrote {target} (a copy of the shipped {library.path(args.copy).stem}); edit it and run "
               f"footzoo run {target}")
         return EXIT_OK
+    from ..runtime.pipeline import Pipeline
+
     for kind in ("pipeline", "study"):
         print(f"{kind} configs ({'footzoo ablate NAME' if kind == 'study' else 'footzoo run NAME'}):")
         for name in library.names(kind):
             print(f"  {name:<24} {_first_comment(library.path(name))}")
+            if kind == "pipeline":
+                print(f"  {'':<24} {live_summary(Pipeline.from_yaml(name))}")
     print("copy one to edit it: footzoo configs --copy NAME [--to FOLDER]")
     return EXIT_OK
 

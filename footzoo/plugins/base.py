@@ -465,6 +465,12 @@ class Analysis(Plugin):
         """Analyse a trajectory; returns ``self``."""
         raise NotImplementedError
 
+    def check(self, meta: dict[str, Any]) -> None:
+        """Refuse a recording the analysis cannot use (from its metadata) before a run spends any time on it.
+
+        Raise a footzoo error that names what is missing and the fix; default: accept every recording.
+        """
+
     def annotate(self, steps: Any, t: np.ndarray) -> Any:
         """The steps table with this analysis' columns."""
         raise NotImplementedError

@@ -307,10 +307,13 @@ class Pipeline:
         return rec.mag is not None and bool(getattr(self.orientation, "use_magnetometer", False))
 
     def _check_inputs(self, rec: Recording) -> None:
+        """Refuse, before any work, a recording that a block cannot use (a missing sensor, an unknown foot)."""
         for p in [*self.calibration, self.orientation, self.detector, *self.corrections, *self.analysis]:
             if p.needs_magnetometer and rec.mag is None:
                 raise RecordingError(f"{p.kind} {p.name!r} needs a magnetometer; the recording {rec.name!r} has none: "
                                      f"load one with mag_x, mag_y, mag_z or choose another {p.kind}")
+        for a in self.analysis:
+            a.check(dict(rec.meta))
 
     def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
         """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""

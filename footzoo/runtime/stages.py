@@ -15,11 +15,13 @@ samples' absolute index in ``k``.
 from __future__ import annotations
 
 import copy
+import warnings
 from typing import Any
 
 import numpy as np
 
 from ..core.context import RunContext
+from ..core.errors import GuardWarning
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
@@ -135,6 +137,7 @@ class DetectorStage:
     def __init__(self, detector: Detector, guard: StanceGuard, ctx: RunContext):
         self.detector = detector.clone().begin(ctx)
         self.guard = guard.stream(ctx)
+        self.ctx, self.max_swing = ctx, guard.max_swing
         self.raw = Queue()  # samples pushed whose detector stance is not final
         self.guarding = Queue()  # samples with their detector stance, whose guarded stance is not final
         self.last = True
@@ -151,9 +154,23 @@ class DetectorStage:
             if finish:
                 out = concat([out, self.guard.finish()])
             done = self._decided(self.guarding, out)
+            if length(out) and out["added"].any():
+                self._warn(out)
         if length(done):
             self.last = bool(done["stance"][-1])
         return done
+
+    def _warn(self, out: Chunk) -> None:
+        """The guard's warning of a batch run (:meth:`StanceGuard.warn`) for the long swings it closed here."""
+        added = out["added"]
+        starts = np.flatnonzero(added & ~np.concatenate([[False], added[:-1]]))
+        t_first = float(out["t"][starts[0]])
+        warnings.warn(f"{self.ctx.name}: detector {self.detector.name!r} found no stance for more than "
+                      f"{self.max_swing:g} s (guards.max_swing) before t = {float(out['t'][-1]):.2f} s. The stance "
+                      f"guard marked {starts.size} still instant(s) there as stance, the first at t = {t_first:.2f} s: "
+                      "the trajectory in that swing is suspect — the detector misses the stances of this motion "
+                      "(running?); choose one made for it, or switch the guard off with guards: {max_swing: 0}",
+                      GuardWarning, stacklevel=6)
 
     def held(self) -> int:
         """Samples waiting for the detector's or the guard's final stance."""

@@ -77,6 +77,10 @@ class Stream:
     max_pending : float
         Warn when this many seconds of samples wait for their final estimate (s): a detector that
         finds no stance keeps a dedrift or a smoother waiting, and the memory grows with it.
+    keep : bool
+        Also keep every final estimate (and the raw signals) for :meth:`result`: a whole
+        :class:`~footzoo.Result` at the end, strides and analyses included (memory grows with the
+        recording; off by default).
 
     Examples
     --------
@@ -88,7 +92,7 @@ class Stream:
 
     def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
                  max_wait: float = 10.0, fits: Any = None, warmup: float = STREAM_WARMUP, guess: bool = True,
-                 max_pending: float = 30.0):
+                 max_pending: float = 30.0, keep: bool = False):
         reasons = pipeline.live_problems(fits=_fit_reports(fits))
         if rate is not None and not (isinstance(rate, (int, float)) and not isinstance(rate, bool)
                                      and math.isfinite(rate) and rate > 0):
@@ -118,6 +122,8 @@ class Stream:
         self._has_mag: bool | None = None
         self._closed = False
         self._warned: set[str] = set()
+        self.keep = bool(keep)
+        self._kept: list[Chunk] = []
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
@@ -204,6 +210,32 @@ class Stream:
                 self._feed({}, finish=True)
         return self.final()
 
+    def result(self, meta: dict[str, Any] | None = None) -> Any:
+        """The whole run as a :class:`~footzoo.Result` (after :meth:`close`; needs ``keep=True``).
+
+        Its samples are the final estimates, its steps and analyses computed on them as a batch
+        run computes them; ``meta`` describes the recording (``name``, ``foot``, ...).
+        """
+        from ..core.data import Recording, Result
+        from ..core.table import samples_frame
+        from .pipeline import versions
+
+        if not self.keep:
+            raise ConfigError("Stream.result() needs the final estimates kept: Stream(..., keep=True)")
+        if not self._closed:
+            raise RecordingError("Stream.result(): close() the stream first (the last samples are not final yet)")
+        from ..plugins.incremental import concat
+
+        k = concat(self._kept)
+        rec = Recording(t=k["t"], acc=k["acc"], gyr=k["gyr"], mag=k.get("mag"), meta=dict(meta or {}))
+        stance = k["stance"].astype(bool)
+        steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
+        config = {**self.pipeline.to_dict(), "engine": "stream"}
+        diagnostics = {"calibration": self.fits} if self.fits is not None else {}
+        return Result(samples=samples_frame(k["t"], k["quat"], k["pos"], k["vel"], k["acc_nav"], stance),
+                      steps=steps, config=config, versions=versions(), recording=dict(rec.meta),
+                      diagnostics=diagnostics)
+
     def run(self, rec: Any, chunk: int | np.ndarray = 1) -> dict[str, np.ndarray]:
         """Push a whole recording and close: every sample's final estimate.
 
@@ -255,6 +287,8 @@ class Stream:
             out = stage.push(out, finish=finish) if (length(out) or finish) else {}
         if length(out):
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
+            if self.keep:
+                self._kept.append({k: v for k, v in out.items() if k in ("k", *COLUMNS, "acc", "gyr", "mag")})
             self._last_final = {k: out[k][-1] for k in ("k", "t", "quat", "pos", "vel", "stance")}
         self._check_pending()
 
