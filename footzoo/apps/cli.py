@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.conventions import ACC_UNITS, GYR_UNITS
-from ..core.errors import ConfigError, FootzooError, FormatError, RecordingError
+from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, RecordingError
 from ..io.canonical import FLOAT_FORMAT
 
 
@@ -53,10 +53,6 @@ EXIT_CODES_HELP = """exit codes:
   3    data error (unreadable, malformed or implausible recording; unwritable output)
   130  interrupted
 """
-
-
-class OutputError(FootzooError, OSError):
-    """An output location cannot be written (exit code 3)."""
 
 
 def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
