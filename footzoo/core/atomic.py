@@ -213,6 +213,13 @@ class FileGroup:
             if self.fsync:
                 os.fsync(fh.fileno())
 
+    def forget(self, target: PathLike) -> None:
+        """Drop ``target`` from the group (its temporary file is deleted; the final file is left as it is)."""
+        key = Path(os.path.abspath(target))
+        tmp = self._members.pop(key, None)
+        if tmp is not None:
+            _remove_quietly(tmp)
+
     def remove(self, target: PathLike) -> None:
         """Delete ``target`` (if it exists) when the group commits: a sidecar the new version no longer has."""
         t = Path(target)
