@@ -213,6 +213,16 @@ class _Packer:
         self.tables: dict[str, pd.DataFrame] = {}
         self.dropped: list[str] = []
 
+    @staticmethod
+    def _key(where: str, taken: dict[str, Any]) -> str:
+        """A file-name-safe key from the value's path (``diagnostics.guards.x`` -> ``diagnostics.guards.x``)."""
+        base = "".join(c if c.isalnum() or c in "._-" else "_" for c in where).strip("._") or "value"
+        key, n = base, 1
+        while key in taken or f"table_{key}" in taken:
+            n += 1
+            key = f"{base}_{n}"
+        return key
+
     def pack(self, value: Any, where: str) -> Any:
         if value is None or isinstance(value, (bool, str)):
             return value
@@ -238,11 +248,11 @@ class _Packer:
             if value.dtype == object:
                 self.dropped.append(f"{where}: an array of Python objects")
                 return {"$dropped": "object array"}
-            key = f"a{len(self.arrays)}"
+            key = self._key(where, self.arrays)
             self.arrays[key] = value
             return {"$array": key}
         if isinstance(value, (pd.DataFrame, pd.Series)):
-            key = f"table_{len(self.tables)}"
+            key = "table_" + self._key(where.replace(".", "_"), self.tables)
             self.tables[key] = value.to_frame() if isinstance(value, pd.Series) else value
             return {"$table": key, **({"series": str(value.name)} if isinstance(value, pd.Series) else {})}
         if isinstance(value, os.PathLike):
@@ -350,16 +360,16 @@ def _metrics_payload(result: Any) -> dict[str, Any]:
     return {"metrics": metrics, "config": result.config, "versions": result.versions, "recording": recording}
 
 
-def _result_files(result: Any, folder: Path, group: FileGroup, backend: str, prefix: str = "") -> dict[str, Any]:
+def _result_files(result: Any, folder: Path, group: FileGroup, backend: str) -> dict[str, Any]:
     """Write a result's files into ``folder`` through ``group``; returns the manifest's ``files``."""
     files: dict[str, Any] = {}
     for attr, holds in (("samples", "per-sample estimates (Result.samples)"),
                         ("steps", "per-stride table (Result.steps)")):
         name, info = _write_table(getattr(result, attr), group, folder, attr, backend)
-        files[prefix + name] = {"holds": holds, **info}
+        files[name] = {"holds": holds, **info}
     with group.open(folder / "metrics.json") as fh:
         fh.write(dumps_json(_metrics_payload(result)))
-    files[prefix + "metrics.json"] = {"holds": "Result.metrics, config, versions and the recording's plain metadata "
+    files["metrics.json"] = {"holds": "Result.metrics, config, versions and the recording's plain metadata "
                                                "(strict JSON, NaN as null; recomputed on load)", "kind": "json"}
     packer = _Packer()
     reference = None
@@ -372,22 +382,22 @@ def _result_files(result: Any, folder: Path, group: FileGroup, backend: str, pre
             "diagnostics": packer.pack(result.diagnostics, "diagnostics"), "reference": reference}
     for key, table in packer.tables.items():
         name, info = _write_table(table, group, folder, key, backend)
-        files[prefix + name] = {"holds": "a table of result.json (diagnostics or reference)", **info}
+        files[name] = {"holds": "a table of result.json (diagnostics or reference)", **info}
         _rename_table_refs(body, key, name)
     if packer.arrays:
         with group.open(folder / "arrays.npz", "wb") as fh:
             np.savez(fh, **packer.arrays)
-        files[prefix + "arrays.npz"] = {
+        files["arrays.npz"] = {
             "holds": "the arrays of result.json (diagnostics, reference)", "kind": "arrays",
             "arrays": {k: {"dtype": str(a.dtype), "shape": list(a.shape)} for k, a in packer.arrays.items()}}
     with group.open(folder / "result.json") as fh:
         fh.write(json.dumps(body, indent=1, allow_nan=False, ensure_ascii=False) + "\n")
-    files[prefix + "result.json"] = {"holds": "config, versions, recording metadata, diagnostics and the reference, "
+    files["result.json"] = {"holds": "config, versions, recording metadata, diagnostics and the reference, "
                                               "lossless (arrays and tables in the files listed here)", "kind": "json"}
     if packer.dropped:
         warnings.warn(FootzooWarning("Result.save: not saved (not plain values, arrays or tables): "
                                      + "; ".join(packer.dropped[:10])), stacklevel=4)
-        files[prefix + "result.json"]["dropped"] = packer.dropped
+        files["result.json"]["dropped"] = packer.dropped
     return files
 
 
@@ -483,32 +493,26 @@ def _read_manifest(folder: Path, kind: str) -> dict[str, Any]:
     return data
 
 
-def _load_result_files(folder: Path, files: dict[str, Any], prefix: str = "") -> Any:
+def _load_result_files(folder: Path, files: dict[str, Any]) -> Any:
     from .data import Result, Truth
 
     def table(stem: str) -> pd.DataFrame:
         for suffix in (".parquet", ".csv"):
-            name = prefix + stem + suffix
-            if name in files:
-                return _read_table(folder.parent if prefix else folder, name, files[name])
+            if stem + suffix in files:
+                return _read_table(folder, stem + suffix, files[stem + suffix])
         raise FormatError(f"{folder}: no {stem} table in the archive")
 
-    base = folder.parent if prefix else folder
-    body = json.loads((base / (prefix + "result.json")).read_text(encoding="utf-8"))
-    tables = {}
-    for name, info in files.items():
-        if info.get("kind") == "table" and Path(name).name.startswith("table_"):
-            tables[Path(name).name] = _read_table(base, name, info)
-    arrays_name = prefix + "arrays.npz"
+    body = json.loads((folder / "result.json").read_text(encoding="utf-8"))
+    tables = {name: _read_table(folder, name, info) for name, info in files.items()
+              if info.get("kind") == "table" and name.startswith("table_")}
     arrays: Any = {}
-    if arrays_name in files:
-        with np.load(base / arrays_name, allow_pickle=False) as npz:
+    if "arrays.npz" in files:
+        with np.load(folder / "arrays.npz", allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
     unpacker = _Unpacker(arrays, tables)
     reference = None
     if body.get("reference") is not None:
-        values = {k: unpacker.unpack(v) for k, v in body["reference"].items()}
-        reference = Truth(**values)
+        reference = Truth(**{k: unpacker.unpack(v) for k, v in body["reference"].items()})
     return Result(samples=table("samples"), steps=table("steps"), config=unpacker.unpack(body["config"]),
                   versions=unpacker.unpack(body["versions"]), recording=unpacker.unpack(body["recording"]),
                   diagnostics=unpacker.unpack(body["diagnostics"]), reference=reference)
@@ -533,7 +537,12 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
         for foot, result in session.results.items():
             sub = folder / foot
             sub.mkdir(exist_ok=True)
-            files.update(_result_files(result, sub, group, backend, prefix=f"{foot}/"))
+            own = _result_files(result, sub, group, backend)
+            with group.open(sub / MANIFEST) as fh:
+                fh.write(_manifest(FORMAT, backend, own, foot=foot))
+            files.update({f"{foot}/{name}": info for name, info in own.items()})
+            files[f"{foot}/{MANIFEST}"] = {"holds": f"the {foot} foot's result (Result.load reads this folder)",
+                                           "kind": "json"}
         for attr, holds in (("steps", "both feet's strides with step_time_s (SessionResult.steps; derived)"),
                             ("bilateral", "medians per foot and symmetry index (SessionResult.bilateral; derived)")):
             name, info = _write_table(getattr(session, attr), group, folder, attr, backend)
@@ -549,12 +558,7 @@ def load_session(path: str | os.PathLike) -> tuple[str, dict[str, Any]]:
     """``(name, {foot: Result})`` of a session saved by :func:`save_session`."""
     folder = Path(path)
     data = _read_manifest(folder, SESSION_FORMAT)
-    feet = data.get("feet") or []
-    results = {}
-    for foot in feet:
-        prefix = f"{foot}/"
-        sub = {k: v for k, v in data["files"].items() if k.startswith(prefix)}
-        results[foot] = _load_result_files(folder / foot, sub, prefix=prefix)
+    results = {str(foot): load_result(folder / str(foot)) for foot in data.get("feet") or []}
     return str(data.get("name", folder.name)), results
 
 

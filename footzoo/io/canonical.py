@@ -91,6 +91,22 @@ class CanonicalReader(Reader):
         return read(path, **options)
 
 
+def check_output(path: str | Path) -> Path:
+    """``path`` when :func:`write` writes its extension (``.csv``, ``.parquet``, ``.pq``), else an OutputError."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (*CSV_SUFFIXES, *PARQUET_SUFFIXES):
+        raise OutputError(f"{str(p)!r}: footzoo writes recordings as .csv or .parquet, not "
+                          f"{suffix or 'a file without extension'!r}; choose one of these extensions")
+    if suffix in PARQUET_SUFFIXES:
+        from ..core.archive import parquet_available
+
+        if not parquet_available():
+            raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
+                              "or write .csv")
+    return p
+
+
 def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     """Write a recording (with truth columns) as canonical CSV or Parquet plus its sidecars.
 
@@ -114,12 +130,9 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     OutputError
         For another extension, an unwritable place, or a path that is one of the recording's inputs.
     """
-    p = Path(path)
+    p = check_output(path)
     closed_loop = check_bool("closed_loop", closed_loop)
     suffix = p.suffix.lower()
-    if suffix not in (*CSV_SUFFIXES, *PARQUET_SUFFIXES):
-        raise OutputError(f"{str(p)!r}: footzoo writes recordings as .csv or .parquet, not "
-                          f"{suffix or 'no extension'!r}; choose one of these extensions")
     df = rec.to_dataframe()
     with FileGroup(inputs=input_files(rec.meta), what=f"writing {p.name}") as group:
         tmp = group.path(p)
