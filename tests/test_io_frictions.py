@@ -187,3 +187,22 @@ def test_a_gap_bridged_in_a_canonical_file_is_reported_not_refused(tmp_path):
     with pytest.warns(FootzooWarning, match="bridged 1 gap"):
         got = load(tmp_path / "g.csv")
     assert got.meta["diagnostics"]["gaps"]["longest_s"] == pytest.approx(0.13)
+
+
+def test_a_sidecar_that_cannot_be_written_leaves_no_data_file_without_it(tmp_path, monkeypatch):
+    from footzoo.io import canonical
+
+    old = simulate(n_strides=3, rate=100.0, noise=NoiseModel(seed=1))
+    p = write(old, tmp_path / "walk.csv")
+    before = {f.name: f.read_bytes() for f in tmp_path.iterdir()}
+
+    def full_disk(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(canonical, "facts_text", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        write(simulate(n_strides=5, rate=100.0, noise=NoiseModel(seed=2)), p)
+    assert {f.name: f.read_bytes() for f in tmp_path.iterdir()} == before  # the old three files, complete
+    with pytest.raises(OSError):
+        write(old, tmp_path / "new.csv")
+    assert sorted(f.name for f in tmp_path.iterdir()) == sorted(before)  # no data file without its sidecar
