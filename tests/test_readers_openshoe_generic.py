@@ -12,6 +12,7 @@ import shutil
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from footzoo import FormatError
@@ -222,3 +223,18 @@ def test_the_xio_example_described_by_a_sidecar_reads_as_the_xio_reader_reads_it
     np.testing.assert_array_equal(described.t, dedicated.t)
     np.testing.assert_array_equal(described.acc, dedicated.acc)
     np.testing.assert_array_equal(described.gyr, dedicated.gyr)
+
+
+def test_date_time_stamps_and_column_positions_with_a_header(walk, tmp_path):
+    stamps = pd.Timestamp("2025-03-01T09:30:00", tz="UTC") + pd.to_timedelta(np.round(walk.t * 1e6), unit="us")
+    signals = {f"c{i}": v for i, v in enumerate(np.hstack([walk.acc, walk.gyr]).T)}
+    df = pd.DataFrame({"when": stamps.strftime("%Y-%m-%dT%H:%M:%S.%f"), **signals})
+    p = tmp_path / "w.csv"
+    df.to_csv(p, index=False)
+    (tmp_path / "w.csv.footzoo.yaml").write_text("time: {column: when, unit: datetime}\n"
+                                                 "acc: {columns: [1, 2, 3], unit: m/s^2}\n"
+                                                 "gyr: {columns: [c3, c4, c5], unit: rad/s}\naxes: x, y, z\n")
+    rec = load(p)
+    np.testing.assert_allclose(rec.t - rec.t[0], np.round(walk.t * 1e6) * 1e-6, rtol=0, atol=5e-7)
+    assert rec.t[0] == pd.Timestamp("2025-03-01T09:30:00", tz="UTC").timestamp()
+    np.testing.assert_array_equal(rec.acc, walk.acc)

@@ -96,7 +96,7 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
         if key in declared:
             out[key] = value
         elif key in fixed:
-            if value != fixed[key]:
+            if not _same_unit(key, value, fixed[key]):
                 raise FormatError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
                                   f"{key}={value!r} cannot apply (drop the option)")
         elif key == "foot":
@@ -114,6 +114,16 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
     if foot is not None and foot not in ("left", "right"):
         raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
     return out, foot
+
+
+def _same_unit(key: str, value: Any, fixed: str) -> bool:
+    """True when ``value`` names the unit ``fixed`` (``m/s2`` is ``m/s^2``)."""
+    from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS
+
+    table = {"acc_unit": ACC_UNITS, "gyr_unit": GYR_UNITS, "dist_unit": DIST_UNITS}.get(key, {})
+    if isinstance(value, str) and value in table and fixed in table:
+        return table[value] == table[fixed]
+    return value == fixed
 
 
 def load(path: str | Path, format: str | None = None, **options: Any) -> Recording:

@@ -19,7 +19,9 @@ For a logger footzoo has no reader for, write ``<file>.footzoo.yaml`` next to th
     closed_loop: false                        # optional: the walk ends where it started
 
 Columns are named as in the header line, or given by position (0 is the first column) when
-``header: false``. Units: time ``s``, ``ms``, ``us``, ``ns``; acc ``m/s^2``, ``g``, ``mg``; gyr
+``header: false`` (positions work with a header too). Units: time ``s``, ``ms``, ``us``, ``ns``, or
+``datetime`` for date-time text such as ``2025-01-01T10:00:00.125`` (seconds since the Unix epoch;
+a double holds them to about 0.2 µs); acc ``m/s^2``, ``g``, ``mg``; gyr
 ``rad/s``, ``deg/s``; mag any (direction only). The axis map is a signed permutation or a
 rotation matrix; a left-handed map (determinant −1) is refused with the fix, because with it
 every turn would come out mirrored. Everything is converted once, here, to FRD and SI.
@@ -45,7 +47,7 @@ SIDECAR_SUFFIX = ".footzoo.yaml"
 #: Keys of a description.
 KEYS = ("time", "acc", "gyr", "mag", "axes", "delimiter", "decimal", "skip_rows", "header", "comment", "meta",
         "closed_loop")
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9, "datetime": None}
 DELIMITERS = {",": ",", ";": ";", "\t": "\t", "\\t": "\t", "tab": "\t", " ": r"\s+", "whitespace": r"\s+"}
 
 
@@ -109,7 +111,7 @@ class _Spec:
         if self.header and isinstance(value, str) and value:
             return value
         if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
-            return value
+            return value  # a position (resolved to the header's name when there is a header)
         kind = "a column name from the header line, or a position (0 = first)" if self.header else \
             "a position (0 = first column), since header: false"
         self.fail(key, f"{value!r} is not {kind}")
@@ -185,6 +187,16 @@ def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recor
     except (ValueError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as described in {side.name}: {err}") from None
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
+    names = list(df.columns)
+
+    def resolve(col: Any) -> Any:
+        if spec.header and isinstance(col, int) and col < len(names):
+            return names[col]
+        return col
+
+    spec.time = {**spec.time, "column": resolve(spec.time.get("column"))} if "column" in spec.time else spec.time
+    for block in (spec.acc, spec.gyr, *([spec.mag] if spec.mag else [])):
+        block["columns"] = [resolve(c) for c in block["columns"]]
     wanted = [spec.time.get("column"), *spec.acc["columns"], *spec.gyr["columns"],
               *(spec.mag["columns"] if spec.mag else [])]
     missing = [c for c in wanted if c is not None and c not in df.columns]
@@ -200,6 +212,8 @@ def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recor
     frame = pd.DataFrame()
     if "rate" in spec.time:
         frame["t"] = np.arange(len(df)) / spec.time["rate"]
+    elif spec.time["scale"] is None:
+        frame["t"] = _epoch_seconds(df[spec.time["column"]], path, side)
     else:
         frame["t"] = numbers([spec.time["column"]])[:, 0] * spec.time["scale"]
     frame[["acc_x", "acc_y", "acc_z"]] = apply_axes(spec.rows, numbers(spec.acc["columns"]) * spec.acc["scale"])
@@ -212,6 +226,18 @@ def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recor
         meta.setdefault("mag_unit", spec.mag["unit"])
     truth = Truth(closed_loop=True, source="closed loop (description)") if spec.closed_loop else None
     return Recording.from_dataframe(frame, meta=meta, truth=truth, **options)
+
+
+def _epoch_seconds(column: pd.Series, path: Path, side: Path) -> np.ndarray:
+    """Date-time text as seconds since the Unix epoch (integer nanoseconds first: no digit is lost)."""
+    try:
+        stamps = pd.to_datetime(column, utc=True, format="ISO8601")
+    except (ValueError, TypeError) as err:
+        raise FormatError(f"{path}: the time column {column.name!r} is not date-time text as {side.name} says "
+                          f"(time.unit: datetime): {err}") from None
+    ns = stamps.dt.as_unit("ns").astype("int64").to_numpy()
+    whole = ns // 1_000_000_000
+    return whole.astype(float) + (ns - whole * 1_000_000_000) * 1e-9
 
 
 class GenericReader(Reader):
