@@ -170,6 +170,8 @@ class FileGroup:
         Flush every file (and the folders' entries) to disk before returning. ``False`` is faster where
         durability against a power cut does not matter (a cache that is recomputed when damaged).
 
+    Notes
+    -----
     Use it as a context manager: on a normal exit every member is renamed into place and every
     file passed to :meth:`remove` deleted; on an exception (Ctrl-C included) the temporary files are
     deleted and nothing under a final name changes.
