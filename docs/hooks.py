@@ -3,7 +3,7 @@
 * ``zoo/``: one page per registered plug-in (summary, paper, parameters with
   defaults, units and meaning, YAML snippet, full docstring) and an index table;
   a plug-in registered tomorrow gets its page without any edit here.
-* ``readers/<format>.md``: one page per reader in ``footzoo.io.READERS`` (and per
+* ``readers/<format>.md``: one page per built-in reader (``footzoo.io.registry.BUILTIN``; and per
   other module of ``footzoo/io``, e.g. reference-data loaders), from the module
   docstring and the reader's options.
 * ``gallery/``: every ``docs/gallery/*.py`` script is run; the figures it saves
@@ -196,10 +196,11 @@ def plugin_nav() -> list[Any]:
 
 
 def reader_modules() -> tuple[dict[str, str], list[str]]:
-    """``({format: module name}, [other io module names])``."""
+    """``({format: module name}, [other io module names])`` of footzoo's own readers (not installed plug-ins)."""
     import footzoo.io as fio
+    from footzoo.io.registry import BUILTIN
 
-    readers = {fmt: fn.__module__ for fmt, fn in fio.READERS.items()}
+    readers = {fmt: target.split(":")[0] for fmt, target in BUILTIN.items()}
     used = set(readers.values())
     others = [f"footzoo.io.{m.name}" for m in pkgutil.iter_modules(fio.__path__)
               if f"footzoo.io.{m.name}" not in used and not m.name.startswith("_")]
@@ -207,30 +208,28 @@ def reader_modules() -> tuple[dict[str, str], list[str]]:
 
 
 def reader_pages() -> dict[str, str]:
-    import footzoo.io as fio
+    from footzoo.io.registry import BUILTIN, _load_target
 
     readers, others = reader_modules()
     pages = {}
     for fmt, modname in readers.items():
         mod = importlib.import_module(modname)
-        fn = fio.READERS[fmt]
-        sig = inspect.signature(fn)
-        params = numpy_section(inspect.getdoc(fn) or "", "Parameters")
+        reader = _load_target(BUILTIN[fmt])()
         lines = [f"# `{fmt}`: {first_line(inspect.getdoc(mod) or '')}", "",
                  "```bash", f"footzoo run yun2012 --data FILE --format {fmt}", "```", "",
                  "```python", "import footzoo", "", f'rec = footzoo.load("FILE", format="{fmt}")', "```", "",
-                 "The format is also detected from the file's extension and header when `format` is left out."]
-        opts = [p for p in sig.parameters.values() if p.name != "path" and p.kind is not p.VAR_KEYWORD]
-        if opts:
-            lines += ["", "## Options", "", "Keyword arguments of `footzoo.load` for this format:", "",
-                      "| option | default | meaning |", "|---|---|---|"]
-            for p in opts:
-                d = "required" if p.default is p.empty else f"`{p.default!r}`"
-                lines.append(f"| `{p.name}` | {md_cell(d)} | {md_cell(params.get(p.name, ''))} |")
-            if any(p.kind is p.VAR_KEYWORD for p in sig.parameters.values()):
-                lines.append("")
-                lines.append("Other keywords (units, `duplicates`, `nan_policy`, `max_gap`) go to "
-                             "[`Recording.from_dataframe`](../api.md#footzoo.core.data.Recording.from_dataframe).")
+                 "The format is also detected from the file when `format` is left out: "
+                 f"{md_cell(inspect.getdoc(reader.guess_can_open) or 'by its extension')}",
+                 "", f"Extensions: {', '.join(f'`{e}`' for e in reader.extensions) or 'any'}."]
+        if reader.fixed_units:
+            lines += ["", "Units the format fixes: " + ", ".join(f"`{k}={v}`" for k, v in reader.fixed_units.items())
+                      + " (a matching option is accepted, another one refused)."]
+        if reader.options:
+            lines += ["", "## Options", "", "Keyword arguments of `footzoo.load` for this format (command line: "
+                      "`--option NAME=VALUE`):", "", "| option | default | unit | meaning |", "|---|---|---|---|"]
+            for name, opt in reader.options.items():
+                lines.append(f"| `{name}` | {md_cell(f'`{opt.default!r}`')} | {md_cell(opt.unit)} | "
+                             f"{md_cell(opt.doc)} |")
         lines += ["", "## Format, units, axis map and reference data", "",
                   f"::: {modname}", "    options:", "      show_root_heading: false",
                   "      show_root_toc_entry: false", "      members: false", ""]

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+#: The shared recordings: ../shared/data next to the checkout, or the folder named by FOOTZOO_DATA.
+DATA = Path(os.environ.get("FOOTZOO_DATA") or Path(__file__).resolve().parents[1].parent / "shared" / "data")
 
 
 def data_file(*parts: str) -> Path:
@@ -19,7 +21,6 @@ def data_file(*parts: str) -> Path:
 
 def pytest_collection_modifyitems(config, items):
     """Skip ``nightly`` tests (long fuzz profiles) unless ``-m nightly`` or ``FOOTZOO_NIGHTLY=1``."""
-    import os
 
     if os.environ.get("FOOTZOO_NIGHTLY") == "1" or "nightly" in (config.getoption("-m") or ""):
         return

@@ -36,11 +36,21 @@ def test_a_short_gap_is_bridged_with_a_warning_and_listed_in_the_diagnostics():
 
 
 def test_a_gap_longer_than_the_limit_is_refused_with_the_fix():
-    df = still_frame().drop(index=range(200, 215)).reset_index(drop=True)  # 160 ms
-    with pytest.raises(RecordingError, match=r"longer than 100.0 ms, the first 160.0 ms at t = 1.990 s.*max_gap"):
+    df = still_frame().drop(index=range(200, 226)).reset_index(drop=True)  # 270 ms
+    with pytest.raises(RecordingError, match=r"longer than 250.0 ms, the first 270.0 ms at t = 1.990 s.*max_gap"):
         Recording.from_dataframe(df)
     with pytest.raises(RecordingError, match=r"longer than 40.0 ms"):
         Recording.from_dataframe(still_frame().drop(index=range(200, 205)), max_gap=0.04)
+
+
+@pytest.mark.parametrize("missing", [10, 11, 23])  # 110 ms, 120 ms and 240 ms intervals at 100 Hz
+def test_a_logger_dropout_of_a_tenth_of_a_second_is_bridged_with_a_warning_naming_it(missing):
+    """Issue 23: 3 of 56 annotated 100 Hz gait files were refused for one 110-120 ms gap."""
+    df = still_frame().drop(index=range(200, 200 + missing)).reset_index(drop=True)
+    with pytest.warns(FootzooWarning, match=r"bridged 1 gap.*1 of them longer than 0.1 s: one in a swing loses"):
+        rec = Recording.from_dataframe(df)
+    assert rec.meta["diagnostics"]["gaps"]["duration_s"] == pytest.approx([(missing + 1) / 100])
+    assert rec.meta["diagnostics"]["gaps"]["max_gap_s"] == DEFAULT_MAX_GAP == 0.25
 
 
 def test_a_regular_recording_has_no_gap_entry(recwarn):

@@ -6,6 +6,7 @@ import pytest
 
 from footzoo import Recording, RecordingError
 from footzoo.core.data import Truth
+from footzoo.core.errors import FootzooWarning
 
 
 def frame(n=400, rate=100.0, acc_scale=1.0, gyr_scale=1.0):
@@ -64,10 +65,11 @@ def test_duplicate_time_stamps_are_an_error_unless_dropped_with_a_count():
 
 
 def test_gaps_are_reported_with_their_length_and_place():
-    df = frame().drop(index=range(100, 120)).reset_index(drop=True)
-    with pytest.raises(RecordingError, match=r"gap\(s\) longer than 100.0 ms, the first 210.0 ms at t = 0.990 s"):
+    df = frame().drop(index=range(100, 130)).reset_index(drop=True)
+    with pytest.raises(RecordingError, match=r"gap\(s\) longer than 250.0 ms, the first 310.0 ms at t = 0.990 s"):
         Recording.from_dataframe(df)
-    assert Recording.from_dataframe(df, max_gap=0.3).n == 380
+    with pytest.warns(FootzooWarning, match="bridged 1 gap"):
+        assert Recording.from_dataframe(df, max_gap=0.4).n == 370
 
 
 def test_too_short_to_align():

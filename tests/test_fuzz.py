@@ -68,9 +68,13 @@ HEADERS = [
     "Time,d:scaledAccelX,d:scaledAccelY,d:scaledAccelZ,d:scaledGyroX,d:scaledGyroY,d:scaledGyroZ",
     "sensor,left_sensor,left_sensor,left_sensor,left_sensor,left_sensor,left_sensor\n"
     "axis,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z",
+    "\nInertial data.\n\nHeader: a_x [g]: a_y [g]: a_z [g]: ar_x [rad/s]: ar_y [rad/s]: ar_z [rad/s]: Counter: "
+    "Checksum: Nr: Filtered ts[s]: Unfiltered ts[s]: Pred. ts[s]: Freq. [Hz]: m_x [G]: m_y [G]: m_z [G]:",
+    "dummy_header " * 32,
 ]
 HEADER = st.one_of(st.sampled_from(HEADERS), st.text(max_size=60).filter(lambda s: "\n" not in s and "\r" not in s))
-ROWS = st.lists(st.lists(CELL, min_size=0, max_size=16).map(",".join), max_size=40)
+ROWS = st.lists(st.one_of(st.lists(CELL, min_size=0, max_size=17).map(",".join),
+                          st.lists(CELL, min_size=0, max_size=17).map("   ".join)), max_size=40)
 SCALAR = st.one_of(
     st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
     st.floats(0.0, 2.0), st.text(max_size=8), st.sampled_from(["no", "yes", "half", ".inf", "1:30", "0.5", "off"]),
@@ -177,6 +181,75 @@ def reader_on_near_valid_recording(text: str) -> None:
             assert np.all(np.diff(rec.t) > 0)
 
 
+def generic_descriptions(description: dict, text: str) -> None:
+    """A data file with a random description sidecar: a footzoo error, or a valid recording."""
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "r.csv"
+        p.write_text(text)
+        p.with_name("r.csv.footzoo.yaml").write_text(yaml.safe_dump(description, allow_unicode=True))
+        rec = _only_footzoo_errors(lambda: load(p))
+        if rec is not None:
+            assert np.isfinite(rec.acc).all() and np.all(np.diff(rec.t) > 0)
+
+
+_META_WALK: list = []
+
+
+def _meta_walk():
+    if not _META_WALK:
+        from footzoo.sim import simulate
+
+        _META_WALK.append(simulate(n_strides=2, rate=50.0))
+    return _META_WALK[0]
+
+
+def metadata_round_trip(meta: dict) -> None:
+    """Metadata written with a recording comes back with the same values and types (text stays text)."""
+    from footzoo.io.canonical import write
+
+    rec = _meta_walk()
+    saved = dict(rec.meta)
+    rec.meta.update(meta)
+    try:
+        with tempfile.TemporaryDirectory() as d:
+            back = load(write(rec, Path(d) / "w.csv"))
+    finally:
+        rec.meta.clear()
+        rec.meta.update(saved)
+    for key, value in meta.items():
+        got = back.meta[key]
+        assert type(got) is type(value) and (got == value or (value != value and got != got)), (key, value, got)
+
+
+def archive_tables(frame: pd.DataFrame) -> None:
+    """A table written in a result archive's CSV form reads back equal, dtypes and NaN included."""
+    from footzoo.core.archive import _read_table, _write_table
+    from footzoo.core.atomic import FileGroup
+
+    with tempfile.TemporaryDirectory() as d:
+        with FileGroup(fsync=False) as group:
+            name, info = _write_table(frame, group, Path(d), "t", "csv")
+        pd.testing.assert_frame_equal(_read_table(Path(d), name, info), frame, check_exact=True)
+
+
+TEXTS = st.one_of(st.none(), st.text(max_size=12), st.sampled_from(["1e3", "007", "true", "", "nan", ".inf", "0x1F",
+                                                                     "1:30", "null", "~", "- a", "a: b", "\n"]))
+
+
+@st.composite
+def tables(draw):
+    n = draw(st.integers(0, 6))
+    floats = st.floats(allow_nan=True, allow_infinity=True, width=64)
+    columns = {
+        "f": st.lists(floats, min_size=n, max_size=n).map(lambda v: np.array(v, dtype=float)),
+        "i": st.lists(st.integers(-2**62, 2**62), min_size=n, max_size=n).map(lambda v: np.array(v, dtype=np.int64)),
+        "b": st.lists(st.booleans(), min_size=n, max_size=n).map(lambda v: np.array(v, dtype=bool)),
+        "s": st.lists(TEXTS, min_size=n, max_size=n).map(lambda v: pd.Series(v, dtype=object)),
+    }
+    chosen = draw(st.lists(st.sampled_from(sorted(columns)), unique=True, min_size=1))
+    return pd.DataFrame({c: draw(columns[c]) for c in chosen})
+
+
 def yaml_text(text: str) -> None:
     _only_footzoo_errors(lambda: load_text(text, "fuzz.yaml"))
 
@@ -235,6 +308,15 @@ PROPERTIES = {
     "readers_on_csvish_text": (readers_on_csvish_text, (HEADER, ROWS, st.sampled_from(["utf-8", "latin-1"]))),
     "reader_on_near_valid_recording": (reader_on_near_valid_recording, (near_valid_recordings(),)),
     "yaml_text": (yaml_text, (st.one_of(YAMLISH, st.text(max_size=200)),)),
+    "generic_descriptions": (generic_descriptions, (
+        st.fixed_dictionaries({}, optional={k: VALUE for k in ("time", "acc", "gyr", "mag", "axes", "delimiter",
+                                                                "decimal", "skip_rows", "header", "meta")}),
+        st.one_of(near_valid_recordings(), st.text(max_size=200)))),
+    "metadata_round_trip": (metadata_round_trip, (st.dictionaries(
+        st.text(alphabet="abcdefgh_", min_size=1, max_size=6).map(lambda k: f"x_{k}"),
+        st.one_of(TEXTS.filter(lambda v: v is not None), st.booleans(), st.integers(-10**9, 10**9),
+                  st.floats(allow_nan=True, allow_infinity=True)), max_size=5),)),
+    "archive_tables": (archive_tables, (tables(),)),
     "config_files": (config_files, (configs(),)),
     "study_mappings": (study_mappings, (studies(),)),
     "stream_pushes": (stream_pushes, (st.lists(SAMPLE, min_size=0, max_size=120), st.booleans(),

@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate``.
+"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate | formats``.
 
 Bad input never prints a Python traceback: the message names the input, the
 problem and the fix, and the exit code says which kind of problem it was
@@ -27,18 +27,38 @@ from pathlib import Path
 from typing import Any
 
 from ..core.conventions import ACC_UNITS, GYR_UNITS
-from ..core.errors import ConfigError, FootzooError, FormatError, RecordingError
-from ..io.canonical import FLOAT_FORMAT
+from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, RecordingError
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
-    options: dict[str, Any] = {}
+    options: dict[str, Any] = dict(getattr(args, "option", None) or [])
     if getattr(args, "foot", None) and args.foot != "both":
         options["foot"] = args.foot
     for key in ("acc_unit", "gyr_unit"):
         if getattr(args, key, None):
             options[key] = getattr(args, key)
     return options
+
+
+def _reader_option(text: str) -> tuple[str, Any]:
+    """An argparse ``type``: ``NAME=VALUE`` (the value read as a YAML scalar: 820 is a number, true a boolean)."""
+    from ..core.yamlsafe import load_text
+
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=VALUE (e.g. --option rate=820)")
+    try:
+        parsed = load_text(value, "--option", ConfigError) if value.strip() else ""
+    except ConfigError:
+        parsed = value
+    return name.strip(), parsed
+
+
+def _output(text: str) -> str:
+    """An argparse ``type`` for ``--out``: a non-empty path (an empty one would write nothing, silently)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
+    return text
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -53,10 +73,6 @@ EXIT_CODES_HELP = """exit codes:
   3    data error (unreadable, malformed or implausible recording; unwritable output)
   130  interrupted
 """
-
-
-class OutputError(FootzooError, OSError):
-    """An output location cannot be written (exit code 3)."""
 
 
 def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
@@ -94,13 +110,10 @@ def _writable_dir(path: str, option: str = "--out") -> Path:
 
 def _writable_file(path: str, option: str = "--out") -> Path:
     """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
-    p = Path(path)
-    if p.is_dir():
-        raise OutputError(f"{option} {path!r} is a directory; give a file name")
-    folder = p.parent if str(p.parent) else Path(".")
-    if not folder.is_dir():
-        raise OutputError(f"{option} {path!r}: the folder {str(folder)!r} does not exist; create it first")
-    if (p.exists() and not os.access(p, os.W_OK)) or not os.access(folder, os.W_OK | os.X_OK):
+    from ..core.atomic import check_target
+
+    p = check_target(path, f"{option} {path!r}")
+    if p.exists() and not os.access(p, os.W_OK):
         raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable place")
     return p
 
@@ -141,15 +154,31 @@ def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
         print(f"  {key:32s} {value:.4f}" if isinstance(value, float) else f"  {key:32s} {value}")
 
 
-def _write_result(result, rec, out: Path, plot: bool) -> list[str]:
-    """samples.csv, steps.csv (units in the column names), metrics.json and optionally the run's figures."""
-    out.mkdir(parents=True, exist_ok=True)
-    result.samples.to_csv(out / "samples.csv", index=False, float_format=FLOAT_FORMAT)
-    result.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
-    payload = {"metrics": result.metrics, "config": result.config, "versions": result.versions,
-               "recording": {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}}
-    (out / "metrics.json").write_text(json.dumps(payload, indent=2, default=str))
-    written = ["samples.csv", "steps.csv", "metrics.json"]
+#: Files ``footzoo run --out DIR`` writes (a result archive with CSV tables, :mod:`footzoo.core.archive`).
+RUN_OUTPUTS = ("samples.csv", "steps.csv", "metrics.json", "result.json", "arrays.npz", "manifest.json")
+
+
+def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
+    """Every file the command read: the recording and its sidecars, the config."""
+    files = [str(f) for f in (rec.meta.get("input_files") or []) if f] if rec is not None else []
+    for name in ("data", "config"):
+        value = getattr(args, name, None)
+        if value and Path(value).is_file():
+            files.append(value)
+    return files
+
+
+def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], option: str = "--out") -> None:
+    """Refuse, before the run, an output folder whose files would replace an input."""
+    from ..core.atomic import refuse_inputs
+
+    refuse_inputs([folder / n for n in names], inputs, option)
+
+
+def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list[str]:
+    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) and optionally the figures."""
+    folder = result.save(out, backend="csv", inputs=inputs)
+    written = sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS)
     if plot:
         from ..evaluation.plots import plot_run
 
@@ -162,8 +191,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     from ..runtime.pipeline import Pipeline
 
     pipeline = Pipeline.from_yaml(args.config)
-    out = _writable_dir(args.out) if args.out else None
-    if args.plot and not args.out:
+    out = _writable_dir(args.out) if args.out is not None else None
+    if args.plot and out is None:
         print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
         return 2
     if _two_feet(args):
@@ -173,6 +202,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         rec = _load_recording(args)
     for w in caught:
         print(f"note: {w.message}", file=sys.stderr)
+    if out is not None:
+        _check_outputs(out, RUN_OUTPUTS, _inputs(args, rec))
     result = pipeline.run(rec)
     metrics = result.metrics
     if "pyshoe_trial_error" in rec.meta:
@@ -180,8 +211,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
     _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
     if out is not None:
-        written = _write_result(result, rec, out, args.plot)
-        print(f"wrote {', '.join(written)} to {args.out}")
+        written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
+        print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
     return 0
 
 
@@ -191,6 +222,12 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
     options = _reader_options(args)
     session = Session.load(args.data, format=args.format, **options)
+    inputs = [f for rec in session.recordings.values() for f in _inputs(args, rec)]
+    if args.out is not None:
+        out = Path(args.out)
+        _check_outputs(out, ("steps.csv", "bilateral.csv", "manifest.json"), inputs)
+        for foot in session.recordings:
+            _check_outputs(out / foot, RUN_OUTPUTS, inputs)
     res = session.run(pipeline)
     for foot, r in res.results.items():
         rec = session.recordings[foot]
@@ -199,13 +236,17 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
                        r.metrics)
     print("bilateral (medians; symmetry index = 100 |L - R| / mean, %)")
     print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
-    if args.out:
+    if args.out is not None:
         out = Path(args.out)
-        for foot, r in res.results.items():
-            written = _write_result(r, session.recordings[foot], out / foot, args.plot)
-        res.steps.to_csv(out / "steps.csv", index=False, float_format=FLOAT_FORMAT)
-        res.bilateral.to_csv(out / "bilateral.csv", float_format=FLOAT_FORMAT)
-        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out}")
+        res.save(out, backend="csv", inputs=inputs)
+        written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
+        if args.plot:
+            from ..evaluation.plots import plot_run
+
+            for foot, r in res.results.items():
+                plot_run(r, out / foot, session.recordings[foot])
+        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out} "
+              f"(footzoo.SessionResult.load({str(out)!r}) reads it back)")
     return 0
 
 
@@ -259,7 +300,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """Simulate a recording with ground truth and write it as canonical CSV/Parquet."""
     import numpy as np
 
-    from ..io.canonical import write
+    from ..io.canonical import check_output, write
     from ..sim import (
         DistanceSensors,
         MagneticDisturbance,
@@ -269,7 +310,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         simulate_pendulum,
     )
 
-    _writable_file(args.out)
+    check_output(_writable_file(args.out))
     biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
     noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
     if args.scenario == "pendulum":
@@ -296,12 +337,15 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..analysis.foot_vector import calibrate_foot_vector
+    from ..core.atomic import atomic_path, refuse_inputs
 
-    _writable_file(args.out)
+    target = _writable_file(args.out)
     rec = _load_recording(args)
+    refuse_inputs([target], _inputs(args, rec), "--out")
     fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
                                flex=tuple(args.flex) if args.flex else None)
-    fv.save(args.out)
+    with atomic_path(target, inputs=_inputs(args, rec), what="--out") as tmp:
+        fv.save(tmp)
     yaw = np.degrees(np.arctan2(-fv.vector[1], fv.vector[0]))
     print(f"foot vector (sensor frame, FRD): {np.round(fv.vector, 4).tolist()}  "
           f"(sensor yawed {yaw:.2f}° on the foot)")
@@ -330,6 +374,26 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
     return 0
+
+
+def cmd_formats(args: argparse.Namespace) -> int:
+    """Print every reader footzoo can use (built-in and installed): name, extensions, description, options."""
+    from ..io.registry import available
+
+    readers = available()
+    for name, reader in readers.items():
+        origin = readers.origins.get(name, "")
+        exts = ", ".join(getattr(reader, "extensions", ()) or ()) or "any file"
+        print(f"{name:<14} {getattr(reader, 'description', '')}")
+        print(f"{'':<14} files: {exts}{'' if origin == 'footzoo' else f'; from {origin}'}")
+        for opt, spec in (getattr(reader, "options", None) or {}).items():
+            unit = f" [{spec.unit}]" if getattr(spec, "unit", "") else ""
+            print(f"{'':<16} --option {opt}=...{unit}  default {getattr(spec, 'default', None)!r}: "
+                  f"{getattr(spec, 'doc', '')}")
+    for name, reason in readers.broken.items():
+        print(f"{name:<14} NOT AVAILABLE: {reason}")
+    print("read a file with: footzoo run CONFIG --data FILE [--format NAME] [--option NAME=VALUE ...]")
+    return EXIT_OK
 
 
 def cmd_list_compat(args: argparse.Namespace) -> int:
@@ -384,13 +448,18 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
     run.add_argument("config", help="pipeline YAML, e.g. yun2012")
     run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
-    run.add_argument("--format", help="canonical, xio, pyshoe, gaitmap or sensorconnect (default: detect)")
+    run.add_argument("--format", help="reader name: canonical, xio, pyshoe, gaitmap, sensorconnect, openshoe, "
+                     "generic or an installed one (footzoo formats lists them; default: detect)")
     run.add_argument("--foot", choices=["left", "right", "both"],
                      help="foot to read from a two-foot file (gaitmap; default: both when the file has both), "
                           "or the foot a one-foot recording is from")
     run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
     run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
-    run.add_argument("--out", help="directory for samples.csv, steps.csv, metrics.json")
+    run.add_argument("--option", action="append", type=_reader_option, metavar="NAME=VALUE",
+                     help="a reader option (repeatable), e.g. --option rate=820; footzoo formats lists them")
+    run.add_argument("--out", type=_output, help="directory for the result: samples.csv, steps.csv, metrics.json "
+                     "(+ result.json, arrays.npz, manifest.json: footzoo.Result.load(DIR) reads it back); written "
+                     "atomically, never over an input")
     run.add_argument("--plot", action="store_true", help="also write the run's figures: trajectory, states, "
                      "errors (with a reference), strides, fpa (.png, needs --out)")
     run.set_defaults(func=cmd_run)
@@ -406,7 +475,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
     sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
                                           "calibration"])
-    sim.add_argument("--out", required=True, help="output file (.csv or .parquet); truth in true_* columns")
+    sim.add_argument("--out", required=True, type=_output,
+                     help="output file (.csv or .parquet); truth in true_* columns, with its sidecars")
     sim.add_argument("--strides", type=_number(1, 100_000, integer=True), default=100,
                      help="strides of a straight walk (default 100)")
     sim.add_argument("--stride-length", type=_number(0.05, 5.0, "m"), default=1.2,
@@ -438,7 +508,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="still period (s); default: found")
     cal.add_argument("--flex", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
                      help="flexion period (s); default: found")
-    cal.add_argument("--out", required=True, help="YAML file to write")
+    cal.add_argument("--option", action="append", type=_reader_option, metavar="NAME=VALUE",
+                     help="a reader option (repeatable), e.g. --option rate=820")
+    cal.add_argument("--out", required=True, type=_output, help="YAML file to write (never over the recording)")
     cal.set_defaults(func=cmd_calibrate)
 
     abl = sub.add_parser("ablate", help="run an ablation study (configs x recordings) and write tables and plots")
@@ -455,6 +527,9 @@ def build_parser() -> argparse.ArgumentParser:
     lst.add_argument("--compatibility", action="store_true",
                      help="print which orientation x correction combinations validate, and why not")
     lst.set_defaults(func=lambda a: cmd_list_compat(a) if a.compatibility else cmd_list(a))
+
+    fmt = sub.add_parser("formats", help="list the readers (file formats) with their options, installed ones too")
+    fmt.set_defaults(func=cmd_formats)
 
     cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
     cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")

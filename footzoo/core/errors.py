@@ -19,6 +19,10 @@ class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
 
 
+class OutputError(FootzooError, OSError):
+    """An output cannot be written: an unwritable or missing location, or it would replace an input."""
+
+
 class PluginError(FootzooError):
     """A plug-in broke its contract or raised: the fault is the plug-in's, not footzoo's nor the data's.
 

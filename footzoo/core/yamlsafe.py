@@ -251,3 +251,28 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
             "save the file as UTF-8 (e.g. iconv -f latin1 -t utf-8)"
         ) from None
     return load_text(text, str(p), error)
+
+
+class StrictDumper(yaml.SafeDumper):
+    """PyYAML's safe dumper, quoting every text that :class:`StrictLoader` would read as something else.
+
+    PyYAML writes YAML 1.1: ``'1e3'``, ``'0o17'`` or ``'.5'`` come out unquoted and a YAML 1.2
+    loader reads them back as numbers. Here any string that the strict loader would resolve to
+    a non-string (number, boolean, null) is written quoted, so text stays text.
+    """
+
+
+def _represent_str(dumper: StrictDumper, value: str) -> yaml.ScalarNode:
+    tag = StrictLoader.resolve(StrictLoader, ScalarNode, value, (True, False))  # type: ignore[arg-type]
+    node = dumper.represent_scalar("tag:yaml.org,2002:str", value)
+    if tag != "tag:yaml.org,2002:str" and node.style is None:
+        node.style = "'"
+    return node
+
+
+StrictDumper.add_representer(str, _represent_str)
+
+
+def dump_text(data: Any) -> str:
+    """YAML text of ``data`` that :func:`load_text` reads back to equal values (text stays text)."""
+    return yaml.dump(data, Dumper=StrictDumper, allow_unicode=True, sort_keys=False)

@@ -1,7 +1,9 @@
 """Readers: every supported format converted once to a :class:`~footzoo.core.data.Recording` (FRD, SI).
 
-``load(path, format=None, **options)`` picks the reader from ``format`` or, when
-``format`` is None, from the file's extension and header.
+``load(path, format=None, **options)`` picks the reader from ``format`` or, when ``format`` is
+None, asks every reader whether it recognises the file (:mod:`footzoo.io.registry`). Readers
+are plug-ins of the entry-point group ``footzoo.readers`` (:mod:`footzoo.io.base`): the formats
+below are registered there by footzoo itself, and an installed package adds its own the same way.
 
 Formats and their axis maps (sensor axes -> FRD):
 
@@ -15,47 +17,51 @@ pyshoe         m/s², rad/s                    already x fwd, y right, z down; V
 gaitmap        m/s², deg/s                    foot frame x toe, y left, z up: (x, −y, −z)
                                               for both feet (see gaitmap.py)
 sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down: identity
+openshoe       g or m/s², rad/s, Gauss        z up in the heel: (x, −y, −z), or ``axes=``
+generic        declared in the sidecar        declared in the sidecar (``axes:``)
 ============== ============================== ============================================
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 from ..core.data import Recording
-from ..core.errors import FootzooError, FormatError, did_you_mean
-from . import canonical, gaitmap, pyshoe, sensorconnect, xio
-
-READERS: dict[str, Callable[..., Recording]] = {
-    "canonical": canonical.read,
-    "xio": xio.read,
-    "pyshoe": pyshoe.read,
-    "gaitmap": gaitmap.read,
-    "sensorconnect": sensorconnect.read,
-}
+from ..core.errors import FootzooError, FormatError, RecordingError
+from .base import REQUIRED, Option, Reader
+from .metadata import read_facts
+from .registry import GROUP, available, refresh
 
 
-#: What each CSV reader expects on the first line (shown when a header is not recognised).
-EXPECTED_HEADERS: dict[str, str] = {
-    "canonical": "columns t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z (optional mag_x..z, dist_*, true_*), "
-                 "SI units unless acc_unit/gyr_unit are declared",
-    "xio": "Time (s), Gyroscope X (deg/s), ..., Accelerometer X (g), ...",
-    "gaitmap": "two header rows: sensor,left_sensor,...,right_sensor,... then ,acc_x,...,gyr_z",
-    "sensorconnect": "Time, <device>:scaledAccelX, ..., <device>:scaledGyroX, ...",
-}
+class _ReaderTable(Mapping[str, Any]):
+    """``READERS``: the available readers by name (discovered at first use)."""
+
+    def __getitem__(self, name: str) -> Any:
+        return available()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(available())
+
+    def __len__(self) -> int:
+        return len(available())
+
+    def __repr__(self) -> str:
+        return repr(available())
 
 
-#: Longest header line read when detecting a format (characters).
-HEADER_MAX_CHARS = 64 * 1024
+#: Every available reader by format name, built-in and installed (see :mod:`footzoo.io.registry`).
+READERS: Mapping[str, Any] = _ReaderTable()
 
 
 def check_input_file(path: str | Path, what: str = "recording") -> Path:
     """The path of an existing, readable, non-empty regular file, or a :class:`FormatError` saying why not."""
     if not isinstance(path, (str, os.PathLike)):
         raise FormatError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
+    if not str(path).strip():
+        raise FormatError(f"{what} is an empty path; give the path of a recording file")
     p = Path(path)
     try:
         if not p.exists():
@@ -76,32 +82,48 @@ def check_input_file(path: str | Path, what: str = "recording") -> Path:
 
 
 def detect_format(path: str | Path) -> str:
-    """Guess a file's format from its extension and first line."""
-    p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix == ".mat":
-        return "pyshoe"
-    if suffix in (".parquet", ".pq"):
-        return "canonical"
-    if suffix in (".csv", ".txt"):
-        with open(p, encoding="utf-8", errors="replace") as fh:
-            head = fh.readline(HEADER_MAX_CHARS)
-        if not head.strip():
-            raise FormatError(f"{p}: the file is empty (no header line)")
-        if xio.matches(head):
-            return "xio"
-        if gaitmap.matches(head):
-            return "gaitmap"
-        if sensorconnect.matches(head):
-            return "sensorconnect"
-        if canonical.matches(head):
-            return "canonical"
-        raise FormatError(
-            f"{p}: cannot tell the format from the header {head.strip()[:80]!r}. Expected one of: "
-            + "; ".join(f"{k}: {v}" for k, v in EXPECTED_HEADERS.items())
-            + f". Rename the columns, or pass format= one of {sorted(READERS)} (command line: --format)"
-        )
-    raise FormatError(f"{p}: unknown extension {suffix!r}; pass format= one of {sorted(READERS)}")
+    """The format of a file: the one reader whose ``guess_can_open`` accepts it (:meth:`Readers.detect`)."""
+    return available().detect(Path(path))
+
+
+def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> tuple[dict[str, Any], Any]:
+    """The options to pass to ``reader.open`` and the declared foot (handled here when the reader has no ``foot``)."""
+    declared: dict[str, Option] = dict(getattr(reader, "options", None) or {})
+    fixed: dict[str, str] = dict(getattr(reader, "fixed_units", None) or {})
+    out: dict[str, Any] = {}
+    foot = None
+    for key, value in options.items():
+        if key in declared:
+            out[key] = value
+        elif key in fixed:
+            if not _same_unit(key, value, fixed[key]):
+                raise FormatError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
+                                  f"{key}={value!r} cannot apply (drop the option)")
+        elif key == "foot":
+            foot = value
+        else:
+            valid = sorted({*declared, "foot"})
+            from ..core.errors import did_you_mean
+
+            raise FormatError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
+                              f"{valid} (see footzoo.io.READERS[{fmt!r}].options)")
+    missing = [k for k, o in declared.items() if o.default is REQUIRED and k not in out]
+    if missing:
+        raise FormatError(f"{path}: the {fmt} reader needs the option(s) {missing}: "
+                          + "; ".join(f"{k}: {declared[k].doc}" for k in missing))
+    if foot is not None and foot not in ("left", "right"):
+        raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
+    return out, foot
+
+
+def _same_unit(key: str, value: Any, fixed: str) -> bool:
+    """True when ``value`` names the unit ``fixed`` (``m/s2`` is ``m/s^2``)."""
+    from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS
+
+    table = {"acc_unit": ACC_UNITS, "gyr_unit": GYR_UNITS, "dist_unit": DIST_UNITS}.get(key, {})
+    if isinstance(value, str) and value in table and fixed in table:
+        return table[value] == table[fixed]
+    return value == fixed
 
 
 def load(path: str | Path, format: str | None = None, **options: Any) -> Recording:
@@ -112,50 +134,49 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     path : str or Path
         File to read.
     format : str, optional
-        One of ``canonical``, ``xio``, ``pyshoe``, ``gaitmap``, ``sensorconnect``;
-        detected from the file when omitted.
+        A reader's name (``canonical``, ``xio``, ``pyshoe``, ``gaitmap``, ``sensorconnect``,
+        ``openshoe``, ``generic`` or an installed reader's, see ``footzoo.io.READERS``); when
+        omitted, the one reader that recognises the file.
     **options
-        Reader options, e.g. ``foot="left"`` for gaitmap (which sensor to read;
-        for other formats it declares the foot, and must agree with a format
-        that knows it: PyShoe's sensor is on the right foot), ``acc_unit="g"``
-        and ``gyr_unit="deg/s"`` for canonical files (the other formats fix
-        their units), ``duplicates="drop"``.
+        Reader options (``footzoo.io.READERS[format].options``), e.g. ``foot="left"`` for gaitmap
+        (which sensor to read; for other formats it declares the foot, and must agree with a
+        format that knows it: PyShoe's sensor is on the right foot), ``acc_unit="g"`` and
+        ``gyr_unit="deg/s"`` for canonical files (the other formats fix their units), ``duplicates="drop"``.
+
+    Raises
+    ------
+    FormatError
+        For a file no reader (or more than one) recognises, an unknown option, or a file the
+        reader cannot read; :class:`~footzoo.core.errors.RecordingError` for data that fails validation.
     """
     p = check_input_file(path)
-    if format is not None and format not in READERS:
-        raise FormatError(
-            f"unknown format {format!r}{did_you_mean(str(format), list(READERS))}; valid: {sorted(READERS)}"
-        )
-    fmt = format or detect_format(p)
-    if fmt not in READERS:
-        raise FormatError(f"unknown format {fmt!r}{did_you_mean(fmt, list(READERS))}; valid: {sorted(READERS)}")
-    for key in ("acc_unit", "gyr_unit"):
-        fixed = FIXED_UNITS.get(fmt, {}).get(key)
-        if key in options and fixed is not None:
-            if options[key] != fixed:
-                raise FormatError(f"{p}: {fmt} files store {key.split('_')[0]} in {fixed}; "
-                                  f"{key}={options[key]!r} cannot apply (drop the option)")
-            del options[key]
-    foot = options.pop("foot", None) if fmt != "gaitmap" else None
-    if foot is not None and foot not in ("left", "right"):
-        raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
+    readers = available()
+    fmt = readers.detect(p) if format is None else format
+    reader = readers.get_reader(fmt)
+    kwargs, foot = _options_for(reader, fmt, p, options)
+    origin = readers.origins.get(fmt, "footzoo")
     try:
-        rec = READERS[fmt](p, **options)
+        rec = reader.open(p, **kwargs)
+    except RecordingError as err:
+        if str(p) in str(err) or p.name in str(err):
+            raise
+        raise RecordingError(f"{p}: {err}") from None  # name the file: a study reads many
     except FootzooError:
         raise
-    except TypeError as err:
-        if "unexpected keyword argument" in str(err):
-            raise FormatError(f"{fmt} reader: {err}; see help(footzoo.io.{fmt}.read) for its options") from err
-        raise FormatError(f"{p}: cannot read as {fmt}: {type(err).__name__}: {err}") from err
     except UnicodeDecodeError as err:
         raise FormatError(
             f"{p}: not UTF-8 text (byte offset {err.start}); is it really a {fmt} file? Pass format= if not"
         ) from err
     except Exception as err:  # parsing untrusted bytes: any library error means "not this format"
+        who = f"{fmt}" if origin == "footzoo" else f"{fmt} (reader from {origin})"
         raise FormatError(
-            f"{p}: cannot read as {fmt}: {type(err).__name__}: {str(err)[:300]}; check the file, or pass the "
-            f"right format= (one of {sorted(READERS)})"
+            f"{p}: cannot read as {who}: {type(err).__name__}: {str(err)[:300]}; check the file, or pass the "
+            f"right format= (one of {sorted(readers)})"
         ) from err
+    if not isinstance(rec, Recording):
+        raise FormatError(f"the {fmt} reader ({origin}) returned {type(rec).__name__}, not a footzoo Recording; "
+                          "its open() must return footzoo.Recording (fix the reader)")
+    _complete_meta(rec, p, fmt, reader)
     if foot is not None:
         known = rec.meta.get("foot")
         if known is not None and known != foot:
@@ -165,16 +186,29 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     return rec
 
 
-#: Units a format fixes (a reader converts them itself); canonical files take acc_unit/gyr_unit.
-FIXED_UNITS: dict[str, dict[str, str]] = {
-    "xio": {"acc_unit": "g", "gyr_unit": "deg/s"},
-    "pyshoe": {"acc_unit": "m/s^2", "gyr_unit": "rad/s"},
-    "gaitmap": {"acc_unit": "m/s^2", "gyr_unit": "deg/s"},
-    "sensorconnect": {"acc_unit": "g", "gyr_unit": "rad/s"},
-}
+def _complete_meta(rec: Recording, path: Path, fmt: str, reader: Any) -> None:
+    """Name, source, format and input files in ``rec.meta``; a metadata sidecar's facts for readers that ignore it."""
+    rec.meta.setdefault("source", str(path))
+    rec.meta.setdefault("format", fmt)
+    files = [str(f) for f in rec.meta.get("input_files") or []]
+    if str(path) not in files:
+        files.insert(0, str(path))
+    if not getattr(reader, "reads_metadata_sidecar", False):
+        facts = read_facts(path)
+        for key, value in facts.meta.items():
+            rec.meta.setdefault(key, value)
+        if facts.closed_loop is not None:
+            from ..core.data import Truth
+
+            if rec.truth is None:
+                rec.truth = Truth(source="closed loop (metadata sidecar)")
+            rec.truth.closed_loop = facts.closed_loop
+        files += [str(f) for f in facts.files if str(f) not in files]
+    rec.meta["input_files"] = files
 
 
-__all__ = ["READERS", "builtin_sample", "check_input_file", "detect_format", "load"]
+__all__ = ["GROUP", "READERS", "Option", "Reader", "builtin_sample", "check_input_file",
+           "detect_format", "load", "refresh"]
 
 
 def builtin_sample() -> Recording:
@@ -182,9 +216,12 @@ def builtin_sample() -> Recording:
     import warnings
     from importlib.resources import as_file, files
 
+    from . import xio
+
     with as_file(files("footzoo.samples") / "xio_short_walk.csv.gz") as p, warnings.catch_warnings():
         # the file's 205 exact duplicate rows are dropped on purpose; the count is in meta
         warnings.simplefilter("ignore", UserWarning)
-        rec = xio.read(Path(p))
+        rec = xio.read(Path(p), closed_loop=True)
     rec.meta.update(name="xio_short_walk", source="footzoo built-in sample (x-io Technologies, MIT)")
+    rec.truth.source = "closed loop (x-io Gait-Tracking short_walk.csv)"
     return rec

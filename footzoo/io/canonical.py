@@ -2,9 +2,11 @@
 
 SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``).
 A file written by ``footzoo simulate`` also carries its ground truth in
-``true_*`` columns, a sidecar ``<file>.meta.yaml`` (metadata and the
-``closed_loop`` marker) and the true steps in ``<file>.steps.csv`` (every true
-stride: its row count becomes ``truth.stride_count``).
+``true_*`` columns, a metadata sidecar ``<file>.meta.yaml`` (metadata and the
+``closed_loop`` marker, :mod:`footzoo.io.metadata`) and the true steps in
+``<file>.steps.csv`` (every true stride: its row count becomes ``truth.stride_count``).
+:func:`write` writes the three files as one unit (atomically, never over an input), and
+removes the steps sidecar of an earlier file of the same name when the new one has none.
 """
 
 from __future__ import annotations
@@ -13,17 +15,21 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
-import yaml
 
+from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.data import Recording
-from ..core.errors import FormatError
-from ..core.yamlsafe import load_file
+from ..core.errors import FormatError, OutputError
+from .base import RECORDING_OPTIONS, Option, Reader, first_line, input_files, text_source
+from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"
 #: ``pd.read_csv`` options that parse those digits back exactly (pandas 3 does by default).
 EXACT_CSV: dict[str, Any] = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+#: File suffixes of the canonical format.
+CSV_SUFFIXES = (".csv",)
+PARQUET_SUFFIXES = (".parquet", ".pq")
 
 
 def matches(header: str) -> bool:
@@ -35,54 +41,114 @@ def matches(header: str) -> bool:
 def read(path: Path, **options: Any) -> Recording:
     """Read a canonical CSV or Parquet file (options go to ``Recording.from_dataframe``)."""
     try:
-        if path.suffix.lower() in (".parquet", ".pq"):
+        if path.suffix.lower() in PARQUET_SUFFIXES:
             df = pd.read_parquet(path)
         else:
-            df = pd.read_csv(path, comment="#", **EXACT_CSV)
+            df = pd.read_csv(text_source(path), comment="#", **EXACT_CSV)
     except UnicodeDecodeError as err:
         raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
+    facts = read_facts(path)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "canonical"}
-    sidecar = path.with_name(path.name + ".meta.yaml")
-    extra = load_file(sidecar, FormatError, "metadata sidecar") if sidecar.exists() else {}
-    extra = {} if extra is None else extra
-    fix = f"fix or delete {sidecar.name} (footzoo simulate writes it: meta: {{...}}, closed_loop: true|false)"
-    if not isinstance(extra, dict):
-        raise FormatError(f"{sidecar}: expected a mapping with 'meta' and 'closed_loop', got {extra!r:.80}; {fix}")
-    if not isinstance(extra.get("meta", {}) or {}, dict):
-        raise FormatError(f"{sidecar}: 'meta' must be a mapping, got {extra['meta']!r:.80}; {fix}")
-    closed_loop = extra.get("closed_loop", False)
-    if not isinstance(closed_loop, bool):
-        raise FormatError(f"{sidecar}: closed_loop must be true or false, got {closed_loop!r}; {fix}")
-    meta.update(extra.get("meta") or {})
+    meta.update(facts.meta)
+    meta["input_files"] = [str(path), *map(str, facts.files)]
     rec = Recording.from_dataframe(df, meta=meta, **options)
     if rec.truth is not None:
-        rec.truth.closed_loop = closed_loop
-        steps = path.with_name(path.name + ".steps.csv")
-        if steps.exists():
+        rec.truth.closed_loop = bool(facts.closed_loop)
+        if facts.steps is not None:
             try:
-                rec.truth.steps = pd.read_csv(steps, **EXACT_CSV)
+                rec.truth.steps = pd.read_csv(facts.steps, **EXACT_CSV)
             except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
-                raise FormatError(f"{steps}: cannot read the true steps: {err}; fix or delete the file") from None
+                raise FormatError(f"{facts.steps}: cannot read the true steps: {err}; fix or delete the file") from None
             rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
         if meta.get("source") == "footzoo.sim":
             rec.truth.source = "simulator"
     return rec
 
 
-def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
-    """Write a recording (with truth columns) as canonical CSV or Parquet plus a sidecar."""
+class CanonicalReader(Reader):
+    """footzoo's own format: canonical column names, SI units and FRD axes (or declared units)."""
+
+    reads_metadata_sidecar = True
+    description = ("footzoo's canonical CSV/Parquet: columns t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z (optional "
+                   "mag_x..z, dist_*, true_*), SI units unless acc_unit/gyr_unit are declared")
+    extensions = (*CSV_SUFFIXES, *PARQUET_SUFFIXES)
+    options = {
+        "acc_unit": Option("m/s^2", "", "unit of the acc columns: 'm/s^2', 'g' or 'mg'"),
+        "gyr_unit": Option("rad/s", "", "unit of the gyr columns: 'rad/s' or 'deg/s'"),
+        "dist_unit": Option("m", "", "unit of the dist columns: 'm', 'cm' or 'mm'"),
+        **RECORDING_OPTIONS,
+    }
+
+    def guess_can_open(self, path: Path) -> bool:
+        suffix = Path(path).suffix.lower()
+        if suffix in PARQUET_SUFFIXES:
+            return True
+        return suffix in (*CSV_SUFFIXES, ".txt") and matches(first_line(path))
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        return read(path, **options)
+
+
+def check_output(path: str | Path) -> Path:
+    """``path`` when :func:`write` writes its extension (``.csv``, ``.parquet``, ``.pq``), else an OutputError."""
     p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (*CSV_SUFFIXES, *PARQUET_SUFFIXES):
+        raise OutputError(f"{str(p)!r}: footzoo writes recordings as .csv or .parquet, not "
+                          f"{suffix or 'a file without extension'!r}; choose one of these extensions")
+    if suffix in PARQUET_SUFFIXES:
+        from ..core.archive import parquet_available
+
+        if not parquet_available():
+            raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
+                              "or write .csv")
+    return p
+
+
+def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
+    """Write a recording (with truth columns) as canonical CSV or Parquet plus its sidecars.
+
+    The data file, its metadata sidecar ``<file>.meta.yaml`` and the true-steps sidecar
+    ``<file>.steps.csv`` (when the truth has steps) are written as one unit: all or nothing
+    replaces an earlier version, and an earlier steps sidecar is removed when the recording has
+    none. The recording's own input files are never overwritten.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    path : str or Path
+        ``.csv``, ``.parquet`` or ``.pq``; another extension is refused (a file named ``.xlsx``
+        would not be what it says).
+    closed_loop : bool
+        Mark the walk as a closed loop (also when ``rec.truth.closed_loop`` says so).
+
+    Raises
+    ------
+    OutputError
+        For another extension, an unwritable place, or a path that is one of the recording's inputs.
+    """
+    p = check_output(path)
     closed_loop = check_bool("closed_loop", closed_loop)
+    suffix = p.suffix.lower()
     df = rec.to_dataframe()
-    if p.suffix.lower() in (".parquet", ".pq"):
-        df.to_parquet(p, index=False)
-    else:
-        df.to_csv(p, index=False, float_format=FLOAT_FORMAT)
-    meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
-    side = {"meta": meta, "closed_loop": bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))}
-    p.with_name(p.name + ".meta.yaml").write_text(yaml.safe_dump(side))
-    if rec.truth is not None and rec.truth.steps is not None:
-        rec.truth.steps.to_csv(p.with_name(p.name + ".steps.csv"), index=False, float_format=FLOAT_FORMAT)
+    with FileGroup(inputs=input_files(rec.meta), what=f"writing {p.name}") as group:
+        tmp = group.path(p)
+        if suffix in PARQUET_SUFFIXES:
+            df.to_parquet(tmp, index=False)
+        else:
+            df.to_csv(tmp, index=False, float_format=FLOAT_FORMAT)
+        steps_sha = None
+        steps = rec.truth.steps if rec.truth is not None else None
+        if steps is not None:
+            tmp_steps = group.path(steps_path(p))
+            steps.to_csv(tmp_steps, index=False, float_format=FLOAT_FORMAT)
+            steps_sha = sha256(tmp_steps)
+        else:
+            group.remove(steps_path(p))
+        meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
+        closed = bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))
+        group.path(meta_path(p)).write_text(facts_text(meta, closed, sha256(tmp), steps_sha), encoding="utf-8")
     return p

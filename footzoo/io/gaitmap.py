@@ -1,8 +1,10 @@
 """gaitmap example data (mad-lab-fau/gaitmap): ``imu_sample.csv``.
 
 Two header rows (sensor, axis); ``left_sensor`` and ``right_sensor`` with
-``acc_x..z`` (m/s²) and ``gyr_x..z`` (**deg/s**); no time column: samples are at
-204.8 Hz. The data are in gaitmap's foot frame, x toward the toe, y left, z up.
+``acc_x..z`` (m/s²) and ``gyr_x..z`` (**deg/s**); no time column: the first column is the
+sample index, at 204.8 Hz, so ``t = index / rate``. A jump in the index (rows missing) is a gap
+in time: a short one is bridged with a warning, a longer one (over ``max_gap``) refused with
+the rows that are missing. The data are in gaitmap's foot frame, x toward the toe, y left, z up.
 
 * Both feet: to FRD by 180° about x, ``(x, −y, −z)`` for accelerometer and
   gyroscope alike.
@@ -24,10 +26,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.checks import check_range
-from ..core.data import Recording, Truth
+from ..core.checks import check_positive, check_range
+from ..core.data import Recording, Truth, gap_limit
 from ..core.errors import FormatError
-from .gaitmap_reference import has_reference, reference_stride_positions, reference_strides
+from .base import RECORDING_OPTIONS, Option, Reader, first_line, text_source
+from .gaitmap_reference import REFERENCE_FILES, has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8
 FEET = ("left", "right")
@@ -46,9 +49,42 @@ def matches(header: str) -> bool:
 
 def feet(path: Path) -> list[str]:
     """The feet a gaitmap file holds (``left``, ``right``), from its first header row."""
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        head = fh.readline()
+    head = first_line(path)
     return [f for f in FEET if f"{f}_sensor" in head]
+
+
+def sample_times(index: pd.Index, rate: float, path: Path, max_gap: float | None = None) -> np.ndarray:
+    """``index / rate`` (s), after checking that the sample index counts up; a long jump is refused.
+
+    Raises
+    ------
+    FormatError
+        For an index that is not whole numbers counting up, or that jumps by more than ``max_gap``.
+    """
+    idx = pd.to_numeric(pd.Series(index), errors="coerce").to_numpy(dtype=float)
+    bad = ~np.isfinite(idx) | (idx != np.round(idx))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FormatError(f"{path}: the first column (sample index) must hold whole numbers; row {k} holds "
+                          f"{index[k]!r}; repair the file (footzoo reads t = index / {rate:g} Hz)")
+    step = np.diff(idx)
+    if np.any(step <= 0):
+        k = int(np.argmax(step <= 0))
+        raise FormatError(f"{path}: the sample index goes from {int(idx[k])} to {int(idx[k + 1])} at row {k + 1}: "
+                          "it must count up; sort the rows or repair the file")
+    limit = gap_limit(1.0 / rate, max_gap)
+    jumps = np.flatnonzero(step * (1.0 / rate) > limit)
+    if jumps.size:
+        k = int(jumps[0])
+        lost = int(step[k]) - 1
+        more = f" and at {jumps.size - 1} more place(s)" if jumps.size > 1 else ""
+        raise FormatError(
+            f"{path}: {lost} rows are missing from the sample index (it jumps from {int(idx[k])} to "
+            f"{int(idx[k + 1])}: {lost / rate:.2f} s at {rate:g} Hz){more}; "
+            f"footzoo bridges gaps up to {limit:g} s. Restore the rows, split the file at the jump, or pass a "
+            "larger max_gap if the filters may bridge it"
+        )
+    return idx / rate
 
 
 def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: Any) -> Recording:
@@ -73,7 +109,10 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
             "or read both with footzoo.Session.load(path) (command line: both feet unless --foot left|right)"
         )
     rate = check_range("rate", rate, 0.0, 100_000.0, "Hz", lo_open=True)
-    df = pd.read_csv(path, header=[0, 1], index_col=0)
+    max_gap = options.get("max_gap")
+    if max_gap is not None:
+        max_gap = check_positive("max_gap", max_gap, unit="s")
+    df = pd.read_csv(text_source(path), header=[0, 1], index_col=0)
     sensor = f"{foot}_sensor"
     if sensor not in df.columns.get_level_values(0):
         raise FormatError(f"{path}: no {sensor!r} columns; found {sorted(set(df.columns.get_level_values(0)))}")
@@ -83,12 +122,33 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
         raise FormatError(f"{path}: {sensor} lacks columns {missing}")
     values = block[AXES].to_numpy(dtype=float) * TO_FRD[foot]
     frame = pd.DataFrame(values, columns=AXES)
-    frame.insert(0, "t", np.arange(len(frame)) / rate)
+    frame.insert(0, "t", sample_times(df.index, rate, path, max_gap))
     meta = {"name": f"{path.stem}_{foot}", "source": str(path), "format": "gaitmap", "foot": foot,
-            "placement": f"{foot} foot instep"}
+            "placement": f"{foot} foot instep", "input_files": [str(path)]}
     truth = None
     if has_reference(path.parent):
+        meta["input_files"] += [str(path.parent / f) for f in REFERENCE_FILES if (path.parent / f).exists()]
         truth = Truth(steps=reference_strides(path.parent, foot),
                       stride_positions=reference_stride_positions(path.parent, foot),
                       source="motion capture (gaitmap)")
     return Recording.from_dataframe(frame, acc_unit="m/s^2", gyr_unit="deg/s", meta=meta, truth=truth, **options)
+
+
+class GaitmapReader(Reader):
+    """gaitmap's example IMU file: both feet, m/s² and deg/s, gaitmap's foot frame; mocap reference as truth."""
+
+    description = "gaitmap example IMU CSV (two header rows: sensor, axis; left_sensor and right_sensor)"
+    extensions = (".csv",)
+    fixed_units = {"acc_unit": "m/s^2", "gyr_unit": "deg/s"}
+    url = "https://github.com/mad-lab-fau/gaitmap"
+    options = {
+        "foot": Option(None, "", "which sensor to read: 'left' or 'right' (required: the file holds both feet)"),
+        "rate": Option(RATE_HZ, "Hz", "sampling rate: the time base is the sample index / rate"),
+        **RECORDING_OPTIONS,
+    }
+
+    def guess_can_open(self, path: Path) -> bool:
+        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        return read(path, **options)

@@ -33,6 +33,8 @@ from ..core.errors import FormatError
 
 IMU_RATE = 204.8
 MOCAP_RATE = 100.0
+#: The reference files read from the IMU file's folder.
+REFERENCE_FILES = ("mocap_sample.csv", "stride_events_sample.csv", "position_sample.csv")
 
 
 def has_reference(folder: str | Path) -> bool:

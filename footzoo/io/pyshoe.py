@@ -22,6 +22,7 @@ import numpy as np
 
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
+from .base import RECORDING_OPTIONS, Reader
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
@@ -53,8 +54,10 @@ def read(path: Path, **options: Any) -> Recording:
         truth = Truth(pos=np.asarray(d["gt"], dtype=float) * mirror, stance=stance)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe", "foot": "right",
                             "placement": "right shoe instep (LORD MicroStrain)"}
+    meta["input_files"] = [str(path)]
     trial = _trial_row(path)
     if trial is not None:
+        meta["input_files"].append(str(path.with_name("trials.csv")))
         truth = truth or Truth()
         truth.stride_count = int(trial["n_strides_manual_koroglu"])
         meta["bipedal_tag"] = int(trial["bipedal_tag_koroglu"])
@@ -63,8 +66,36 @@ def read(path: Path, **options: Any) -> Recording:
     if "trial_error" in d:
         errors = np.ravel(d["trial_error"]).astype(float)
         meta["pyshoe_trial_error"] = {k: float(e) for k, e in zip(TRIAL_ERROR_DETECTORS, errors, strict=True)}
-    rec = Recording(t=t, acc=imu[:, :3], gyr=imu[:, 3:6], meta=meta, truth=truth, **options)
-    return rec
+    return Recording(t=t, acc=imu[:, :3], gyr=imu[:, 3:6], meta=meta, truth=truth, **options)
+
+
+class PyShoeReader(Reader):
+    """PyShoe's VICON-room trials (MATLAB .mat): m/s², rad/s, already FRD; VICON reference as truth."""
+
+    description = "PyShoe VICON-room trial (MATLAB .mat with imu, ts, gt, zv_*_opt, trial_error)"
+    extensions = (".mat",)
+    fixed_units = {"acc_unit": "m/s^2", "gyr_unit": "rad/s"}
+    url = "https://github.com/utiasSTARS/pyshoe"
+    options = {"max_gap": RECORDING_OPTIONS["max_gap"]}
+
+    def guess_can_open(self, path: Path) -> bool:
+        """A ``.mat`` file with the variables ``imu`` and ``ts`` (its directory is read, not its data).
+
+        A ``.mat`` file that MATLAB's format cannot even list is claimed too, so that the error
+        says what is wrong with it; a valid one without ``imu`` and ``ts`` is left to other readers.
+        """
+        if Path(path).suffix.lower() != ".mat":
+            return False
+        import scipy.io as sio
+
+        try:
+            names = {name for name, _, _ in sio.whosmat(path)}
+        except Exception:  # not a readable MATLAB file: open() says why
+            return True
+        return {"imu", "ts"} <= names
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        return read(path, **options)
 
 
 def _trial_row(path: Path) -> dict[str, Any] | None:

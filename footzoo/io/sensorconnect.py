@@ -22,6 +22,7 @@ import pandas as pd
 
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
+from .base import RECORDING_OPTIONS, Reader, first_line, text_source
 
 SIGNALS = {
     "scaledAccelX": "acc_x", "scaledAccelY": "acc_y", "scaledAccelZ": "acc_z",
@@ -37,7 +38,7 @@ def matches(header: str) -> bool:
 
 def read(path: Path, **options: Any) -> Recording:
     """Read a SensorConnect CSV and convert to FRD/SI."""
-    df = pd.read_csv(path)
+    df = pd.read_csv(text_source(path))
     rename = {"Time": "t"}
     for col in df.columns:
         key = col.split(":")[-1]
@@ -49,9 +50,11 @@ def read(path: Path, **options: Any) -> Recording:
     if missing:
         raise FormatError(f"{path}: not a SensorConnect export with scaled signals, missing {missing}")
     keep = [c for c in ["t", *SIGNALS.values()] if c in df.columns]
-    meta = {"name": path.stem, "source": str(path), "format": "sensorconnect", "mag_unit": "Gauss"}
+    gcp = path.with_suffix(".mat")
+    meta = {"name": path.stem, "source": str(path), "format": "sensorconnect", "mag_unit": "Gauss",
+            "input_files": [str(path), *([str(gcp)] if gcp.exists() else [])]}
     return Recording.from_dataframe(df[keep], acc_unit="g", gyr_unit="rad/s", meta=meta,
-                                    truth=footprint_reference(path.with_suffix(".mat")), **options)
+                                    truth=footprint_reference(gcp), **options)
 
 
 def footprint_reference(path: Path) -> Truth | None:
@@ -71,3 +74,19 @@ def footprint_reference(path: Path) -> Truth | None:
     count = int(np.ravel(d["numberOfStrides"])[0]) if "numberOfStrides" in d else None
     return Truth(footprints=np.asarray(d["GCP_meters"], dtype=float), stride_count=count,
                  source="ground control points (Köroğlu)")
+
+
+class SensorConnectReader(Reader):
+    """MicroStrain SensorConnect CSV: g, rad/s, Gauss, already FRD; Köroğlu's ground control points as truth."""
+
+    description = "MicroStrain SensorConnect CSV (Time, <device>:scaledAccelX, ..., scaledGyroX, ..., scaledMagX, ...)"
+    extensions = (".csv",)
+    fixed_units = {"acc_unit": "g", "gyr_unit": "rad/s"}
+    url = "https://www.microstrain.com/software/sensorconnect"
+    options = dict(RECORDING_OPTIONS)
+
+    def guess_can_open(self, path: Path) -> bool:
+        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        return read(path, **options)

@@ -8,8 +8,14 @@ sensor's x axis is taken as the foot's forward axis; it is tilted on the foot
 
 The file has exact duplicate rows (time stamp repeated) and short gaps (up to
 17 ms at 400 Hz). Duplicates are dropped with a warning that gives the count;
-gaps up to ``max_gap`` (default: the library's, 0.1 s) are bridged by the filters, which use
-each sample's own interval, with a warning. The walk is a closed loop: ``truth.closed_loop``.
+gaps up to ``max_gap`` (default: the library's, 0.25 s) are bridged by the filters, which use
+each sample's own interval, with a warning.
+
+**Closed loop.** Nothing in an x-io file says whether the walk ends where it started. Only
+x-io's published example walk (``short_walk.csv``, recognised by its SHA-256, and footzoo's
+built-in sample made from it) is known to be a closed loop; for any other file
+``truth.closed_loop`` is false unless ``closed_loop=True`` is passed or the file's metadata
+sidecar (``<file>.meta.yaml``, :mod:`footzoo.io.metadata`) says ``closed_loop: true``.
 """
 
 from __future__ import annotations
@@ -22,6 +28,8 @@ import pandas as pd
 from ..core.checks import check_bool
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
+from .base import RECORDING_OPTIONS, Option, Reader, first_line, text_source
+from .metadata import read_facts, sha256
 
 COLUMNS = {
     "Time (s)": "t",
@@ -33,36 +41,82 @@ COLUMNS = {
     "Accelerometer Z (g)": "acc_z",
 }
 
+#: x-io files known to be closed walks: (size in bytes, SHA-256) -> name. The built-in sample is the first.
+KNOWN_CLOSED_LOOPS: dict[tuple[int, str], str] = {
+    (1203193, "35abfa9b3224cb69962917e945f2dc299595c8e5a8c427f77019dc09c27710e0"): "x-io Gait-Tracking short_walk.csv",
+}
+
 
 def matches(header: str) -> bool:
     """True for an x-io Gait-Tracking header."""
     return header.startswith("Time (s)") and "Gyroscope X (deg/s)" in header
 
 
+def known_closed_loop(path: Path) -> str | None:
+    """The name of the known closed walk ``path`` is, or None (the hash is computed only when the size matches)."""
+    size = path.stat().st_size
+    if not any(size == s for s, _ in KNOWN_CLOSED_LOOPS):
+        return None
+    return KNOWN_CLOSED_LOOPS.get((size, sha256(path)))
+
+
 def read(
-    path: Path, duplicates: str = "drop", max_gap: float | None = None, closed_loop: bool = True, **options: Any
+    path: Path, duplicates: str = "drop", max_gap: float | None = None, closed_loop: bool | None = None,
+    **options: Any,
 ) -> Recording:
     """Read an x-io CSV and convert to FRD/SI.
 
     Parameters
     ----------
     duplicates : {"drop", "error"}
-        Repeated time stamps (the file has about 1 % exact duplicates).
+        Repeated time stamps (the example file has about 1 % exact duplicates).
     max_gap : float, optional
         Largest gap bridged (s); default :data:`footzoo.core.data.DEFAULT_MAX_GAP`.
-    closed_loop : bool
-        Whether the walk ends where it started (true for ``short_walk.csv``).
+    closed_loop : bool, optional
+        Whether the walk ends where it started. Default: true for x-io's example walk, else what
+        the metadata sidecar says, else false.
     """
-    closed_loop = check_bool("closed_loop", closed_loop)
-    df = pd.read_csv(path)
+    df = pd.read_csv(text_source(path))
     missing = [c for c in COLUMNS if c not in df.columns]
     if missing:
         raise FormatError(f"{path}: not an x-io Gait-Tracking CSV, missing {missing}")
     df = df.rename(columns=COLUMNS)[list(COLUMNS.values())]
     for c in ("acc_y", "acc_z", "gyr_y", "gyr_z"):  # z up -> z down: 180° about x
         df[c] = -df[c]
-    meta = {"name": path.stem, "source": str(path), "format": "xio", "placement": "foot (NGIMU, tilted ~30°)"}
+    facts = read_facts(path)
+    known = known_closed_loop(path)
+    if closed_loop is None:
+        closed_loop = bool(known) or bool(facts.closed_loop)
+        source = f"closed loop ({known})" if known else "closed loop (metadata sidecar)" if closed_loop else ""
+    else:
+        closed_loop = check_bool("closed_loop", closed_loop)
+        source = "closed loop (declared)" if closed_loop else ""
+    meta = {"name": path.stem, "source": str(path), "format": "xio", "placement": "foot (NGIMU, tilted ~30°)",
+            **facts.meta, "input_files": [str(path), *map(str, facts.files)]}
     return Recording.from_dataframe(
         df, acc_unit="g", gyr_unit="deg/s", duplicates=duplicates, max_gap=max_gap, meta=meta,
-        truth=Truth(closed_loop=closed_loop, source="closed loop (x-io)" if closed_loop else ""), **options,
+        truth=Truth(closed_loop=closed_loop, source=source), **options,
     )
+
+
+class XioReader(Reader):
+    """x-io Technologies Gait-Tracking CSV (NGIMU): g and deg/s, z up."""
+
+    reads_metadata_sidecar = True
+    description = "x-io Technologies Gait-Tracking CSV (NGIMU): Time (s), Gyroscope X (deg/s), ..., Accelerometer X (g)"
+    extensions = (".csv",)
+    fixed_units = {"acc_unit": "g", "gyr_unit": "deg/s"}
+    url = "https://github.com/xioTechnologies/Gait-Tracking"
+    options = {
+        **RECORDING_OPTIONS,
+        "duplicates": Option("drop", "", "repeated time stamps: 'drop' (keep the first, warn with the count) or "
+                                         "'error'"),
+        "closed_loop": Option(None, "", "whether the walk ends where it started (default: true for x-io's example "
+                                        "walk, else the metadata sidecar's closed_loop, else false)"),
+    }
+
+    def guess_can_open(self, path: Path) -> bool:
+        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        return read(path, **options)

@@ -120,6 +120,23 @@ class SessionResult:
     results: dict[str, Result]
     name: str = "session"
 
+    def save(self, path: str | Path, backend: str = "auto", inputs: Any = ()) -> Path:
+        """Save as a folder: one :meth:`Result.save` folder per foot, and the stride and bilateral tables.
+
+        Atomic as one unit and never over an input (see :mod:`footzoo.core.archive`).
+        """
+        from ..core.archive import save_session
+
+        return save_session(self, path, backend=backend, inputs=inputs)
+
+    @classmethod
+    def load(cls, path: str | Path) -> SessionResult:
+        """A session saved by :meth:`save` (the stride and bilateral tables are recomputed)."""
+        from ..core.archive import load_session
+
+        name, results = load_session(path)
+        return cls(results=results, name=name)
+
     @cached_property
     def steps(self) -> pd.DataFrame:
         """Stride tables of both feet, one after the other, with ``foot`` and ``step_time_s`` (s)."""

@@ -1,0 +1,421 @@
+"""Atomic output files: every file footzoo writes appears complete under its final name, or not at all.
+
+A file is written to a temporary name in its target folder (``.<name>.footzoo-tmp-<random>``),
+flushed to disk, and renamed into place (:func:`os.replace`, atomic on POSIX and Windows within one
+file system). An interrupt (Ctrl-C) or a crash while writing leaves the old file untouched and no
+partial file under the final name; the temporary file is removed on any error.
+
+Files that belong together (a recording and its sidecars; the tables of a result) are written as
+one :class:`FileGroup`: every member is written first, then all are renamed, with Ctrl-C deferred
+until the renames are done; files of an earlier version that the new one no longer has (a stale
+sidecar) are removed in the same step.
+
+No output may replace an input: :func:`refuse_inputs` compares each target with every input by
+file identity (same inode and device: symlinks, ``..`` and hard links included) and raises
+:class:`~footzoo.core.errors.OutputError` naming both.
+
+Usage::
+
+    from footzoo.core.atomic import FileGroup, atomic_path, atomic_write, write_json
+
+    with atomic_write("notes.txt") as fh:          # a text (or "wb": binary) file handle
+        fh.write("...")
+    with atomic_path("figure.png") as tmp:         # a temporary path, for writers that take a path
+        fig.savefig(tmp, format="png")
+    write_json("metrics.json", {"rmse_m": float("nan")})   # strict JSON: NaN -> null
+    with FileGroup(inputs=[data_file]) as group:   # several files, committed together
+        frame.to_csv(group.path("walk.csv"))
+        group.path("walk.csv.meta.yaml").write_text(text)
+        group.remove("walk.csv.steps.csv")         # a stale sidecar of the earlier file
+
+Writers pass the recording's input files as ``inputs`` so that ``--out`` pointing at the data is
+refused before anything is written.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import math
+import os
+import secrets
+import signal
+import threading
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO, Any
+
+from .errors import OutputError
+
+#: Infix of the temporary files (a leftover one, from a killed process, can be deleted).
+TMP_INFIX = ".footzoo-tmp-"
+
+PathLike = str | os.PathLike
+
+
+def _temporary_name(target: Path) -> Path:
+    return target.with_name(f".{target.name}{TMP_INFIX}{secrets.token_hex(4)}")
+
+
+def check_target(path: PathLike, what: str = "output") -> Path:
+    """``path`` as a :class:`~pathlib.Path` a file can be written to, or an :class:`OutputError` saying why not.
+
+    Refuses an empty path, a directory, a missing folder and a folder without write permission,
+    before any work is done.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise OutputError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
+    if not str(path).strip():
+        raise OutputError(f"{what} is an empty path; give a file name")
+    p = Path(path)
+    if p.is_dir():
+        raise OutputError(f"{what} {str(p)!r} is a directory; give a file name")
+    folder = p.parent
+    if not folder.is_dir():
+        raise OutputError(f"{what} {str(p)!r}: the folder {str(folder)!r} does not exist; create it first")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{what} {str(p)!r} is not writable (permission denied on {str(folder)!r}); "
+                          "choose a writable place")
+    return p
+
+
+def same_file(a: PathLike, b: PathLike) -> bool:
+    """True when ``a`` and ``b`` name the same existing file (symlinks, ``..``, hard links resolved)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (or is unreadable): nothing to clobber
+        return False
+
+
+def refuse_inputs(targets: Iterable[PathLike], inputs: Iterable[PathLike], what: str = "output") -> None:
+    """Raise :class:`OutputError` when a target file is one of the inputs.
+
+    Parameters
+    ----------
+    targets : iterable of paths
+        Files about to be written (or removed).
+    inputs : iterable of paths
+        Files the run read (recording, sidecars, reference files, configs).
+    what : str
+        How the output was named (``"--out"``, ``"Result.save path"``), for the message.
+    """
+    inputs = [Path(i) for i in inputs if i is not None and str(i)]
+    for target in targets:
+        for source in inputs:
+            if same_file(target, source):
+                raise OutputError(
+                    f"{what} would overwrite the input {str(source)!r} (the output {str(target)!r} is that file); "
+                    "choose another output location: footzoo never replaces its inputs"
+                )
+
+
+@contextlib.contextmanager
+def _interrupts_deferred() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) until the block has finished; re-raise it afterwards (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[Any] = []
+    try:
+        previous = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    except (ValueError, OSError):  # no signal handling here (embedded interpreter)
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if caught:
+            raise KeyboardInterrupt
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Make the renames in ``folder`` durable (POSIX; a no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _remove_quietly(path: Path) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        path.unlink()
+
+
+def _os_error(err: OSError, target: Path) -> OutputError:
+    if err.errno in (errno.EACCES, errno.EPERM):
+        return OutputError(f"{str(target)!r} cannot be written (permission denied); choose a writable place")
+    if err.errno == errno.ENOSPC:
+        return OutputError(f"{str(target)!r} cannot be written: no space left on the device; the old file is kept")
+    return OutputError(f"{str(target)!r} cannot be written: {err.strerror or err}")
+
+
+class FileGroup:
+    """Files written together and renamed into place together (a data file and its sidecars).
+
+    Parameters
+    ----------
+    inputs : iterable of paths
+        Files that must not be replaced (the run's inputs); checked at every :meth:`path` and :meth:`remove`.
+    what : str
+        How the output was named, for messages.
+    fsync : bool
+        Flush every file (and the folders' entries) to disk before returning. ``False`` is faster where
+        durability against a power cut does not matter (a cache that is recomputed when damaged).
+
+    Notes
+    -----
+    Use it as a context manager: on a normal exit every member is renamed into place and every
+    file passed to :meth:`remove` deleted; on an exception (Ctrl-C included) the temporary files are
+    deleted and nothing under a final name changes.
+    """
+
+    def __init__(self, inputs: Iterable[PathLike] = (), what: str = "output", fsync: bool = True):
+        self.inputs = [Path(i) for i in inputs]
+        self.what = what
+        self.fsync = fsync
+        self._members: dict[Path, Path] = {}
+        self._stale: list[Path] = []
+        self._done = False
+
+    def path(self, target: PathLike) -> Path:
+        """The temporary path to write ``target`` to (created empty, in ``target``'s folder)."""
+        t = check_target(target, self.what)
+        refuse_inputs([t], self.inputs, self.what)
+        key = Path(os.path.abspath(t))
+        if key in self._members:
+            return self._members[key]
+        tmp = _temporary_name(t)
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # the umask applies, as for any file
+            os.close(fd)
+        except OSError as err:
+            raise _os_error(err, t) from None
+        self._members[key] = tmp
+        return tmp
+
+    @contextlib.contextmanager
+    def open(self, target: PathLike, mode: str = "w", encoding: str | None = "utf-8",
+             newline: str | None = None) -> Iterator[IO[Any]]:
+        """A file handle on the temporary file of ``target`` (``"w"`` text, ``"wb"`` binary)."""
+        if mode not in ("w", "wb"):
+            raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+        tmp = self.path(target)
+        kwargs = {} if "b" in mode else {"encoding": encoding, "newline": newline}
+        with open(tmp, mode, **kwargs) as fh:
+            yield fh
+            fh.flush()
+            if self.fsync:
+                os.fsync(fh.fileno())
+
+    def forget(self, target: PathLike) -> None:
+        """Drop ``target`` from the group (its temporary file is deleted; the final file is left as it is)."""
+        key = Path(os.path.abspath(target))
+        tmp = self._members.pop(key, None)
+        if tmp is not None:
+            _remove_quietly(tmp)
+
+    def remove(self, target: PathLike) -> None:
+        """Delete ``target`` (if it exists) when the group commits: a sidecar the new version no longer has."""
+        t = Path(target)
+        refuse_inputs([t], self.inputs, self.what)
+        self._stale.append(t)
+
+    def commit(self) -> list[Path]:
+        """Rename every member into place and delete the stale files; returns the final paths."""
+        if self._done:
+            raise RuntimeError("this FileGroup was already committed or aborted")
+        done: list[Path] = []
+        with _interrupts_deferred():
+            try:
+                if self.fsync:
+                    for tmp in self._members.values():
+                        _fsync_file(tmp)
+                for final, tmp in self._members.items():
+                    os.replace(tmp, final)
+                    done.append(final)
+                for stale in self._stale:
+                    if Path(os.path.abspath(stale)) not in self._members:
+                        _remove_quietly(stale)
+            except OSError as err:
+                self._discard()
+                written = f" ({', '.join(p.name for p in done)} already replaced)" if done else ""
+                raise OutputError(f"{self.what}: renaming the new files into place failed{written}: "
+                                  f"{err.strerror or err}") from None
+            finally:
+                self._done = True
+            if self.fsync:
+                for folder in {p.parent for p in done} | {s.parent for s in self._stale}:
+                    _fsync_folder(folder)
+        return done
+
+    def abort(self) -> None:
+        """Delete the temporary files; nothing under a final name changes."""
+        self._discard()
+        self._done = True
+
+    def _discard(self) -> None:
+        for tmp in self._members.values():
+            _remove_quietly(tmp)
+
+    def __enter__(self) -> FileGroup:
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if self._done:
+            return
+        if exc_type is None:
+            self.commit()
+        else:
+            self.abort()
+
+
+def _fsync_file(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def atomic_path(path: PathLike, inputs: Iterable[PathLike] = (), what: str = "output",
+                fsync: bool = True) -> Iterator[Path]:
+    """A temporary path for ``path``, renamed into place when the block ends without an error.
+
+    For writers that take a file name (``DataFrame.to_parquet``, ``Figure.savefig``, ``np.savez``).
+    The writer must not add its own extension (pass ``format=`` where it would: ``savefig(tmp,
+    format="png")``; ``np.savez`` with an open file handle).
+    """
+    with FileGroup(inputs=inputs, what=what, fsync=fsync) as group:
+        yield group.path(path)
+
+
+@contextlib.contextmanager
+def atomic_write(path: PathLike, mode: str = "w", encoding: str | None = "utf-8", newline: str | None = None,
+                 inputs: Iterable[PathLike] = (), what: str = "output", fsync: bool = True) -> Iterator[IO[Any]]:
+    """A file handle whose content replaces ``path`` only once the block ends without an error.
+
+    Parameters
+    ----------
+    path : path
+        The final file.
+    mode : {"w", "wb"}
+        Text or binary.
+    encoding, newline : str, optional
+        As for :func:`open` (text mode).
+    inputs : iterable of paths
+        Files that must not be replaced (:func:`refuse_inputs`).
+    what : str
+        How the output was named, for messages.
+    fsync : bool
+        Flush to disk before the rename.
+    """
+    with FileGroup(inputs=inputs, what=what, fsync=fsync) as group, \
+            group.open(path, mode, encoding=encoding, newline=newline) as fh:
+        yield fh
+
+
+def write_text(path: PathLike, text: str, inputs: Iterable[PathLike] = (), what: str = "output",
+               encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` atomically; returns the path."""
+    with atomic_write(path, "w", encoding=encoding, inputs=inputs, what=what) as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def write_bytes(path: PathLike, data: bytes, inputs: Iterable[PathLike] = (), what: str = "output") -> Path:
+    """Write ``data`` to ``path`` atomically; returns the path."""
+    with atomic_write(path, "wb", inputs=inputs, what=what) as fh:
+        fh.write(data)
+    return Path(path)
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` as plain JSON data: NaN and ±inf -> None, numpy scalars and arrays -> numbers and lists.
+
+    Mappings keep their keys (as strings), tuples and sets become lists, paths and other objects
+    their ``str``.
+    """
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, int):
+        return int(value)
+    if isinstance(value, float):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return [json_safe(v) for v in value]
+    tolist = getattr(value, "tolist", None)  # numpy scalars and arrays, pandas objects
+    if callable(tolist):
+        return json_safe(tolist())
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    return str(value)
+
+
+def dumps_json(value: Any, indent: int | None = 2) -> str:
+    """Strict JSON text of ``value`` (:func:`json_safe` first: no bare ``NaN`` or ``Infinity``)."""
+    return json.dumps(json_safe(value), indent=indent, allow_nan=False, ensure_ascii=False) + "\n"
+
+
+def write_json(path: PathLike, value: Any, inputs: Iterable[PathLike] = (), what: str = "output",
+               indent: int | None = 2) -> Path:
+    """Write ``value`` as strict JSON (NaN -> null) to ``path`` atomically; returns the path."""
+    return write_text(path, dumps_json(value, indent), inputs=inputs, what=what)
+
+
+@contextlib.contextmanager
+def folder_lock(folder: PathLike, what: str = "output folder") -> Iterator[Path]:
+    """Hold an exclusive lock on ``folder`` (a ``.footzoo.lock`` file in it) for the block.
+
+    A second footzoo process that asks for the same folder gets an :class:`OutputError` at once
+    (it does not wait). The lock is released when the block ends or the process dies.
+    """
+    p = Path(folder)
+    p.mkdir(parents=True, exist_ok=True)
+    lock = p / ".footzoo.lock"
+    fh = open(lock, "a+")
+    try:
+        if not _try_lock(fh):
+            fh.seek(0)
+            holder = fh.read().strip() or "another process"
+            raise OutputError(f"{what} {str(p)!r} is being written by {holder}; wait until it has finished, "
+                              "or choose another output folder")
+        fh.seek(0)
+        fh.truncate()
+        fh.write(f"footzoo process {os.getpid()}\n")
+        fh.flush()
+        yield p
+    finally:
+        fh.close()  # closing releases the lock
+
+
+def _try_lock(fh: IO[Any]) -> bool:
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        import msvcrt
+
+        try:
+            msvcrt.locking(fh.fileno(), msvcrt.LK_NBLCK, 1)
+            return True
+        except OSError:
+            return False
+    try:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except OSError:
+        return False
+
+
+__all__ = ["TMP_INFIX", "FileGroup", "OutputError", "atomic_path", "atomic_write", "check_target", "dumps_json",
+           "folder_lock", "json_safe", "refuse_inputs", "same_file", "write_bytes", "write_json", "write_text"]

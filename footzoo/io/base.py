@@ -1,0 +1,187 @@
+"""What a reader is: the :class:`Reader` base class, its declared :class:`Option`\\ s, and helpers for text files.
+
+A reader (modelled on xarray's backend entry points) is an object with
+
+* ``guess_can_open(path) -> bool``: a cheap look at the file (extension, first line) that says
+  whether the reader recognises it; it must not raise for a file it does not know;
+* ``open(path, **options) -> Recording``: the whole conversion into footzoo's conventions
+  (FRD axes, SI units), with a :class:`~footzoo.core.data.Truth` where the format has a reference;
+
+and, to be listed and documented, ``description`` (one line), ``extensions`` (the suffixes it
+claims, lower case with the dot), ``options`` (name -> :class:`Option` with default, unit and
+meaning), ``fixed_units`` (the units the format always stores, e.g. ``{"acc_unit": "g"}``: a
+matching ``acc_unit=`` is accepted and ignored, another one refused) and ``url``.
+
+Readers are registered under the entry-point group ``footzoo.readers`` (the built-in formats
+too, in footzoo's ``setup.cfg``); :func:`footzoo.io.load` finds them there (see
+:mod:`footzoo.io.registry`).
+"""
+
+from __future__ import annotations
+
+import io
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from ..core.data import Recording
+from ..core.errors import FootzooWarning
+
+#: Longest line read when looking at a file's header (characters).
+HEADER_MAX_CHARS = 64 * 1024
+#: Suffixes of compressed files (read through pandas' decompression).
+COMPRESSED = (".gz", ".bz2", ".xz", ".zip", ".zst")
+#: Most leading blank lines skipped when looking for the header line.
+MAX_BLANK_LINES = 1000
+
+
+class _Required:
+    def __repr__(self) -> str:
+        return "required"
+
+
+#: Default of an option that has none (the user must give it).
+REQUIRED: Any = _Required()
+
+
+@dataclass(frozen=True)
+class Option:
+    """One keyword option of a reader.
+
+    Parameters
+    ----------
+    default : any
+        Value when the option is not given (:data:`REQUIRED` when it must be).
+    unit : str
+        Unit of a numeric option ("Hz", "s"), empty otherwise.
+    doc : str
+        What it means (one sentence or two).
+    """
+
+    default: Any = None
+    unit: str = ""
+    doc: str = ""
+
+
+#: Options every built-in reader accepts, passed on to :meth:`footzoo.Recording.from_dataframe`.
+RECORDING_OPTIONS: dict[str, Option] = {
+    "duplicates": Option("error", "", "rows whose time stamp repeats the previous one: 'error' or 'drop' "
+                                      "(keep the first, warn with the count)"),
+    "nan_policy": Option("error", "", "non-finite IMU values: 'error' or 'interpolate'"),
+    "max_gap": Option(None, "s", "largest gap between samples that is bridged (default 0.25 s, or 5 median "
+                                 "periods if longer); longer gaps are refused"),
+}
+
+
+class Reader:
+    """Base class of a footzoo reader (subclassing is optional: any object with the same methods works).
+
+    Attributes
+    ----------
+    name : str
+        The format's name (``format=`` in :func:`footzoo.load`); set from the entry point's name.
+    description : str
+        One line: what files it reads.
+    extensions : tuple of str
+        File suffixes it claims (``(".csv", ".txt")``), for the listings and the default
+        :meth:`guess_can_open`.
+    options : dict
+        Keyword options of :meth:`open`: name -> :class:`Option`.
+    fixed_units : dict
+        Units the format always stores (``{"acc_unit": "g", "gyr_unit": "deg/s"}``).
+    url : str
+        Where the format is described.
+    reads_metadata_sidecar : bool
+        True when :meth:`open` applies the file's metadata sidecar ``<file>.meta.yaml`` itself;
+        otherwise :func:`footzoo.load` merges its ``meta`` (without replacing what the reader set)
+        and its ``closed_loop`` (:mod:`footzoo.io.metadata`).
+    """
+
+    name: ClassVar[str] = ""
+    reads_metadata_sidecar: ClassVar[bool] = False
+    description: ClassVar[str] = ""
+    extensions: ClassVar[tuple[str, ...]] = ()
+    options: ClassVar[dict[str, Option]] = {}
+    fixed_units: ClassVar[dict[str, str]] = {}
+    url: ClassVar[str] = ""
+
+    def guess_can_open(self, path: Path) -> bool:
+        """True when the file looks like this format (default: its suffix is one of :attr:`extensions`)."""
+        return Path(path).suffix.lower() in self.extensions
+
+    def open(self, path: Path, **options: Any) -> Recording:
+        """Read the file into a :class:`~footzoo.core.data.Recording` (FRD, SI)."""
+        raise NotImplementedError(f"{type(self).__name__}.open")
+
+    def __call__(self, path: Path, **options: Any) -> Recording:
+        """The same as :meth:`open` (``footzoo.io.READERS[name](path)`` reads a file, as in footzoo 0.2)."""
+        return self.open(Path(path), **options)
+
+    def __repr__(self) -> str:
+        return f"<footzoo reader {self.name or type(self).__name__!r}: {self.description}>"
+
+
+def input_files(meta: dict[str, Any]) -> list[str]:
+    """The files a recording was read from (``meta["input_files"]``, else its ``source`` when that is a file).
+
+    Writers refuse to replace any of them (:func:`footzoo.core.atomic.refuse_inputs`).
+    """
+    files = [str(f) for f in meta.get("input_files") or [] if f]
+    source = meta.get("source")
+    if not files and isinstance(source, str) and source and Path(source).exists():
+        files.append(source)
+    return files
+
+
+def first_line(path: str | Path) -> str:
+    """The first non-blank line of a text file (without its line break); ``""`` when there is none.
+
+    Leading blank lines (a logger's empty first line) are skipped; at most
+    :data:`HEADER_MAX_CHARS` characters of the line are read. Bytes that are not UTF-8 are replaced.
+    """
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for _ in range(MAX_BLANK_LINES):
+            line = fh.readline(HEADER_MAX_CHARS)
+            if not line:
+                return ""
+            if line.strip():
+                return line.rstrip("\r\n")
+    return ""
+
+
+def has_extension(path: str | Path, *suffixes: str) -> bool:
+    """True when ``path`` ends with one of ``suffixes`` (case-insensitive)."""
+    return Path(path).suffix.lower() in suffixes
+
+
+def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
+    """``path``, or its content without a last line that was cut short, for ``pandas.read_csv``.
+
+    A text table ends with a line break. When the file does not, its last row may have been cut
+    in the middle of a number (a logger stopped mid-write, a copy interrupted) and would be read
+    as a valid but wrong number: that row is dropped with a :class:`FootzooWarning` quoting it.
+    A file of one line only is returned as it is (its header alone), and so is a compressed file
+    (``.gz``, ``.bz2``, ``.xz``, ``.zip``, ``.zst``: pandas decompresses it and its format checks its end).
+    """
+    if Path(path).suffix.lower() in COMPRESSED:
+        return path
+    with open(path, "rb") as fh:
+        fh.seek(0, 2)
+        size = fh.tell()
+        if size == 0:
+            return path
+        fh.seek(size - 1)
+        if fh.read(1) in (b"\n", b"\r"):
+            return path
+        fh.seek(0)
+        data = fh.read()
+    cut = data.rfind(b"\n")
+    if cut < 0 or not data[:cut].strip():
+        return path
+    last = data[cut + 1:].decode("utf-8", errors="replace")
+    warnings.warn(FootzooWarning(
+        f"{what or path}: the file does not end with a line break, so its last row may have been cut short "
+        f"(a logger stopped or a copy interrupted mid-write); dropped that row: {last[:80]!r}. If the file is "
+        "complete, end it with a line break"), stacklevel=3)
+    return io.BytesIO(data[:cut + 1])

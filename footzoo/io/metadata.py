@@ -1,0 +1,128 @@
+"""The metadata sidecar ``<file>.meta.yaml``: facts about a recording that its data file cannot hold.
+
+Any recording file may have one, next to it::
+
+    # walk.csv.meta.yaml
+    meta:                 # merged into Recording.meta (text stays text: '1e3' is the string '1e3')
+      subject: S07
+      foot: left
+    closed_loop: true     # the walk ends where it started: loop-closure metrics apply
+
+``footzoo simulate`` and :func:`footzoo.io.canonical.write` write it for every recording, with
+``data_sha256`` (the SHA-256 of the data file it describes) and, when there is a true-steps
+sidecar ``<file>.steps.csv``, ``steps_sha256``. A sidecar whose ``data_sha256`` does not match
+the data file is **stale** (left over from an earlier file of the same name): it is ignored,
+together with the steps file, with a warning. A steps file is read only when the metadata
+sidecar vouches for it (its ``steps_sha256`` matches) or when the sidecar carries no hashes at
+all (a hand-written sidecar, or one written before footzoo 0.3).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..core.errors import FootzooWarning, FormatError
+from ..core.yamlsafe import dump_text, load_file
+
+#: Keys of a metadata sidecar.
+KEYS = ("meta", "closed_loop", "data_sha256", "steps_sha256")
+
+
+def meta_path(path: Path) -> Path:
+    """The metadata sidecar of a data file: ``<file>.meta.yaml``."""
+    return path.with_name(path.name + ".meta.yaml")
+
+
+def steps_path(path: Path) -> Path:
+    """The true-steps sidecar of a data file: ``<file>.steps.csv``."""
+    return path.with_name(path.name + ".steps.csv")
+
+
+def sha256(path: Path) -> str:
+    """SHA-256 (hex) of a file's bytes."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+@dataclass
+class Facts:
+    """What a metadata sidecar says about its data file.
+
+    Attributes
+    ----------
+    meta : dict
+        Metadata to merge into ``Recording.meta``.
+    closed_loop : bool or None
+        Whether the walk is a closed loop (None: the sidecar does not say).
+    steps : Path or None
+        The true-steps sidecar to read, when there is a valid one.
+    files : list of Path
+        The sidecar files that were used (inputs of the run).
+    """
+
+    meta: dict[str, Any] = field(default_factory=dict)
+    closed_loop: bool | None = None
+    steps: Path | None = None
+    files: list[Path] = field(default_factory=list)
+
+
+def read_facts(path: Path) -> Facts:
+    """The facts of ``path``'s sidecars (empty when there are none, or when they are stale)."""
+    side, steps = meta_path(path), steps_path(path)
+    facts = Facts()
+    if not side.exists():
+        if steps.exists():
+            facts.steps = steps
+            facts.files.append(steps)
+        return facts
+    raw = load_file(side, FormatError, "metadata sidecar")
+    raw = {} if raw is None else raw
+    fix = f"fix or delete {side.name} (see footzoo.io.metadata: meta: {{...}}, closed_loop: true|false)"
+    if not isinstance(raw, dict):
+        raise FormatError(f"{side}: expected a mapping with 'meta' and 'closed_loop', got {raw!r:.80}; {fix}")
+    unknown = [k for k in raw if k not in KEYS]
+    if unknown:
+        raise FormatError(f"{side}: unknown key(s) {unknown}; a metadata sidecar holds {list(KEYS)}; {fix}")
+    meta = raw.get("meta", {}) or {}
+    if not isinstance(meta, dict):
+        raise FormatError(f"{side}: 'meta' must be a mapping, got {raw['meta']!r:.80}; {fix}")
+    closed_loop = raw.get("closed_loop")
+    if closed_loop is not None and not isinstance(closed_loop, bool):
+        raise FormatError(f"{side}: closed_loop must be true or false, got {closed_loop!r}; {fix}")
+    for key in ("data_sha256", "steps_sha256"):
+        if raw.get(key) is not None and not isinstance(raw[key], str):
+            raise FormatError(f"{side}: {key} must be a hex digest (text), got {raw[key]!r:.80}; {fix}")
+    if raw.get("data_sha256") and raw["data_sha256"] != sha256(path):
+        warnings.warn(FootzooWarning(
+            f"{side.name} describes an earlier {path.name} (its data_sha256 does not match the file): stale, ignored"
+            + (f" together with {steps.name}" if steps.exists() else "")
+            + "; delete it, or write the recording again with footzoo.io.canonical.write"), stacklevel=3)
+        return Facts()
+    facts = Facts(meta=dict(meta), closed_loop=closed_loop, files=[side])
+    if steps.exists():
+        vouched = raw.get("steps_sha256")
+        hashed = raw.get("data_sha256") is not None
+        if vouched is not None and vouched == sha256(steps) or (vouched is None and not hashed):
+            facts.steps = steps
+            facts.files.append(steps)
+        else:
+            why = "belongs to an earlier file (its hash does not match)" if vouched else \
+                "is not listed in the metadata sidecar"
+            warnings.warn(FootzooWarning(f"{steps.name} {why}: stale, not used as the reference; delete it"),
+                          stacklevel=3)
+    return facts
+
+
+def facts_text(meta: dict[str, Any], closed_loop: bool, data_sha256: str, steps_sha256: str | None) -> str:
+    """YAML text of a metadata sidecar (metadata values that are text stay text)."""
+    side: dict[str, Any] = {"meta": meta, "closed_loop": bool(closed_loop), "data_sha256": data_sha256}
+    if steps_sha256 is not None:
+        side["steps_sha256"] = steps_sha256
+    return dump_text(side)
