@@ -6,13 +6,12 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_bool, check_range
 from ..filters.strapdown import quat_product, rotvec_quat, sample_intervals
 from ..kernels.jit import njit
-from ..plugins.base import Orientation
+from ..plugins.base import Boolean, Orientation, Real
 from ..plugins.registry import register
 from .fqa import fqa_sample
-from .magnetic import magnetometer_valid, rejection_parameters
+from .magnetic import REJECTION_PARAMETERS, magnetometer_valid
 
 _NO_MAG = np.zeros((1, 3))
 
@@ -117,6 +116,11 @@ def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
     return quat_product(w, x, y, z, dw, dx, dy, dz)
 
 
+#: Why the gains stop at 20 1/s.
+_GAIN_RANGE = ("k is the static branch's corner frequency (eqs. 3-4): above 20 rad/s (3 Hz) the attitude would "
+               "follow the gait's accelerations, and at 50 Hz k dt would approach 1, a full reset every sample")
+
+
 @register
 class FQAComplementary(Orientation):
     """Adaptive-gain quaternion complementary filter with an FQA static branch.
@@ -172,17 +176,26 @@ class FQAComplementary(Orientation):
 
     name = "fqa_complementary"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
-    units = {"static_gain": "1/s", "dynamic_gain": "1/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
+    parameters = {
+        "static_gain": Real("1/s", "[0, 20]", "k_s: the gain of the static (FQA) branch in stance",
+                            source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
+        "dynamic_gain": Real("1/s", "[0, 20]", "k_d: the gain of the static branch in swing",
+                             source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
+        "use_magnetometer": Boolean("use the magnetometer for heading when the recording has one",
+                                    source="Yun et al. 2012 (a MARG filter)"),
+        **REJECTION_PARAMETERS,
+    }
     needs_stance = True
 
     def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True,
                  mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
                  mag_dip_tolerance: float = float(np.radians(5.0))):
-        self.static_gain = check_range("static_gain", static_gain, 0.0, 100.0, "1/s")
-        self.dynamic_gain = check_range("dynamic_gain", dynamic_gain, 0.0, 100.0, "1/s")
-        self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
-        self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
-            mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
+        self.static_gain = static_gain
+        self.dynamic_gain = dynamic_gain
+        self.use_magnetometer = use_magnetometer
+        self.mag_rejection = mag_rejection
+        self.mag_norm_tolerance = mag_norm_tolerance
+        self.mag_dip_tolerance = mag_dip_tolerance
 
     def estimate(
         self,
