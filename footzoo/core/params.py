@@ -77,7 +77,8 @@ def shown(value: Any) -> str:
     """A value as the user wrote it, for messages (numpy scalars as plain numbers)."""
     if isinstance(value, np.generic):
         value = value.item()
-    return repr(value)
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
 
 
 def _g(x: float) -> str:
