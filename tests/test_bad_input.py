@@ -282,7 +282,7 @@ CASES = [
         YUN, orientation="{type: madgwick, mag_dip_tolerance: 5}")), ConfigError, "for 5 ° write 0.0873"),
     Case("min-duration-in-samples", lambda d, w: _config(d, _with(YUN, detector="{type: angular_rate_fsm, "
                                                                              "min_duration: 5}")),
-         ConfigError, "min_duration = 5 s is out of range: it must lie in [0, 1] s"),
+         ConfigError, "for 5 ms write 0.005 (a count of samples? durations are in s: 5 samples at 100 Hz are 0.05 s)"),
     Case("foot-choice-misspelt", lambda d, w: _config(d, YUN + "analysis: [{type: huang_fpa, foot: rigth}]\n"),
          ConfigError, "foot must be one of ['auto', 'right', 'left'], got 'rigth' (did you mean 'right'?)"),
     Case("ekf-zero-rate-without-gyro-bias", lambda d, w: _config(d, _with(

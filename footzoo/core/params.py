@@ -351,8 +351,11 @@ class Real(Param):
                 if isinstance(default, (int, float)) and not isinstance(default, bool) and default:
                     known = f" (the default {_g(default)} {self.unit} is {_g(default / size)} {other})"
                 short = name.rsplit(".", 1)[-1].split(" ")[-1]
+                samples = ""
+                if self.unit == "s" and float(v).is_integer() and 1 <= v <= 1000:  # a paper's sample count?
+                    samples = f" (a count of samples? durations are in s: {v:g} samples at 100 Hz are {_g(v / 100)} s)"
                 return (f". {_g(v)} {self.unit} is {_g(v / size)} {other}: {short} is in {self.unit}{known}; "
-                        f"for {_g(v)} {other} write {_g(v * size)}")
+                        f"for {_g(v)} {other} write {_g(v * size)}{samples}")
         return ""
 
     def invalid_values(self) -> list[Any]:
