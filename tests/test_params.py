@@ -47,8 +47,9 @@ def test_interval_messages_read_as_written():
     assert str(Interval.parse("(0, pi]")) == "(0, π]"
     assert Interval.parse("(0, inf)").requirement("s") == "be > 0 s"
     assert Interval.parse("[9.7, 9.9]").requirement("m/s^2") == "lie in [9.7, 9.9] m/s^2"
-    with pytest.raises(TypeError, match="written like"):
-        Interval.parse("0..10")
+    for bad in ("0..10", "(0, x]", "(0, 1, 2]"):
+        with pytest.raises(TypeError, match="written like"):
+            Interval.parse(bad)
     with pytest.raises(TypeError, match="must not exceed"):
         Interval.parse("[2, 1]")
 
@@ -268,3 +269,19 @@ def test_spec_round_trips_declared_values():
     fpa = build("analysis", {"type": "huang_fpa", "window": (0.1, 0.9), "foot": "left"})
     assert fpa.spec()["window"] == [0.1, 0.9]
     assert build("analysis", fpa.spec()).get_params() == fpa.get_params()
+
+
+def test_every_builtin_physical_quantity_has_a_plausible_upper_bound():
+    """The range review holds for every built-in (and a new one): a rate, angle, acceleration or duration is bounded,
+    so that a value in another unit (°/s, °, g, ms) is refused with the conversion instead of passing silently."""
+    from footzoo.core.params import UNIT_SLIPS
+    from footzoo.plugins.registry import KINDS
+    from footzoo.runtime.validate import settings_declarations
+
+    declared = {f"{n}.{p}": d for k in KINDS for n, cls in available(k).items() if not n.startswith("test_")
+                for p, d in cls.declaration().items()}
+    declared.update(settings_declarations())
+    physical = {k: d for k, d in declared.items() if isinstance(d.param, Real) and d.param.unit in UNIT_SLIPS}
+    assert len(physical) > 40
+    unbounded = [k for k, d in physical.items() if not math.isfinite(d.param.interval.hi)]
+    assert not unbounded

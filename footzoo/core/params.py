@@ -51,6 +51,8 @@ covered without writing tests for it.
 from __future__ import annotations
 
 import copy
+import functools
+import inspect
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -61,8 +63,16 @@ import numpy as np
 
 from .errors import ConfigError, did_you_mean
 
+
+class _Required:
+    """The default of a parameter that has none (a required argument)."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
 #: Marks a parameter without a default (a required argument).
-REQUIRED = object()
+REQUIRED = _Required()
 
 #: Units a value is often given in by mistake, per declared unit: ``(unit, size of one of it in the declared unit)``.
 UNIT_SLIPS: dict[str, tuple[tuple[str, float], ...]] = {
@@ -117,8 +127,11 @@ class Interval:
         t = text.strip()
         if len(t) < 5 or t[0] not in "[(" or t[-1] not in "])" or "," not in t:
             raise TypeError(f"an interval is written like '(0, 10]' or '[0, inf)', got {text!r}")
-        lo_text, hi_text = t[1:-1].split(",")
-        lo, hi = _bound(lo_text), _bound(hi_text)
+        try:
+            lo_text, hi_text = t[1:-1].split(",")
+            lo, hi = _bound(lo_text), _bound(hi_text)
+        except ValueError:
+            raise TypeError(f"an interval is written like '(0, 10]' or '[0, inf)', got {text!r}") from None
         if not lo <= hi:
             raise TypeError(f"interval {text!r}: the lower end must not exceed the upper one")
         shown_text = f"{t[0]}{lo_text.strip()}, {hi_text.strip()}{t[-1]}".replace("pi", "π")
@@ -653,9 +666,6 @@ def validated_init(cls: type, init: Callable[..., None], declaration: Callable[[
     ``super().__init__`` validates against the subclass's declarations (which may redeclare a range),
     and the base's body then receives the values as they are.
     """
-    import functools
-    import inspect
-
     sig = inspect.signature(init)
 
     @functools.wraps(init)
