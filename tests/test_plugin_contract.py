@@ -200,20 +200,28 @@ def test_check_plugin_returns_a_report_and_prints_one_line(capsys):
     assert capsys.readouterr().out == ""
 
 
-def test_check_plugin_from_the_command_line(tmp_path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+def test_check_plugin_from_the_command_line(tmp_path, capsys):
+    """``python -m footzoo.apps.testing FILE.py``: one line per plug-in, exit 1 when one fails."""
+    from footzoo.apps.testing import main
+
     good = tmp_path / "good.py"
     good.write_text(PLUGIN_FILE.format(version=1, name="test_contract_cli"))
-    proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", str(good)], capture_output=True, text=True,
-                          env=env, cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.startswith("check_plugin: detector 'test_contract_cli' passed")
+    assert main([str(good)]) == 0
+    assert capsys.readouterr().out.startswith("check_plugin: detector 'test_contract_cli' passed")
     bad = tmp_path / "bad.py"
     bad.write_text(PLUGIN_FILE.format(version=1, name="test_contract_cli_bad").replace(
         "gyr, axis=1)\n        self.stance_", "gyr, axis=1)\n        gyr[:] = 0\n        self.stance_"))
-    proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", str(bad)], capture_output=True, text=True,
-                          env=env, cwd=tmp_path)
-    assert proc.returncode == 1 and "FAILED: " in proc.stderr and "modified its input" in proc.stderr
+    assert main([str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "check_plugin: detector 'test_contract_cli_bad' FAILED: " in err and "modified its input" in err
+    assert main([str(tmp_path / "none.py")]) == 2 and "does not exist" in capsys.readouterr().err
+
+
+def test_the_testing_module_runs_as_a_script():
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", "--help"], capture_output=True, text=True,
+                          env=env)
+    assert proc.returncode == 0 and proc.stdout.startswith("usage: python -m footzoo.apps.testing")
 
 
 def test_check_plugin_checks_the_declarations():

@@ -116,9 +116,9 @@ def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
     return quat_product(w, x, y, z, dw, dx, dy, dz)
 
 
-#: Why the gains stop at 20 1/s.
-_GAIN_RANGE = ("k is the static branch's corner frequency (eqs. 3-4): above 20 rad/s (3 Hz) the attitude would "
-               "follow the gait's accelerations, and at 50 Hz k dt would approach 1, a full reset every sample")
+#: Why the gains stop at 100 1/s.
+_GAIN_RANGE = ("k is the static branch's corner frequency in rad/s (eqs. 3-4): at 100 Hz, k = 100 replaces the "
+               "estimate by the FQA quaternion at every sample")
 
 
 @register
@@ -177,9 +177,9 @@ class FQAComplementary(Orientation):
     name = "fqa_complementary"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
     parameters = {
-        "static_gain": Real("1/s", "[0, 20]", "k_s: the gain of the static (FQA) branch in stance",
+        "static_gain": Real("1/s", "[0, 100]", "k_s: the gain of the static (FQA) branch in stance",
                             source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
-        "dynamic_gain": Real("1/s", "[0, 20]", "k_d: the gain of the static branch in swing",
+        "dynamic_gain": Real("1/s", "[0, 100]", "k_d: the gain of the static branch in swing",
                              source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
         "use_magnetometer": Boolean("use the magnetometer for heading when the recording has one",
                                     source="Yun et al. 2012 (a MARG filter)"),
