@@ -659,7 +659,7 @@ def declared(cls: type, defaults: Mapping[str, Any]) -> dict[str, Declared]:
     return out
 
 
-def validated_init(cls: type, init: Callable[..., None], declaration: Callable[[], dict[str, Declared]]):
+def validated_init(init: Callable[..., None], declaration: Callable[[], dict[str, Declared]]) -> Callable[..., None]:
     """``init`` wrapped: the declared arguments are validated (and converted) before its body runs.
 
     Only the outermost constructor of an object validates: a subclass's ``__init__`` that calls

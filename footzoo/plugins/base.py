@@ -205,7 +205,7 @@ def _declare(cls: type[Plugin]) -> None:
         init = cls.__init__
     if init is not None:
         raw = init.__wrapped__ if getattr(init, "__footzoo_validated__", False) else init
-        cls.__init__ = validated_init(cls, raw, lambda: decl)  # type: ignore[method-assign]
+        cls.__init__ = validated_init(raw, lambda: decl)  # type: ignore[method-assign]
 
 
 def _plain(value: Any) -> Any:
