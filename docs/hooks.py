@@ -1,8 +1,10 @@
 """MkDocs hooks: pages generated at build time from the code, so they cannot go stale.
 
-* ``zoo/``: one page per registered plug-in (summary, paper, parameters with
-  defaults, units and meaning, YAML snippet, full docstring) and an index table;
-  a plug-in registered tomorrow gets its page without any edit here.
+* ``zoo/``: one page per registered plug-in (summary, paper, a table of its declared
+  parameters: name, type, unit, accepted range, default, source of the default and
+  meaning; YAML snippet, full docstring), an index table and ``zoo/settings.md``
+  (the config's settings blocks, from the same declarations); a plug-in registered
+  tomorrow gets its page without any edit here.
 * ``readers/<format>.md``: one page per built-in reader (``footzoo.io.registry.BUILTIN``; and per
   other module of ``footzoo/io``, e.g. reference-data loaders), from the module
   docstring and the reader's options.
@@ -47,7 +49,7 @@ log = logging.getLogger("mkdocs.hooks.footzoo")
 KIND_TITLES = {"calibration": "Calibration", "orientation": "Orientation", "detector": "Stance detectors",
                "correction": "Corrections", "analysis": "Analysis"}
 #: Class attributes of a plug-in that are not capabilities.
-NOT_CAPABILITIES = {"kind", "name", "paper", "units"}
+NOT_CAPABILITIES = {"kind", "name", "paper", "units", "parameters"}
 
 _gallery_dir: Path | None = None
 
@@ -153,15 +155,11 @@ def plugin_pages() -> dict[str, str]:
                      (inspect.Parameter.VAR_KEYWORD, inspect.Parameter.VAR_POSITIONAL)]
             spec: dict[str, Any] = {"type": name}
             if names:
-                lines += ["## Parameters", "", "| parameter | default | unit | meaning |", "|---|---|---|---|"]
+                lines += ["## Parameters", "", *parameter_table(cls, names, sig, units, params), ""]
                 for p in names:
                     default = sig.parameters[p].default
-                    shown = "required" if default is inspect.Parameter.empty else f"`{default!r}`"
-                    lines.append(f"| `{p}` | {md_cell(shown)} | {md_cell(units.get(p, ''))} | "
-                                 f"{md_cell(params.get(p, ''))} |")
                     if default is not inspect.Parameter.empty and yaml_value(default) is not None:
                         spec[p] = yaml_value(default)
-                lines.append("")
             slot = {"orientation": "orientation", "detector": "detector"}.get(kind)
             snippet = {slot: spec} if slot else {"corrections" if kind == "correction" else kind: [spec]}
             lines += ["## In a config", "", "With every default written out:", "", "```yaml",
@@ -175,16 +173,60 @@ def plugin_pages() -> dict[str, str]:
     index = ["# Plug-in zoo", "",
              "Every plug-in footzoo knows, generated from the registry and the plug-ins' docstrings when the "
              "documentation is built. `footzoo list` prints the same information in a terminal; "
-             "[the plug-in guide](../plugins.md) shows how to add your own.", "",
+             "[the plug-in guide](../plugins.md) shows how to add your own; [the config settings](settings.md) "
+             "lists the top-level blocks of a config.", "",
              "| kind | name | what it does | paper |", "|---|---|---|---|", *rows, ""]
     pages["zoo/index.md"] = "\n".join(index)
+    pages["zoo/settings.md"] = settings_page()
     return pages
+
+
+PARAMETER_HEADER = ["| parameter | type | unit | accepted | default | source of the default | meaning |",
+                    "|---|---|---|---|---|---|---|"]
+
+
+def declared_row(name: str, d: Any) -> str:
+    """A table row of one declared parameter (``footzoo.core.params.Declared``)."""
+    p = d.param
+    accepted = p.range_text + (f" ({p.why})" if p.why else "")
+    return (f"| `{name}` | {md_cell(p.type_text)} | {md_cell(p.unit)} | {md_cell(accepted)} | "
+            f"`{md_cell(d.default_text)}` | {md_cell(p.source)} | {md_cell(p.doc)} |")
+
+
+def parameter_table(cls: type, names: list[str], sig: inspect.Signature, units: dict[str, str],
+                    described: dict[str, str]) -> list[str]:
+    """The parameters of a plug-in as a table: from its declarations, else from its signature and docstring."""
+    declaration = cls.declaration()
+    rows = list(PARAMETER_HEADER)
+    for p in names:
+        if p in declaration:
+            rows.append(declared_row(p, declaration[p]))
+            continue
+        default = sig.parameters[p].default
+        shown = "required" if default is inspect.Parameter.empty else f"`{default!r}`"
+        rows.append(f"| `{p}` | | {md_cell(units.get(p, ''))} | | {md_cell(shown)} | | "
+                    f"{md_cell(described.get(p, ''))} (not declared) |")
+    return rows
+
+
+def settings_page() -> str:
+    """``zoo/settings.md``: the top-level settings of a pipeline config, from their declarations."""
+    from footzoo.runtime.validate import settings_declarations
+
+    rows = [declared_row(name, d) for name, d in settings_declarations().items()]
+    return "\n".join([
+        "# Config settings", "",
+        "The top-level settings of a pipeline config, declared and validated like a plug-in's parameters "
+        "(`footzoo list --kind settings` prints the same). Each is refused outside its accepted range, with the "
+        "reason and, for a value that looks like one in another unit, the conversion.", "",
+        "```yaml", "gravity: 9.81", "init: {duration: 0.5, max_gyr: 0.6}", "navigation: {velocity_noise: 0.01}",
+        "guards: {max_swing: 1.5, max_speed: 50}", "```", "", *PARAMETER_HEADER, *rows, ""])
 
 
 def plugin_nav() -> list[Any]:
     from footzoo.plugins import registry
 
-    nav: list[Any] = ["zoo/index.md"]
+    nav: list[Any] = ["zoo/index.md", {"Config settings": "zoo/settings.md"}]
     for kind in registry.KINDS:
         names = sorted(registry.available(kind))
         if names:

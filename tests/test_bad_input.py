@@ -8,6 +8,7 @@ studies, stream, sensor sanity, command line).
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -198,7 +199,7 @@ CASES = [
     Case("gaitmap-rate-inf", lambda d, w: (lambda: load(_text(d, "g.csv", "sensor,left_sensor\n"), format="gaitmap",
                                                         foot="left", rate=float("inf"))), ConfigError, "finite"),
     Case("max-gap-negative", lambda d, w: (lambda: load(_csv(d, w), max_gap=-1.0)), ConfigError,
-         "max_gap must be > 0"),
+         "max_gap = -1.0 s is out of range: it must be > 0 s"),
     Case("acc-1e30", lambda d, w: _modified(w, acc=((50, 0), 1e30)), RecordingError,
          "beyond any body-worn IMU"),
     Case("gyr-1e30-not-called-deg-s", lambda d, w: _modified(w, gyr=((50, 2), -1e30)), RecordingError,
@@ -271,7 +272,25 @@ CASES = [
     Case("init-duration-zero", lambda d, w: _config(d, _with(YUN, init="{duration: 0}")), ConfigError,
          "init.duration = 0 s is out of range"),
     Case("init-max-gyr-negative", lambda d, w: _config(d, _with(YUN, init="{max_gyr: -1}")), ConfigError,
-         "init.max_gyr must be > 0"),
+         "init.max_gyr = -1 rad/s is out of range: it must lie in (0, 10] rad/s"),
+    Case("init-duration-in-ms", lambda d, w: _config(d, _with(YUN, init="{duration: 500}")), ConfigError,
+         "500 s is 500000 ms: duration is in s (the default 0.5 s is 500 ms); for 500 ms write 0.5"),
+    Case("threshold-in-deg-per-s", lambda d, w: _config(d, _with(YUN, detector="{type: angular_rate_fsm, "
+                                                                            "threshold: 35}")),
+         ConfigError, "35 rad/s is 2005 °/s: threshold is in rad/s (the default 0.6 rad/s is 34.4 °/s)"),
+    Case("gravity-in-g", lambda d, w: _config(d, _with(YUN, gravity="1.0")), ConfigError,
+         "gravity is in m/s^2 (the default 9.81 m/s^2 is 1 g); for 1 g write 9.81"),
+    Case("dip-tolerance-in-degrees", lambda d, w: _config(d, _with(
+        YUN, orientation="{type: madgwick, mag_dip_tolerance: 5}")), ConfigError, "for 5 ° write 0.0873"),
+    Case("min-duration-in-samples", lambda d, w: _config(d, _with(YUN, detector="{type: angular_rate_fsm, "
+                                                                             "min_duration: 5}")),
+         ConfigError, "for 5 ms write 0.005 (a count of samples? durations are in s: 5 samples at 100 Hz are 0.05 s)"),
+    Case("foot-choice-misspelt", lambda d, w: _config(d, YUN + "analysis: [{type: huang_fpa, foot: rigth}]\n"),
+         ConfigError, "foot must be one of ['auto', 'right', 'left'], got 'rigth' (did you mean 'right'?)"),
+    Case("ekf-zero-rate-without-gyro-bias", lambda d, w: _config(d, _with(
+        YUN, orientation="{type: ins}", detector="{type: dgp}",
+        corrections="[{type: ekf_zupt, gyro_bias: false}]")), ConfigError,
+        "corrections[0] (ekf_zupt): zero_rate measures the gyro bias: it needs gyro_bias: true"),
     Case("sexagesimal-is-text", lambda d, w: _config(d, _with(YUN, detector="{type: angular_rate_fsm, "
                                                                           "min_duration: 1:30}")),
          ConfigError, "min_duration must be a number, got str '1:30'"),
@@ -290,7 +309,7 @@ CASES = [
                                                                      "static_gain: 1e300}")),
          ConfigError, "static_gain = 1e+300 1/s is out of range"),
     Case("foot-vector-zero", lambda d, w: _config(d, YUN + "analysis: [{type: huang_fpa, foot_vector: [0, 0, 0]}]\n"),
-         ConfigError, "foot_vector (sensor frame) must not be all zeros"),
+         ConfigError, "foot_vector must not be all zeros"),
     Case("foot-vector-nan", lambda d, w: _config(d, YUN + "analysis: [{type: huang_fpa, foot_vector: [.nan, 0, 0]}]\n"),
          ConfigError, "foot_vector[0] must be a finite number"),
     Case("height-direction-zero", lambda d, w: _config(d, _with(
@@ -498,30 +517,62 @@ def test_cli_console_script_has_no_traceback(tmp_path):
     assert "exit codes:" in helptext and "3    data error" in helptext
 
 
-# --------------------------------------------------------------------------- parameter ranges
-def _ranged_parameters() -> list[tuple[str, str, str, float]]:
-    """Every (kind, plug-in, parameter, edge value) of a range-checked parameter, read from its error message."""
-    import re
+# --------------------------------------------------------------------------- parameters, from their declarations
+def _declared() -> list[tuple[str, str, str, object]]:
+    """(kind, plug-in, parameter, Declared) of every declared parameter of every registered plug-in."""
+    from footzoo.plugins.registry import KINDS, available
 
-    from footzoo.plugins.registry import available, build
-
-    out = []
-    for kind in ("orientation", "detector", "correction"):
-        for name, cls in sorted(available(kind).items()):
-            for p in cls.param_names():
-                try:
-                    build(kind, {"type": name, p: 1e300})
-                    continue
-                except ConfigError as err:
-                    m = re.search(r"must lie in ([\[(])([-0-9.e+]+), ([-0-9.e+]+)([\])])", str(err))
-                if m:
-                    lo = float(m[2]) if m[1] == "[" else float(m[2]) + 1e-6
-                    hi = float(m[3]) if m[4] == "]" else float(m[3]) - 1e-6
-                    out += [(kind, name, p, lo), (kind, name, p, hi)]
-    return out
+    return [(kind, name, p, d) for kind in KINDS for name, cls in sorted(available(kind).items())
+            if not name.startswith("test_") for p, d in cls.declaration().items()]
 
 
-RANGED = _ranged_parameters()
+DECLARED = _declared()
+PLUGINS = sorted({(kind, name) for kind, name, _, _ in DECLARED})
+
+
+@pytest.mark.parametrize("kind, name", PLUGINS, ids=[n for _, n in PLUGINS])
+def test_every_value_a_declaration_refuses_is_a_clear_config_error(kind, name):
+    """Wrong types, NaN, ±inf and values just beyond each end, derived from each parameter's declaration: each is a
+    ConfigError from ``build`` that names the place, the plug-in and the parameter (a new plug-in is covered too)."""
+    from footzoo.plugins.registry import build
+
+    where = f"{kind}s[0]" if kind in ("correction", "calibration") else kind
+    for k, n, param, d in DECLARED:
+        if (k, n) != (kind, name):
+            continue
+        for bad in d.param.invalid_values():
+            with pytest.raises(ConfigError) as err:
+                build(kind, {"type": name, param: bad}, where)
+            message = str(err.value)
+            assert message.startswith(f"{where} ({name}): ") and param in message, message
+            if isinstance(bad, float) and math.isfinite(bad) and type(d.param).__name__ in ("Real", "Integer"):
+                assert "is out of range: it must" in message, message
+                assert d.param.unit in ("", "1") or f" {d.param.unit}" in message, message  # "1": dimensionless
+
+
+SETTINGS = [(key, d) for key, d in __import__("footzoo.runtime.validate", fromlist=["x"]).settings_declarations(
+).items()]
+
+
+@pytest.mark.parametrize("key, declared", SETTINGS, ids=[k for k, _ in SETTINGS])
+def test_every_bad_setting_is_a_clear_config_error(key, declared):
+    """The same for the settings blocks (gravity, init, navigation, guards): one mechanism."""
+    for bad in declared.param.invalid_values():
+        block, _, field = key.partition(".")
+        cfg = load_yaml("yun2012")
+        cfg[block] = {field: bad} if field else bad
+        with pytest.raises(ConfigError) as err:
+            Pipeline.from_dict(cfg)
+        assert key in str(err.value), str(err.value)
+
+
+def _edges() -> list[tuple[str, str, str, float]]:
+    """Every (kind, plug-in, parameter, value) at an end of a declared numeric range (the nearest float inside)."""
+    return [(kind, name, p, v) for kind, name, p, d in DECLARED if kind in ("orientation", "detector", "correction")
+            and type(d.param).__name__ == "Real" for v in d.param.interval.inside()]
+
+
+EDGES = _edges()
 
 
 @pytest.fixture(scope="module")
@@ -529,9 +580,9 @@ def sensors_walk() -> Recording:
     return simulate(n_strides=4, rate=50.0, noise=NoiseModel(seed=1), distance_sensors=True)
 
 
-@pytest.mark.parametrize("kind, name, param, value", RANGED, ids=[f"{n}.{p}={v:g}" for _, n, p, v in RANGED])
+@pytest.mark.parametrize("kind, name, param, value", EDGES, ids=[f"{n}.{p}={v:g}" for _, n, p, v in EDGES])
 def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name, param, value, sensors_walk):
-    """The documented ranges are safe: no NaN or crash at either end (or a clear footzoo error)."""
+    """The declared ranges are safe: no NaN or crash at either end (or a clear footzoo error)."""
     yun, nguyen, duong = (load_yaml(c) for c in ("yun2012", "nguyen2016", "duong2015"))
     if kind == "orientation":
         cfg = nguyen if name == "ins" else yun
@@ -552,5 +603,9 @@ def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name
     assert np.isfinite(result.pos).all() and np.isfinite(result.quat).all()
 
 
-def test_range_checked_parameters_were_found():
-    assert len(RANGED) >= 50  # both ends of every range-checked parameter
+def test_declared_parameters_were_found():
+    from footzoo.plugins.registry import KINDS, available
+
+    builtins = [cls for kind in KINDS for n, cls in available(kind).items() if not n.startswith("test_")]
+    assert all(not cls.undeclared() for cls in builtins)  # every built-in parameter is declared
+    assert len(DECLARED) >= 60 and len(EDGES) >= 80 and len(SETTINGS) == 16

@@ -45,10 +45,28 @@ def test_unknown_parameter_lists_valid_parameters():
         Pipeline.from_dict(with_(orientation={"type": "fqa_complementary", "static_gian": 1}))
 
 
-def test_bad_value_names_the_parameter():
+def test_bad_value_names_the_parameter_the_range_and_the_fix():
     with pytest.raises(ConfigError, match=r"detector \(angular_rate_fsm\): threshold = -1 rad/s is out of range: "
-                                          r"it must lie in \(0, 50\] rad/s"):
+                                          r"it must lie in \(0, 10\] rad/s \(.*\); e.g. the default 0.6 rad/s"):
         Pipeline.from_dict(with_(detector={"type": "angular_rate_fsm", "threshold": -1}))
+
+
+@pytest.mark.parametrize("section, value, hint", [
+    # issue 24: a deg/s value given as rad/s passed validation silently
+    ({"detector": {"type": "angular_rate_fsm", "threshold": 35}},
+     "detector (angular_rate_fsm): threshold = 35 rad/s is out of range", "35 rad/s is 2005 °/s: threshold is in rad/s "
+     "(the default 0.6 rad/s is 34.4 °/s); for 35 °/s write 0.611"),
+    ({"gravity": 1.0}, "gravity = 1.0 m/s^2 is out of range: it must lie in [9.7, 9.9] m/s^2",
+     "1 m/s^2 is 0.102 g: gravity is in m/s^2 (the default 9.81 m/s^2 is 1 g); for 1 g write 9.81"),
+    ({"init": {"duration": 500}}, "init.duration = 500 s is out of range", "for 500 ms write 0.5"),
+    ({"corrections": [{"type": "hdr", "threshold": 30}], "orientation": {"type": "madgwick"}},
+     "corrections[0] (hdr): threshold = 30 rad is out of range", "for 30 ° write 0.524"),
+    ({"guards": {"still_rate": 57}}, "guards.still_rate = 57 rad/s is out of range", "for 57 °/s write 0.995"),
+])
+def test_values_in_the_wrong_unit_are_refused_with_the_conversion(section, value, hint):
+    with pytest.raises(ConfigError) as err:
+        Pipeline.from_dict(with_(**section))
+    assert value in str(err.value) and hint in str(err.value)
 
 
 def test_missing_section_and_missing_type():
@@ -63,6 +81,27 @@ def test_missing_section_and_missing_type():
 def test_unknown_correction_is_placed_in_the_list():
     with pytest.raises(ConfigError, match=r"corrections\[0\]: unknown correction type 'zvu'"):
         Pipeline.from_dict(with_(corrections=[{"type": "zvu"}]))
+
+
+def test_cli_list_shows_every_kind_the_settings_and_one_plugin(capsys):
+    assert main(["list", "--kind", "calibration"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("calibration:\n") and "\n  hard_iron — " in out  # (other tests may register more)
+    assert "min_spread = 0.01 [1]  [0, 1/3]" in out and "\ndetector:" not in out
+    assert main(["list", "--kind", "settings"]) == 0
+    out = capsys.readouterr().out
+    assert "gravity = 9.81 [m/s^2]  [9.7, 9.9]" in out and "guards.max_swing = 1.5 [s]  [0, 10]" in out
+    assert main(["list", "angular_rate_fsm"]) == 0
+    out = capsys.readouterr().out
+    assert "threshold = 0.6 [rad/s]  (0, 10]  Ω_th" in out and "default: footzoo's design notes" in out
+    assert "shoe" not in out
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert all(f"\n{kind}:\n" in f"\n{out}" for kind in ("calibration", "orientation", "detector", "correction",
+                                                          "analysis"))
+    assert "settings (top-level blocks of a pipeline config):" in out
+    assert main(["list", "sheo"]) == 2
+    assert "no plug-in named 'sheo' (did you mean 'shoe'?)" in capsys.readouterr().err
 
 
 def test_unknown_init_key():
@@ -93,6 +132,71 @@ def test_cli_validate_reports_errors_with_exit_code_2(tmp_path, capsys):
     good.write_text("orientation: {type: fqa_complementary}\ndetector: {type: angular_rate_fsm}\n")
     assert main(["validate", str(good)]) == 0
     assert "valid" in capsys.readouterr().out
+
+
+PLUGIN = '''
+import footzoo
+from footzoo.plugins.base import Detector, Real
+
+
+@footzoo.register
+class MyDetector(Detector):
+    """Stance while |ω| is small (a user's plug-in)."""
+
+    name = "{name}"
+    paper = "none (test)"
+    parameters = {{"gyro_max": Real("rad/s", "(0, 10]", "bound on |ω|", source="test")}}
+
+    def __init__(self, gyro_max: float = 0.8):
+        self.gyro_max = gyro_max
+
+    def detect(self, t, acc, gyr):
+        import numpy as np
+
+        self.statistic_ = np.linalg.norm(gyr, axis=1)
+        self.stance_ = self.statistic_ < self.gyro_max
+        return self
+'''
+
+
+def _user_config(folder, name, detector_line):
+    (folder / "my_detector.py").write_text(PLUGIN.format(name=name))
+    config = folder / "mine.yaml"
+    config.write_text("plugins: [my_detector.py]\norientation: {type: madgwick}\n"
+                      f"detector: {detector_line}\ncorrections: [{{type: zvu_dedrift}}]\n")
+    return config
+
+
+def test_validate_loads_plugins_as_run_does(tmp_path, monkeypatch, capsys):
+    """Issue 24: validate refused `plugins: [my_detector.py]` as 'unknown detector type' while run accepted it."""
+    folder = tmp_path / "study"
+    folder.mkdir()
+    config = _user_config(folder, "test_config_validate_mine", "{type: test_config_validate_mine, gyro_max: 0.7}")
+    monkeypatch.chdir(tmp_path)  # elsewhere: the plug-in path is relative to the config file's folder
+    assert main(["validate", str(config)]) == 0
+    assert "valid" in capsys.readouterr().out
+    assert main(["run", str(config)]) == 0
+    assert "strides" in capsys.readouterr().out
+
+
+def test_validate_lists_a_plugins_problems_with_the_others(tmp_path, capsys):
+    config = _user_config(tmp_path, "test_config_validate_bad", "{type: test_config_validate_bad, gyro_max: 35}")
+    config.write_text(config.read_text() + "gravity: 1.0\nguards: {max_swing: -1}\ninit: {duration: 0}\n")
+    assert main(["validate", str(config)]) == 2
+    err = capsys.readouterr().err
+    assert "4 problem(s)" in err
+    for what in ("detector (test_config_validate_bad): gyro_max = 35 rad/s is out of range", "for 35 °/s write 0.611",
+                 "gravity = 1.0 m/s^2", "guards.max_swing = -1", "init.duration = 0 s"):
+        assert what in err
+
+
+def test_validate_reports_a_missing_plugin_file_and_the_types_it_would_have_registered(tmp_path, capsys):
+    config = tmp_path / "c.yaml"
+    config.write_text("plugins: [nowhere.py]\norientation: {type: madgwick}\ndetector: {type: mine}\n")
+    assert main(["validate", str(config)]) == 2
+    err = capsys.readouterr().err
+    assert "plugins[0]: plug-in file" in err and "nowhere.py' does not exist" in err
+    assert "unknown detector type 'mine'" in err
 
 
 @pytest.mark.parametrize("key, value, message", [

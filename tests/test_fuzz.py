@@ -1,5 +1,9 @@
 """Property-based fuzzing: readers, YAML, configs, studies and live samples raise only footzoo's documented errors.
 
+The plug-ins' parameters and the settings blocks are fuzzed with values derived from their declarations
+(:mod:`footzoo.core.params`: the values each declaration refuses, its edges, numbers in and around its
+range), so a plug-in registered tomorrow is fuzzed without a line here.
+
 Documented errors: :class:`~footzoo.core.errors.FootzooError` and its subclasses
 (``ConfigError``, ``RecordingError``, ``FormatError``). Anything else escaping
 is a bug. Parsing is bounded by the loader's limits (size, depth, aliases), so
@@ -29,18 +33,19 @@ from hypothesis import strategies as st
 from footzoo import Pipeline
 from footzoo.config import TOP_LEVEL_KEYS
 from footzoo.core.checks import validate_sample
-from footzoo.core.errors import FootzooError
+from footzoo.core.errors import ConfigError, FootzooError
 from footzoo.core.yamlsafe import load_text
 from footzoo.io import READERS, load
-from footzoo.plugins.registry import available
+from footzoo.plugins.registry import KINDS, available, build
+from footzoo.runtime.validate import settings_declarations
 from footzoo.studies.study import STUDY_KEYS, Study
 
 CI_EXAMPLES = int(os.environ.get("FOOTZOO_FUZZ_EXAMPLES", "25"))
 NIGHTLY_EXAMPLES = 2000
 
 
-def _settings(examples: int) -> settings:
-    return settings(max_examples=examples, deadline=None, database=None, derandomize=examples == CI_EXAMPLES,
+def _settings(examples: int, ci: bool = True) -> settings:
+    return settings(max_examples=examples, deadline=None, database=None, derandomize=ci,
                     suppress_health_check=list(HealthCheck))
 
 
@@ -86,6 +91,36 @@ YAMLISH = st.lists(st.sampled_from(list(":-[]{}&*!|>'\"#,?% \n\t<=@`~abcxyz019."
                    max_size=120).map("".join)
 
 
+def _yamlable(value) -> bool:
+    try:
+        yaml.safe_dump(value)
+        return True
+    except yaml.YAMLError:
+        return False
+
+
+def declared_values(param, default, yaml_only: bool = False) -> st.SearchStrategy:
+    """Values for one declared parameter: the ones its declaration refuses or accepts at the edges, numbers inside
+    and around its range, and anything (derived from the declaration, so a new plug-in is fuzzed too)."""
+    edge = param.edge_values(default)
+    invalid = [v for v in param.invalid_values() if not yaml_only or _yamlable(v)]
+    options = [st.sampled_from(invalid), VALUE]
+    if edge:
+        options.append(st.sampled_from(edge))
+    interval = getattr(param, "interval", None)
+    if interval is not None:
+        lo = interval.lo if math.isfinite(interval.lo) else -1e6
+        hi = interval.hi if math.isfinite(interval.hi) else 1e6
+        inside = st.floats(lo, hi, exclude_min=interval.lo_open, exclude_max=interval.hi_open) if lo < hi else None
+        around = st.floats(lo - (hi - lo) - 1.0, hi + (hi - lo) + 1.0)
+        options += [around] + ([inside] if inside is not None else [])
+        size = getattr(param, "size", None)
+        if size is not None:  # a vector: rows of such numbers
+            row = st.lists(inside if inside is not None else around, min_size=size, max_size=size)
+            options += [row, st.lists(row, min_size=1, max_size=3)]
+    return st.one_of(options)
+
+
 def _spec(kind: str) -> st.SearchStrategy:
     plugins = available(kind)
 
@@ -93,8 +128,10 @@ def _spec(kind: str) -> st.SearchStrategy:
     def spec(draw):
         name = draw(st.sampled_from(sorted(plugins)))
         params = plugins[name].param_names()
+        declaration = plugins[name].declaration()
         keys = draw(st.lists(st.sampled_from(params), unique=True, max_size=len(params))) if params else []
-        out = {"type": name, **{k: draw(VALUE) for k in keys}}
+        out = {"type": name, **{k: draw(declared_values(declaration[k].param, declaration[k].default, True)
+                                        if k in declaration and draw(st.booleans()) else VALUE) for k in keys}}
         if draw(st.booleans()):
             out[draw(st.text(max_size=6))] = draw(VALUE)
         return out
@@ -271,6 +308,71 @@ def config_files(cfg: dict) -> None:
         assert 9.7 <= pipeline.gravity <= 9.9
 
 
+DECLARED = [(kind, name, p, d) for kind in KINDS for name, cls in sorted(available(kind).items())
+            if not name.startswith("test_") for p, d in cls.declaration().items()]
+
+
+@st.composite
+def declared_parameter_values(draw):
+    kind, name, p, d = draw(st.sampled_from(DECLARED))
+    return kind, name, p, d, draw(declared_values(d.param, d.default))
+
+
+def declared_parameters(case) -> None:
+    """A plug-in accepts a value only if its declaration does, and then stores the declaration's conversion of it."""
+    kind, name, p, d, value = case
+    try:
+        expected = d.validate(value)
+    except ConfigError:
+        expected = REFUSED
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            plugin = build(kind, {"type": name, p: value}, kind)
+        except ConfigError:  # refused, by the declaration or a rule between parameters (e.g. a window's order)
+            return
+    assert expected is not REFUSED, f"{name}.{p} = {value!r} was accepted, but its declaration refuses it"
+    assert _same(plugin.get_params()[p], expected), (name, p, value, plugin.get_params()[p], expected)
+
+
+REFUSED = object()
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return a == b and type(a) is type(b)
+
+
+SETTINGS = list(settings_declarations().items())
+
+
+@st.composite
+def setting_values(draw):
+    key, d = draw(st.sampled_from(SETTINGS))
+    return key, d, draw(declared_values(d.param, d.default))
+
+
+def settings_blocks(case) -> None:
+    """The settings blocks follow their declarations as plug-ins do: accepted iff declared valid."""
+    key, d, value = case
+    block, _, field = key.partition(".")
+    cfg = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}],
+           block: {field: value} if field else value}
+    try:
+        expected = d.validate(value)
+    except ConfigError:
+        expected = REFUSED
+    try:
+        pipeline = Pipeline.from_dict(cfg)
+    except ConfigError as err:
+        assert expected is REFUSED and key in str(err), (key, value, err)
+        return
+    assert expected is not REFUSED, f"{key} = {value!r} was accepted, but its declaration refuses it"
+    got = pipeline.to_dict()[block][field] if field else pipeline.to_dict()[block]
+    assert _same(got, expected), (key, value, got, expected)
+
+
 def study_mappings(d: dict) -> None:
     with tempfile.TemporaryDirectory() as root:
         _only_footzoo_errors(lambda: Study.from_dict(d, root=root))
@@ -318,6 +420,8 @@ PROPERTIES = {
                   st.floats(allow_nan=True, allow_infinity=True)), max_size=5),)),
     "archive_tables": (archive_tables, (tables(),)),
     "config_files": (config_files, (configs(),)),
+    "declared_parameters": (declared_parameters, (declared_parameter_values(),)),
+    "settings_blocks": (settings_blocks, (setting_values(),)),
     "study_mappings": (study_mappings, (studies(),)),
     "stream_pushes": (stream_pushes, (st.lists(SAMPLE, min_size=0, max_size=120), st.booleans(),
                                       st.sampled_from([0.0, 1.7e9]))),
@@ -327,13 +431,17 @@ PROPERTIES = {
 }
 
 
-def _make(name: str, examples: int):
+#: Properties whose examples take microseconds: more of them in the CI profile.
+CI_MORE = {"declared_parameters": 4 * CI_EXAMPLES, "settings_blocks": 2 * CI_EXAMPLES}
+
+
+def _make(name: str, examples: int, ci: bool = True):
     body, strategies = PROPERTIES[name]
-    test = _settings(examples)(given(*strategies)(body))
+    test = _settings(examples, ci)(given(*strategies)(body))
     test.__name__ = f"test_{name}"
     return test
 
 
 for _name in PROPERTIES:
-    globals()[f"test_{_name}"] = _make(_name, CI_EXAMPLES)
-    globals()[f"test_{_name}_nightly"] = pytest.mark.nightly(_make(_name, NIGHTLY_EXAMPLES))
+    globals()[f"test_{_name}"] = _make(_name, CI_MORE.get(_name, CI_EXAMPLES))
+    globals()[f"test_{_name}_nightly"] = pytest.mark.nightly(_make(_name, NIGHTLY_EXAMPLES, ci=False))

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.ndimage import median_filter, uniform_filter1d
 
 import footzoo
-from footzoo.plugins.base import Detector
+from footzoo.plugins.base import Detector, Real
 
 
 @footzoo.register
@@ -52,24 +52,27 @@ class ThreeCondition(Detector):
 
     name = "three_condition"
     paper = "Jiménez, Seco, Prieto & Guevara 2009, IEEE WISP (stance conditions C1-C3)"
-    units = {"acc_min": "m/s^2", "acc_max": "m/s^2", "acc_std_max": "m/s^2", "gyro_max": "rad/s",
-             "window": "s", "median": "s"}
+    # one declaration per parameter: unit, accepted range, meaning, source of the default
+    parameters = {
+        "acc_min": Real("m/s^2", "[5, 15]", "C1: lower bound of |a|", source="the paper"),
+        "acc_max": Real("m/s^2", "[5, 15]", "C1: upper bound of |a|", source="the paper"),
+        "acc_std_max": Real("m/s^2", "(0, 10]", "C2: bound on the local σ of |a|", source="the paper"),
+        "gyro_max": Real("rad/s", "(0, 10]", "C3: bound on |ω|", source="the paper: 50 °/s"),
+        "window": Real("s", "(0, 1]", "C2's window", source="the paper: 15 samples (at 100 Hz)"),
+        "median": Real("s", "(0, 1]", "median filter on C1-C3", source="the paper: 11 samples (at 100 Hz)"),
+    }
 
     def __init__(self, acc_min: float = 9.0, acc_max: float = 11.0, acc_std_max: float = 3.0,
                  gyro_max: float = 0.87, window: float = 0.15, median: float = 0.11):
-        for name, value in (("acc_min", acc_min), ("acc_max", acc_max), ("acc_std_max", acc_std_max),
-                            ("gyro_max", gyro_max), ("window", window), ("median", median)):
-            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
-                    and value > 0):
-                raise footzoo.ConfigError(f"{name} must be a positive number ({self.units[name]}), got {value!r}")
+        # footzoo has checked each value against its declaration; what is left is the rule between two
         if acc_min >= acc_max:
             raise footzoo.ConfigError(f"acc_min ({acc_min} m/s²) must be below acc_max ({acc_max} m/s²)")
-        self.acc_min = float(acc_min)
-        self.acc_max = float(acc_max)
-        self.acc_std_max = float(acc_std_max)
-        self.gyro_max = float(gyro_max)
-        self.window = float(window)
-        self.median = float(median)
+        self.acc_min = acc_min
+        self.acc_max = acc_max
+        self.acc_std_max = acc_std_max
+        self.gyro_max = gyro_max
+        self.window = window
+        self.median = median
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> ThreeCondition:
         """Stance per sample from time (s), specific force (m/s²) and angular rate (rad/s)."""

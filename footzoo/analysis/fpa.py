@@ -7,12 +7,11 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..core.checks import check_range, check_vector
 from ..core.errors import ConfigError
 from ..evaluation.metrics import intervals, nearest_index
 from ..kernels.jit import njit
-from ..plugins.base import Analysis
-from ..plugins.registry import check_positive, register
+from ..plugins.base import Analysis, Choice, File, Real, Vector
+from ..plugins.registry import register
 from .foot_vector import FootVector
 
 
@@ -59,8 +58,20 @@ class HuangFPA(Analysis):
 
     name = "huang_fpa"
     paper = "Huang et al. 2016, IEEE TBME, Sec. II-C to II-E, eqs. 11-16"
-    units = {"alpha": "1", "window": "fraction of stance", "stance_fraction": "fraction of stride",
-             "foot_vector": "unit vector (sensor frame)"}
+    parameters = {
+        "alpha": Real("1", "(0, 1]", "α: weight of the newest displacement in the heading vector (eq. 14)",
+                      source="Huang et al. 2016, Sec. II-D"),
+        "window": Vector(2, "1", "averaging window [start, end] as fractions of the stance (eq. 16)",
+                         range="[0, 1]", source="Huang et al. 2016, Sec. II-E"),
+        "stance_fraction": Real("1", "(0, 1]", "the stance as a fraction of the stride time",
+                                source="Huang et al. 2016, Sec. II-E"),
+        "foot_vector": Vector(3, "1", "the foot vector f in the sensor frame (FRD)", nonzero=True,
+                              source="footzoo's: the sensor's x axis (calibrate for the real one)"),
+        "calibration": File("YAML file of footzoo calibrate (replaces foot_vector)", optional=True,
+                            source="none: use foot_vector"),
+        "foot": Choice(("auto", "right", "left"), "which foot the sensor is on (auto: the recording's meta['foot'])",
+                       source="footzoo's: from the recording"),
+    }
 
     def __init__(
         self,
@@ -71,22 +82,15 @@ class HuangFPA(Analysis):
         calibration: str | None = None,
         foot: str = "auto",
     ):
-        self.alpha = check_positive("alpha", alpha)
-        if not self.alpha <= 1.0:
-            raise ConfigError(f"alpha must be in (0, 1], got {alpha}")
-        window = check_vector("window", window, 2)
-        if not 0.0 <= window[0] < window[1] <= 1.0:
-            raise ConfigError(f"window must be [start, end] fractions of the stance with 0 <= start < end <= 1, "
-                              f"got {window}")
-        self.window = [float(window[0]), float(window[1])]
-        self.stance_fraction = check_range("stance_fraction", stance_fraction, 0.0, 1.0, "fraction of stride",
-                                           lo_open=True)
-        self.foot_vector = check_vector("foot_vector", foot_vector, 3, nonzero=True, unit="sensor frame")
-        self.calibration = calibration
+        if not window[0] < window[1]:
+            raise ConfigError(f"window must be [start, end] fractions of the stance with start < end, got {window}")
         if calibration is not None:
             FootVector.load(calibration)  # fail early on a bad file
-        if foot not in ("auto", "right", "left"):
-            raise ConfigError(f"foot must be 'auto', 'right' or 'left', got {foot!r}")
+        self.alpha = alpha
+        self.window = window
+        self.stance_fraction = stance_fraction
+        self.foot_vector = foot_vector
+        self.calibration = calibration
         self.foot = foot
 
     def _side(self, meta: dict) -> int:

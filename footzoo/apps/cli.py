@@ -251,30 +251,46 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    """Print every plug-in with its parameters, defaults, units and paper."""
+    """Print every plug-in (or one kind, or one by name) with its parameters, and the config's settings."""
     from ..plugins.registry import describe
 
-    print(describe(args.kind), end="")
-    return 0
+    if args.kind == "settings" or (args.kind is None and args.name is None):
+        plugins = describe() if args.kind is None else ""
+        print(plugins + ("\n" if plugins else "") + describe_settings(), end="")
+        return EXIT_OK
+    print(describe(args.kind, args.name), end="")
+    return EXIT_OK
+
+
+def describe_settings() -> str:
+    """The settings of a pipeline config (``gravity``, ``init``, ``navigation``, ``guards``), as declared."""
+    from ..core.params import describe as describe_parameters
+    from ..runtime.validate import settings_declarations
+
+    lines = ["settings (top-level blocks of a pipeline config):"]
+    lines += describe_parameters(settings_declarations(), indent="  ")
+    return "\n".join(lines) + "\n"
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    """Check a config without running it."""
+    """Check a config without running it: ``plugins:`` loaded as ``footzoo run`` loads them, every problem listed."""
+    from ..config.library import resolve
     from ..config.schema import load_yaml
     from ..runtime.pipeline import Pipeline
     from ..runtime.validate import config_errors
 
-    errors = config_errors(load_yaml(args.config))
+    path = resolve(args.config)
+    errors = config_errors(load_yaml(path), base_dir=path.parent)
     if errors:
         print(f"{args.config}: {len(errors)} problem(s)", file=sys.stderr)
         for e in errors:
             print(f"  - {e}", file=sys.stderr)
-        return 2
-    pipeline = Pipeline.from_yaml(args.config)
+        return EXIT_USAGE
+    pipeline = Pipeline.from_yaml(path)
     print(f"{args.config}: valid")
     print(live_summary(pipeline))
     print(json.dumps(pipeline.to_dict(), indent=2))
-    return 0
+    return EXIT_OK
 
 
 def live_summary(pipeline: Any) -> str:
@@ -522,8 +538,11 @@ def build_parser() -> argparse.ArgumentParser:
     abl.add_argument("--quiet", action="store_true", help="no progress bar")
     abl.set_defaults(func=cmd_ablate)
 
-    lst = sub.add_parser("list", help="list plug-ins with their parameters, defaults, units and papers")
-    lst.add_argument("--kind", choices=["orientation", "detector", "correction", "analysis"], help="only this kind")
+    lst = sub.add_parser("list", help="list plug-ins with their parameters (default, unit, accepted range, meaning, "
+                         "source) and papers, and the config's settings blocks")
+    lst.add_argument("name", nargs="?", help="only the plug-in of this name (e.g. shoe)")
+    lst.add_argument("--kind", choices=[*_kinds(), "settings"],
+                     help="only this kind of plug-in, or the settings blocks (gravity, init, navigation, guards)")
     lst.add_argument("--compatibility", action="store_true",
                      help="print which orientation x correction combinations validate, and why not")
     lst.set_defaults(func=lambda a: cmd_list_compat(a) if a.compatibility else cmd_list(a))
@@ -541,6 +560,13 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument("config", help="pipeline YAML")
     val.set_defaults(func=cmd_validate)
     return parser
+
+
+def _kinds() -> list[str]:
+    """The plug-in kinds (``calibration``, ``orientation``, ``detector``, ``correction``, ``analysis``)."""
+    from ..plugins.base import BASES
+
+    return list(BASES)
 
 
 def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]:

@@ -1,21 +1,30 @@
 """Conformance checks for plug-ins, like scikit-learn's ``check_estimator``.
 
 ``check_plugin(cls)`` runs a plug-in class through the contract of :mod:`footzoo.plugins.base` on a
-short simulated walk (with magnetometer, distance sensors and truth) and raises
-``AssertionError`` naming the first broken rule. Use it in your plug-in's tests::
+short simulated walk (with magnetometer, distance sensors and truth), raises ``AssertionError``
+naming the first broken rule, and otherwise returns a :class:`CheckReport` of what it checked
+(printed as one line; ``print(report.details())`` lists every check). Use it in your plug-in's
+tests::
 
     from footzoo.apps.testing import check_plugin
     def test_my_detector_follows_the_contract():
         check_plugin(MyDetector)
 
+or on a plug-in file from the command line: ``python -m footzoo.apps.testing my_detector.py``.
+
 The checks:
 
 * registered under its kind and name, derived from the kind's base class, with a docstring
   and a ``paper``;
-* every constructor parameter has a default; every numeric one has a unit in ``units``;
+* every constructor parameter has a default; declared parameters (``parameters``, see
+  :mod:`footzoo.core.params`) have a meaning, a unit where they are numbers and the source of their
+  default, and every value their declaration refuses (wrong types, NaN, infinities, values just out
+  of range) is refused by the constructor and by ``set_params`` with a ``ConfigError`` naming the
+  parameter, while the edges of the accepted ranges are accepted; a plug-in without declarations
+  needs a unit in ``units`` for every numeric parameter (and the report suggests declaring);
   parameters are stored as attributes under their own names (``get_params``), constructing
   from ``get_params()`` gives the same parameters (idempotent), ``set_params`` works and
-  rejects unknown names;
+  rejects unknown names with a ``ConfigError``;
 * YAML round trip: ``spec()`` dumps with ``yaml.safe_dump`` and builds back to the same
   parameters; ``clone()`` gives an equal, unfitted, independent copy;
 * the action method leaves its inputs untouched, returns results of the documented shapes,
@@ -35,14 +44,17 @@ from __future__ import annotations
 
 import copy
 import inspect
+import sys
 import warnings
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import yaml
 
 from ..core.context import RunContext
-from ..core.errors import FootzooError
+from ..core.errors import ConfigError, FootzooError
+from ..core.params import Real
 from ..plugins.base import (
     AccelerationCorrection,
     Analysis,
@@ -54,7 +66,7 @@ from ..plugins.base import (
     VelocityCorrection,
 )
 from ..plugins.incremental import Latency, concat
-from ..plugins.registry import available, build
+from ..plugins.registry import available, build, same_plugin
 
 _WALK: Any = None
 
@@ -70,27 +82,95 @@ def _walk():
     return _WALK
 
 
-def check_plugin(cls: type[Plugin]) -> None:
-    """Run every conformance check on a plug-in class (see the module docstring)."""
+@dataclass
+class CheckReport:
+    """What :func:`check_plugin` checked on a plug-in that passed, and what it suggests.
+
+    Attributes
+    ----------
+    plugin : str
+        ``"<kind> '<name>'"``.
+    checks : list of str
+        Each check that passed, in order.
+    notes : list of str
+        Suggestions that are not failures (e.g. declare the parameters).
+    """
+
+    plugin: str
+    checks: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def passed(self, what: str) -> None:
+        """Record a check that passed."""
+        self.checks.append(what)
+
+    def __str__(self) -> str:
+        notes = f"; {len(self.notes)} note(s): " + " ".join(self.notes) if self.notes else ""
+        return f"check_plugin: {self.plugin} passed {len(self.checks)} checks ({', '.join(self.checks)}){notes}"
+
+    def details(self) -> str:
+        """One line per check and note."""
+        return "\n".join([f"check_plugin: {self.plugin}", *(f"  passed: {c}" for c in self.checks),
+                          *(f"  note: {n}" for n in self.notes)])
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
+def check_plugin(cls: type[Plugin], verbose: bool | None = None) -> CheckReport:
+    """Run every conformance check on a plug-in class (see the module docstring).
+
+    Parameters
+    ----------
+    cls : type
+        The plug-in class.
+    verbose : bool, optional
+        Print the report's one-line summary (default: in an interactive session or a notebook).
+
+    Returns
+    -------
+    CheckReport
+        What was checked; an ``AssertionError`` names the first broken rule instead.
+    """
+    report = CheckReport(f"{getattr(cls, 'kind', '?')} {getattr(cls, 'name', '?')!r}")
     _check_declaration(cls)
+    report.passed("registration and declaration")
+    _check_declared_parameters(cls, report)
     instance = cls()
     _check_params(cls, instance)
+    report.passed("get_params/set_params")
     _check_round_trip(cls, instance)
+    report.passed("YAML round trip and clone")
     if isinstance(instance, Calibration):
         _check_calibration(instance)
+        report.passed("calibrate on a simulated walk, with and without magnetometer, NaN refused")
     elif isinstance(instance, Detector):
         _check_detector(instance)
+        report.passed("detect on a simulated walk, NaN refused" + (", chunked = batch" if instance.causal else ""))
     elif isinstance(instance, Orientation):
         _check_orientation(instance)
+        report.passed("estimate on a simulated walk (unit quaternions), NaN refused")
     elif isinstance(instance, KalmanCorrection) and not isinstance(instance, (VelocityCorrection,
                                                                               AccelerationCorrection)):
         _check_kalman(instance)
+        report.passed("compiled = reference engine" + (" = live stream" if instance.causal else ""))
     elif isinstance(instance, (VelocityCorrection, AccelerationCorrection)):
         _check_batch_correction(instance)
+        report.passed("batch correction on a simulated walk, NaN refused")
         if isinstance(instance, KalmanCorrection):
             _check_kalman(instance)
+            report.passed("compiled = reference engine" + (" = live stream" if instance.causal else ""))
     elif isinstance(instance, Analysis):
         _check_analysis(instance)
+        report.passed("analyze and annotate on a simulated walk, NaN refused")
+    if verbose if verbose is not None else _interactive():
+        print(report)
+    return report
+
+
+def _interactive() -> bool:
+    """Whether Python runs interactively (a REPL, ``python -i``, IPython or a notebook)."""
+    return hasattr(sys, "ps1") or bool(sys.flags.interactive) or "IPython" in sys.modules
 
 
 # --------------------------------------------------------------------------- declaration
@@ -98,10 +178,57 @@ def _check_declaration(cls: type[Plugin]) -> None:
     assert isinstance(cls, type) and issubclass(cls, Plugin), f"{cls!r} is not a footzoo plug-in class"
     assert cls.name, f"{cls.__name__}: class attribute 'name' is empty"
     registered = available(cls.kind).get(cls.name)
-    assert registered is cls, (f"{cls.__name__}: not registered as {cls.kind} {cls.name!r} "
-                               f"(decorate it with @footzoo.register; found {registered!r})")
+    assert registered is not None and same_plugin(registered, cls), (
+        f"{cls.__name__}: not registered as {cls.kind} {cls.name!r} (decorate it with @footzoo.register; "
+        f"found {registered!r})")
     assert (cls.__doc__ or "").strip(), f"{cls.__name__}: no docstring (cite the paper and its equations)"
     assert cls.paper, f"{cls.__name__}: class attribute 'paper' is empty (cite the source)"
+
+
+def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
+    """Declarations complete; every value a declaration refuses is refused by the constructor and set_params."""
+    declaration = cls.declaration()
+    undeclared = cls.undeclared()
+    if undeclared:
+        report.notes.append(f"declare {undeclared} in {cls.__name__}.parameters (see footzoo.core.params): "
+                            "validation, footzoo list, the docs and fuzzed bad values then come from it")
+    if not declaration:
+        return
+    for name, d in declaration.items():
+        p = d.param
+        assert p.doc, f"{cls.__name__}: the declaration of {name!r} has no meaning (its doc text)"
+        assert p.source or d.default is None, (f"{cls.__name__}: the declaration of {name!r} gives no source of its "
+                                               "default (source='Paper 2020, Table 1' or footzoo's reason)")
+        if isinstance(p, Real):
+            assert p.unit, f"{cls.__name__}: numeric parameter {name!r} declares no unit ('1' if dimensionless)"
+    base = cls()
+    refused = accepted = 0
+    for name, d in declaration.items():
+        for bad in d.param.invalid_values():
+            for how in ("the constructor", "set_params"):
+                try:
+                    if how == "set_params":
+                        base.clone().set_params(**{name: copy.deepcopy(bad)})
+                    else:
+                        cls(**{name: copy.deepcopy(bad)})
+                except ConfigError as err:
+                    assert name in str(err), f"{cls.__name__}: {how} refused {name}={bad!r} without naming it: {err}"
+                    refused += 1
+                    continue
+                except Exception as err:  # noqa: BLE001 - the check reports what it got
+                    raise AssertionError(f"{cls.__name__}: {how} refused {name}={bad!r} with "
+                                         f"{type(err).__name__} ({err}), not a ConfigError") from None
+                raise AssertionError(f"{cls.__name__}: {how} accepted {name}={bad!r}, which its declaration refuses")
+        for edge in d.param.edge_values(d.default):
+            try:
+                cls(**{name: copy.deepcopy(edge)})
+                accepted += 1
+            except ConfigError:
+                pass  # a cross-parameter rule may refuse an edge together with the other defaults
+            except Exception as err:  # noqa: BLE001 - the check reports what it got
+                raise AssertionError(f"{cls.__name__}: {name}={edge!r} (within its declared range) raised "
+                                     f"{type(err).__name__} ({err}), not a ConfigError") from None
+    report.passed(f"declared parameters ({refused} bad values refused, {accepted} edge values accepted)")
 
 
 def _check_params(cls: type[Plugin], p: Plugin) -> None:
@@ -109,7 +236,8 @@ def _check_params(cls: type[Plugin], p: Plugin) -> None:
     for name, default in defaults.items():
         assert default is not inspect.Parameter.empty, f"{cls.__name__}: parameter {name!r} has no default"
         numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
-        assert not numeric or name in cls.units, f"{cls.__name__}: numeric parameter {name!r} has no unit in 'units'"
+        assert not numeric or name in cls.units, (f"{cls.__name__}: numeric parameter {name!r} has no unit: declare "
+                                                  f"it in parameters (or give its unit in 'units')")
         assert hasattr(p, name), f"{cls.__name__}: parameter {name!r} is not stored as attribute self.{name}"
     stray = sorted(set(cls.units) - set(defaults))
     assert not stray, f"{cls.__name__}: 'units' names no parameter {stray}"
@@ -123,8 +251,11 @@ def _check_params(cls: type[Plugin], p: Plugin) -> None:
         assert _equal(q.get_params(), params), f"{cls.__name__}: set_params to the same value changed parameters"
     try:
         q.set_params(no_such_parameter_xyz=1)
-    except (ValueError, FootzooError):
+    except ConfigError:
         pass
+    except Exception as err:  # noqa: BLE001 - the check reports what it got
+        raise AssertionError(f"{cls.__name__}: set_params refused an unknown parameter with {type(err).__name__}, "
+                             "not a ConfigError (Plugin.set_params raises one)") from None
     else:
         raise AssertionError(f"{cls.__name__}: set_params accepted an unknown parameter")
 
@@ -354,3 +485,37 @@ def _check_analysis(a: Analysis) -> None:
     steps = out.annotate(res.steps.copy(), t)
     assert len(steps) == len(res.steps), f"{who}: annotate() must keep one row per step"
     _expect_nan_error(lambda: a.clone().analyze(t, _nan(quat), pos, stance, dict(rec.meta, foot="right")), who)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m footzoo.apps.testing PLUGIN.py|module [...]``: check every plug-in the files register."""
+    from ..plugins.extensions import load_plugins
+    from ..plugins.registry import KINDS
+
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv or argv[0] in ("-h", "--help"):
+        print("usage: python -m footzoo.apps.testing PLUGIN.py|module [...]: run check_plugin on every plug-in "
+              "they register")
+        return 0 if argv else 2
+    try:
+        modules = {info["module"] for info in load_plugins(argv)}
+    except FootzooError as err:
+        print(f"footzoo: error: {err}", file=sys.stderr)
+        return 2
+    found = [c for k in KINDS for c in available(k).values() if c.__module__ in modules]
+    if not found:
+        print(f"no plug-in is registered by {', '.join(argv)} (decorate the classes with @footzoo.register)",
+              file=sys.stderr)
+        return 2
+    failed = 0
+    for cls in found:
+        try:
+            check_plugin(cls, verbose=True)
+        except AssertionError as err:
+            failed += 1
+            print(f"check_plugin: {cls.kind} {cls.name!r} FAILED: {err}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -7,9 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import check_range, check_vector
 from ..core.errors import CalibrationWarning
-from ..plugins.base import Calibration
+from ..plugins.base import Calibration, Real, Vector
 from ..plugins.registry import register
 
 
@@ -165,14 +164,23 @@ class HardIron(Calibration):
     name = "hard_iron"
     paper = ("Camps, Harasse & Monin 2009, Proc. IEEE EIT, 217-221 (offset-only); "
              "Yun et al. 2012, IEEE TIM 61(7), Sec. VIII")
-    units = {"offset": "magnetometer unit", "min_spread": "1", "outlier_mads": "1", "max_residual": "1"}
+    parameters = {
+        "offset": Vector(3, "magnetometer unit", "a known offset b (FRD) to remove instead of fitting one",
+                         optional=True, source="none: fitted on the recording"),
+        "min_spread": Real("1", "[0, 1/3]", "smallest accepted eigenvalue of the field directions' covariance",
+                           source="footzoo's", why="1/3 for directions all over the sphere, 0 for one direction"),
+        "outlier_mads": Real("1", "(0, 100]", "samples off the sphere by more robust σ are left out of the fit",
+                             source="footzoo's: 3 robust σ"),
+        "max_residual": Real("1", "(0, 1]", "largest accepted robust σ about the sphere, a fraction of its radius",
+                             source="footzoo's: Köroğlu's indoor walks give 20-30 %, the simulator 0.2 %"),
+    }
 
     def __init__(self, offset: list[float] | None = None, min_spread: float = 0.01, outlier_mads: float = 3.0,
                  max_residual: float = 0.05):
-        self.offset = None if offset is None else [float(v) for v in check_vector("offset", offset, 3)]
-        self.min_spread = check_range("min_spread", min_spread, 0.0, 1.0 / 3.0, "1")
-        self.outlier_mads = check_range("outlier_mads", outlier_mads, 0.0, 100.0, "1", lo_open=True)
-        self.max_residual = check_range("max_residual", max_residual, 0.0, 1.0, "1", lo_open=True)
+        self.offset = offset
+        self.min_spread = min_spread
+        self.outlier_mads = outlier_mads
+        self.max_residual = max_residual
 
     fits_on = ("mag",)
 

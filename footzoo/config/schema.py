@@ -13,11 +13,14 @@ A configuration::
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..core.checks import check_positive, check_range
+from ..core.checks import GRAVITY_RANGE, Settings
+from ..core.conventions import GRAVITY as GRAVITY_DEFAULT
 from ..core.errors import ConfigError, did_you_mean
+from ..core.params import Declared, Real
 from ..core.yamlsafe import load_file
 from .library import resolve
 
@@ -32,15 +35,54 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
     "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
-    "navigation": "INS core of the Kalman filter: {attitude_noise: rad²/s, velocity_noise: (m/s)²/s, "
-                  "position_noise: m²/s, initial_attitude_std: rad, initial_velocity_std: m/s, "
-                  "initial_position_std: m, impact_noise: s (velocity noise per squared acceleration)}",
-    "guards": "what happens when the detector misses stances: {max_swing: s (default 1.5, 0 = off), still_rate: "
-              "rad/s, min_step: s, half_width: s, window: s, max_speed: m/s (default 50, 0 = off)}",
+    "navigation": "process noise and initial uncertainty of the Kalman filter's INS core: {velocity_noise: 0.01, "
+                  "...} (footzoo list --kind settings)",
+    "guards": "what happens when the detector misses stances: {max_swing: 1.5, max_speed: 50, ...} "
+              "(footzoo list --kind settings)",
     "plugins": "external plug-ins to load first: module names or .py paths (relative to the YAML file)",
 }
-INIT_KEYS: dict[str, Any] = {"duration": 0.5, "max_gyr": 0.6}
 REQUIRED = ("orientation", "detector")
+
+
+#: Longest accepted ``init.duration`` (s): the still start used for the initial alignment.
+INIT_DURATION_MAX = 60.0
+
+#: The declaration of ``gravity``, the magnitude g (m/s²) a pipeline removes from the specific force.
+GRAVITY_PARAMETER = Declared(
+    "gravity", Real("m/s^2", f"[{GRAVITY_RANGE[0]}, {GRAVITY_RANGE[1]}]", "gravity magnitude g",
+                    source="footzoo's conventions: 9.81 m/s²",
+                    why="Earth's surface gravity lies between 9.76 and 9.834 m/s²"),
+    GRAVITY_DEFAULT)
+
+
+@dataclass
+class Init(Settings):
+    """The still start used for the initial alignment (``init:`` of a config).
+
+    Parameters
+    ----------
+    duration : float
+        Longest stretch of the start taken as still (s).
+    max_gyr : float
+        Largest angular rate of a still sample (rad/s).
+    """
+
+    duration: float = 0.5
+    max_gyr: float = 0.6
+
+    section = "init"
+    example = "{duration: 0.5}"
+    parameters = {
+        "duration": Real("s", f"(0, {INIT_DURATION_MAX:g}]", "longest stretch of the start taken as still",
+                         source="footzoo's: half a second of a quiet stand",
+                         why="a minute of standing is plenty"),
+        "max_gyr": Real("rad/s", "(0, 10]", "largest |ω| of a still sample", source="footzoo's: 0.6 rad/s",
+                        why="a foot turning at 10 rad/s (573 °/s) is not still"),
+    }
+
+
+#: The keys of ``init:`` and their defaults.
+INIT_KEYS: dict[str, Any] = Init().to_dict()
 
 
 def load_yaml(path: str | Path) -> dict[str, Any]:
@@ -72,11 +114,11 @@ def top_level_errors(d: dict[str, Any]) -> list[str]:
             errors.append(f"config is missing {key!r} ({TOP_LEVEL_KEYS[key]})")
     init = d.get("init", {}) or {}
     if not isinstance(init, dict):
-        errors.append(f"init must be a mapping like {{duration: 0.5}}, got {init!r}")
+        errors.append(f"init must be a mapping like {Init.example}, got {init!r}")
     else:
         for key in init:
             if key not in INIT_KEYS:
-                errors.append(f"unknown init key {key!r}{did_you_mean(key, list(INIT_KEYS))}; "
+                errors.append(f"unknown init key {key!r}{did_you_mean(str(key), list(INIT_KEYS))}; "
                               f"valid: {list(INIT_KEYS)}")
     for key, example in (("corrections", "[{type: zvu_dedrift}]"), ("analysis", "[{type: huang_fpa}]"),
                          ("calibration", "[{type: hard_iron}]")):
@@ -92,19 +134,6 @@ def check_top_level(d: dict[str, Any]) -> None:
         raise ConfigError("; ".join(errors))
 
 
-#: Longest accepted ``init.duration`` (s): the still start used for the initial alignment.
-INIT_DURATION_MAX = 60.0
-
-
 def check_init(init: dict[str, Any]) -> dict[str, float]:
     """Validate ``init`` (``duration`` in s, ``max_gyr`` in rad/s) and fill in the defaults."""
-    if not isinstance(init, dict):
-        raise ConfigError(f"init must be a mapping like {{duration: 0.5, max_gyr: 0.6}}, got {init!r}")
-    unknown = [k for k in init if k not in INIT_KEYS]
-    if unknown:
-        raise ConfigError(f"unknown init key {unknown[0]!r}{did_you_mean(str(unknown[0]), list(INIT_KEYS))}; "
-                          f"valid: {list(INIT_KEYS)}")
-    out = {**INIT_KEYS, **init}
-    out["duration"] = check_range("init.duration", out["duration"], 0.0, INIT_DURATION_MAX, "s", lo_open=True)
-    out["max_gyr"] = check_positive("init.max_gyr", out["max_gyr"], unit="rad/s")
-    return out
+    return Init.from_dict(init).to_dict()

@@ -1,9 +1,12 @@
 """Typed, bounded validation of parameters and live samples (bottom layer: footzoo.core.errors and numpy only).
 
 Every check returns the value converted to its Python type, or raises a footzoo
-error whose message names the input, the problem and the fix. Plug-in
-constructors use :func:`check_positive`, :func:`check_range` and
-:func:`check_bool`; :func:`validate_sample` guards ``Stream.push``.
+error whose message names the input, the problem and the fix. Plug-ins and the
+settings blocks of a config (:class:`Settings`) declare their parameters
+(:mod:`footzoo.core.params`); :func:`check_positive`, :func:`check_range`,
+:func:`check_bool` and :func:`check_vector` are the same checks for other values
+(and for plug-ins written before declarations); :func:`validate_sample` guards
+``Stream.push``.
 
 Physical bounds (SI units) shared by the recording checks and the stream:
 
@@ -25,6 +28,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .errors import ConfigError, RecordingError, did_you_mean
+from .params import Boolean, Declared, Interval, Param, Real, Vector, declared
 
 #: Plausible gravity magnitude g on the Earth's surface (m/s²), inclusive bounds.
 GRAVITY_RANGE = (9.7, 9.9)
@@ -36,19 +40,6 @@ GYR_MAX = 50.0
 STREAM_MAX_GAP = 0.1
 
 
-def _number(name: str, value: Any, error: type[Exception]) -> float:
-    if isinstance(value, bool) or isinstance(value, str) or value is None:
-        hint = " (write the number without quotes)" if isinstance(value, str) else ""
-        raise error(f"{name} must be a number, got {type(value).__name__} {value!r}{hint}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise error(f"{name} must be a number, got {type(value).__name__} {value!r}") from None
-    if not math.isfinite(v):
-        raise error(f"{name} must be a finite number, got {value!r}; give a finite value in its unit")
-    return v
-
-
 def check_positive(name: str, value: Any, allow_zero: bool = False, unit: str = "") -> float:
     """A finite number ``> 0`` (or ``>= 0`` with ``allow_zero``), as float.
 
@@ -57,18 +48,16 @@ def check_positive(name: str, value: Any, allow_zero: bool = False, unit: str = 
     ConfigError
         For a non-number (strings, booleans, None), NaN, ±inf or a value out of bounds.
     """
-    v = _number(name, value, ConfigError)
-    if v < 0 if allow_zero else v <= 0:
-        bound = ">= 0" if allow_zero else "> 0"
-        u = f" {unit}" if unit else ""
-        raise ConfigError(f"{name} must be {bound}{u}, got {value!r}")
-    return v
+    return Real(unit, "[0, inf)" if allow_zero else "(0, inf)").validate(name, value)
 
 
 def check_range(
     name: str, value: Any, lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False
 ) -> float:
     """A finite number in ``[lo, hi]`` (ends open with ``lo_open`` / ``hi_open``), as float.
+
+    A plug-in declares its parameters instead (:mod:`footzoo.core.params`); this is the same check
+    for a value that is not a declared parameter.
 
     Parameters
     ----------
@@ -81,35 +70,17 @@ def check_range(
     unit : str
         Unit of the value, shown in the message (e.g. ``"m/s^2"``).
     """
-    v = _number(name, value, ConfigError)
-    below = v <= lo if lo_open else v < lo
-    above = v >= hi if hi_open else v > hi
-    if below or above:
-        u = f" {unit}" if unit else ""
-        interval = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-        raise ConfigError(f"{name} = {value!r}{u} is out of range: it must lie in {interval}{u}")
-    return v
+    return Real(unit, Interval(float(lo), float(hi), lo_open, hi_open)).validate(name, value)
 
 
 def check_bool(name: str, value: Any) -> bool:
     """A real boolean; strings such as ``'no'`` or ``'false'`` (truthy in Python) are rejected."""
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    raise ConfigError(
-        f"{name} must be true or false, got {type(value).__name__} {value!r}; "
-        "write true or false without quotes"
-    )
+    return Boolean().validate(name, value)
 
 
 def check_vector(name: str, value: Any, size: int = 3, nonzero: bool = False, unit: str = "") -> list[float]:
     """A list of ``size`` finite numbers (and not all zero with ``nonzero``)."""
-    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") or len(value) != size:
-        raise ConfigError(f"{name} must be a list of {size} numbers like [1, 0, 0], got {value!r}")
-    out = [_number(f"{name}[{i}]", v, ConfigError) for i, v in enumerate(value)]
-    if nonzero and not any(out):
-        u = f" ({unit})" if unit else ""
-        raise ConfigError(f"{name}{u} must not be all zeros, got {value!r}: its direction is undefined")
-    return out
+    return Vector(size, unit, nonzero=nonzero).validate(name, value)
 
 
 def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: str) -> np.ndarray:
@@ -276,24 +247,32 @@ def validate_block(
 
 
 class Settings:
-    """Base of a config's settings blocks (``navigation:``, ``guards:``): a dataclass of numbers.
+    """Base of a config's settings blocks (``init:``, ``navigation:``, ``guards:``): a dataclass of numbers.
 
-    A subclass is a ``@dataclass`` whose fields are the keys (with their defaults) and sets
-    ``section`` (the config key), ``units`` and ``ranges`` (per field) and ``example`` (a valid
-    mapping, for the error message). Values are checked against their ranges on construction;
-    :meth:`from_dict` refuses unknown keys with the valid ones; :meth:`to_dict` gives every value.
+    A subclass is a ``@dataclass`` whose fields are the keys (with their defaults); it sets
+    ``section`` (the config key), ``example`` (a valid mapping, for the error message) and
+    ``parameters``, the declaration of every field (:mod:`footzoo.core.params`, as for a plug-in).
+    Values are validated on construction; :meth:`from_dict` refuses unknown keys with the valid ones;
+    :meth:`to_dict` gives every value.
     """
 
     section: ClassVar[str] = ""
     example: ClassVar[str] = ""
-    units: ClassVar[dict[str, str]] = {}
-    ranges: ClassVar[dict[str, tuple[float, float]]] = {}
+    parameters: ClassVar[dict[str, Param]] = {}
 
     def __post_init__(self) -> None:
-        for f in fields(self):  # type: ignore[arg-type]
-            lo, hi = self.ranges[f.name]
-            setattr(self, f.name, check_range(f"{self.section}.{f.name}", getattr(self, f.name), lo, hi,
-                                              self.units[f.name]))
+        for name, d in self.declaration().items():
+            setattr(self, name, d.validate(getattr(self, name), f"{self.section}.{name}"))
+
+    @classmethod
+    def declaration(cls) -> dict[str, Declared]:
+        """``{key: Declared}`` of every field, in order (a field without a declaration is a TypeError)."""
+        defaults = {f.name: f.default for f in fields(cls)}  # type: ignore[arg-type]
+        out = declared(cls, defaults)
+        missing = [k for k in defaults if k not in out]
+        if missing:
+            raise TypeError(f"{cls.__name__}: declare {missing} in its parameters")
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> Any:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import check_bool, check_range
+from ..core.errors import ConfigError
 from ..filters.measurement import ACC_BIAS, BA, BG, GYRO_BIAS, VEL, MeasurementModel, StateBlock, measurement_function
-from ..plugins.base import KalmanCorrection, Samples
+from ..plugins.base import Boolean, KalmanCorrection, Real, Samples
 from ..plugins.registry import register
 
 
@@ -107,8 +107,30 @@ class EKFZUPT(KalmanCorrection):
     name = "ekf_zupt"
     observes = ("velocity", "angular_rate")
     paper = "Nguyen & La 2016, IEEE THMS 46(6), eqs. 28-52, Algorithm 2, Sec. VI"
-    units = {"velocity_std": "m/s", "rate_std": "rad/s", "gyro_bias_std": "rad/s", "accel_bias_std": "m/s^2",
-             "gyro_bias_noise": "(rad/s)^2/s", "accel_bias_noise": "(m/s^2)^2/s", "bias_limit": "1"}
+    parameters = {
+        "gyro_bias": Boolean("estimate the gyro bias (needs orientation: ins)", source="Nguyen & La 2016, eq. 31"),
+        "accel_bias": Boolean("estimate the accelerometer bias", source="Nguyen & La 2016, eq. 31"),
+        "zero_rate": Boolean("measure the zero angular rate in stance (needs gyro_bias)",
+                             source="Nguyen & La 2016, eq. 30"),
+        "velocity_std": Real("m/s", "[1e-9, 1]", "σ of the zero-velocity measurement",
+                             source="footzoo's (the paper takes R from the IMU driver)",
+                             why="with σ of 1 m/s, a walking foot's speed, the update constrains nothing"),
+        "rate_std": Real("rad/s", "[1e-9, 1]", "σ of the zero-rate measurement",
+                         source="footzoo's (the paper takes R from the IMU driver)",
+                         why="with σ of 1 rad/s (57 °/s) the update constrains nothing"),
+        "gyro_bias_std": Real("rad/s", "[0, 1]", "initial σ of the gyro bias",
+                              source="Nguyen & La 2016, Table II: the 3DM-GX3-25's ±0.25 °/s",
+                              why="consumer MEMS gyros are specified to ±0.35 rad/s (20 °/s) at most"),
+        "accel_bias_std": Real("m/s^2", "[0, 2]", "initial σ of the accelerometer bias",
+                               source="Nguyen & La 2016, Table II: the 3DM-GX3-25's ±0.002 g",
+                               why="consumer MEMS accelerometers are specified to ±0.1 g (1 m/s²) at most"),
+        "gyro_bias_noise": Real("(rad/s)^2/s", "[0, 1]", "variance growth of the gyro bias (random walk)",
+                                source="Nguyen & La 2016's Q (zero)"),
+        "accel_bias_noise": Real("(m/s^2)^2/s", "[0, 10]", "variance growth of the accelerometer bias (random walk)",
+                                 source="Nguyen & La 2016's Q (zero)"),
+        "bias_limit": Real("1", "[0, 1000]", "bound of the bias estimates in initial σ; 0: none",
+                           source="footzoo's guard: beyond any turn-on bias of the paper's sensor (see the docstring)"),
+    }
 
     def __init__(
         self,
@@ -123,18 +145,18 @@ class EKFZUPT(KalmanCorrection):
         accel_bias_noise: float = 0.0,
         bias_limit: float = 10.0,
     ):
-        self.gyro_bias = check_bool("gyro_bias", gyro_bias)
-        self.accel_bias = check_bool("accel_bias", accel_bias)
-        self.zero_rate = check_bool("zero_rate", zero_rate)
-        if self.zero_rate and not self.gyro_bias:
-            raise ValueError("zero_rate measures the gyro bias: it needs gyro_bias: true")
-        self.velocity_std = check_range("velocity_std", velocity_std, 1e-9, 10.0, "m/s")
-        self.rate_std = check_range("rate_std", rate_std, 1e-9, 10.0, "rad/s")
-        self.gyro_bias_std = check_range("gyro_bias_std", gyro_bias_std, 0.0, 1.0, "rad/s")
-        self.accel_bias_std = check_range("accel_bias_std", accel_bias_std, 0.0, 10.0, "m/s^2")
-        self.gyro_bias_noise = check_range("gyro_bias_noise", gyro_bias_noise, 0.0, 1.0, "(rad/s)^2/s")
-        self.accel_bias_noise = check_range("accel_bias_noise", accel_bias_noise, 0.0, 10.0, "(m/s^2)^2/s")
-        self.bias_limit = check_range("bias_limit", bias_limit, 0.0, 1000.0, "1")
+        if zero_rate and not gyro_bias:
+            raise ConfigError("zero_rate measures the gyro bias: it needs gyro_bias: true (or set zero_rate: false)")
+        self.gyro_bias = gyro_bias
+        self.accel_bias = accel_bias
+        self.zero_rate = zero_rate
+        self.velocity_std = velocity_std
+        self.rate_std = rate_std
+        self.gyro_bias_std = gyro_bias_std
+        self.accel_bias_std = accel_bias_std
+        self.gyro_bias_noise = gyro_bias_noise
+        self.accel_bias_noise = accel_bias_noise
+        self.bias_limit = bias_limit
 
     def state_blocks(self) -> list[StateBlock]:
         """The core bias blocks this correction switches on (initial variance, variance growth per s)."""
@@ -179,7 +201,8 @@ class ZUPT(EKFZUPT):
     name = "zupt"
     observes = ("velocity",)
     paper = "Duong & Suh 2015, Sensors 15, eq. 23, Table 1"
-    units = {"velocity_std": "m/s"}
+    parameters = {"velocity_std": EKFZUPT.parameters["velocity_std"].replace(
+        source="Duong & Suh 2015, Table 1 (variance 0.0001)")}
 
     def __init__(self, velocity_std: float = 0.01):
         super().__init__(gyro_bias=False, accel_bias=False, zero_rate=False, velocity_std=velocity_std)

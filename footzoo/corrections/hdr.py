@@ -6,12 +6,11 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
 from ..core.conventions import quat_yaw
 from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
 from ..kernels.jit import njit
-from ..plugins.base import AccelerationCorrection, KalmanCorrection, Samples
+from ..plugins.base import AccelerationCorrection, KalmanCorrection, Real, Samples
 from ..plugins.incremental import Chunk, Latency
 from ..plugins.registry import register
 
@@ -138,11 +137,16 @@ class HDR(AccelerationCorrection, KalmanCorrection):
     name = "hdr"
     observes = ("heading",)
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-C, eqs. 23-27"
-    units = {"threshold": "rad", "yaw_std": "rad"}
+    parameters = {
+        "threshold": Real("rad", "(0, pi]", "th_γ: a heading bias |δψ| above it is a real turn (eq. 24)",
+                          source="Nguyen & La 2016, Sec. VI"),
+        "yaw_std": Real("rad", "[1e-9, pi]", "σ of δψ as a Kalman measurement",
+                        source="footzoo's (the paper gives no value)"),
+    }
 
     def __init__(self, threshold: float = 0.5, yaw_std: float = 0.1):
-        self.threshold = check_range("threshold", threshold, 0.0, 3.1416, "rad", lo_open=True)
-        self.yaw_std = check_range("yaw_std", yaw_std, 1e-9, 3.1416, "rad")
+        self.threshold = threshold
+        self.yaw_std = yaw_std
 
     # ------------------------------------------------------------- no EKF: eqs. 25-27
     def apply_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,

@@ -29,16 +29,15 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..core.checks import check_bool, check_range
 from ..core.errors import ConfigError, RecordingError
 from ..core.yamlsafe import load_file
 from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
-from ..plugins.base import KalmanCorrection, Samples
+from ..plugins.base import Boolean, File, KalmanCorrection, Real, Samples, Vectors
 from ..plugins.registry import register
 
 #: Duong & Suh Table 1 in their IMU frame (x toward the floor), mapped to FRD: (x, y, z)_DS -> (y, z, x).
-TABLE1_POSITIONS = [[0.080, 0.0, -0.008], [-0.062, 0.0, -0.006]]
-TABLE1_DIRECTIONS = [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+TABLE1_POSITIONS = ((0.080, 0.0, -0.008), (-0.062, 0.0, -0.006))
+TABLE1_DIRECTIONS = ((0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
 TABLE1_BASELINE = 0.142
 
 
@@ -202,13 +201,36 @@ class HeightDistance(KalmanCorrection):
     needs_distance = True
     observes = ("floor_distance",)
     paper = "Duong & Suh 2015, Sensors 15, eqs. 1, 9-20, 24, Table 1"
-    units = {"positions": "m", "directions": "1", "baseline": "m", "range_std": "m", "max_range": "m",
-             "position_std": "m", "direction_std": "1", "constraint_std": "1", "baseline_std": "m"}
+    parameters = {
+        "positions": Vectors(3, "m", "r̂ of each sensor in the body frame (FRD)", range="[-1, 1]",
+                             source="Duong & Suh 2015, Table 1, mapped to FRD",
+                             why="a sensor on the foot sits within 1 m of the IMU"),
+        "directions": Vectors(3, "1", "n̂ of each sensor in the body frame (FRD)", nonzero=True,
+                              source="Duong & Suh 2015, Table 1, mapped to FRD"),
+        "baseline": Real("m", "(0, 1]", "z_AB: the measured distance between the first two sensors",
+                         source="Duong & Suh 2015, Table 1", why="two sensors on one foot are less than 1 m apart"),
+        "range_std": Real("m", "[1e-9, 1]", "σ of the range readings v_A, v_B",
+                          source="Duong & Suh 2015, Table 1 (variance 0.0004)"),
+        "max_range": Real("m", "(0, 10]", "readings above it are no floor (rejected)",
+                          source="the VL6180's 0.2 m", why="beyond any range sensor used on a foot"),
+        "calibrate": Boolean("estimate the sensors' mounting (21 states) rather than keep it fixed (9)",
+                             source="Duong & Suh 2015, eqs. 16-20"),
+        "position_std": Real("m", "[1e-9, 1]", "initial σ of each sensor-position error component",
+                             source="Duong & Suh 2015, Table 1 (variance 1e-6)"),
+        "direction_std": Real("1", "[1e-9, 1]", "initial σ of each direction error component (≈ rad)",
+                              source="Duong & Suh 2015, Table 1 (variance 1e-6)"),
+        "constraint_std": Real("1", "[1e-9, 1]", "σ of v_constraint (eq. 18)",
+                               source="Duong & Suh 2015, Table 1 (variance 1e-8)"),
+        "baseline_std": Real("m", "[1e-9, 1]", "σ of v_AB (eq. 20)",
+                             source="Duong & Suh 2015, Table 1 (variance 1e-6)"),
+        "calibration": File("YAML file of save_calibration; replaces positions and directions", optional=True,
+                            source="none: use positions and directions"),
+    }
 
     def __init__(
         self,
-        positions: list | None = None,
-        directions: list | None = None,
+        positions: list | tuple = TABLE1_POSITIONS,
+        directions: list | tuple = TABLE1_DIRECTIONS,
         baseline: float = TABLE1_BASELINE,
         range_std: float = 0.02,
         max_range: float = 0.2,
@@ -219,24 +241,24 @@ class HeightDistance(KalmanCorrection):
         baseline_std: float = 0.001,
         calibration: str | None = None,
     ):
-        self.positions = positions if positions is not None else TABLE1_POSITIONS
-        self.directions = directions if directions is not None else TABLE1_DIRECTIONS
+        self.positions = positions
+        self.directions = directions
         self.calibration = calibration
-        pos, dirs = self.positions, self.directions
+        pos, dirs = positions, directions
         if calibration is not None:
             data = load_calibration(calibration)
             pos, dirs = data["positions"], data["directions"]
         self._r = _vectors("positions", pos)
         self._n = _vectors("directions", dirs, self._r.shape[0], nonzero=True)
         self._n = self._n / np.linalg.norm(self._n, axis=1, keepdims=True)
-        self.baseline = check_range("baseline", baseline, 0.0, 1.0, "m", lo_open=True)
-        self.range_std = check_range("range_std", range_std, 1e-9, 1.0, "m")
-        self.max_range = check_range("max_range", max_range, 0.0, 10.0, "m", lo_open=True)
-        self.calibrate = check_bool("calibrate", calibrate)
-        self.position_std = check_range("position_std", position_std, 1e-9, 1.0, "m")
-        self.direction_std = check_range("direction_std", direction_std, 1e-9, 1.0, "1")
-        self.constraint_std = check_range("constraint_std", constraint_std, 1e-9, 1.0, "1")
-        self.baseline_std = check_range("baseline_std", baseline_std, 1e-9, 1.0, "m")
+        self.baseline = baseline
+        self.range_std = range_std
+        self.max_range = max_range
+        self.calibrate = calibrate
+        self.position_std = position_std
+        self.direction_std = direction_std
+        self.constraint_std = constraint_std
+        self.baseline_std = baseline_std
 
     @property
     def k(self) -> int:
@@ -340,10 +362,11 @@ class HeightFlatFloor(KalmanCorrection):
     name = "height_flat_floor"
     observes = ("height",)
     paper = "Duong & Suh 2015, Sensors 15, Sec. 5 (zero velocity + height updating)"
-    units = {"height_std": "m"}
+    parameters = {"height_std": Real("m", "[1e-9, 1]", "σ of the height measurement in stance",
+                                     source="footzoo's (the paper gives no value)")}
 
     def __init__(self, height_std: float = 0.001):
-        self.height_std = check_range("height_std", height_std, 1e-9, 1.0, "m")
+        self.height_std = height_std
 
     def model(self, samples: Samples) -> MeasurementModel:
         """One height row in every stance sample."""

@@ -134,7 +134,6 @@ class ZVUDedrift(VelocityCorrection):
 
     name = "zvu_dedrift"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-B, eqs. 5-10"
-    units: dict[str, str] = {}
 
     def __init__(self) -> None:
         pass

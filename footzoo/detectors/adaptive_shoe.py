@@ -8,9 +8,9 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..kernels.jit import njit
-from ..plugins.base import run_context
+from ..plugins.base import Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, after_stance
-from ..plugins.registry import check_positive, register
+from ..plugins.registry import register
 from .runs import close_short_swings
 from .shoe import SHOE
 
@@ -126,15 +126,27 @@ class AdaptiveSHOE(SHOE):
 
     name = "adaptive_shoe"
     paper = "Wahlström et al. 2019, IEEE Sensors Letters 3(6) (Bayesian adaptive threshold) on SHOE (Skog et al. 2010)"
-    units = {**SHOE.units, "time_constant": "s", "max_threshold": "1", "min_swing": "s"}
+    parameters = {
+        "threshold": SHOE.parameters["threshold"].replace(
+            doc="γ_0: the threshold right after a zero-velocity update",
+            source="footzoo's: chosen on PyShoe's 36 trials per motion class (see the docstring)"),
+        "time_constant": Real("s", "(0, 60]", "τ: the threshold grows by e every τ without an update",
+                              source="footzoo's: chosen on PyShoe's 36 trials per motion class",
+                              why="with τ over a minute the threshold never grows within a stride"),
+        "max_threshold": Real("1", "(0, inf)", "γ_max: the cap of the threshold's growth",
+                              source="footzoo's: chosen on PyShoe's 36 trials per motion class"),
+        "min_swing": Real("s", "[0, 1]", "shortest swing: a shorter run of 'moving' counts as stance",
+                          source="footzoo's, against split stances",
+                          why="a real swing lasts 0.3-0.6 s"),
+    }
 
     def __init__(self, threshold: float = 1e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.5, max_threshold: float = 5e5,
                  min_swing: float = 0.15):
         super().__init__(threshold, window, sigma_a, sigma_g)
-        self.time_constant = check_positive("time_constant", time_constant)
-        self.max_threshold = check_positive("max_threshold", max_threshold)
-        self.min_swing = check_positive("min_swing", min_swing, allow_zero=True)
+        self.time_constant = time_constant
+        self.max_threshold = max_threshold
+        self.min_swing = min_swing
 
     def min_swing_samples(self, ctx: RunContext) -> int:
         """``min_swing`` in samples at the run's rate."""

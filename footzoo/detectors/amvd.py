@@ -37,6 +37,8 @@ class AMVD(SkogTest):
 
     name = "amvd"
     paper = "Skog et al. 2010, IEEE TBME 57(11), Sec. III (acceleration moving variance detector (MV))"
+    parameters = {"threshold": SkogTest.parameters["threshold"].replace(
+        source="footzoo's: cross-validated over PyShoe's motion classes (the paper tunes γ per data set)")}
 
     def __init__(self, threshold: float = 1e2, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):

@@ -6,9 +6,8 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
-from ..plugins.base import Detector, run_context
+from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
 from .runs import after_long_stance, dated_and_online_states
@@ -113,11 +112,18 @@ class AngularRateFSM(Detector):
 
     name = "angular_rate_fsm"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-C/II-D, Figs. 5-6"
-    units = {"threshold": "rad/s", "min_duration": "s"}
+    parameters = {
+        "threshold": Real("rad/s", "(0, 10]", "Ω_th: stance while |ω| stays below it",
+                          source="footzoo's design notes (the paper gives no value)",
+                          why="a foot turns faster than 10 rad/s (573 °/s) only in mid-swing"),
+        "min_duration": Real("s", "[0, 1]", "Γ_th: how long |ω| must stay across Ω_th before a switch",
+                             source="footzoo's design notes: 5 samples at the paper's 50 Hz",
+                             why="a switch held back for over 1 s would miss every walking stance (≈ 0.6 s)"),
+    }
 
     def __init__(self, threshold: float = 0.6, min_duration: float = 0.1):
-        self.threshold = check_range("threshold", threshold, 0.0, 50.0, "rad/s", lo_open=True)
-        self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
+        self.threshold = threshold
+        self.min_duration = min_duration
 
     def min_samples(self, ctx: RunContext) -> int:
         """Γ_th in samples at the run's rate: ``max(1, round(min_duration · rate))``."""

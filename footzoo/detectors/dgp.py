@@ -6,14 +6,13 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
-from ..plugins.base import Detector, run_context
+from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency
-from ..plugins.registry import check_positive, register
+from ..plugins.registry import register
 
 
 def _count(x: float) -> int:
@@ -290,8 +289,30 @@ class DGP(Detector):
     name = "dgp"
     causal = True
     paper = "Nguyen & La 2016, IEEE THMS 46(6), Sec. III-A, eqs. 3-15, Algorithm 1"
-    units = {"window": "s", "condition_window": "s", "initial_delay": "1", "initial_threshold": "1",
-             "reference_rate": "Hz", "min_swing": "s", "max_swing": "s", "max_stance_rate": "rad/s"}
+    parameters = {
+        "window": Real("s", "(0, 2]", "the 2f + 1 samples of eqs. 7-8, as a duration",
+                       source="Nguyen & La 2016 (f = 15: 31 samples at 100 Hz)",
+                       why="a window over 2 s spans several strides"),
+        "condition_window": Real("s", "(0, 1]", "the average of s_c (eq. 9), as a duration",
+                                 source="Nguyen & La 2016 (5 samples at 100 Hz)",
+                                 why="an average over 1 s spans a whole stance"),
+        "initial_delay": Real("1", "[0, inf)", "s_d^0: the delayed condition's start (eq. 10)",
+                              source="Nguyen & La 2016"),
+        "initial_threshold": Real("1", "(0, inf)", "th^0: the threshold before the first step",
+                                  source="Nguyen & La 2016"),
+        "reference_rate": Real("Hz", "[1, 10000]", "the rate at which the paper's sample counts hold",
+                               source="footzoo's reading: the paper's IMU runs at 100 Hz",
+                               why="an IMU's sampling rate: 1 Hz to 10 kHz"),
+        "min_swing": Real("s", "[0, 2]", "shortest swing the threshold is re-learned from; 0: every one",
+                          source="footzoo's guard (see the docstring); the paper: 0",
+                          why="a real swing lasts 0.3-0.6 s"),
+        "max_swing": Real("s", "[0, 60]", "the threshold doubles after each max_swing without a stance; 0: never",
+                          source="footzoo's guard (see the docstring); the paper: 0",
+                          why="no human swing lasts a minute"),
+        "max_stance_rate": Real("rad/s", "[0, 10]", "fastest |ω| of a stance sample; 0: no bound",
+                                source="footzoo's guard (see the docstring); the paper: 0",
+                                why="a foot turns faster than 10 rad/s (573 °/s) only in mid-swing"),
+    }
 
     def __init__(
         self,
@@ -304,14 +325,14 @@ class DGP(Detector):
         max_swing: float = 2.0,
         max_stance_rate: float = 1.0,
     ):
-        self.window = check_range("window", window, 0.0, 10.0, "s", lo_open=True)
-        self.condition_window = check_range("condition_window", condition_window, 0.0, 10.0, "s", lo_open=True)
-        self.initial_delay = check_positive("initial_delay", initial_delay, allow_zero=True)
-        self.initial_threshold = check_positive("initial_threshold", initial_threshold)
-        self.reference_rate = check_range("reference_rate", reference_rate, 0.0, 100000.0, "Hz", lo_open=True)
-        self.min_swing = check_range("min_swing", min_swing, 0.0, 10.0, "s")
-        self.max_swing = check_range("max_swing", max_swing, 0.0, 100.0, "s")
-        self.max_stance_rate = check_range("max_stance_rate", max_stance_rate, 0.0, 50.0, "rad/s")
+        self.window = window
+        self.condition_window = condition_window
+        self.initial_delay = initial_delay
+        self.initial_threshold = initial_threshold
+        self.reference_rate = reference_rate
+        self.min_swing = min_swing
+        self.max_swing = max_swing
+        self.max_stance_rate = max_stance_rate
 
     def begin(self, ctx: RunContext) -> DGP:
         """Fresh state for a run at the context's rate (Hz)."""

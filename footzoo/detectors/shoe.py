@@ -6,10 +6,9 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
-from ..plugins.base import run_context
+from ..plugins.base import Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
 from .runs import after_long_stance, dated_and_online_states
@@ -49,6 +48,7 @@ class SHOE(SkogTest):
 
     name = "shoe"
     paper = "Skog et al. 2010, IEEE TBME 57(11), Sec. III (cited by Yun 2012 and Huang 2016)"
+    parameters = {"threshold": SkogTest.parameters["threshold"].replace(source="Skog's OpenShoe")}
 
     def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
@@ -94,12 +94,17 @@ class HuangStance(SHOE):
 
     name = "huang_stance"
     paper = "Huang et al. 2016, IEEE TBME, Sec. II-B (SHOE [Skog 2010] + state machine [Yun 2012])"
-    units = {**SHOE.units, "min_duration": "s"}
+    parameters = {
+        "threshold": SkogTest.parameters["threshold"].replace(source="Skog's OpenShoe (Huang gives no value)"),
+        "min_duration": Real("s", "[0, 1]", "Γ_th: how long the SHOE decision must hold before a switch",
+                             source="footzoo's (Huang gives no value)",
+                             why="a switch held back for over 1 s would miss every walking stance (≈ 0.6 s)"),
+    }
 
     def __init__(self, threshold: float = 3e4, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1)), min_duration: float = 0.05):
         super().__init__(threshold, window, sigma_a, sigma_g)
-        self.min_duration = check_range("min_duration", min_duration, 0.0, 10.0, "s")
+        self.min_duration = min_duration
 
     def min_samples(self, ctx: RunContext) -> int:
         """Γ_th in samples at the run's rate."""

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
-from ..plugins.base import Detector, run_context
+from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, feed
-from ..plugins.registry import check_positive
 from .windows import window_moments, window_statistic
 
 #: Built-in ``test`` methods that :func:`~footzoo.detectors.windows.window_statistic` evaluates in its window pass,
@@ -52,14 +50,23 @@ class SkogTest(Detector):
         W in samples at the recording's median rate.
     """
 
-    units = {"threshold": "1", "window": "s", "sigma_a": "m/s^2", "sigma_g": "rad/s"}
+    parameters = {
+        "threshold": Real("1", "(0, inf)", "γ: stance where the test statistic T_k is below it"),
+        "window": Real("s", "(0, 1]", "W: the window of the test, as a duration",
+                       source="Skog's OpenShoe: 5 samples at 200 Hz",
+                       why="a window longer than 1 s spans a whole stride and hides its stance"),
+        "sigma_a": Real("m/s^2", "[1e-9, 10]", "σ_a: accelerometer noise", source="Skog's OpenShoe",
+                        why="10 m/s² of noise is 1 g, beyond any accelerometer"),
+        "sigma_g": Real("rad/s", "[1e-9, 1]", "σ_ω: gyroscope noise", source="Skog's OpenShoe: 0.1 °/s",
+                        why="1 rad/s (57 °/s) of noise is beyond any gyroscope"),
+    }
 
     def __init__(self, threshold: float, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1))):
-        self.threshold = check_positive("threshold", threshold)
-        self.window = check_range("window", window, 0.0, 10.0, "s", lo_open=True)
-        self.sigma_a = check_range("sigma_a", sigma_a, 1e-9, 100.0, "m/s^2")
-        self.sigma_g = check_range("sigma_g", sigma_g, 1e-9, 50.0, "rad/s")
+        self.threshold = threshold
+        self.window = window
+        self.sigma_a = sigma_a
+        self.sigma_g = sigma_g
 
     def test(self, m: np.ndarray) -> np.ndarray:
         """T_k from the (N, 6) window moments (see ``window_moments``)."""

@@ -6,11 +6,10 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
-from ..plugins.base import run_context
+from ..plugins.base import Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, run_starts
 from ..plugins.registry import register
 from .adaptive_shoe import AdaptiveSHOE, adaptive_threshold_kernel
@@ -271,7 +270,19 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
     paper = ("Wagstaff, Peretroukhin & Kelly 2017, IPIN (motion-adaptive zero-velocity threshold), "
              "on SHOE (Skog et al. 2010) and Wahlström et al. 2019")
     causal = False
-    units = {**AdaptiveSHOE.units, "speed_scale": "m/s", "still_speed": "m/s"}
+    parameters = {
+        "threshold": AdaptiveSHOE.parameters["threshold"].replace(
+            doc="γ_0: the threshold at zero swing speed",
+            source="footzoo's: benchmarks/select_recommended.py on PyShoe's 36 trials, per motion class"),
+        "time_constant": AdaptiveSHOE.parameters["time_constant"].replace(
+            doc="τ of the provisional pass", source="footzoo's: benchmarks/select_recommended.py"),
+        "max_threshold": AdaptiveSHOE.parameters["max_threshold"].replace(
+            source="footzoo's: benchmarks/select_recommended.py"),
+        "speed_scale": Real("m/s", "[0.001, 100]", "v_s: the threshold grows by e per v_s of swing speed",
+                            source="footzoo's: benchmarks/select_recommended.py"),
+        "still_speed": Real("m/s", "[0, 100]", "fastest a stance sample may move by the provisional strapdown",
+                            source="footzoo's: 0.5 m/s rejected real running stances (see the docstring)"),
+    }
 
     #: Stance time used to level the attitude at the start of a swing (s).
     LEVELLING = 0.1
@@ -282,8 +293,8 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
                  sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.2, max_threshold: float = 1e6,
                  speed_scale: float = 1.0, still_speed: float = 1.0, min_swing: float = 0.15):
         super().__init__(threshold, window, sigma_a, sigma_g, time_constant, max_threshold, min_swing)
-        self.speed_scale = check_range("speed_scale", speed_scale, 1e-3, 100.0, "m/s")
-        self.still_speed = check_range("still_speed", still_speed, 0.0, 100.0, "m/s")
+        self.speed_scale = speed_scale
+        self.still_speed = still_speed
 
     def _speed_test(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, statistic: np.ndarray,
                     provisional: np.ndarray) -> dict[str, np.ndarray]:

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import check_range
 from ..core.context import RunContext
-from ..plugins.base import Detector, run_context
+from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
 from .windows import row_norms, window_max
@@ -58,8 +57,20 @@ class Windowed(Detector):
 
     name = "windowed"
     paper = "Duong & Suh 2015, Sensors 15, eq. 21"
-    units = {"gyro_threshold": "rad/s", "acc_diff_threshold": "m/s^2", "gyro_window": "s", "acc_window": "s",
-             "reference_rate": "Hz"}
+    parameters = {
+        "gyro_threshold": Real("rad/s", "(0, 10]", "B_g: the bound on |ω| over the window",
+                               source="footzoo's (the paper gives no value)",
+                               why="a foot turns faster than 10 rad/s (573 °/s) only in mid-swing"),
+        "acc_diff_threshold": Real("m/s^2", "(0, 50]", "B_a: the bound on |Δa| between samples at reference_rate",
+                                   source="footzoo's (the paper gives no value)",
+                                   why="a change of 50 m/s² in 10 ms is a heel strike, not a stance"),
+        "gyro_window": Real("s", "[0, 1]", "N_g as a duration", source="footzoo's: 10 samples at the paper's 100 Hz",
+                            why="a window longer than 1 s spans a whole stride and hides its stance"),
+        "acc_window": Real("s", "[0, 1]", "N_a as a duration", source="footzoo's: 10 samples at the paper's 100 Hz",
+                           why="a window longer than 1 s spans a whole stride and hides its stance"),
+        "reference_rate": Real("Hz", "[1, 10000]", "the rate at which B_a is a change between consecutive samples",
+                               source="Duong & Suh 2015's IMU (100 Hz)", why="an IMU's sampling rate: 1 Hz to 10 kHz"),
+    }
 
     def __init__(
         self,
@@ -69,12 +80,11 @@ class Windowed(Detector):
         acc_window: float = 0.1,
         reference_rate: float = 100.0,
     ):
-        self.gyro_threshold = check_range("gyro_threshold", gyro_threshold, 0.0, 50.0, "rad/s", lo_open=True)
-        self.acc_diff_threshold = check_range("acc_diff_threshold", acc_diff_threshold, 0.0, 2000.0, "m/s^2",
-                                              lo_open=True)
-        self.gyro_window = check_range("gyro_window", gyro_window, 0.0, 10.0, "s")
-        self.acc_window = check_range("acc_window", acc_window, 0.0, 10.0, "s")
-        self.reference_rate = check_range("reference_rate", reference_rate, 0.0, 100000.0, "Hz", lo_open=True)
+        self.gyro_threshold = gyro_threshold
+        self.acc_diff_threshold = acc_diff_threshold
+        self.gyro_window = gyro_window
+        self.acc_window = acc_window
+        self.reference_rate = reference_rate
 
     def _counts(self, ctx: RunContext) -> tuple[int, int, int, float]:
         """Half windows (samples), the lag of the accelerometer change (samples) and its scale, at the run's rate."""

@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_bool, check_range
 from ..filters.strapdown import quat_product, rotvec_quat
 from ..kernels.jit import njit
+from ..plugins.base import Boolean, Real
 from ..plugins.incremental import Chunk
 from ..plugins.registry import register
 from .fqa import fqa_sample
-from .magnetic import rejection_parameters
+from .magnetic import REJECTION_PARAMETERS
 from .recursive import RecursiveFilter
 
 _NO_MAG = np.zeros((1, 3))
@@ -118,6 +118,11 @@ def static_sample(ax, ay, az, mx, my, mz, use_mag, wx, wy, wz, h):
     return quat_product(w, x, y, z, dw, dx, dy, dz)
 
 
+#: Why the gains stop at 100 1/s.
+_GAIN_RANGE = ("k is the static branch's corner frequency in rad/s (eqs. 3-4): at 100 Hz, k = 100 replaces the "
+               "estimate by the FQA quaternion at every sample")
+
+
 @register
 class FQAComplementary(RecursiveFilter):
     """Adaptive-gain quaternion complementary filter with an FQA static branch.
@@ -173,18 +178,27 @@ class FQAComplementary(RecursiveFilter):
 
     name = "fqa_complementary"
     paper = "Yun et al. 2012, IEEE TIM 61(7), Sec. II-A, eqs. 2-4, Table II"
-    units = {"static_gain": "1/s", "dynamic_gain": "1/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
+    parameters = {
+        "static_gain": Real("1/s", "[0, 100]", "k_s: the gain of the static (FQA) branch in stance",
+                            source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
+        "dynamic_gain": Real("1/s", "[0, 100]", "k_d: the gain of the static branch in swing",
+                             source="Yun et al. 2012, Table II", why=_GAIN_RANGE),
+        "use_magnetometer": Boolean("use the magnetometer for heading when the recording has one",
+                                    source="Yun et al. 2012 (a MARG filter)"),
+        **REJECTION_PARAMETERS,
+    }
     needs_stance = True
     checks_magnetometer = True
 
     def __init__(self, static_gain: float = 1.05, dynamic_gain: float = 0.0, use_magnetometer: bool = True,
                  mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
                  mag_dip_tolerance: float = float(np.radians(5.0))):
-        self.static_gain = check_range("static_gain", static_gain, 0.0, 100.0, "1/s")
-        self.dynamic_gain = check_range("dynamic_gain", dynamic_gain, 0.0, 100.0, "1/s")
-        self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
-        self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
-            mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
+        self.static_gain = static_gain
+        self.dynamic_gain = dynamic_gain
+        self.use_magnetometer = use_magnetometer
+        self.mag_rejection = mag_rejection
+        self.mag_norm_tolerance = mag_norm_tolerance
+        self.mag_dip_tolerance = mag_dip_tolerance
 
     def propagate(self, q_prev: np.ndarray, first: bool, t: np.ndarray, dt: np.ndarray, acc: np.ndarray,
                   gyr: np.ndarray, mag: np.ndarray | None, stance: np.ndarray,

@@ -35,7 +35,6 @@ class INS(RecursiveFilter):
 
     name = "ins"
     paper = "Nguyen & La 2016, eqs. 37-39, 51-52, Sec. VI (Q); Duong & Suh 2015, eqs. 3-8"
-    units: dict[str, str] = {}
     carried_by_filter = True
     causal = True
     use_magnetometer = True  # for the initial alignment only

@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_bool, check_range
 from ..filters.strapdown import rotate
 from ..kernels.jit import njit
+from ..plugins.base import Boolean, Real
 from ..plugins.incremental import Chunk
 from ..plugins.registry import register
-from .magnetic import rejection_parameters
+from .magnetic import REJECTION_PARAMETERS
 from .recursive import RecursiveFilter
 
 
@@ -130,15 +130,23 @@ class Madgwick(RecursiveFilter):
     checks_magnetometer = True
     name = "madgwick"
     paper = "Huang et al. 2016, IEEE TBME, eqs. 1-10 (Madgwick 2011)"
-    units = {"gyro_error": "rad/s", "mag_norm_tolerance": "1", "mag_dip_tolerance": "rad"}
+    parameters = {
+        "gyro_error": Real("rad/s", "[0, 1]", "ω̃_max: maximum gyro error per axis; β = √(3/4) ω̃_max (eq. 3)",
+                           source="Madgwick 2011's 5 °/s (β = 0.076; Huang gives no number)",
+                           why="a gyroscope with 1 rad/s (57 °/s) of error is no gyroscope"),
+        "use_magnetometer": Boolean("MARG (accelerometer + magnetometer) rather than IMU-only (eq. 10)",
+                                    source="Huang et al. 2016 (MARG)"),
+        **REJECTION_PARAMETERS,
+    }
 
     def __init__(self, gyro_error: float = float(np.radians(5.0)), use_magnetometer: bool = True,
                  mag_rejection: bool = True, mag_norm_tolerance: float = 0.1,
                  mag_dip_tolerance: float = float(np.radians(5.0))):
-        self.gyro_error = check_range("gyro_error", gyro_error, 0.0, 50.0, "rad/s")
-        self.use_magnetometer = check_bool("use_magnetometer", use_magnetometer)
-        self.mag_rejection, self.mag_norm_tolerance, self.mag_dip_tolerance = rejection_parameters(
-            mag_rejection, mag_norm_tolerance, mag_dip_tolerance)
+        self.gyro_error = gyro_error
+        self.use_magnetometer = use_magnetometer
+        self.mag_rejection = mag_rejection
+        self.mag_norm_tolerance = mag_norm_tolerance
+        self.mag_dip_tolerance = mag_dip_tolerance
 
     def propagate(self, q_prev: np.ndarray, first: bool, t: np.ndarray, dt: np.ndarray, acc: np.ndarray,
                   gyr: np.ndarray, mag: np.ndarray | None, stance: np.ndarray,

@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from ..core.checks import check_bool, check_range
 from ..core.conventions import GRAVITY
+from ..core.params import Boolean, Real
 from ..kernels.jit import njit
 
 #: Longest stretch of the still start used to learn the reference (s).
@@ -144,8 +144,11 @@ def _valid_kernel(acc: np.ndarray, mag: np.ndarray, norm_ref: float, dip_ref: fl
         valid[k] = ok
 
 
-def rejection_parameters(rejection: bool, norm_tolerance: float, dip_tolerance: float) -> tuple[bool, float, float]:
-    """Validated ``mag_rejection``, ``mag_norm_tolerance`` (fraction) and ``mag_dip_tolerance`` (rad)."""
-    return (check_bool("mag_rejection", rejection),
-            check_range("mag_norm_tolerance", norm_tolerance, 0.0, 1.0, "1", lo_open=True),
-            check_range("mag_dip_tolerance", dip_tolerance, 0.0, float(np.pi), "rad", lo_open=True))
+#: Declarations of the rejection's parameters, shared by the filters that use it.
+REJECTION_PARAMETERS = {
+    "mag_rejection": Boolean("reject disturbed magnetometer samples (false: the paper's filter)",
+                             source="footzoo's (not the paper's)"),
+    "mag_norm_tolerance": Real("1", "(0, 1]", "accepted relative deviation of the field magnitude",
+                               source="footzoo's: 10 %"),
+    "mag_dip_tolerance": Real("rad", "(0, pi]", "accepted deviation of the dip angle", source="footzoo's: 5°"),
+}

@@ -6,9 +6,14 @@ Every plug-in (built-in or yours) derives from one of :class:`Orientation`, :cla
 scikit-learn:
 
 * ``__init__`` takes every parameter as a keyword with its paper's default, stores it under the
-  same name (validated, converted to plain numbers), and does nothing else that depends on data;
-* ``units`` gives the unit of every numeric parameter, ``paper`` the reference, the class
-  docstring the equations;
+  same name, and does nothing else that depends on data;
+* ``parameters`` declares each of them once (:mod:`footzoo.core.params`: type, unit, accepted
+  range, one line of meaning, the source of the default); the declared arguments are validated
+  before the body of ``__init__`` runs (so it receives them converted to their type, equal to what
+  was given) and the declaration drives ``set_params``, ``footzoo list``, the documentation and
+  the fuzz tests. ``paper`` gives the reference, the class docstring the equations. (A plug-in
+  without declarations, with a ``units`` dict and its own checks, works as before;
+  ``check_plugin`` then suggests declaring.)
 * the one action method (``calibrate``, ``estimate``, ``detect``, ``apply``, ``apply_acceleration``,
   ``analyze``; a Kalman correction's ``model``) sets results as attributes ending in ``_`` and
   returns ``self`` (or the corrected array);
@@ -31,7 +36,21 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.errors import ConfigError, RecordingError
+from ..core.errors import ConfigError, RecordingError, did_you_mean
+from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocabulary, re-exported for plug-ins
+    REQUIRED,
+    Boolean,
+    Choice,
+    Declared,
+    File,
+    Integer,
+    Param,
+    Real,
+    Vector,
+    Vectors,
+    declared,
+    validated_init,
+)
 from ..filters.measurement import MeasurementModel, StateBlock
 from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
 
@@ -79,6 +98,9 @@ class Plugin:
     kind: ClassVar[str] = ""
     name: ClassVar[str] = ""
     paper: ClassVar[str] = ""
+    #: The declaration of each parameter (:mod:`footzoo.core.params`), new or changed in this class.
+    parameters: ClassVar[dict[str, Param]] = {}
+    #: The unit of each parameter (derived from ``parameters`` when the class declares them).
     units: ClassVar[dict[str, str]] = {}
     needs_magnetometer: ClassVar[bool] = False
     needs_truth: ClassVar[bool] = False
@@ -87,6 +109,7 @@ class Plugin:
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
+        _declare(cls)
         for action in ACTIONS:
             method = cls.__dict__.get(action)
             if callable(method) and not getattr(method, "__footzoo_checked__", False):
@@ -100,21 +123,43 @@ class Plugin:
 
     @classmethod
     def defaults(cls) -> dict[str, Any]:
-        """The constructor's defaults (the paper's values)."""
+        """The constructor's defaults (the paper's values; ``inspect.Parameter.empty`` for a required one)."""
         sig = inspect.signature(cls.__init__)
         return {p: sig.parameters[p].default for p in cls.param_names()}
 
-    def get_params(self) -> dict[str, Any]:
-        """Current parameter values (scikit-learn style)."""
+    @classmethod
+    def declaration(cls) -> dict[str, Declared]:
+        """``{name: Declared}`` of the declared parameters, in the constructor's order (:mod:`footzoo.core.params`)."""
+        cached = cls.__dict__.get("_footzoo_declaration")
+        return dict(cached) if cached is not None else _declaration(cls)
+
+    @classmethod
+    def undeclared(cls) -> list[str]:
+        """The constructor's parameters without a declaration."""
+        decl = cls.declaration()
+        return [p for p in cls.param_names() if p not in decl]
+
+    def get_params(self, deep: bool = True) -> dict[str, Any]:
+        """Current parameter values (scikit-learn style; ``deep`` is accepted for compatibility)."""
         return {p: getattr(self, p) for p in self.param_names()}
 
     def set_params(self, **params: Any) -> Plugin:
-        """Change parameters, validated as the constructor validates them; returns ``self``."""
-        unknown = [k for k in params if k not in self.param_names()]
-        if unknown:
-            raise ValueError(f"{self.kind} {self.name!r}: unknown parameter(s) {unknown}; "
-                             f"valid parameters: {self.param_names()}")
-        fresh = type(self)(**{**self.get_params(), **params})
+        """Change parameters, validated as the constructor validates them; returns ``self``.
+
+        Raises
+        ------
+        ConfigError
+            An unknown parameter (with a did-you-mean) or a value the constructor refuses.
+        """
+        names = self.param_names()
+        for key in params:
+            if key not in names:
+                raise ConfigError(f"{self.kind} {self.name!r}: unknown parameter {key!r}"
+                                  f"{did_you_mean(key, names)}; valid parameters: {names}")
+        try:
+            fresh = type(self)(**{**self.get_params(), **params})
+        except (TypeError, ValueError) as err:  # ConfigError is a ValueError; a plug-in's own checks may raise either
+            raise ConfigError(f"{self.kind} {self.name!r}: {err}") from None
         self.__dict__.clear()
         self.__dict__.update(fresh.__dict__)
         return self
@@ -209,6 +254,32 @@ def run_whole(block: Plugin, ctx: RunContext, *arrays: Any) -> Chunk:
     """A block's outputs over whole arrays through its incremental protocol: begin, one step, finish."""
     block.begin(ctx)
     return concat([block.step(*arrays), block.finish()])
+def _declaration(cls: type[Plugin]) -> dict[str, Declared]:
+    defaults = {k: (REQUIRED if v is inspect.Parameter.empty else v) for k, v in cls.defaults().items()}
+    return declared(cls, defaults)
+
+
+def _declare(cls: type[Plugin]) -> None:
+    """Bind a new plug-in class's declarations to its constructor (see :mod:`footzoo.core.params`).
+
+    The constructor is wrapped so that the declared arguments are validated before its body runs;
+    ``units`` is derived from the declarations unless the class sets it. Mistakes in the
+    declarations (a name that is no parameter, a default the declaration refuses) raise a
+    ``TypeError`` here, when the class is defined.
+    """
+    decl = _declaration(cls)
+    cls._footzoo_declaration = decl  # type: ignore[attr-defined]
+    if not decl:
+        return
+    if "units" not in cls.__dict__:
+        inherited = {k: v for k, v in cls.units.items() if k in cls.param_names()}
+        cls.units = {**inherited, **{n: d.param.unit for n, d in decl.items() if d.param.unit}}
+    init = cls.__dict__.get("__init__")
+    if init is None and "parameters" in cls.__dict__:  # redeclared without a constructor of its own
+        init = cls.__init__
+    if init is not None:
+        raw = init.__wrapped__ if getattr(init, "__footzoo_validated__", False) else init
+        cls.__init__ = validated_init(raw, lambda: decl)  # type: ignore[method-assign]
 
 
 def _plain(value: Any) -> Any:

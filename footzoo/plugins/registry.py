@@ -1,9 +1,10 @@
 """Plug-in registry: ``register`` by kind and name, ``build`` from a spec, ``describe``.
 
 A plug-in is a subclass of one of the kinds' base classes in :mod:`footzoo.plugins.base`, with
-keyword parameters in ``__init__`` (paper defaults) and class attributes ``name``, ``paper``
-and ``units`` (unit of each parameter). ``build`` rejects unknown names and keys with the list
-of valid ones and a did-you-mean suggestion.
+keyword parameters in ``__init__`` (paper defaults), their declarations in ``parameters``
+(:mod:`footzoo.core.params`) and class attributes ``name`` and ``paper``. ``build`` rejects
+unknown names and keys with the list of valid ones and a did-you-mean suggestion; ``describe``
+lists every plug-in's declared parameters (``footzoo list``).
 
 The registry imports no plug-in module: the built-in packages and every module in them are
 imported by name the first time a listing or a lookup needs them (so a new built-in plug-in is
@@ -12,13 +13,17 @@ one new file), then the installed packages' entry points (group ``footzoo.plugin
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 import inspect
 import pkgutil
+import sys
+from pathlib import Path
 from typing import Any
 
 from ..core.checks import check_bool, check_positive, check_range, check_vector  # noqa: F401 - re-exported for plug-ins
 from ..core.errors import ConfigError, did_you_mean
+from ..core.params import describe as describe_parameters
 from .base import BASES, Plugin
 
 KINDS: tuple[str, ...] = tuple(BASES)
@@ -33,8 +38,11 @@ _LOADED = False
 def register(cls: type[Plugin]) -> type[Plugin]:
     """Class decorator: make a plug-in available under its kind and ``cls.name``.
 
-    Registering the same class again (a module imported twice) is a no-op; another class under a
-    taken name is an error.
+    Registering the same class again is a no-op, and so is registering the same plug-in loaded
+    twice under two module names (a file imported by a script and also listed under ``plugins:``,
+    unchanged in between): the registry keeps the copy of the script's own module, which its
+    ``isinstance`` checks see. A file that changed in between replaces its old registration (the
+    newest code runs, as in a study's workers). Another class under a taken name is an error.
     """
     if not (isinstance(cls, type) and issubclass(cls, Plugin)):
         raise TypeError(f"register expects a plug-in class deriving from a footzoo.plugins kind, got {cls!r}")
@@ -46,13 +54,52 @@ def register(cls: type[Plugin]) -> type[Plugin]:
         raise TypeError(f"{cls.__name__}: a {cls.kind} plug-in derives from {names}")
     if not cls.name or not isinstance(cls.name, str):
         raise ValueError(f"{cls.__name__}: set the class attribute name = '...' (the YAML type)")
+    source = _source(cls)
     old = _REGISTRY[cls.kind].get(cls.name)
-    # a module executed again (an edited plug-in file loaded again) replaces its own registrations
-    if old is not None and old.__module__ != cls.__module__:
-        raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered by "
-                         f"{old.__module__}.{old.__qualname__}; choose another name")
+    if old is not None and old is not cls and old.__module__ != cls.__module__:
+        # a module executed again (an edited plug-in file loaded again) replaces its own registrations
+        old_source = _SOURCES.get(old)
+        if old_source is None or source is None or old_source[:2] != source[:2]:
+            raise ValueError(f"a {cls.kind} plug-in named {cls.name!r} is already registered by "
+                             f"{old.__module__}.{old.__qualname__}; choose another name")
+        if old_source[2] == source[2] and _by_loader(cls) and not _by_loader(old):
+            return cls  # the same file and source, loaded again under the stable name: keep the script's copy
     _REGISTRY[cls.kind][cls.name] = cls
+    if source is not None:
+        _SOURCES[cls] = source
     return cls
+
+
+#: (file, qualified name, sha256 of the file) of each registered plug-in from outside the package.
+_SOURCES: dict[type, tuple[str, str, str]] = {}
+
+
+def _source(cls: type) -> tuple[str, str, str] | None:
+    """Where a plug-in class comes from: its resolved source file, qualified name and the file's hash."""
+    if cls.__module__.startswith("footzoo."):
+        return None  # a built-in: its name is its identity
+    module = sys.modules.get(cls.__module__)
+    path = getattr(module, "__file__", None)
+    if not path:
+        return None
+    try:
+        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
+    return str(Path(path).resolve()), cls.__qualname__, digest
+
+
+def _by_loader(cls: type) -> bool:
+    """Whether the class was loaded from a ``plugins:`` file (under footzoo's stable module name)."""
+    return cls.__module__.startswith("footzoo_plugin_")
+
+
+def same_plugin(a: type, b: type) -> bool:
+    """Whether two classes are one plug-in: the same class, or the same file's class loaded twice."""
+    if a is b:
+        return True
+    sa, sb = _SOURCES.get(a) or _source(a), _SOURCES.get(b) or _source(b)
+    return sa is not None and sb is not None and sa[:2] == sb[:2]
 
 
 def available(kind: str) -> dict[str, type[Plugin]]:
@@ -106,23 +153,45 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
         raise ConfigError(f"{where} ({cls.name}): {err}") from None
 
 
-def describe(kind: str | None = None) -> str:
-    """Human-readable table of plug-ins with parameters, defaults, units and paper."""
+def describe(kind: str | None = None, name: str | None = None) -> str:
+    """Human-readable listing of plug-ins: summary, paper, and each parameter's default, unit, type, range,
+    meaning and source (from its declaration; for a plug-in without declarations, the default and unit).
+
+    Parameters
+    ----------
+    kind : str, optional
+        Only this kind.
+    name : str, optional
+        Only the plug-in of this name (of any kind, or of ``kind``).
+    """
+    if kind is not None and kind not in KINDS:
+        raise ConfigError(f"unknown plug-in kind {kind!r}{did_you_mean(kind, list(KINDS))}; kinds are {list(KINDS)}")
     lines: list[str] = []
+    found = False
     for k in [kind] if kind else list(KINDS):
+        plugins = sorted((n, c) for n, c in available(k).items() if name is None or n == name)
+        if not plugins:
+            continue
+        found = True
         lines.append(f"{k}:")
-        for name, cls in sorted(available(k).items()):
-            summary = (inspect.getdoc(cls) or "").splitlines()[0] if inspect.getdoc(cls) else ""
-            lines.append(f"  {name} — {summary}")
+        for plugin_name, cls in plugins:
+            doc = inspect.getdoc(cls) or ""
+            summary = doc.splitlines()[0] if doc else ""
+            lines.append(f"  {plugin_name} — {summary}")
             if cls.paper:
                 lines.append(f"      paper: {cls.paper}")
+            declaration = cls.declaration()
+            lines += describe_parameters(declaration)
             sig = inspect.signature(cls.__init__)
-            for p in cls.param_names():
+            for p in cls.undeclared():
                 default = sig.parameters[p].default
                 unit = cls.units.get(p, "")
-                unit = f" [{unit}]" if unit else ""
-                lines.append(f"      {p} = {default!r}{unit}")
+                lines.append(f"      {p} = {'required' if default is inspect.Parameter.empty else repr(default)}"
+                             f"{f' [{unit}]' if unit else ''}  (not declared)")
         lines.append("")
+    if name is not None and not found:
+        names = sorted({n for k in ([kind] if kind else KINDS) for n in available(k)})
+        raise ConfigError(f"no plug-in named {name!r}{did_you_mean(name, names)}; footzoo list shows them all")
     return "\n".join(lines).rstrip() + "\n"
 
 

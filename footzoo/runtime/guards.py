@@ -46,6 +46,7 @@ import numpy as np
 from ..core.checks import Settings
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
+from ..core.params import Real
 from ..evaluation.metrics import intervals
 from ..kernels.jit import njit
 from ..plugins.incremental import Chunk, Latency, OverlapSave
@@ -110,10 +111,21 @@ class StanceGuard(Settings):
 
     section = "guards"
     example = "{max_swing: 1.5}"
-    units = {"max_swing": "s", "still_rate": "rad/s", "min_step": "s", "half_width": "s", "window": "s",
-             "max_speed": "m/s"}
-    ranges = {"max_swing": (0.0, 3600.0), "still_rate": (0.0, 50.0), "min_step": (0.0, 10.0),
-              "half_width": (0.0, 1.0), "window": (0.0, 1.0), "max_speed": (0.0, 1000.0)}
+    parameters = {
+        "max_swing": Real("s", "[0, 10]", "longest swing left as the detector gave it; 0: the guard is off",
+                          source="footzoo's: the longest human swing lasts about 0.6 s (1.2 s dated to the rolls)",
+                          why="a swing of 10 s is a detector that found no stance; use 0 to switch the guard off"),
+        "still_rate": Real("rad/s", "[0, 10]", "|ω| below which an instant can be stance",
+                           source="footzoo's: a foot turning about a contact 0.1 m away moves at 0.1 m/s",
+                           why="a foot turns faster than 10 rad/s (573 °/s) only in mid-swing"),
+        "min_step": Real("s", "[0, 10]", "shortest time between two stance instants the guard marks",
+                         source="footzoo's: shorter than any stride of one foot"),
+        "half_width": Real("s", "[0, 1]", "widest extent of a marked stance either side of its instant",
+                           source="footzoo's: one sample (0.05 s made the Kalman pipelines worse on PyShoe)"),
+        "window": Real("s", "[0, 1]", "duration of the centred average of |ω|", source="footzoo's"),
+        "max_speed": Real("m/s", "[0, 1000]", "speed above which the estimate has diverged; 0: no check",
+                          source="footzoo's: twice a sprinting foot's 20-25 m/s"),
+    }
 
     def apply(self, t: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
               ctx: RunContext | None = None) -> tuple[np.ndarray, dict[str, Any]]:

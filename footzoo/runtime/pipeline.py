@@ -20,8 +20,7 @@ import pandas as pd
 from .._version import __version__
 from ..analysis.strides import segment_steps
 from ..config.library import resolve
-from ..config.schema import check_init, check_top_level, load_yaml
-from ..core.checks import GRAVITY_RANGE, check_range
+from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level, load_yaml
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
@@ -115,7 +114,7 @@ class Pipeline:
         self.corrections = list(corrections or [])
         self.analysis = list(analysis or [])
         self.name = name
-        self.gravity = check_range("gravity", gravity, *GRAVITY_RANGE, "m/s^2")
+        self.gravity = GRAVITY_PARAMETER.validate(gravity)
         self.init = check_init(init or {})
         self.navigation = (navigation if isinstance(navigation, NavigationNoise)
                            else NavigationNoise.from_dict(navigation))
@@ -138,28 +137,7 @@ class Pipeline:
         working directory) is loaded first, so the config can use the plug-ins it registers.
         """
         check_top_level(d)
-        plugins = [p["spec"] for p in load_plugins(d.get("plugins"), base_dir)]
-        calibration = [build("calibration", c, f"calibration[{i}]") for i, c in enumerate(d.get("calibration") or [])]
-        orientation = build("orientation", d["orientation"], "orientation")
-        detector = build("detector", d["detector"], "detector")
-        corrections = [
-            build("correction", c, f"corrections[{i}]") for i, c in enumerate(d.get("corrections") or [])
-        ]
-        analysis = [build("analysis", a, f"analysis[{i}]") for i, a in enumerate(d.get("analysis") or [])]
-        return cls(
-            orientation,
-            detector,
-            corrections,
-            name=str(d.get("name", "pipeline")),
-            gravity=d.get("gravity", GRAVITY),
-            init=d.get("init") or {},
-            analysis=analysis,
-            navigation=d.get("navigation"),
-            smoother=d.get("smoother", "none"),
-            plugins=plugins,
-            guards=d.get("guards"),
-            calibration=calibration,
-        )
+        return cls(**pipeline_arguments(d, base_dir))
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> Pipeline:
@@ -397,6 +375,69 @@ class Pipeline:
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps
+
+
+def pipeline_arguments(d: dict[str, Any], base_dir: str | Path | None = None,
+                       errors: list[str] | None = None) -> dict[str, Any]:
+    """The keyword arguments of :class:`Pipeline` for a config mapping: its plug-ins loaded and built.
+
+    The one way a config becomes a pipeline, for :meth:`Pipeline.from_dict` (``footzoo run``) and
+    :func:`footzoo.runtime.validate.config_errors` (``footzoo validate``) alike: the ``plugins:``
+    list first (paths relative to ``base_dir``, the config file's folder; default the working
+    directory), then each plug-in section.
+
+    Parameters
+    ----------
+    d : dict
+        The config mapping (its top-level keys already checked).
+    base_dir : path, optional
+        Folder the ``plugins:`` paths are relative to.
+    errors : list of str, optional
+        Collect every problem here (each section on its own, the settings blocks too) instead of
+        raising the first.
+
+    Raises
+    ------
+    ConfigError
+        Without ``errors``: the first problem.
+    """
+
+    def attempt(action, *args):
+        if errors is None:
+            return action(*args)
+        try:
+            return action(*args)
+        except ConfigError as err:
+            errors.append(str(err))
+            return None
+
+    def listed(key: str) -> list[Any]:
+        items = d.get(key) or []
+        return items if isinstance(items, list) else []  # not a list: a top-level error already
+
+    loaded = attempt(load_plugins, d.get("plugins"), base_dir) or []
+    calibration = [attempt(build, "calibration", c, f"calibration[{i}]") for i, c in enumerate(listed("calibration"))]
+    parts = {key: attempt(build, key, d[key], key) for key in ("orientation", "detector") if key in d}
+    corrections = [attempt(build, "correction", c, f"corrections[{i}]") for i, c in enumerate(listed("corrections"))]
+    analysis = [attempt(build, "analysis", a, f"analysis[{i}]") for i, a in enumerate(listed("analysis"))]
+    if errors is not None:  # each settings block on its own, so that one error does not hide another
+        attempt(GRAVITY_PARAMETER.validate, d.get("gravity", GRAVITY))
+        for block, key in ((Init, "init"), (NavigationNoise, "navigation"), (StanceGuard, "guards")):
+            attempt(block.from_dict, d.get(key))
+    return dict(
+        orientation=parts.get("orientation"),
+        detector=parts.get("detector"),
+        corrections=corrections,
+        name=str(d.get("name", "pipeline")),
+        gravity=d.get("gravity", GRAVITY),
+        init=d.get("init") or {},
+        analysis=analysis,
+        navigation=d.get("navigation"),
+        smoother=d.get("smoother", "none"),
+        plugins=[p["spec"] for p in loaded],
+        guards=d.get("guards"),
+        calibration=calibration,
+    )
 
 
 def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np.ndarray, ...]:
