@@ -200,11 +200,14 @@ class StanceGuard(Settings):
             return {"stance": out, "added": out & ~np.asarray(stance, dtype=bool), "t": t}
 
         def ready(inp: Chunk, start: int) -> int:
-            # every swing the guard may still change: open, or without the score's half window after it
+            # every swing the guard may still change: the open one, or one without the score's half window after it
             s = inp["stance"]
-            swings = intervals(~s)
-            pending = swings[(swings[:, 1] == s.size) | (swings[:, 1] + k > s.size)] if len(swings) else swings
-            return start + (int(pending[0, 0]) if len(pending) else s.size)
+            swing = np.flatnonzero(~s[max(s.size - k - 1, 0):])
+            if not swing.size:  # the last k + 1 samples are stance: every swing before them is final
+                return start + s.size
+            first = s.size - k - 1 + int(swing[0]) if s.size > k + 1 else int(swing[0])
+            before = np.flatnonzero(s[:first])  # the pending swing starts after the last stance sample before it
+            return start + (int(before[-1]) + 1 if before.size else 0)
 
         return OverlapSave(compute, lookahead=ready, restart=lambda out, inp, start, final: final - k - 1,
                            wants=("t", "gyr", "stance"))

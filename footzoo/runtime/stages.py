@@ -32,7 +32,7 @@ from ..plugins.base import (
     Samples,
     VelocityCorrection,
 )
-from ..plugins.incremental import Chunk, concat, length, take
+from ..plugins.incremental import Chunk, Columns, concat, length, take
 from .guards import StanceGuard
 
 #: Raw signals every chunk carries (``mag``, ``dist`` only when the recording has them).
@@ -61,29 +61,35 @@ def pad_to(guess: Chunk, samples: Chunk, name: str, last: Any) -> np.ndarray:
 
 
 class Queue:
-    """Samples waiting between stages: appended at the end, taken from the front, by absolute index."""
+    """Samples waiting between stages: appended at the end, taken from the front, by absolute index ``k``.
+
+    Backed by :class:`~footzoo.plugins.incremental.Columns`: appending and taking cost the samples
+    moved, not the samples held.
+    """
 
     def __init__(self) -> None:
-        self.data: Chunk = {}
+        self._columns = Columns()
 
     def put(self, chunk: Chunk) -> None:
         if length(chunk):
-            self.data = concat([self.data, chunk]) if self.data else {k: np.asarray(v) for k, v in chunk.items()}
+            self._columns.append(chunk)
 
     def take(self, stop_k: int) -> Chunk:
         """The samples with absolute index below ``stop_k`` (removed)."""
-        if not self.data:
+        if not len(self._columns):
             return {}
-        n = int(np.searchsorted(self.data["k"], stop_k))
-        out = take(self.data, 0, n)
-        self.data = take(self.data, n)
+        view = self._columns.view()
+        n = int(np.searchsorted(view["k"], stop_k))
+        out = take(view, 0, n)
+        self._columns.drop(n)
         return out
 
     def peek(self) -> Chunk:
-        return self.data
+        """The samples held (views: read them before the next change)."""
+        return self._columns.view() if len(self._columns) else {}
 
     def __len__(self) -> int:
-        return length(self.data)
+        return len(self._columns)
 
 
 class CalibrationStage:

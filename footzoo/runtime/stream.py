@@ -36,7 +36,7 @@ from ..core.checks import validate_block, validate_sample
 from ..core.context import RunContext
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..plugins.base import Samples
-from ..plugins.incremental import Chunk, Latency, length
+from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
 from .pipeline import STREAM_WARMUP
 from .stages import (
@@ -345,8 +345,9 @@ class Stream:
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
                           FootzooWarning, stacklevel=4)
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
-        b = self._with_init(b)
-        self._raw.data = b
+        b = self._with_init(take(b, 0))  # a copy, with the still-start flag
+        self._raw = Queue()
+        self._raw.put(b)
         stages: list[Any] = []
         calibrated = b
         if pipe.calibration:
