@@ -79,8 +79,12 @@ class Latency:
         return math.isfinite(self.seconds) and WHOLE_RECORDING not in self.until
 
     def __str__(self) -> str:
-        text = "0 s (causal)" if self.causal else " + ".join(
-            ([] if self.seconds == 0.0 and self.until else [f"{self.seconds:.3g} s"]) + list(self.until))
+        if self.causal:
+            text = "0 s (causal)"
+        elif self.seconds == 0.0:
+            text = "until " + " + ".join(self.until)
+        else:
+            text = " + ".join([f"{self.seconds:.3g} s", *self.until])
         return text + (f"; warm-up {self.warmup:.3g} s at the start" if self.warmup else "")
 
     def to_dict(self) -> dict[str, Any]:

@@ -24,7 +24,7 @@ from typing import Any
 from ..core.checks import check_bool, check_positive, check_range, check_vector  # noqa: F401 - re-exported for plug-ins
 from ..core.errors import ConfigError, did_you_mean
 from ..core.params import describe as describe_parameters
-from .base import BASES, Plugin
+from .base import BASES, KalmanCorrection, Plugin
 
 KINDS: tuple[str, ...] = tuple(BASES)
 #: Packages whose import registers the built-in plug-ins.
@@ -153,6 +153,26 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
         raise ConfigError(f"{where} ({cls.name}): {err}") from None
 
 
+def _live(cls: type[Plugin]) -> str:
+    """The plug-in's latency with its defaults at 100 Hz, or why it does not run live."""
+    from ..core.context import RunContext
+
+    if cls.needs_truth:
+        return "no (it reads the reference)"
+    if cls.kind == "correction" and issubclass(cls, KalmanCorrection):
+        return "yes, inside the Kalman filter (causal)"
+    if cls.kind == "analysis":
+        return "on the final estimates (Stream(..., keep=True).result())"
+    if cls.kind == "calibration":
+        return "with a given fit, or fitted online on the stream's first seconds"
+    if not cls.incremental():
+        return "no (batch only: it implements no step)"
+    try:
+        return f"yes, latency {cls().latency(RunContext(rate=100.0))} (at 100 Hz)"
+    except Exception as err:  # a plug-in that cannot be built with its defaults  # noqa: BLE001
+        return f"yes (latency unknown with the defaults: {type(err).__name__})"
+
+
 def describe(kind: str | None = None, name: str | None = None) -> str:
     """Human-readable listing of plug-ins: summary, paper, and each parameter's default, unit, type, range,
     meaning and source (from its declaration; for a plug-in without declarations, the default and unit).
@@ -180,6 +200,7 @@ def describe(kind: str | None = None, name: str | None = None) -> str:
             lines.append(f"  {plugin_name} — {summary}")
             if cls.paper:
                 lines.append(f"      paper: {cls.paper}")
+            lines.append(f"      live: {_live(cls)}")
             declaration = cls.declaration()
             lines += describe_parameters(declaration)
             sig = inspect.signature(cls.__init__)
