@@ -10,6 +10,8 @@
   docstring and the reader's options.
 * ``gallery/``: every ``docs/gallery/*.py`` script is run; the figures it saves
   into ``$FOOTZOO_GALLERY_OUT`` are shown with its docstring and source.
+* ``benchmarks/``: every summary a benchmark script writes into ``benchmarks/`` (``*.md``, with the
+  figures it links) becomes a page as it is, so the site shows the numbers of the last benchmark run.
 
 The ``nav`` entries ``zoo/index.md``, ``readers/index.md`` and
 ``gallery/index.md`` in ``mkdocs.yml`` are expanded into sections here.
@@ -367,12 +369,30 @@ def on_config(config, **_):
     return config
 
 
+BENCHMARKS = ROOT / "benchmarks"
+
+
+def benchmark_pages() -> dict[str, str]:
+    """``benchmarks/<name>.md`` for every summary in ``benchmarks/``, and an index of them."""
+    pages, rows = {}, []
+    for md in sorted(BENCHMARKS.glob("*.md")):
+        text = md.read_text()
+        title = next((line.lstrip("# ").strip() for line in text.splitlines() if line.startswith("#")), md.stem)
+        pages[f"benchmarks/{md.name}"] = text if text.startswith("#") else f"# {title}\n\n{text}"
+        rows.append(f"* [{title}]({md.name}) (`benchmarks/{md.name}`)")
+    intro = "The summaries the scripts in `benchmarks/` wrote at their last run (each script's `--help` tells how)"
+    pages["benchmarks/index.md"] = f"# Benchmarks\n\n{intro}:\n\n" + "\n".join(rows) + "\n"
+    return pages
+
+
 def on_files(files, config, **_):
     from mkdocs.structure.files import File
 
     global _gallery_dir
     use_checkout()
-    pages = {**plugin_pages(), **reader_pages()}
+    pages = {**plugin_pages(), **reader_pages(), **benchmark_pages()}
+    for png in sorted(BENCHMARKS.glob("*.png")):
+        files.append(File.generated(config, f"benchmarks/{png.name}", abs_src_path=str(png)))
     if os.environ.get("FOOTZOO_DOCS_NO_GALLERY"):
         pages["gallery/index.md"] = "# Gallery\n\nNot rendered in this build (`FOOTZOO_DOCS_NO_GALLERY` is set).\n"
     else:

@@ -1,11 +1,32 @@
-"""Shared fixtures: the real recordings in ../shared/data (skipped when absent)."""
+"""Shared fixtures: the real recordings in ../shared/data (skipped when absent); the wheel's compiled kernels."""
 
 from __future__ import annotations
 
+import importlib.metadata
 import os
 from pathlib import Path
 
 import pytest
+
+
+def installed_kernels() -> Path | None:
+    """The machine code an installed footzoo wheel ships (``footzoo/_compiled``), if footzoo is installed so.
+
+    The tests import the checkout's footzoo, whose kernels numba would compile afresh (about a minute of
+    CPU on a new machine). A kernel's shipped code is used only where its source file has the same
+    content (footzoo.kernels.cache checks a SHA-256 of the file), so after ``pip install .`` of this
+    checkout the tests load what the wheel compiled, and compile whatever differs. Pointing
+    ``FOOTZOO_SHIPPED_KERNELS`` at a folder (an empty one: nothing shipped) overrides this.
+    """
+    for dist in importlib.metadata.distributions(name="footzoo"):  # the checkout's own egg-info may come first
+        folder = Path(dist.locate_file("footzoo/_compiled"))
+        if folder.is_dir():
+            return folder
+    return None
+
+
+if "FOOTZOO_SHIPPED_KERNELS" not in os.environ and (_shipped := installed_kernels()) is not None:
+    os.environ["FOOTZOO_SHIPPED_KERNELS"] = str(_shipped)  # the tests' subprocesses inherit it
 
 #: The shared recordings: ../shared/data next to the checkout, or the folder named by FOOTZOO_DATA.
 DATA = Path(os.environ.get("FOOTZOO_DATA") or Path(__file__).resolve().parents[1].parent / "shared" / "data")

@@ -42,6 +42,7 @@ def test_study_errors_name_the_problem(tmp_path):
     assert len(Study.from_dict(SMALL).cells()) == 2 * 2 * 2
 
 
+@pytest.mark.slow
 def test_serial_joblib_and_dask_give_identical_tables():
     from dask.distributed import LocalCluster
 
@@ -55,6 +56,7 @@ def test_serial_joblib_and_dask_give_identical_tables():
         np.testing.assert_array_equal(serial["value"].to_numpy(), other["value"].to_numpy())
 
 
+@pytest.mark.slow
 def test_an_interrupted_study_resumes_without_redoing_work(tmp_path):
     study = Study.from_dict(SMALL)
     first = run_study(study, out=tmp_path, max_runs=3)  # what a kill after three runs leaves
@@ -69,6 +71,7 @@ def test_an_interrupted_study_resumes_without_redoing_work(tmp_path):
     assert list(tmp_path.glob("trajectories_*.png")) and list(tmp_path.glob("metric_*_by_detector_type.png"))
 
 
+@pytest.mark.slow
 def test_killing_the_command_line_run_keeps_finished_runs(tmp_path):
     study = tmp_path / "study.yaml"
     import yaml
@@ -98,6 +101,7 @@ def test_a_failing_run_is_reported_and_the_study_goes_on():
     assert table["metric"].notna().sum() > 0
 
 
+@pytest.mark.slow
 def test_every_valid_combination_gives_a_finite_trajectory():
     from footzoo import Pipeline
     from footzoo.sim import NoiseModel, simulate

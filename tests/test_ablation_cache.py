@@ -96,6 +96,7 @@ def folder_of_recordings(tmp_path):
     return data
 
 
+@pytest.mark.slow
 def test_a_dangling_link_or_a_directory_fails_its_cells_not_the_study(tmp_path, folder_of_recordings):
     d = {**SMALL, "recordings": [{"path": str(folder_of_recordings / "*.parquet")}]}
     out = tmp_path / "out"
@@ -119,6 +120,7 @@ def test_a_dangling_link_or_a_directory_fails_its_cells_not_the_study(tmp_path, 
     assert not np.array_equal(values["b_dangling"], values["a_good"])
 
 
+@pytest.mark.slow
 def test_a_cached_run_takes_the_labels_of_the_cell_that_reads_it(tmp_path):
     data = tmp_path / "data"
     data.mkdir()
@@ -130,6 +132,7 @@ def test_a_cached_run_takes_the_labels_of_the_cell_that_reads_it(tmp_path):
     assert table.attrs["cached"] == 4 and sorted(set(table["recording"])) == ["first", "second"]
 
 
+@pytest.mark.slow
 def test_failed_cells_are_retried_when_footzoos_code_changes_and_only_then(tmp_path, monkeypatch):
     d = {**SMALL, "factors": {"corrections": [[{"type": "zvu_dedrift"}], [{"type": "height_distance"}]]}}
     first = run_study(Study.from_dict(d), out=tmp_path)
@@ -253,6 +256,7 @@ def test_the_progress_bar_covers_loading_runs_and_report(tmp_path, monkeypatch):
     assert sum(1 for p in phases if p == "report") == 4
 
 
+@pytest.mark.slow
 def test_outputs_are_rewritten_only_when_something_they_show_changed(tmp_path):
     study = Study.from_dict(SMALL)
     run_study(study, out=tmp_path)
@@ -274,6 +278,7 @@ def test_outputs_are_rewritten_only_when_something_they_show_changed(tmp_path):
     assert (tmp_path / "results.csv").stat().st_mtime_ns > stamps["results.csv"]
 
 
+@pytest.mark.slow
 def test_a_truncated_parquet_output_is_rebuilt(tmp_path):
     study = Study.from_dict(SMALL)
     first = run_study(study, out=tmp_path)
@@ -287,6 +292,7 @@ def test_a_truncated_parquet_output_is_rebuilt(tmp_path):
     assert not list(tmp_path.glob(".staging-*"))
 
 
+@pytest.mark.slow
 def test_two_studies_on_one_output_folder_at_once(tmp_path):
     import subprocess
     import sys
@@ -305,6 +311,7 @@ def test_two_studies_on_one_output_folder_at_once(tmp_path):
     assert pd.read_csv(out / "results.csv").shape == table.shape
 
 
+@pytest.mark.slow
 def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path):
     study = Study.from_dict({**SMALL, "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]},
                              "sweep": {"points": 5}})
@@ -317,6 +324,7 @@ def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path):
     assert all(serial[name] == parallel[name] for name in serial)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("processes", [False, True])
 def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, processes):
     """The cluster's workers draw in memory (one figure at a time per process), the client writes the files."""

@@ -187,6 +187,7 @@ def test_a_study_with_a_plugin_file_runs_serially_and_with_two_jobs(tmp_path):
     assert serial.equals(parallel)
 
 
+@pytest.mark.slow
 def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tmp_path):
     from dask.distributed import LocalCluster
 
@@ -199,6 +200,7 @@ def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tm
     assert serial.equals(distributed)
 
 
+@pytest.mark.slow
 def test_editing_the_plugin_reruns_its_cells_only(tmp_path):
     write_plugin(tmp_path, threshold=0.6)
     out = tmp_path / "out"

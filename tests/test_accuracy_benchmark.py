@@ -20,6 +20,7 @@ def accuracy():
     return mod
 
 
+@pytest.mark.slow
 def test_quick_run_without_datasets_skips_them_and_writes_table_and_summary(accuracy, tmp_path):
     summary = tmp_path / "summary.md"
     assert accuracy.main(["--quick", "--data", str(tmp_path / "absent"), "--results", str(tmp_path / "res"),
@@ -56,6 +57,7 @@ def test_gaitmap_stride_errors_are_the_ones_session_reports(accuracy):
             per_foot.loc[foot, "stride_length_rms_error_straight_m"])
 
 
+@pytest.mark.slow
 def test_koroglu_footprint_errors_against_the_measured_footprints(accuracy):
     """Where the stride count is exact, the benchmark reports the footprint error against GCP_meters."""
     from scipy.io import loadmat

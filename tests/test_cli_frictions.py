@@ -113,13 +113,15 @@ def test_steps_csv_columns_carry_units(tmp_path):
     assert "fpa_rad" in cols and "heading_rad" in cols
 
 
-def test_every_command_in_the_readme_parses():
-    """The README's `footzoo ...` lines (continuations joined, comments cut) are accepted by the parser."""
+@pytest.mark.parametrize("page, at_least", [("README.md", 5), ("docs/command-line.md", 15)])
+def test_every_command_in_the_readme_parses(page, at_least):
+    """The `footzoo ...` lines of the README and of the command-line page (continuations joined, comments cut)
+    are accepted by the parser."""
     import shlex
 
     parser = build_parser()
-    text = Path("README.md").read_text().replace("\\\n", " ")
+    text = (Path(__file__).resolve().parents[1] / page).read_text().replace("\\\n", " ")
     commands = [line.split("#", 1)[0] for line in text.splitlines() if line.startswith("footzoo ")]
-    assert len(commands) >= 10
+    assert len(commands) >= at_least
     for cmd in commands:
         parser.parse_args(shlex.split(cmd)[1:])

@@ -93,6 +93,7 @@ def test_an_external_kalman_correction_runs_everywhere_like_the_builtin_it_copie
     assert runs["auto"].config["corrections"] == [{"type": "test_my_zupt", "velocity_std": 0.01}]
 
 
+@pytest.mark.slow
 def test_a_correction_that_does_not_compile_falls_back_loudly_and_never_drops(walk, external):
     p = _pipeline("test_python_zupt")
     reference = _pipeline("zupt").run(walk, engine="reference")

@@ -67,6 +67,7 @@ def shipped(tmp_path_factory):
     return tmp
 
 
+@pytest.mark.slow
 def test_shipping_writes_the_kernels_into_the_folder_and_not_into_numbas_cache(shipped):
     names = [p.name for p in _cached_files(shipped / "shipped")]
     # the folders mirror the package's modules (orientation/fqa.py -> orientation/)
@@ -75,6 +76,7 @@ def test_shipping_writes_the_kernels_into_the_folder_and_not_into_numbas_cache(s
     assert _cached_files(shipped / "cache") == []
 
 
+@pytest.mark.slow
 def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, tmp_path):
     cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
     warm = json.loads(_run(RUN, cache=tmp_path / "b", shipped=shipped / "shipped").stdout)
@@ -97,6 +99,7 @@ def test_a_recording_read_from_a_file_without_magnetometer_needs_no_compilation_
     assert np.all(np.isfinite(warm["pos"]))
 
 
+@pytest.mark.slow
 def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_path):
     changed = tmp_path / "shipped"
     subprocess.run(["cp", "-r", str(shipped / "shipped"), str(changed)], check=True)
@@ -113,6 +116,7 @@ def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_
     assert stale["pos"] == cold["pos"]
 
 
+@pytest.mark.slow
 def test_compile_without_ship_fills_numbas_cache(tmp_path):
     _run(["compile", CONFIG], cache=tmp_path / "cache")
     assert len(_cached_files(tmp_path / "cache")) >= 5
@@ -145,6 +149,7 @@ def test_compile_names_a_file_that_is_not_a_config(tmp_path, capsys):
     assert "bad.yaml" in err or "no_such_filter" in err
 
 
+@pytest.mark.slow
 def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_path):
     damaged = tmp_path / "shipped"
     subprocess.run(["cp", "-r", str(shipped / "shipped"), str(damaged)], check=True)
@@ -159,6 +164,7 @@ def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_
     assert "could not be loaded" in proc.stderr
 
 
+@pytest.mark.slow
 def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_none_of_it(tmp_path):
     """A user's Kalman correction (the plug-in guide's example, beside its YAML) is compiled and cached like a
     built-in one, whichever folder the command runs from."""

@@ -272,6 +272,7 @@ def test_eight_configs_share_one_axis_with_the_legend_outside(tmp_path):
 
 
 
+@pytest.mark.slow
 def test_many_configs_get_small_multiples(tmp_path):
     runs = fake_runs(110, n_recordings=1)
     fig = roc_figure(runs, run_labels(runs, FACTORS, only=["detector.threshold"]))
@@ -291,6 +292,7 @@ def test_many_configs_get_small_multiples(tmp_path):
     close(fig)
 
 
+@pytest.mark.slow
 def test_plot_study_writes_its_files(tmp_path):
     runs = fake_runs(9, n_recordings=2)
     written = plot_study(table_of(runs, FACTORS), runs, FACTORS, tmp_path)
@@ -365,6 +367,7 @@ def _reference_plot_study(table, runs, factors, out):
     return written
 
 
+@pytest.mark.slow
 def test_one_figure_tasks_draw_the_files_of_the_whole_call(tmp_path):
     """The report's one-figure tasks (shared out to workers) give the previous plot_study's files, byte for byte."""
     from footzoo.studies.report import draw_figure, figure_tasks

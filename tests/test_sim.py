@@ -199,6 +199,7 @@ def test_cli_simulate_then_run_prints_metrics_against_the_truth(tmp_path, capsys
     assert "loop_closure_xy_m" in text and "armse_3d_m" in text
 
 
+@pytest.mark.slow
 def test_yun_reproduction_claims_hold_with_few_runs():
     import importlib.util
     from pathlib import Path

@@ -33,6 +33,7 @@ def test_the_smoother_leaves_the_forward_pass_unchanged_and_gets_closer_to_the_t
     np.testing.assert_allclose(smoothed.pos[-1], forward.pos[-1], atol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["duong2015_zupt", "nguyen2016"])
 def test_both_engines_smooth_alike(walk, name):
     p = _pipeline(name, "rts")

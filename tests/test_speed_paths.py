@@ -46,6 +46,7 @@ def test_a_kalman_config_with_an_external_attitude_matches_too(walk):
     np.testing.assert_allclose(b.pos, a.pos, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_without_a_compiler_the_same_code_gives_the_same_numbers(tmp_path):
     """FOOTZOO_DISABLE_JIT=1 runs the kernels as plain Python (an install without numba)."""
     script = (
