@@ -412,3 +412,33 @@ def test_saved_figures_keep_a_legend_placed_below_the_axes(tmp_path, layout):
         assert (width, height) == (round(4 * dpi), round(3 * dpi))
     else:  # without a layout engine the legend hangs below the figure: the saved area grows to hold it
         assert height > 3 * dpi * 1.05
+
+
+def test_a_figure_save_that_fails_midway_leaves_the_previous_figure(tmp_path):
+    """Figures are written under a temporary name and renamed: a save cut short (Ctrl-C, a full disk) keeps
+    the old file whole, and no temporary file is left behind."""
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from footzoo.evaluation.plots import save
+
+    target = tmp_path / "trajectory.png"
+    fig, _ = plt.subplots()
+    save(fig, target)
+    before = target.read_bytes()
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [1, 0])
+
+    def cut_short(fname, **kwargs):
+        Path(fname).write_bytes(b"\x89PNG half a figure")
+        raise KeyboardInterrupt
+
+    fig.savefig = cut_short
+    with pytest.raises(KeyboardInterrupt):
+        save(fig, target)
+    assert target.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["trajectory.png"]

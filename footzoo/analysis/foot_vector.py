@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..core.atomic import write_text
 from ..core.checks import check_vector
 from ..core.data import Recording
 from ..core.errors import ConfigError, RecordingError
@@ -39,15 +40,13 @@ class FootVector:
 
     def save(self, path: str | Path) -> Path:
         """Write as YAML (loaded by ``huang_fpa``'s ``calibration``)."""
-        p = Path(path)
-        p.write_text(yaml.safe_dump({
+        return write_text(path, yaml.safe_dump({
             "foot_vector": [float(v) for v in self.vector],
             "gravity_axis": [float(v) for v in self.gravity_axis],
             "rotation_axis": [float(v) for v in self.rotation_axis],
             "still_s": [float(v) for v in self.still], "flex_s": [float(v) for v in self.flex],
             "frame": "sensor body frame (FRD)", "method": "Huang et al. 2016 eq. 11: f = k x g",
-        }, sort_keys=False))
-        return p
+        }, sort_keys=False), what="foot-vector calibration")
 
     @classmethod
     def load(cls, path: str | Path) -> FootVector:

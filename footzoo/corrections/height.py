@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..core.atomic import write_text
 from ..core.errors import ConfigError, RecordingError
 from ..core.yamlsafe import load_file
 from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
@@ -315,10 +316,10 @@ class HeightDistance(KalmanCorrection):
 
 def save_calibration(calibration: dict, path: str | Path) -> Path:
     """Write a distance-sensor calibration (``Result.diagnostics['distance_calibration']``) as YAML."""
-    p = Path(path)
-    p.write_text(yaml.safe_dump({"frame": "FRD body frame of the IMU", "units": "m",
-                                 "positions": calibration["positions"], "directions": calibration["directions"]}))
-    return p
+    return write_text(path, yaml.safe_dump({"frame": "FRD body frame of the IMU", "units": "m",
+                                            "positions": calibration["positions"],
+                                            "directions": calibration["directions"]}),
+                      what="distance-sensor calibration")
 
 
 def load_calibration(path: str | Path) -> dict:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 import numpy as np
 import pandas as pd
 
+from ..core.atomic import atomic_path
 from ..core.data import Recording, Result
 from ..core.errors import ConfigError, RecordingError
 from .metrics import rotate_about_vertical, yaw_alignment
@@ -79,10 +80,16 @@ def _bbox(fig: Figure) -> str | None:
 
 
 def save(fig: Figure, path: str | Path) -> Path:
-    """Save ``fig`` (format from the suffix; no legend cut off, see :func:`_bbox`) and close it."""
+    """Save ``fig`` (format from the suffix; no legend cut off, see :func:`_bbox`) and close it.
+
+    The file is written under a temporary name and renamed into place (:func:`footzoo.core.atomic.atomic_path`):
+    an interrupted save leaves the previous figure, never a truncated one.
+    """
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
+    fmt = out.suffix.lstrip(".").lower() or "png"
+    with atomic_path(out, what="figure") as tmp:
+        fig.savefig(tmp, format=fmt, dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
     import matplotlib.pyplot as plt
 
     plt.close(fig)
