@@ -18,7 +18,8 @@ import numpy as np
 import pandas as pd
 
 from .._version import __version__
-from ..analysis.strides import segment_steps
+from ..analysis.mounting import mounting_report, warn_mounting
+from ..analysis.strides import real_stances, segment_steps
 from ..config.library import resolve
 from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level, load_yaml
 from ..core.context import RunContext
@@ -271,6 +272,8 @@ class Pipeline:
                        "guards": guard_report, **nav["diagnostics"]}
         if self.calibration:
             diagnostics["calibration"] = calibration
+        diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], real_stances(stance, nav["pos"]))
+        warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"))
         config = self.to_dict()
         config["engine"] = nav["engine"]
         samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
@@ -371,7 +374,7 @@ class Pipeline:
 
     def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
         """Stage 4: the steps table, with the analysis plug-ins' columns."""
-        steps = segment_steps(rec.t, stance, pos, rec.gyr)
+        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat)
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps
