@@ -517,3 +517,57 @@ def gait_phase_errors(t: np.ndarray, estimated: pd.DataFrame, reference: pd.Data
     return {"gait_phase_error_rate": s["error_rate"],
             "gait_phase_sample_error": float(np.mean(est[scored] != ref[scored])) if scored.any() else float("nan"),
             "stance_phases": float(s["true_steps"])}
+
+
+def vertical_errors(pos: np.ndarray, ref: np.ndarray | None = None) -> dict[str, float]:
+    """Height error at the end of a walk and per distance walked; against a reference or, without one, a closed loop.
+
+    Both trajectories start at the origin. Heights are up positive (``−d`` of NED).
+
+    Parameters
+    ----------
+    pos : (N, 3) ndarray
+        Estimated position, NED (m).
+    ref : (N, 3) ndarray, optional
+        Reference position, NED (m); without it the walk is taken to end at its start's height.
+
+    Returns
+    -------
+    dict
+        ``height_end_error_m`` (estimate − reference at the last sample, m), ``height_end_error_pct``
+        (its absolute value in % of the horizontal path length of the estimate) and
+        ``height_rms_error_m`` (RMS over the samples, m; with a reference only).
+    """
+    e = np.asarray(pos, dtype=float)
+    up = -(e[:, 2] - e[0, 2])
+    ref_up = np.zeros_like(up) if ref is None else -(np.asarray(ref, dtype=float)[:, 2] - ref[0, 2])
+    if ref is not None:
+        _check_same_length(e, np.asarray(ref))
+    d = up - ref_up
+    length = path_length(e)
+    out = {"height_end_error_m": float(d[-1]),
+           "height_end_error_pct": 100.0 * abs(float(d[-1])) / length if length > 0 else float("nan")}
+    if ref is not None:
+        out["height_rms_error_m"] = float(np.sqrt(np.mean(d**2)))
+    return out
+
+
+def position_nees(pos: np.ndarray, ref: np.ndarray, var: np.ndarray) -> np.ndarray:
+    """Normalised estimation error squared of the position per sample (Bar-Shalom et al. 2001, Sec. 5.4.2).
+
+    ``ε_k = Σ_i (p̂_ki − p_ki)² / σ²_ki`` over the three axes, with the filter's position variances
+    only (the diagonal of the covariance: the cross terms are not kept). A consistent filter has
+    ``E[ε] = 3`` (χ² with 3 degrees of freedom for Gaussian errors). Both trajectories are compared
+    as given (no alignment): the simulator's truth shares the estimate's frame and start.
+
+    Parameters
+    ----------
+    pos, ref : (N, 3) ndarray
+        Estimated and true position (m).
+    var : (N, 3) ndarray
+        The filter's position variances (m²).
+    """
+    d = np.asarray(pos, dtype=float) - np.asarray(ref, dtype=float)
+    v = np.asarray(var, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sum(np.where(v > 0, d**2 / v, np.nan), axis=1)
