@@ -44,6 +44,8 @@ TARGETS = {"median_2d_m": 0.045, "ratio": 1.1, "median_3d_m": 0.08, "worst_m": 0
            "flat_height_pct": 0.3, "stairs_height_pct": 2.0, "event_s": 0.010, "gait_phase": 0.03,
            "mounting_s": 0.010, "within_2sigma": 0.95}
 RATES = (100.0, 250.0, 400.0, 1000.0)
+#: Noise seeds of the rectangle walk at each rate (one seed's heading drift varies by a factor 3).
+SEEDS = (0, 1, 2, 3, 4)
 
 
 def _sim(**spec: Any) -> dict[str, Any]:
@@ -137,12 +139,18 @@ def rates() -> list[str]:
     lines = ["### Rate independence (simulator)", ""]
     rows = []
     for rate in RATES:
-        rec = simulate(path="rectangle", rate=rate, **_sim())
-        for cfg in CONFIGS:
-            p = _pos(_run(cfg, rec))
-            rows.append({"walk": "rectangle 120 m", "rate (Hz)": rate, "config": cfg,
-                         "3-D ARMSE (m)": armse(p, rec.truth.pos), "2-D (m)": pyshoe_error(p, rec.truth.pos),
-                         "end height (% dist)": vertical_errors(p, rec.truth.pos)["height_end_error_pct"]})
+        per_seed = []
+        for seed in SEEDS:
+            rec = simulate(path="rectangle", rate=rate, **_sim(noise=NoiseModel(scale=1, seed=seed)))
+            for cfg in CONFIGS:
+                p = _pos(_run(cfg, rec))
+                per_seed.append({"config": cfg, "3-D ARMSE (m)": armse(p, rec.truth.pos),
+                                 "2-D (m)": pyshoe_error(p, rec.truth.pos),
+                                 "end height (% dist)": vertical_errors(p, rec.truth.pos)["height_end_error_pct"]})
+        for cfg, g in pd.DataFrame(per_seed).groupby("config", sort=False):
+            rows.append({"walk": f"rectangle 120 m, median of {len(SEEDS)} seeds", "rate (Hz)": rate, "config": cfg,
+                         **g.drop(columns="config").median().to_dict(),
+                         "3-D ARMSE per seed (m)": " ".join(f"{v:.3f}" for v in g["3-D ARMSE (m)"])})
     for rate in RATES[:3]:
         rec = simulate(path="track", laps=1, rate=rate, **_sim())
         for cfg in CONFIGS:
@@ -165,7 +173,7 @@ def rates() -> list[str]:
     tg: list[dict[str, str]] = []
     r = t[(t["config"] == CONFIGS[0]) & t["walk"].str.startswith("rectangle")]["3-D ARMSE (m)"]
     spread = (r.max() - r.min()) / r.min()
-    _target(tg, "rectangle walk, 3-D ARMSE spread over 100–1000 Hz (max − min) / min",
+    _target(tg, "rectangle walk, median 3-D ARMSE over seeds, spread over 100–1000 Hz (max − min) / min",
             f"≤ {TARGETS['rate_spread']:.0%}", spread, spread <= TARGETS["rate_spread"])
     f = t[(t["config"] == CONFIGS[0]) & t["walk"].str.startswith("track")]["end height (% dist)"]
     _target(tg, "437.5 m flat walk, worst end-height error over 100/250/400 Hz",
@@ -174,8 +182,14 @@ def rates() -> list[str]:
     _target(tg, "stairs, worst height error at the top over 100/250/400 Hz", f"≤ {TARGETS['stairs_height_pct']} %",
             s.max(), s.max() <= TARGETS["stairs_height_pct"])
     return lines + [f"`{CONFIGS[0]}`:", "", to_markdown(pd.DataFrame(tg)), "",
-                    "Physical foot model, Table II noise and biases (seed 0), no magnetometer; the same footsteps "
-                    "at every rate.", "", to_markdown(t, digits=3), ""]
+                    "Physical foot model, Table II noise and biases (the simulator's σ per sample at every rate), "
+                    "no magnetometer; the same footsteps at every rate; track and stairs noise seed 0. The stairs "
+                    "at 250 and 400 Hz: the simulated foot stops in the air about 0.14 s before it lands on a "
+                    "step and moves again; at those rates the speed-adaptive detector's provisional pass takes "
+                    "the pause and the short descent after it as stance (a gap shorter than min_swing closed, "
+                    "detectors/speed_adaptive_shoe.py), so every stance starts about 0.14 s early and the ZUPT "
+                    "stops a moving foot; SHOE at the same threshold (3000) gets 0.028 m ARMSE there.", "",
+                    to_markdown(t, digits=3), ""]
 
 
 # ------------------------------------------------------------------------------------------ events
