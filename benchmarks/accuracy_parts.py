@@ -183,12 +183,16 @@ def rates() -> list[str]:
             s.max(), s.max() <= TARGETS["stairs_height_pct"])
     return lines + [f"`{CONFIGS[0]}`:", "", to_markdown(pd.DataFrame(tg)), "",
                     "Physical foot model, Table II noise and biases (the simulator's σ per sample at every rate), "
-                    "no magnetometer; the same footsteps at every rate; track and stairs noise seed 0. The stairs "
-                    "at 250 and 400 Hz: the simulated foot stops in the air about 0.14 s before it lands on a "
-                    "step and moves again; at those rates the speed-adaptive detector's provisional pass takes "
-                    "the pause and the short descent after it as stance (a gap shorter than min_swing closed, "
-                    "detectors/speed_adaptive_shoe.py), so every stance starts about 0.14 s early and the ZUPT "
-                    "stops a moving foot; SHOE at the same threshold (3000) gets 0.028 m ARMSE there.", "",
+                    "no magnetometer; the same footsteps at every rate; track and stairs noise seed 0. Stairs: the "
+                    "simulated foot stops in the air about 0.14 s before it lands on a step and moves again; "
+                    "before `provisional_min_swing: 0` the speed-adaptive detector's provisional pass took the "
+                    "stop and the short descent after it as stance at 250 and 400 Hz (every stance 0.14 s early, "
+                    "3-D ARMSE 0.78 and 0.73 m, climb 15–17 % too high; benchmarks/recommended_selection.md). "
+                    "The height drift left on the flat walks comes from the accelerometer bias along the foot "
+                    "(0.049 m/s², Table II): the levelling at rest takes it for a pitch of b/g = 5 mrad, which "
+                    "tilts every stride: about 3.8 mm of height per 1.2 m stride at every rate (+x bias: up, "
+                    "−x: down; a y or z bias gives < 0.3 mm), so 0.26–0.28 % of the distance; a 9-state filter "
+                    "cannot tell that bias from a tilt.", "",
                     to_markdown(t, digits=3), ""]
 
 
