@@ -495,10 +495,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--recommended", default="recommended", help="config the targets are checked for")
     ap.add_argument("--progress", action="store_true", help="progress bars")
     ap.add_argument("--plots", action="store_true", help="also the ablation runner's report per dataset (slow)")
-    ap.add_argument("--parts", default=",".join(["configs", *accuracy_parts.PARTS]),
-                    help="comma-separated parts (default all): configs," + ",".join(accuracy_parts.PARTS))
+    ap.add_argument("--parts", default=None,
+                    help="comma-separated parts (default all; with --quick: configs): configs,"
+                         + ",".join(accuracy_parts.PARTS))
     args = ap.parse_args(argv)
-    parts = [p for p in args.parts.split(",") if p]
+    parts = [p for p in (args.parts or ("configs" if args.quick else
+                                        ",".join(["configs", *accuracy_parts.PARTS]))).split(",") if p]
     unknown = sorted(set(parts) - {"configs", *accuracy_parts.PARTS})
     if unknown:
         raise SystemExit(f"unknown part(s) {unknown}; known: configs, {', '.join(accuracy_parts.PARTS)}")
