@@ -98,7 +98,7 @@ def test_the_fix_is_composed_with_the_axis_map_the_file_was_read_with():
 def test_no_mounting_estimate_from_too_few_strides():
     rep = mounting_report(np.tile([1.0, 0, 0, 0], (300, 1)), np.zeros((300, 3)), np.zeros((300, 3)),
                           np.array([[0, 100], [150, 300]]))
-    assert rep == {"strides": 1}
+    assert rep == {"strides": 1}  # too few strides: no estimate
     assert nearest_axis_map(np.full((3, 3), 1 / np.sqrt(3))) is None
 
 

@@ -13,7 +13,8 @@ stride's direction of travel ``d_i``, right, down, in NED; :func:`travel_directi
 middle of each stance (foot flat) the sensor's axes in it are ``A_i = F_iᵀ C_b^n``, so that
 ``v_foot = A_i · v_sensor``: the rows of ``A_i`` are the FRD axes of the foot in sensor
 coordinates, the same form as an axis map (:mod:`footzoo.io.axes`). Its element-wise median over
-the stances, made orthonormal again (nearest rotation, SVD), is the measured mounting. Two
+the stances before the strides of at least 0.5 m (a turn on the spot has no direction of travel),
+made orthonormal again (nearest rotation, SVD), is the measured mounting. Two
 symptoms are flagged:
 
 * **walks backwards**: the sensor's x axis points against the direction of travel,
@@ -44,6 +45,8 @@ from .gait_events import sagittal_rate, travel_directions
 
 #: Fewest strides for a mounting estimate.
 MIN_STRIDES = 3
+#: Shortest stride (m, horizontal) whose direction of travel counts: a turn on the spot or a shuffle has none.
+MIN_STRIDE_LENGTH = 0.5
 #: ``A[0, 0]`` (``A[1, 1]``) below this: the sensor's x axis points backwards (its y axis left), cos 120°.
 REVERSED_COS = -0.5
 
@@ -91,7 +94,8 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     Returns
     -------
     dict
-        ``strides``; with at least :data:`MIN_STRIDES` of them also ``sensor_in_foot`` (3 × 3 list,
+        ``strides``, ``strides_used`` (those of at least :data:`MIN_STRIDE_LENGTH`); with at
+        least :data:`MIN_STRIDES` used also ``sensor_in_foot`` (3 × 3 list,
         ``v_foot = A · v_sensor``), ``x_forward`` (``A[0, 0]``), ``pitch_rate_correlation``
         (``gyr_y`` against the sagittal rate, over the swings), ``walks_backwards``,
         ``pitch_reversed`` (bool) and ``suggested_axes`` (the proper signed permutation nearest
@@ -103,7 +107,14 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
         return out
     a0, b0 = stances[:, 0], stances[:, 1]
     mid = (a0 + b0 - 1) // 2
+    pos = np.asarray(pos, dtype=float)
     d, _ = travel_directions(pos, stances)
+    # the stance before each long stride, with that stride's direction (turns on the spot and shuffles left out)
+    long = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T) >= MIN_STRIDE_LENGTH
+    out["strides_used"] = int(long.sum())
+    if long.sum() < MIN_STRIDES:
+        return out
+    mid = mid[:-1][long]
     fwd = np.column_stack([d[mid], np.zeros(len(mid))])
     right = np.column_stack([-d[mid, 1], d[mid, 0], np.zeros(len(mid))])
     down = np.broadcast_to([0.0, 0.0, 1.0], fwd.shape)
