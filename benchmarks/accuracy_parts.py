@@ -45,7 +45,7 @@ TARGETS = {"median_2d_m": 0.045, "ratio": 1.1, "median_3d_m": 0.08, "worst_m": 0
            "mounting_s": 0.010, "within_2sigma": 0.95}
 RATES = (100.0, 250.0, 400.0, 1000.0)
 #: Noise seeds of the rectangle walk at each rate (one seed's heading drift varies by a factor 3).
-SEEDS = (0, 1, 2, 3, 4)
+SEEDS = tuple(range(10))
 
 
 def _sim(**spec: Any) -> dict[str, Any]:
@@ -168,19 +168,22 @@ def rates() -> list[str]:
     """The same simulated walks at several rates."""
     lines = ["### Rate independence (simulator)", ""]
     rows = []
-    for rate in RATES:
-        per_seed = []
-        for seed in SEEDS:
-            rec = simulate(path="rectangle", rate=rate, **_sim(noise=NoiseModel(scale=1, seed=seed)))
-            for cfg in CONFIGS:
-                p = _pos(_run(cfg, rec))
-                per_seed.append({"config": cfg, "3-D ARMSE (m)": armse(p, rec.truth.pos),
-                                 "2-D (m)": pyshoe_error(p, rec.truth.pos),
-                                 "end height (% dist)": vertical_errors(p, rec.truth.pos)["height_end_error_pct"]})
-        for cfg, g in pd.DataFrame(per_seed).groupby("config", sort=False):
-            rows.append({"walk": f"rectangle 120 m, median of {len(SEEDS)} seeds", "rate (Hz)": rate, "config": cfg,
-                         **g.drop(columns="config").median().to_dict(),
-                         "3-D ARMSE per seed (m)": " ".join(f"{v:.3f}" for v in g["3-D ARMSE (m)"])})
+    for density in (True, False):
+        for rate in RATES:
+            per_seed = []
+            scale = np.sqrt(rate / RATES[0]) if density else 1.0
+            for seed in SEEDS:
+                rec = simulate(path="rectangle", rate=rate, **_sim(noise=NoiseModel(scale=scale, seed=seed)))
+                for cfg in CONFIGS:
+                    p = _pos(_run(cfg, rec))
+                    per_seed.append({"config": cfg, "3-D ARMSE (m)": armse(p, rec.truth.pos),
+                                     "2-D (m)": pyshoe_error(p, rec.truth.pos),
+                                     "end height (% dist)": vertical_errors(p, rec.truth.pos)["height_end_error_pct"]})
+            walk = f"rectangle 120 m, {'noise density' if density else 'σ per sample'} fixed, {len(SEEDS)} seeds"
+            for cfg, g in pd.DataFrame(per_seed).groupby("config", sort=False):
+                rows.append({"walk": walk, "rate (Hz)": rate, "config": cfg,
+                             **g.drop(columns="config").median().to_dict(),
+                             "3-D ARMSE per seed (m)": " ".join(f"{v:.3f}" for v in g["3-D ARMSE (m)"])})
     for rate in RATES[:3]:
         rec = simulate(path="track", laps=1, rate=rate, **_sim())
         for cfg in CONFIGS:
@@ -201,10 +204,12 @@ def rates() -> list[str]:
                          "climb error (% climb)": 100.0 * (est_up[top] - up[top]) / up[top]})
     t = pd.DataFrame(rows)
     tg: list[dict[str, str]] = []
-    r = t[(t["config"] == CONFIGS[0]) & t["walk"].str.startswith("rectangle")]["3-D ARMSE (m)"]
-    spread = (r.max() - r.min()) / r.min()
-    _target(tg, "rectangle walk, median 3-D ARMSE over seeds, spread over 100–1000 Hz (max − min) / min, %",
-            f"≤ {100 * TARGETS['rate_spread']:.0f} %", 100 * spread, spread <= TARGETS["rate_spread"])
+    for kind in ("noise density", "σ per sample"):
+        r = t[(t["config"] == CONFIGS[0]) & t["walk"].str.contains(kind)]["3-D ARMSE (m)"]
+        spread = (r.max() - r.min()) / r.min()
+        _target(tg, f"rectangle walk, {kind} fixed: median 3-D ARMSE over seeds, spread over 100–1000 Hz "
+                "(max − min) / min, %", f"≤ {100 * TARGETS['rate_spread']:.0f} %", 100 * spread,
+                spread <= TARGETS["rate_spread"])
     f = t[(t["config"] == CONFIGS[0]) & t["walk"].str.startswith("track")]["end height (% dist)"]
     _target(tg, "437.5 m flat walk, worst end-height error over 100/250/400 Hz",
             f"≤ {TARGETS['flat_height_pct']} % of distance", f.max(), f.max() <= TARGETS["flat_height_pct"])
@@ -212,8 +217,12 @@ def rates() -> list[str]:
     _target(tg, "stairs, worst height error at the top over 100/250/400 Hz", f"≤ {TARGETS['stairs_height_pct']} %",
             s.max(), s.max() <= TARGETS["stairs_height_pct"])
     return lines + [f"`{CONFIGS[0]}`:", "", to_markdown(pd.DataFrame(tg)), "",
-                    "Physical foot model, Table II noise and biases (the simulator's σ per sample at every rate), "
-                    "no magnetometer; the same footsteps at every rate; track and stairs noise seed 0. Stairs: the "
+                    "Physical foot model, Table II noise and biases, no magnetometer; the same footsteps at every "
+                    "rate. The rectangle walk twice: with the noise density of Table II at 100 Hz held at every "
+                    "rate (σ per sample × sqrt(rate / 100 Hz), a real sensor's white noise; this measures the "
+                    "pipeline), and with the simulator's σ per sample at every rate (less noise per second at a "
+                    "higher rate, so 100 Hz is worse for a reason outside the pipeline). Track and stairs: σ per "
+                    "sample fixed, noise seed 0. Stairs: the "
                     "simulated foot stops in the air about 0.14 s before it lands on a step and moves again; "
                     "before `provisional_min_swing: 0` the speed-adaptive detector's provisional pass took the "
                     "stop and the short descent after it as stance at 250 and 400 Hz (every stance 0.14 s early, "
