@@ -3,6 +3,12 @@
 Usage: python benchmarks/accuracy.py [--jobs 2] [--quick] [--results benchmarks/results/]
                                      [--data ../shared/data] [--configs yun2012,nguyen2016]
                                      [--summary benchmarks/accuracy.md]
+                                     [--parts configs,pyshoe3d,rates,events,consistency,mounting]
+
+``--parts`` chooses what runs (default all): ``configs`` is the table of every shipped config below;
+the others score the flagship on every axis (benchmarks/accuracy_parts.py: 3-D and height on PyShoe
+per motion class, rate independence, gait events, filter consistency, 24 mountings). Without
+``configs`` only the flagship section of the existing summary is rewritten.
 
 Every config in ``footzoo/config/builtin/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
 ablation runner (one study per dataset: parallel with ``--jobs``, cached in
@@ -40,6 +46,9 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import accuracy_parts  # noqa: E402
 
 from footzoo.config import BUILTIN  # noqa: E402
 from footzoo.studies import Study, run_cell, run_study, tidy  # noqa: E402
@@ -48,6 +57,8 @@ from footzoo.studies.report import to_markdown  # noqa: E402
 DEFAULT_DATA = ROOT.parent / "shared" / "data"
 DEFAULT_RESULTS = ROOT / "benchmarks" / "results"
 DEFAULT_SUMMARY = ROOT / "benchmarks" / "accuracy.md"
+#: Where the flagship section starts in the summary (a rerun of some parts replaces what follows).
+FLAGSHIP_MARK = "<!-- flagship parts: everything below is rewritten by --parts -->"
 
 #: PyShoe trials by recording day (the dataset does not label them; see ../shared/data/README.md).
 MOTION_CLASSES = {
@@ -484,18 +495,35 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--recommended", default="recommended", help="config the targets are checked for")
     ap.add_argument("--progress", action="store_true", help="progress bars")
     ap.add_argument("--plots", action="store_true", help="also the ablation runner's report per dataset (slow)")
+    ap.add_argument("--parts", default=None,
+                    help="comma-separated parts (default all; with --quick: configs): configs,"
+                         + ",".join(accuracy_parts.PARTS))
     args = ap.parse_args(argv)
+    parts = [p for p in (args.parts or ("configs" if args.quick else
+                                        ",".join(["configs", *accuracy_parts.PARTS]))).split(",") if p]
+    unknown = sorted(set(parts) - {"configs", *accuracy_parts.PARTS})
+    if unknown:
+        raise SystemExit(f"unknown part(s) {unknown}; known: configs, {', '.join(accuracy_parts.PARTS)}")
     # readers warn about what they repair (x-io's duplicate rows): expected here, and workers inherit this
     os.environ.setdefault("PYTHONWARNINGS", "ignore::UserWarning")
     warnings.simplefilter("ignore", UserWarning)
     configs = shipped_configs([c for c in args.configs.split(",") if c] or None)
     t0 = time.time()
-    table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
     ref = pyshoe_reference(args.data / "pyshoe_vicon") if (args.data / "pyshoe_vicon").is_dir() else \
         pd.DataFrame(columns=["best_error_m", "best_detector", "n_strides_manual_koroglu"])
     summary = args.summary or (args.results / "accuracy_quick.md" if args.quick else DEFAULT_SUMMARY)
-    write_summary(table, ref, summary, args.recommended, time.time() - t0, args.quick)
-    print(f"tables in {args.results}, summary {summary}")
+    flagship = [p for p in parts if p != "configs"]
+    lines = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER) \
+        if flagship else []
+    if "configs" in parts:
+        table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
+        write_summary(table, ref, summary, args.recommended, time.time() - t0, args.quick)
+        print(f"tables in {args.results}, summary {summary}")
+    if lines:
+        old = summary.read_text() if summary.exists() else ""
+        head = old.split(FLAGSHIP_MARK)[0].rstrip("\n")
+        summary.write_text(f"{head}\n\n{FLAGSHIP_MARK}\n\n" + "\n".join(lines))
+        print(f"flagship parts {flagship} in {summary}")
     return 0
 
 

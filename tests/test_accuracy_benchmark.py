@@ -78,3 +78,19 @@ def test_koroglu_footprint_errors_against_the_measured_footprints(accuracy):
     aligned, _ = rigid_align_2d(est, gcp)
     assert got["footprint_error_mean_m"] == pytest.approx(np.linalg.norm(aligned - gcp, axis=1).mean())
     assert 0 < got["footprint_error_mean_m"] < 1.0  # measured 0.24 m over a 51 m walk
+
+
+@pytest.mark.slow
+def test_flagship_parts_rewrite_only_their_section(accuracy, tmp_path):
+    summary = tmp_path / "summary.md"
+    summary.write_text("# kept\n\nthe configs' table\n")
+    assert accuracy.main(["--parts", "mounting", "--data", str(tmp_path / "absent"), "--summary", str(summary)]) == 0
+    text = summary.read_text()
+    assert text.startswith("# kept\n\nthe configs' table") and accuracy.FLAGSHIP_MARK in text
+    assert "### 24 sensor mountings (simulator)" in text
+    assert "| 24 mountings: largest event difference | ≤ 10 ms |" in text
+    # a second run replaces the section, it does not append another
+    assert accuracy.main(["--parts", "mounting", "--data", str(tmp_path / "absent"), "--summary", str(summary)]) == 0
+    assert summary.read_text().count(accuracy.FLAGSHIP_MARK) == 1
+    with pytest.raises(SystemExit, match="unknown part"):
+        accuracy.main(["--parts", "nonsense", "--summary", str(summary)])

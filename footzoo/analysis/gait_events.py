@@ -1,12 +1,13 @@
-"""Gait events per stride from the sagittal angular rate: toe-off (TO) and initial contact (IC).
+"""Gait events per stride from the foot's sagittal angular rate: toe-off (TO) and initial contact (IC).
 
 Method (Rampp et al. 2015, "Inertial sensor-based stride parameter calculation from
 gait sequences in geriatric patients", IEEE TBME 62(4), 1089-1097, the gait event
 detection of its Methods section, which states the rules in prose, without numbered
-equations; implemented in gaitmap as ``RamppEventDetection``): the events of one stride
-are features of the foot's sagittal (medio-lateral) angular rate ``ω_ml`` between
-two stances. footzoo's body frame is FRD, so ``ω_ml`` is ``gyr_y`` (positive
-lifts the toe). Between two stances the rate has three landmarks:
+equations; implemented in gaitmap as ``RamppEventDetection``; the same landmarks as
+Sabatini et al. 2005, "Assessment of walking features from foot inertial sensing",
+IEEE TBME 52(3), 486-494, Sec. II-B): the events of one stride are features of the
+foot's sagittal (medio-lateral) angular rate ``ω_ml`` between two stances, positive
+when the toe lifts. Between two stances the rate has three landmarks:
 
 * the push-off: the foot plantar-flexes ever faster until the toe leaves the
   floor, a negative peak of ``ω_ml`` — **TO** is this minimum (Rampp's "terminal
@@ -15,9 +16,20 @@ lifts the toe). Between two stances the rate has three landmarks:
 * the heel strike: the dorsi-flexion stops when the heel lands, ``ω_ml`` goes
   through zero and then negative while the foot rolls flat — **IC** is that first
   downward zero crossing after ``p`` (Rampp's IC is the ``ω_ml`` minimum right after
-  it, refined by the acceleration peak of the impact).
+  it, refined by the acceleration peak of the impact; Sabatini's is the same
+  zero crossing).
 
-footzoo's choices (not fixed by the paper): the stances come from the pipeline's
+**Independent of the mounting** (footzoo's choice, :func:`sagittal_rate`): ``ω_ml`` is
+not a sensor axis but the angular rate rotated into the navigation frame with the
+estimated attitude, ``ω_n = C_b^n ω_b``, projected on the horizontal axis to the right of
+each stride's direction of travel, ``r = e_down × d`` with ``d`` the horizontal unit
+vector from the mid-stance before the swing to the one after it. A sensor turned on the
+foot (or read with a wrong but right-handed axis map) sees the same physical rotation,
+so it gives the same events. With a sensor aligned to the foot (x toe, y right, z
+down) and a level foot, ``ω_ml`` equals ``gyr_y``; :func:`detect_gait_events` still takes
+that body-frame signal when no attitude is given.
+
+footzoo's other choices (not fixed by the paper): the stances come from the pipeline's
 stance detector instead of Rampp's DTW stride segmentation; TO is searched from
 the middle of the stance before the swing to ``p``, IC from ``p`` to the middle of
 the next stance; the TO minimum is refined to sub-sample time with a parabola
@@ -35,8 +47,8 @@ TO minimum is 4–5 samples (20–25 ms at 204.8 Hz) late, which is why the mini
 is used.
 
 Where a swing lacks the pattern (no positive ``ω_ml`` after the push-off, e.g. a
-shuffle or a sensor mounted upside down), the events fall back to the detector's
-stance edges and ``events_from`` says so.
+shuffle), the events fall back to the detector's stance edges and ``events_from``
+says so.
 """
 
 from __future__ import annotations
@@ -45,6 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.conventions import quat_rotate
 from ..kernels.jit import njit
 
 
@@ -128,6 +141,49 @@ def _mid_times(ts: np.ndarray, idx: np.ndarray, needed: np.ndarray) -> np.ndarra
     return ts[idx] - 0.5 * d
 
 
+def travel_directions(pos: np.ndarray, stances: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample's stride direction of travel: horizontal unit vector (N, 2) (north, east), and the stride index.
+
+    Stride ``i`` runs from the middle of stance ``i`` to the middle of stance ``i + 1``; its
+    direction is that of the horizontal displacement between the two middles. Samples before
+    the first middle belong to the first stride, those after the last middle to the last one.
+    A stride that does not move (shorter than 1 mm) takes the direction (1, 0).
+    """
+    pos = np.asarray(pos, dtype=float)
+    a, b = stances[:, 0], stances[:, 1]
+    mid = (a + b - 1) // 2
+    d = pos[mid[1:], :2] - pos[mid[:-1], :2]
+    norm = np.hypot(d[:, 0], d[:, 1])
+    still = norm < 1e-3
+    d = np.where(still[:, None], [1.0, 0.0], d / np.where(still, 1.0, norm)[:, None])
+    stride = np.clip(np.searchsorted(mid, np.arange(len(pos)), side="right") - 1, 0, len(d) - 1)
+    return d[stride], stride
+
+
+def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray) -> np.ndarray:
+    """The foot's sagittal angular rate ``ω_ml`` (N,) (rad/s, positive lifts the toe), whatever the mounting.
+
+    ``ω_ml = (C_b^n ω_b) · (e_down × d)``: the angular rate rotated into NED with the attitude
+    ``quat`` (scalar-first, body to NED) and projected on the horizontal axis to the right of the
+    stride's direction of travel ``d`` (:func:`travel_directions`). Needs two stances or more.
+
+    Parameters
+    ----------
+    quat : (N, 4) ndarray
+        Attitude, body to NED.
+    gyr : (N, 3) ndarray
+        Angular rate in the sensor frame (rad/s).
+    pos : (N, 3) ndarray
+        Position in NED (m).
+    stances : (K + 1, 2) int ndarray
+        ``(start, stop)`` sample indices (stop exclusive) of the stances, in order, K ≥ 1.
+    """
+    w_n = quat_rotate(np.asarray(quat, dtype=float), np.asarray(gyr, dtype=float))
+    d, _ = travel_directions(pos, stances)
+    # right of travel: e_down × (d_n, d_e, 0) = (−d_e, d_n, 0)
+    return -w_n[:, 0] * d[:, 1] + w_n[:, 1] * d[:, 0]
+
+
 def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> GaitEvents:
     """TO and IC of each swing between consecutive stances (Rampp et al. 2015, Sec. II-C).
 
@@ -135,8 +191,10 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     ----------
     t : (N,) ndarray
         Time (s).
-    gyr : (N, 3) ndarray
-        Angular rate in FRD (rad/s); ``gyr[:, 1]`` is the sagittal rate.
+    gyr : (N,) or (N, 3) ndarray
+        The sagittal angular rate ``ω_ml`` (rad/s, positive lifts the toe; :func:`sagittal_rate`),
+        or the angular rate in FRD (rad/s) of a sensor aligned with the foot, whose ``gyr[:, 1]``
+        is then taken as ``ω_ml``.
     stances : (K + 1, 2) int ndarray
         ``(start, stop)`` sample indices (stop exclusive) of the stances, in order.
 
@@ -145,7 +203,8 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     GaitEvents
         One TO and one IC per swing (K of each).
     """
-    w = np.asarray(gyr, dtype=float)[:, 1]
+    w = np.asarray(gyr, dtype=float)
+    w = w if w.ndim == 1 else w[:, 1]
     n = len(t)
     # a sample is the mean over (t[k-1], t[k]] (footzoo's interval convention): it belongs to the middle
     # of its interval, computed for the event samples only (_mid_times)

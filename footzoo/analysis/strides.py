@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..evaluation.metrics import intervals
-from .gait_events import detect_gait_events, segment_argext
+from .gait_events import detect_gait_events, sagittal_rate, segment_argext
 
 #: Columns of :func:`segment_steps`, units in the names.
 STEP_COLUMNS = [
@@ -41,14 +41,17 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
 
 
 def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.ndarray | None = None,
-                  min_stride_length: float = 0.1, max_stance_time: float = 2.0) -> pd.DataFrame:
+                  min_stride_length: float = 0.1, max_stance_time: float = 2.0,
+                  quat: np.ndarray | None = None) -> pd.DataFrame:
     """One row per stride: the stance from its initial contact, its toe-off, the swing to the next contact.
 
     Strides start at the first real step: the standing before the first toe-off
     is not a stride, and gaps between stances that do not move the foot
     (shuffles, split stances; see :func:`real_stances`) are not steps. The
     events come from the sagittal angular rate (:mod:`footzoo.analysis.gait_events`)
-    when ``gyr`` is given, otherwise from the stance edges. Vectorised: no Python
+    when ``gyr`` is given — in the navigation frame, independent of the sensor's
+    mounting, when ``quat`` is given too; ``gyr[:, 1]`` of a sensor aligned with the
+    foot otherwise — and from the stance edges without ``gyr``. Vectorised: no Python
     loop over samples or strides.
 
     Parameters
@@ -60,12 +63,15 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     pos : (N, 3) ndarray
         Position in NED (m).
     gyr : (N, 3) ndarray, optional
-        Angular rate in FRD (rad/s) for the gait events.
+        Angular rate in the sensor frame (rad/s) for the gait events.
     min_stride_length : float
         Shortest displacement (m) between two stances that counts as a step.
     max_stance_time : float
         A stance longer than this (s) is a pause: the stride after it has no
         start (``start_s`` and the times that need it are NaN), like the first.
+    quat : (N, 4) ndarray, optional
+        Attitude (scalar-first, body to NED) that turns ``gyr`` into the navigation
+        frame (:func:`footzoo.analysis.gait_events.sagittal_rate`).
 
     Returns
     -------
@@ -92,7 +98,8 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     a, b = st[:, 0], st[:, 1]
     mid = (a + b - 1) // 2
     if gyr is not None:
-        ev = detect_gait_events(t, gyr, st)
+        rate = gyr if quat is None else sagittal_rate(quat, gyr, pos, st)
+        ev = detect_gait_events(t, rate, st)
         to, ic, from_rate = ev.to, ev.ic, ev.from_rate
     else:
         to, ic, from_rate = t[np.minimum(b[:-1], n - 1)], t[a[1:]], np.zeros(len(st) - 1, bool)

@@ -172,9 +172,10 @@ class AdaptiveSHOE(SHOE):
         """The adaptive test, carrying the time of the last stance sample."""
         return AdaptiveThreshold(self.threshold, self.time_constant, max(self.max_threshold, self.threshold), keep)
 
-    def gap_stage(self, keep: tuple[str, ...] = ()) -> OverlapSave:
-        """:func:`close_short_swings` over the recent test, restarted at a stance sample."""
-        m = self.min_swing_samples(self.ctx_)
+    def gap_stage(self, keep: tuple[str, ...] = (), samples: int | None = None) -> OverlapSave:
+        """:func:`close_short_swings` over the recent test (swings shorter than ``samples``, default
+        ``min_swing``), restarted at a stance sample."""
+        m = self.min_swing_samples(self.ctx_) if samples is None else samples
 
         def compute(test: np.ndarray, **given: np.ndarray) -> Chunk:
             return {"stance": close_short_swings(test, m), **{k: given[k] for k in ("statistic", "threshold", *keep)}}

@@ -253,6 +253,13 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         stances, where the dedrift of a swing with missed stances leaves that much error.
     min_swing : float
         Shortest swing (s), as for ``adaptive_shoe``.
+    provisional_min_swing : float or None
+        Shortest swing of the provisional pass (s); None: ``min_swing``. Closing a short
+        provisional swing sets the strapdown speed in it to zero, so the speed test can no
+        longer see that the foot moved there: a foot that stops in the air and moves again
+        before landing (stairs) was taken as standing from the stop on at 250 Hz and above,
+        where the stop spans enough samples to pass the adaptive test. With 0 the speed test
+        alone closes the short gaps where the foot stayed slower than ``still_speed``.
 
     Attributes
     ----------
@@ -282,6 +289,12 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
                             source="footzoo's: benchmarks/select_recommended.py"),
         "still_speed": Real("m/s", "[0, 100]", "fastest a stance sample may move by the provisional strapdown",
                             source="footzoo's: 0.5 m/s rejected real running stances (see the docstring)"),
+        "provisional_min_swing": Real("s", "[0, 1]", "shortest swing of the provisional pass (null: min_swing)",
+                                      optional=True,
+                                      source="footzoo's: 0 in recommended (benchmarks/recommended_selection.md)",
+                                      why="closing a short provisional swing hides the foot's motion in it from "
+                                          "the speed test: at 250 Hz and above a foot that stops in the air "
+                                          "before landing was taken as standing from the stop on"),
     }
 
     #: Stance time used to level the attitude at the start of a swing (s).
@@ -291,10 +304,18 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
 
     def __init__(self, threshold: float = 3e3, window: float = 0.025, sigma_a: float = 0.01,
                  sigma_g: float = float(np.radians(0.1)), time_constant: float = 0.2, max_threshold: float = 1e6,
-                 speed_scale: float = 1.0, still_speed: float = 1.0, min_swing: float = 0.15):
+                 speed_scale: float = 1.0, still_speed: float = 1.0, min_swing: float = 0.15,
+                 provisional_min_swing: float | None = None):
         super().__init__(threshold, window, sigma_a, sigma_g, time_constant, max_threshold, min_swing)
         self.speed_scale = speed_scale
         self.still_speed = still_speed
+        self.provisional_min_swing = provisional_min_swing
+
+    def provisional_gap_samples(self, ctx: RunContext) -> int:
+        """``provisional_min_swing`` (default ``min_swing``) in samples at the run's rate."""
+        if self.provisional_min_swing is None:
+            return self.min_swing_samples(ctx)
+        return int(math.floor(self.provisional_min_swing * ctx.rate + 0.5))
 
     def _speed_test(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, statistic: np.ndarray,
                     provisional: np.ndarray) -> dict[str, np.ndarray]:
@@ -320,7 +341,7 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         g_max = max(self.max_threshold, self.threshold)
         provisional, _, _ = adaptive_threshold_kernel(t, self.statistic_, self.threshold, self.time_constant, g_max,
                                                       float(t[0]))
-        provisional = close_short_swings(provisional, self.min_swing_samples(self.ctx_))
+        provisional = close_short_swings(provisional, self.provisional_gap_samples(self.ctx_))
         out = self._speed_test(t, acc, gyr, self.statistic_, provisional)
         self.speed_, self.threshold_, self.stance_ = out["speed"], out["threshold"], out["stance"]
         self.stance_online_ = self.stance_.copy()
@@ -358,7 +379,9 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         speed = OverlapSave(self._speed_test, lookahead=ready, restart=restart,
                             wants=("t", "acc", "gyr", "statistic", "provisional"))
         self._stages = [self.window_stage(keep=("t", "acc", "gyr")), self.threshold_stage(keep=("acc", "gyr")),
-                        _Renamed(self.gap_stage(keep=("t", "acc", "gyr")), {"stance": "provisional"}), speed]
+                        _Renamed(self.gap_stage(keep=("t", "acc", "gyr"),
+                                                samples=self.provisional_gap_samples(self.ctx_)),
+                                 {"stance": "provisional"}), speed]
         return self
 
 

@@ -463,3 +463,111 @@ def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, referenc
         turn = ref.steps["turn"].to_numpy(dtype=bool) if ref.steps is not None and "turn" in ref.steps else None
         out.update(stride_path_errors(t, pos, ref.stride_positions, turn))
     return out
+
+
+def event_stance_mask(t: np.ndarray, to: np.ndarray, ic: np.ndarray) -> np.ndarray:
+    """Stance flag per sample from gait events: False in every swing ``[TO, IC)``, True elsewhere.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Sample times (s).
+    to, ic : (K,) ndarray
+        Toe-off and the initial contact ending the same swing (s); pairs with a NaN are skipped.
+    """
+    t = np.asarray(t, dtype=float)
+    to, ic = np.asarray(to, dtype=float), np.asarray(ic, dtype=float)
+    ok = np.isfinite(to) & np.isfinite(ic) & (ic > to)
+    edges = np.zeros(len(t) + 1, dtype=np.int64)
+    np.add.at(edges, np.searchsorted(t, to[ok]), 1)
+    np.add.at(edges, np.searchsorted(t, ic[ok]), -1)
+    return np.cumsum(edges[:-1]) <= 0
+
+
+def gait_phase_errors(t: np.ndarray, estimated: pd.DataFrame, reference: pd.DataFrame,
+                      max_swing: float = 1.0, margin: float = 0.3) -> dict[str, float]:
+    """Gait phases (stance from IC to TO, swing from TO to IC) of two stride tables compared on the samples ``t``.
+
+    Both tables' events (``to_s``, ``end_s``) become stance masks (:func:`event_stance_mask`); the
+    scored samples run from ``margin`` (s) before the reference's first toe-off to ``margin`` after its
+    last initial contact, without the reference swings longer than ``max_swing`` (s), which span
+    more than one step (e.g. gaitmap's 180° turn stride): there both masks are set to swing, so a
+    stance of the estimate inside such a swing is not counted. The step-level error rate is Nguyen &
+    La's ("1 wrong in 36 steps", :func:`step_detection`).
+
+    Returns
+    -------
+    dict
+        ``gait_phase_error_rate`` (wrong stance phases / reference stance phases),
+        ``gait_phase_sample_error`` (fraction of scored samples whose phase differs) and
+        ``stance_phases`` (reference count). The timing of the phase borders is that of the
+        events: stance starts at IC and ends at TO (:func:`stride_errors`, ``ic_error_mean_s``,
+        ``to_error_mean_s``).
+    """
+    t = np.asarray(t, dtype=float)
+    to_r, ic_r = reference["to_s"].to_numpy(float), reference["end_s"].to_numpy(float)
+    est = event_stance_mask(t, estimated["to_s"].to_numpy(float), estimated["end_s"].to_numpy(float))
+    ref = event_stance_mask(t, to_r, ic_r)
+    scored = (t >= np.nanmin(to_r) - margin) & (t <= np.nanmax(ic_r) + margin)
+    long = (ic_r - to_r) > max_swing
+    scored &= event_stance_mask(t, to_r[long], ic_r[long])
+    est &= scored
+    ref &= scored
+    s = step_detection(est, ref, t)
+    return {"gait_phase_error_rate": s["error_rate"],
+            "gait_phase_sample_error": float(np.mean(est[scored] != ref[scored])) if scored.any() else float("nan"),
+            "stance_phases": float(s["true_steps"])}
+
+
+def vertical_errors(pos: np.ndarray, ref: np.ndarray | None = None) -> dict[str, float]:
+    """Height error at the end of a walk and per distance walked; against a reference or, without one, a closed loop.
+
+    Both trajectories start at the origin. Heights are up positive (``−d`` of NED).
+
+    Parameters
+    ----------
+    pos : (N, 3) ndarray
+        Estimated position, NED (m).
+    ref : (N, 3) ndarray, optional
+        Reference position, NED (m); without it the walk is taken to end at its start's height.
+
+    Returns
+    -------
+    dict
+        ``height_end_error_m`` (estimate − reference at the last sample, m), ``height_end_error_pct``
+        (its absolute value in % of the horizontal path length of the estimate) and
+        ``height_rms_error_m`` (RMS over the samples, m; with a reference only).
+    """
+    e = np.asarray(pos, dtype=float)
+    up = -(e[:, 2] - e[0, 2])
+    ref_up = np.zeros_like(up) if ref is None else -(np.asarray(ref, dtype=float)[:, 2] - ref[0, 2])
+    if ref is not None:
+        _check_same_length(e, np.asarray(ref))
+    d = up - ref_up
+    length = path_length(e)
+    out = {"height_end_error_m": float(d[-1]),
+           "height_end_error_pct": 100.0 * abs(float(d[-1])) / length if length > 0 else float("nan")}
+    if ref is not None:
+        out["height_rms_error_m"] = float(np.sqrt(np.mean(d**2)))
+    return out
+
+
+def position_nees(pos: np.ndarray, ref: np.ndarray, var: np.ndarray) -> np.ndarray:
+    """Normalised estimation error squared of the position per sample (Bar-Shalom et al. 2001, Sec. 5.4.2).
+
+    ``ε_k = Σ_i (p̂_ki − p_ki)² / σ²_ki`` over the three axes, with the filter's position variances
+    only (the diagonal of the covariance: the cross terms are not kept). A consistent filter has
+    ``E[ε] = 3`` (χ² with 3 degrees of freedom for Gaussian errors). Both trajectories are compared
+    as given (no alignment): the simulator's truth shares the estimate's frame and start.
+
+    Parameters
+    ----------
+    pos, ref : (N, 3) ndarray
+        Estimated and true position (m).
+    var : (N, 3) ndarray
+        The filter's position variances (m²).
+    """
+    d = np.asarray(pos, dtype=float) - np.asarray(ref, dtype=float)
+    v = np.asarray(var, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sum(np.where(v > 0, d**2 / v, np.nan), axis=1)

@@ -18,7 +18,8 @@ import numpy as np
 import pandas as pd
 
 from .._version import __version__
-from ..analysis.strides import segment_steps
+from ..analysis.mounting import mounting_report, warn_mounting
+from ..analysis.strides import real_stances, segment_steps
 from ..config.library import resolve
 from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level, load_yaml
 from ..core.context import RunContext
@@ -251,7 +252,11 @@ class Pipeline:
             warning. Both give the same numbers.
         covariance : bool
             Keep the Kalman filter's variances per sample in ``Result.diagnostics['P_diag']``
-            ((N, n), n × 8 bytes per sample; off by default).
+            ((N, n), n × 8 bytes per sample; off by default) and the position's standard deviation
+            (m, north, east, down) in ``Result.diagnostics['pos_std']`` (N, 3) and in the samples'
+            columns ``pos_std_n``, ``pos_std_e``, ``pos_std_d``. Both are the forward
+            filter's: with the RTS smoother the smoothed positions are at least as certain, so
+            ``pos_std`` bounds their error from above (see benchmarks/accuracy.md, consistency).
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
@@ -271,9 +276,14 @@ class Pipeline:
                        "guards": guard_report, **nav["diagnostics"]}
         if self.calibration:
             diagnostics["calibration"] = calibration
+        diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], real_stances(stance, nav["pos"]))
+        warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"))
         config = self.to_dict()
         config["engine"] = nav["engine"]
         samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
+        if "pos_std" in diagnostics:  # covariance=True: the position's standard deviation beside the position
+            for j, axis in enumerate("ned"):
+                samples[f"pos_std_{axis}"] = diagnostics["pos_std"][:, j]
         return Result(samples=samples, steps=steps, config=config, versions=versions(),
                       recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
 
@@ -341,6 +351,8 @@ class Pipeline:
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
             if covariance:
                 out["diagnostics"]["P_diag"] = out["P_diag"]
+                if eng.layout.has("pos"):  # the forward filter's position standard deviation (m), N, E, D
+                    out["diagnostics"]["pos_std"] = np.sqrt(out["P_diag"][:, eng.layout["pos"]])
             out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
             out["engine"] = eng.engine
             return out
@@ -371,7 +383,7 @@ class Pipeline:
 
     def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
         """Stage 4: the steps table, with the analysis plug-ins' columns."""
-        steps = segment_steps(rec.t, stance, pos, rec.gyr)
+        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat)
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps

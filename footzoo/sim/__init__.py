@@ -8,6 +8,7 @@
 """
 
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
+from .mounting import axis_map_name, proper_axis_permutations, remount
 from .pendulum import simulate_pendulum
 from .scenarios import SPEEDS, simulate, simulate_calibration
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned
@@ -21,7 +22,10 @@ __all__ = [
     "MagneticDisturbance",
     "NoiseModel",
     "StrideSpec",
+    "axis_map_name",
     "magnetic_field_ned",
+    "proper_axis_permutations",
+    "remount",
     "simulate",
     "simulate_calibration",
     "simulate_pendulum",

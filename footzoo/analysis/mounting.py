@@ -1,0 +1,162 @@
+"""How the sensor sits on the foot, measured from the gait: a wrong (right-handed) axis map is named with its fix.
+
+A right-handed but wrong axis map is physically the data of another mounting: the attitude,
+the trajectory and footzoo's gait events (navigation-frame sagittal rate,
+:func:`footzoo.analysis.gait_events.sagittal_rate`) come out the same. What it breaks is every
+reading of a *sensor axis* as a foot axis: the foot walks backwards along the sensor's x axis,
+or ``gyr_y`` turns negative when the toe lifts, which reverses the heel-strike/toe-off sequence of
+any body-frame method (Rampp et al. 2015 on ``gyr_y``, a foot-flat detector on one axis, a
+heading taken from the sensor's x axis).
+
+The foot frame of stride ``i`` is ``F_i = [d_i, e_down × d_i, e_down]`` (forward along the
+stride's direction of travel ``d_i``, right, down, in NED; :func:`travel_directions`). At the
+middle of each stance (foot flat) the sensor's axes in it are ``A_i = F_iᵀ C_b^n``, so that
+``v_foot = A_i · v_sensor``: the rows of ``A_i`` are the FRD axes of the foot in sensor
+coordinates, the same form as an axis map (:mod:`footzoo.io.axes`). Its element-wise median over
+the stances before the strides of at least 0.5 m (a turn on the spot has no direction of travel),
+made orthonormal again (nearest rotation, SVD), is the measured mounting. Two
+symptoms are flagged:
+
+* **walks backwards**: the sensor's x axis points against the direction of travel,
+  ``A[0, 0] < −0.5`` (more than 120° away);
+* **pitch reversed**: the sensor's y axis points left, ``A[1, 1] < −0.5``: ``gyr_y`` turns
+  negative when the toe lifts. The report gives the correlation of ``gyr_y`` with the sagittal
+  rate ``ω_ml`` over the swings too (near −1 for a reversed pitch); it is not the criterion,
+  because a sensor turned on the foot by a few tens of degrees sees a scaled pitch rate with the
+  same shape (correlation ±0.6 on gaitmap's example turned 90° about z).
+
+The fix is the signed permutation nearest to ``A`` (its largest entry per row): the axis map
+that, applied on top of the one used, makes the sensor's axes the foot's FRD axes. A sensor
+mounted upside down on purpose (PyShoe's 2018-02-22 trial) shows the same symptom as a map that
+flips y and z: the warning says so.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..core.conventions import quat_to_matrix
+from ..core.errors import FormatError, SensorWarning
+from ..io.axes import describe_axes, parse_axes
+from .gait_events import sagittal_rate, travel_directions
+
+#: Fewest strides for a mounting estimate.
+MIN_STRIDES = 3
+#: Shortest stride (m, horizontal) whose direction of travel counts: a turn on the spot or a shuffle has none.
+MIN_STRIDE_LENGTH = 0.5
+#: ``A[0, 0]`` (``A[1, 1]``) below this: the sensor's x axis points backwards (its y axis left), cos 120°.
+REVERSED_COS = -0.5
+
+
+def nearest_rotation(a: np.ndarray) -> np.ndarray:
+    """The rotation matrix nearest to ``a`` (3, 3) in the Frobenius norm (SVD, determinant +1)."""
+    u, _, vt = np.linalg.svd(a)
+    s = np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt))])
+    return u @ s @ vt
+
+
+def nearest_axis_map(a: np.ndarray) -> np.ndarray | None:
+    """The proper signed permutation nearest to the rotation ``a``: each row's largest entry, or None if ambiguous."""
+    k = np.argmax(np.abs(a), axis=1)
+    if len(set(k.tolist())) < 3:
+        return None
+    p = np.zeros((3, 3))
+    p[np.arange(3), k] = np.sign(a[np.arange(3), k])
+    return p if np.linalg.det(p) > 0 else None
+
+
+def axis_map_text(p: np.ndarray) -> str:
+    """``[-x, -y, z]`` for a signed permutation (rows: FRD axes in sensor coordinates)."""
+    names = []
+    for row in p:
+        k = int(np.argmax(np.abs(row)))
+        names.append(("-" if row[k] < 0 else "") + "xyz"[k])
+    return "[" + ", ".join(names) + "]"
+
+
+def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray) -> dict[str, Any]:
+    """The sensor's mounting on the foot measured from the strides (see the module docstring).
+
+    Parameters
+    ----------
+    quat : (N, 4) ndarray
+        Attitude, body (sensor) to NED, scalar first.
+    gyr : (N, 3) ndarray
+        Angular rate in the sensor frame (rad/s).
+    pos : (N, 3) ndarray
+        Position in NED (m).
+    stances : (K + 1, 2) int ndarray
+        The real stances ``(start, stop)`` (:func:`footzoo.analysis.strides.real_stances`).
+
+    Returns
+    -------
+    dict
+        ``strides``, ``strides_used`` (those of at least :data:`MIN_STRIDE_LENGTH`); with at
+        least :data:`MIN_STRIDES` used also ``sensor_in_foot`` (3 × 3 list,
+        ``v_foot = A · v_sensor``), ``x_forward`` (``A[0, 0]``), ``pitch_rate_correlation``
+        (``gyr_y`` against the sagittal rate, over the swings), ``walks_backwards``,
+        ``pitch_reversed`` (bool) and ``suggested_axes`` (the proper signed permutation nearest
+        to ``A``, ``[x, y, z]`` when the axes are right, None when no permutation is near).
+    """
+    k = len(stances) - 1
+    out: dict[str, Any] = {"strides": int(max(k, 0))}
+    if k < MIN_STRIDES:
+        return out
+    a0, b0 = stances[:, 0], stances[:, 1]
+    mid = (a0 + b0 - 1) // 2
+    pos = np.asarray(pos, dtype=float)
+    d, _ = travel_directions(pos, stances)
+    # the stance before each long stride, with that stride's direction (turns on the spot and shuffles left out)
+    long = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T) >= MIN_STRIDE_LENGTH
+    out["strides_used"] = int(long.sum())
+    if long.sum() < MIN_STRIDES:
+        return out
+    mid = mid[:-1][long]
+    fwd = np.column_stack([d[mid], np.zeros(len(mid))])
+    right = np.column_stack([-d[mid, 1], d[mid, 0], np.zeros(len(mid))])
+    down = np.broadcast_to([0.0, 0.0, 1.0], fwd.shape)
+    foot = np.stack([fwd, right, down], axis=1)  # rows: foot axes in NED
+    a = nearest_rotation(np.median(foot @ quat_to_matrix(np.asarray(quat, dtype=float)[mid]), axis=0))
+    w = sagittal_rate(quat, gyr, pos, stances)
+    swing = np.zeros(len(w), bool)
+    for lo, hi in zip(b0[:-1], a0[1:], strict=True):
+        swing[lo:hi] = True
+    gy = np.asarray(gyr, dtype=float)[swing, 1]
+    corr = float(np.corrcoef(gy, w[swing])[0, 1]) if swing.sum() > 2 and np.std(gy) > 0 else float("nan")
+    p = nearest_axis_map(a)
+    out.update(sensor_in_foot=np.round(a, 4).tolist(), x_forward=float(a[0, 0]), y_right=float(a[1, 1]),
+               pitch_rate_correlation=corr, walks_backwards=bool(a[0, 0] < REVERSED_COS),
+               pitch_reversed=bool(a[1, 1] < REVERSED_COS),
+               suggested_axes=None if p is None else axis_map_text(p))
+    return out
+
+
+def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | None = None) -> None:
+    """A :class:`SensorWarning` when the report finds the foot walking backwards or its pitch reversed.
+
+    ``axes`` is the axis map the recording was read with (``Recording.meta["axes"]``), named in the fix.
+    """
+    symptoms = []
+    if report.get("walks_backwards"):
+        symptoms.append(f"the foot walks backwards along the sensor's x axis (x · direction of travel = "
+                        f"{report['x_forward']:+.2f})")
+    if report.get("pitch_reversed"):
+        symptoms.append(f"the sensor's y axis points left (y · right = {report['y_right']:+.2f}): gyr_y is negative "
+                        "when the toe lifts, so heel strike and toe-off swap places for a method reading gyr_y")
+    if not symptoms:
+        return
+    where = f"recording {name!r}: " if name else ""
+    suggested = report.get("suggested_axes")
+    if suggested and axes:
+        try:  # the map to read the raw file with: the fix applied after the map used
+            suggested = describe_axes(parse_axes(suggested.strip("[]")) @ parse_axes(axes))
+        except FormatError:
+            suggested = f"{suggested} on top of the axis map it was read with ({axes})"
+    fix = (f"if the sensor is not mounted so on purpose (e.g. upside down), the axis map is wrong: read it with "
+           f"the axis map {suggested} (x toward the toe, y right, z down, in sensor axes)"
+           if suggested else "check the axis map (x toward the toe, y right, z down)")
+    warnings.warn(f"{where}{'; '.join(symptoms)}. footzoo's strides and gait events do not depend on the "
+                  f"mounting; {fix}. Details in Result.diagnostics['mounting']", SensorWarning, stacklevel=3)

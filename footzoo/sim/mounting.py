@@ -1,0 +1,64 @@
+"""A simulated walk seen by a sensor turned on the foot: the 24 proper axis permutations, any rotation.
+
+A sensor mounted with the rotation ``M`` (sensor axes in the original body frame: ``v_body = M · v_sensor``)
+measures ``a' = Mᵀ a``, ``ω' = Mᵀ ω`` and ``m' = Mᵀ m``; its true attitude is ``q ⊗ q(M)``. Reading a
+recording with a wrong but right-handed axis map is the same thing: the data of another proper mounting.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from itertools import permutations, product
+
+import numpy as np
+
+from ..core.conventions import quat_from_matrix, quat_mul
+from ..core.data import Recording
+
+
+def proper_axis_permutations() -> list[np.ndarray]:
+    """The 24 signed permutation matrices with determinant +1 (the rotations of a cube), identity first."""
+    out = []
+    for perm in permutations(range(3)):
+        for signs in product((1.0, -1.0), repeat=3):
+            m = np.zeros((3, 3))
+            m[np.arange(3), perm] = signs
+            if np.linalg.det(m) > 0:
+                out.append(m)
+    return out
+
+
+def axis_map_name(m: np.ndarray) -> str:
+    """``x, -z, y``: the sensor axis that each body axis (rows of ``m``) is, for a signed permutation."""
+    names = []
+    for row in np.asarray(m, dtype=float):
+        k = int(np.argmax(np.abs(row)))
+        names.append(("-" if row[k] < 0 else "") + "xyz"[k])
+    return ", ".join(names)
+
+
+def remount(rec: Recording, m: np.ndarray) -> Recording:
+    """``rec`` as measured by a sensor mounted with the rotation ``m`` (3, 3) (``v_body = m · v_sensor``).
+
+    The readings are rotated (``a' = mᵀ a``), the true attitude becomes ``q ⊗ q(m)``; positions,
+    velocities, stances and events are the same physical ones.
+
+    Raises
+    ------
+    ValueError
+        ``m`` is not a rotation (orthonormal, determinant +1).
+    """
+    m = np.asarray(m, dtype=float)
+    if m.shape != (3, 3) or not np.allclose(m @ m.T, np.eye(3), atol=1e-9) or np.linalg.det(m) < 0:
+        raise ValueError(f"mounting {m.tolist()} is not a rotation matrix (orthonormal with determinant +1); "
+                         "a mirror image is no mounting")
+
+    def sensor(v: np.ndarray | None) -> np.ndarray | None:
+        return None if v is None else v @ m  # rows: (mᵀ v)ᵀ = vᵀ m
+
+    truth = rec.truth
+    if truth is not None and truth.quat is not None:
+        qm = np.broadcast_to(quat_from_matrix(m), truth.quat.shape)
+        truth = replace(truth, quat=quat_mul(truth.quat, qm))
+    return replace(rec, acc=sensor(rec.acc), gyr=sensor(rec.gyr), mag=sensor(rec.mag), truth=truth,
+                   meta=dict(rec.meta))
