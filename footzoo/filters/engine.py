@@ -25,6 +25,7 @@ from ..core.params import Real
 from ..kernels import jit as _jit
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
+from .stepwise import RECORD_KEYS
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -199,28 +200,55 @@ class KalmanEngine:
 
     # ------------------------------------------------------------------ runs
     def run(self, t, acc, gyr, stance, q0, quat_ext=None, covariance: bool = True,
-            smoother: bool = False) -> dict[str, Any]:
+            smoother: bool | str = False) -> dict[str, Any]:
         """Filter a whole recording; returns the trajectories and each model's diagnostics.
 
-        With ``smoother`` the trajectories are the RTS-smoothed ones (:mod:`footzoo.filters.smoother`)
-        and the forward pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
+        With ``smoother`` (``"rts"`` or True: :mod:`footzoo.filters.smoother`; ``"stepwise"``:
+        :mod:`footzoo.filters.stepwise`) the trajectories are the smoothed ones and the forward
+        pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
         """
+        smoother = {True: "rts", False: "none"}.get(smoother, smoother)
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
-                           smoother)
+                           smoother == "rts", record=smoother == "stepwise")
         out["diagnostics"] = self.diagnostics(state)
-        if smoother:
-            from .smoother import rts_backward
-
+        if smoother != "none":
             for key in ("quat", "vel", "pos"):
                 out[f"{key}_forward"] = out[key].copy()
+        if smoother == "stepwise":
+            self.smooth_stepwise(out, stance, closed=True)
+        if smoother == "rts":
+            from .smoother import rts_backward
+
             core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
             rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
                          out["pos"], out["gyro_bias"], out["acc_bias"])
-        del out["gains"], out["dxs"]
+        for key in ("gains", "dxs", *RECORD_KEYS):
+            out.pop(key, None)
         return out
+
+    def core_offsets(self) -> np.ndarray:
+        """Offsets of the INS core's blocks (att, gyro_bias, pos, vel, acc_bias; −1 if absent)."""
+        return np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
+
+    def smooth_stepwise(self, rows: dict[str, np.ndarray], stance: np.ndarray, closed: bool) -> int:
+        """Step-wise smoothing of the segments that have closed in ``rows`` (in place); how many rows are final.
+
+        ``rows``: per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and the record
+        (:meth:`advance` with ``record``), its row 0 the first sample after the last segment end,
+        aligned with ``stance``. The segments end where :func:`footzoo.filters.stepwise.segment_ends`
+        says (``closed``: the data ends at the last row); the rows up to the last end are final.
+        """
+        from .stepwise import segment_ends, smooth_segments
+
+        ends = segment_ends(stance, closed)
+        if not ends.size:
+            return 0
+        smooth_segments(tuple(rows[k] for k in RECORD_KEYS), ends, 0, self.core_offsets(), not self.carries_attitude,
+                        rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"], rows["acc_bias"])
+        return int(ends[-1]) + 1
 
     def start(self, nav0: np.ndarray) -> Any:
         """The filter's state before sample 0 (resumable with :meth:`advance`)."""
@@ -231,9 +259,17 @@ class KalmanEngine:
         return self.pack(nav0)
 
     def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
-                covariance: bool = True, smoother: bool = False) -> dict[str, np.ndarray]:
-        """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state."""
+                covariance: bool = True, smoother: bool = False, record: bool = False) -> dict[str, np.ndarray]:
+        """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state.
+
+        ``smoother``: also the RTS gains (``gains``, ``dxs``); ``record``: also the step-wise
+        smoother's record of every row (``record_cov``, ``record_phi``, ``record_rows``,
+        ``record_count``: :func:`footzoo.filters.stepwise.record_arrays`).
+        """
         n = len(t)
+        if record and self.engine == "reference":
+            raise ConfigError("smoother: stepwise runs on the compiled engine; engine='reference' smooths with "
+                              "smoother: rts only (use engine='auto' or 'fast')")
         if self.engine == "reference":
             from .kalman_reference import run_reference
 
@@ -244,6 +280,10 @@ class KalmanEngine:
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
+        if record:
+            from .stepwise import record_arrays
+
+            out.update(zip(RECORD_KEYS, record_arrays(n, nx, state.core[4]), strict=True))
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
@@ -325,14 +365,15 @@ class KalmanEngine:
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
+        record = tuple(out[k] for k in RECORD_KEYS) if RECORD_KEYS[0] in out else None  # step-wise smoother
         if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
-                         k0, work)
+                         k0, work, record)
             return
         measures, feedbacks, afters = packed.functions
         smoother = smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0] else None
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0, work, smoother)
+                                                data_off, hooks), outputs, k0, work, smoother, record)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -413,10 +454,10 @@ def _bound_loop(functions: tuple) -> Any:
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
 
-        def bound(signals, core, state, arrays, out, k0, work):
+        def bound(signals, core, state, arrays, out, k0, work, record):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0, work, None)
+                                             data_off, hooks), out, k0, work, None, record)
 
         import numba
 

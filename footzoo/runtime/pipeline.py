@@ -88,7 +88,7 @@ class Pipeline:
         ``Result.diagnostics["calibration"]``.
     """
 
-    SMOOTHERS = ("none", "rts")
+    SMOOTHERS = ("none", "rts", "stepwise")
 
     def __init__(
         self,
@@ -337,7 +337,7 @@ class Pipeline:
         if kalman:
             samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
             eng = self.kalman_engine(kalman, samples, engine)
-            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother == "rts")
+            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother)
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
             if covariance:
                 out["diagnostics"]["P_diag"] = out["P_diag"]

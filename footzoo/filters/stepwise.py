@@ -1,0 +1,190 @@
+"""Step-wise smoothing of the ZUPT-aided error-state filter: one stride at a time, live.
+
+Colomar, Nilsson & Händel 2012 ("Smoothing for ZUPT-aided INSs", IPIN 2012) observe that in a
+zero-velocity-aided INS the velocity error is observed at every zero-velocity instant, which
+all but decorrelates the errors before it from the measurements after it: the
+Rauch–Tung–Striebel smoother run over each segment between zero-velocity instants, started
+from the filtered estimate at the segment's end, is nearly the whole-recording smoother, with
+the memory of one stride and the latency of one stride.
+
+Where a segment ends
+    At the **last sample of every stance** — sample k with ``stance[k]`` and not
+    ``stance[k+1]`` (known once sample k+1 has been seen) — and at the last sample of the
+    recording. There the forward filter has used every zero-velocity update of the stance;
+    its estimate is taken as the smoothed one (``e_k = 0``). A segment holds the samples after
+    the previous end up to this one: a swing and the stance after it (the first segment, the
+    still start too). :func:`segment_ends` is the rule; the batch run
+    (:meth:`footzoo.filters.engine.KalmanEngine.run`) and the live stage
+    (:class:`footzoo.runtime.stages.KalmanStage`) both use it, so a stream's final estimates
+    equal the batch run's.
+
+The backward pass of a segment ``(s₀, s]``
+    The closed-loop RTS recursion of :mod:`footzoo.filters.smoother`,
+    ``e_s = 0``, ``e_{k−1} = A_{k−1} (e_k + δx̂_k)`` with ``A_{k−1} = P⁺_{k−1} Φ_kᵀ (P⁻_k)⁻¹``,
+    run for k = s … s₀+2 (sample s₀ is the previous segment's end, ``e_{s₀} = 0``). It is
+    evaluated without forming the gain — no inverse or factorisation of ``P⁻`` (the RTS gain's
+    Cholesky factorisation and n triangular solves per sample are what make the
+    whole-recording smoother cost 8× the forward pass) — by carrying
+    ``λ_k = (P⁻_k)⁻¹ (e_k + δx̂_k)`` backwards (the Bryson–Frazier form of the same recursion;
+    Bierman 1973)::
+
+        λ ← 0                                      (at k = s: e_s = 0, before the update of s)
+        λ ← λ + h_aᵀ (ν_a / s_a − k_aᵀ λ)          for the update rows a of sample k, last first
+        μ = Φ_kᵀ λ                                 (= (P⁺_{k−1})⁻¹ e_{k−1})
+        e_{k−1} = P⁺_{k−1} μ,   λ ← μ
+
+    with each scalar update row's ``h_a`` (1, n), gain ``k_a = P h_aᵀ / s_a``, innovation
+    ``ν_a`` and its variance ``s_a`` (the compiled loop updates with one row at a time; the
+    rows of a stacked update give the same λ). Because ``P⁺ = (I − K H) P⁻`` and
+    ``K = P⁻ Hᵀ S⁻¹``, ``(P⁻_k)⁻¹ (P⁺_k μ + K_k y_k) = (I − K_k H_k)ᵀ μ + H_kᵀ S_k⁻¹ y_k``: the
+    recursion is exactly the RTS one, and states without variance (the position before the
+    first step) need no special case. ``e_{k−1}`` is applied as the feedback is
+    (:func:`footzoo.filters.smoother.correct_sample`, shared with the RTS pass).
+
+What is kept (per sample of the open segment, :func:`record_arrays`)
+    ``P⁺_k`` (its upper triangle, n(n+1)/2), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``;
+    Nguyen & La eq. 33, as :func:`footzoo.filters.eskf.transition`), and the update rows
+    (``h``, ``k``, ``ν/s``: 2n+1 each, at most the models' rows per sample) — written by the
+    compiled loop (:func:`footzoo.filters.kalman_fast.eskf_loop`'s ``record``), dropped once
+    their segment has been smoothed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kernels.jit import njit
+from .smoother import correct_sample
+
+#: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
+PHI_WIDTH = 19
+
+
+def record_arrays(n_samples: int, n: int, m_max: int) -> tuple:
+    """Empty per-sample record of the forward pass for ``n_samples`` samples of an ``n``-state filter.
+
+    ``(cov (N, n(n+1)/2): P⁺ upper triangle, phi (N, 19): Φ's blocks, rows (N, m_max, 2n+1): h, k, ν/s,
+    count (N,) int: rows used)``.
+    """
+    return (np.zeros((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
+            np.zeros((n_samples, max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64))
+
+
+RECORD_KEYS = ("record_cov", "record_phi", "record_rows", "record_count")
+
+
+@njit(inline=True)
+def record_transition(record, k, dt, sdt, cdt):
+    """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
+    phi = record[1]
+    phi[k, 0] = dt
+    for i in range(3):
+        for j in range(3):
+            phi[k, 1 + 3 * i + j] = sdt[i, j]
+            phi[k, 10 + 3 * i + j] = cdt[i, j]
+    record[3][k] = 0
+
+
+@njit(inline=True)
+def record_row(record, k, h, gain, scaled_innovation):
+    """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
+    rows, count = record[2], record[3]
+    a = count[k]
+    n = h.shape[0]
+    for i in range(n):
+        rows[k, a, i] = h[i]
+        rows[k, a, n + i] = gain[i]
+    rows[k, a, 2 * n] = scaled_innovation
+    count[k] = a + 1
+
+
+@njit(inline=True)
+def record_covariance(record, k, P):
+    """Keep ``P⁺_k`` (upper triangle, row by row)."""
+    cov = record[0]
+    n = P.shape[0]
+    c = 0
+    for i in range(n):
+        for j in range(i, n):
+            cov[k, c] = P[i, j]
+            c += 1
+
+
+@njit(inline=True)
+def transition_transposed(phi, idx, lam, out):
+    """``out = Φᵀ λ`` for Φ = I + Δ with the blocks of Nguyen & La eq. 33 (kept by :func:`record_transition`).
+
+    Δ[pos, vel] = I dt, Δ[vel, att] = −[f^n×] dt, Δ[vel, acc_bias] = C dt, Δ[att, gyro_bias] = C dt.
+    """
+    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
+    for i in range(lam.shape[0]):
+        out[i] = lam[i]
+    dt = phi[0]
+    for j in range(3):
+        out[vel_i + j] += dt * lam[pos_i + j]
+        for i in range(3):
+            if att >= 0:
+                out[att + j] += phi[1 + 3 * i + j] * lam[vel_i + i]
+            if ab_i >= 0:
+                out[ab_i + j] += phi[10 + 3 * i + j] * lam[vel_i + i]
+            if att >= 0 and gb_i >= 0:
+                out[gb_i + j] += phi[10 + 3 * i + j] * lam[att + i]
+
+
+@njit
+def smooth_segment(record, lo, hi, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
+    """Smooth samples ``lo … hi − 1`` in place, the segment ending at ``hi`` (``e_hi = 0``; module docstring).
+
+    ``record`` holds samples ``lo … hi`` at the same indices as the trajectories; ``lam``, ``mu``,
+    ``e`` (n,) are work arrays.
+    """
+    cov, phi, rows, count = record
+    n = lam.shape[0]
+    for i in range(n):
+        lam[i] = 0.0
+    for k in range(hi, lo, -1):
+        for a in range(count[k] - 1, -1, -1):  # the update of sample k, last row first
+            kl = 0.0
+            for i in range(n):
+                kl += rows[k, a, n + i] * lam[i]
+            c = rows[k, a, 2 * n] - kl
+            for i in range(n):
+                lam[i] += rows[k, a, i] * c
+        transition_transposed(phi[k], idx, lam, mu)
+        p = cov[k - 1]
+        for i in range(n):
+            e[i] = 0.0
+        c = 0
+        for i in range(n):  # e = P⁺_{k−1} μ from the upper triangle
+            e[i] += p[c] * mu[i]
+            c += 1
+            for j in range(i + 1, n):
+                e[i] += p[c] * mu[j]
+                e[j] += p[c] * mu[i]
+                c += 1
+        correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
+        for i in range(n):
+            lam[i] = mu[i]
+
+
+@njit
+def smooth_segments(record, ends, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn."""
+    n = (record[2].shape[2] - 1) // 2
+    lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
+    for s in ends:
+        smooth_segment(record, lo, s, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
+        lo = s + 1
+
+
+def segment_ends(stance: np.ndarray, closed: bool) -> np.ndarray:
+    """Indices of the samples that end a segment: the last sample of each stance (module docstring).
+
+    Sample k ends one when ``stance[k]`` and not ``stance[k + 1]``; the last sample of ``stance``
+    only when ``closed`` (the end of the data; live, its successor is not known yet).
+    """
+    s = np.asarray(stance, dtype=bool)
+    ends = np.flatnonzero(s[:-1] & ~s[1:]).astype(np.int64)
+    if closed and s.size and (ends.size == 0 or ends[-1] != s.size - 1):
+        ends = np.append(ends, np.int64(s.size - 1))
+    return ends
