@@ -56,6 +56,9 @@ import numpy as np
 from ..kernels.jit import njit
 from .smoother import correct_sample
 
+#: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
+WAITS_FOR = "the end of the next stance"
+
 #: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
 PHI_WIDTH = 19
 

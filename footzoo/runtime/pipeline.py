@@ -27,6 +27,7 @@ from ..core.data import Recording, Result
 from ..core.errors import ConfigError, RecordingError
 from ..core.table import samples_frame
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
+from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from ..plugins.base import (
     AccelerationCorrection,
@@ -71,10 +72,13 @@ class Pipeline:
         Run on the finished trajectory.
     navigation : NavigationNoise or dict, optional
         Process noise and initial uncertainty of the INS core of the Kalman filter.
-    smoother : {"none", "rts"}
+    smoother : {"none", "rts", "stepwise"}
         ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
-        (:mod:`footzoo.filters.smoother`; offline only). The forward trajectory stays in
-        ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
+        over the whole recording (:mod:`footzoo.filters.smoother`; offline only). ``stepwise``:
+        the same backward pass over each stride, from the last sample of a stance back to the
+        previous one (Colomar, Nilsson & Händel 2012; :mod:`footzoo.filters.stepwise`): it runs
+        live, each stride final once the stance after it has ended. The forward trajectory
+        stays in ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
     plugins : list of str, optional
         External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
         :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.plugins.extensions`).
@@ -200,6 +204,8 @@ class Pipeline:
         parts += [b.latency(ctx) for b in self.blocks() if b is not self.detector and not isinstance(b, Calibration)]
         if self.smoother == "rts":
             parts.append(Latency(until=(WHOLE_RECORDING,)))
+        elif self.smoother == "stepwise":  # a stride closes at its stance's last sample, seen at the next one
+            parts.append(Latency(ctx.seconds(1), (STEPWISE_WAIT,)))
         if any(not c.is_fitted() for c in self.calibration):
             parts.append(Latency(warmup=STREAM_WARMUP))
         return total(parts)
