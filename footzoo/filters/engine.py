@@ -25,7 +25,7 @@ from ..core.params import Real
 from ..kernels import jit as _jit
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
-from .stepwise import RECORD_KEYS
+from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -225,7 +225,7 @@ class KalmanEngine:
             core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
             rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
                          out["pos"], out["gyro_bias"], out["acc_bias"])
-        for key in ("gains", "dxs", *RECORD_KEYS):
+        for key in ("gains", "dxs", ROWS_KEY, *RECORD_KEYS):
             out.pop(key, None)
         return out
 
@@ -237,8 +237,8 @@ class KalmanEngine:
         """Step-wise smoothing of the segments that have closed in ``rows`` (in place); how many rows are final.
 
         ``rows``: per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and the record
-        (:meth:`advance` with ``record``), its row 0 the first sample after the last segment end,
-        aligned with ``stance``. The segments end where :func:`footzoo.filters.stepwise.segment_ends`
+        (:meth:`advance` with ``record``; ``record_first`` indexing ``record_rows``), its row 0 the
+        first sample after the last segment end, aligned with ``stance``. The segments end where :func:`footzoo.filters.stepwise.segment_ends`
         says (``closed``: the data ends at the last row); the rows up to the last end are final.
         """
         from .stepwise import segment_ends, smooth_segments
@@ -246,7 +246,7 @@ class KalmanEngine:
         ends = segment_ends(stance, closed)
         if not ends.size:
             return 0
-        smooth_segments(tuple(rows[k] for k in RECORD_KEYS), ends, 0, self.core_offsets(), not self.carries_attitude,
+        smooth_segments(record_tuple(rows), ends, 0, self.core_offsets(), not self.carries_attitude,
                         rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"], rows["acc_bias"])
         return int(ends[-1]) + 1
 
@@ -283,7 +283,9 @@ class KalmanEngine:
         if record:
             from .stepwise import record_arrays
 
-            out.update(zip(RECORD_KEYS, record_arrays(n, nx, state.core[4]), strict=True))
+            cov, phi, rows, first, count = record_arrays(n, nx, state.core[4])
+            out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
+            out[ROWS_KEY] = rows
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
@@ -365,7 +367,7 @@ class KalmanEngine:
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
-        record = tuple(out[k] for k in RECORD_KEYS) if RECORD_KEYS[0] in out else None  # step-wise smoother
+        record = record_tuple(out) if ROWS_KEY in out else None  # step-wise smoother
         if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
                          k0, work, record)

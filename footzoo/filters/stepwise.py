@@ -44,7 +44,7 @@ The backward pass of a segment ``(s₀, s]``
 What is kept (per sample of the open segment, :func:`record_arrays`)
     ``P⁺_k`` (its upper triangle, n(n+1)/2), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``;
     Nguyen & La eq. 33, as :func:`footzoo.filters.eskf.transition`), and the update rows
-    (``h``, ``k``, ``ν/s``: 2n+1 each, at most the models' rows per sample) — written by the
+    (``h``, ``k``, ``ν/s``: 2n+1 each, only the rows there are) — written by the
     compiled loop (:func:`footzoo.filters.kalman_fast.eskf_loop`'s ``record``), dropped once
     their segment has been smoothed.
 """
@@ -64,41 +64,53 @@ PHI_WIDTH = 19
 
 
 def record_arrays(n_samples: int, n: int, m_max: int) -> tuple:
-    """Empty per-sample record of the forward pass for ``n_samples`` samples of an ``n``-state filter.
+    """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
 
-    ``(cov (N, n(n+1)/2): P⁺ upper triangle, phi (N, 19): Φ's blocks, rows (N, m_max, 2n+1): h, k, ν/s,
-    count (N,) int: rows used)``.
+    ``(cov (N, n(n+1)/2): P⁺ upper triangle, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
+    h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
+    its number of rows)``. ``rows`` has room for ``m_max`` rows per sample; only the rows written are
+    touched (the memory of a zeroed array is given when first written).
     """
-    return (np.zeros((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
-            np.zeros((n_samples, max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64))
+    return (np.empty((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
+            np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
+            np.zeros(n_samples, np.int64))
 
 
-RECORD_KEYS = ("record_cov", "record_phi", "record_rows", "record_count")
+#: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
+RECORD_KEYS = ("record_cov", "record_phi", "record_first", "record_count")
+ROWS_KEY = "record_rows"
+
+
+def record_tuple(out: dict[str, np.ndarray]) -> tuple:
+    """The record in the order of :func:`record_arrays` from a dict of its arrays."""
+    cov, phi, first, count = (out[k] for k in RECORD_KEYS)
+    return cov, phi, out[ROWS_KEY], first, count
 
 
 @njit(inline=True)
 def record_transition(record, k, dt, sdt, cdt):
     """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
-    phi = record[1]
+    phi, first, count = record[1], record[3], record[4]
     phi[k, 0] = dt
     for i in range(3):
         for j in range(3):
             phi[k, 1 + 3 * i + j] = sdt[i, j]
             phi[k, 10 + 3 * i + j] = cdt[i, j]
-    record[3][k] = 0
+    first[k] = first[k - 1] + count[k - 1]
+    count[k] = 0
 
 
 @njit(inline=True)
 def record_row(record, k, h, gain, scaled_innovation):
     """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
-    rows, count = record[2], record[3]
-    a = count[k]
+    rows, first, count = record[2], record[3], record[4]
+    r = first[k] + count[k]
     n = h.shape[0]
     for i in range(n):
-        rows[k, a, i] = h[i]
-        rows[k, a, n + i] = gain[i]
-    rows[k, a, 2 * n] = scaled_innovation
-    count[k] = a + 1
+        rows[r, i] = h[i]
+        rows[r, n + i] = gain[i]
+    rows[r, 2 * n] = scaled_innovation
+    count[k] += 1
 
 
 @njit(inline=True)
@@ -138,21 +150,21 @@ def transition_transposed(phi, idx, lam, out):
 def smooth_segment(record, lo, hi, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
     """Smooth samples ``lo … hi − 1`` in place, the segment ending at ``hi`` (``e_hi = 0``; module docstring).
 
-    ``record`` holds samples ``lo … hi`` at the same indices as the trajectories; ``lam``, ``mu``,
-    ``e`` (n,) are work arrays.
+    ``record`` (:func:`record_arrays`) holds samples ``lo … hi`` at the same indices as the
+    trajectories; ``lam``, ``mu``, ``e`` (n,) are work arrays.
     """
-    cov, phi, rows, count = record
+    cov, phi, rows, first, count = record
     n = lam.shape[0]
     for i in range(n):
         lam[i] = 0.0
     for k in range(hi, lo, -1):
-        for a in range(count[k] - 1, -1, -1):  # the update of sample k, last row first
+        for r in range(first[k] + count[k] - 1, first[k] - 1, -1):  # the update of sample k, last row first
             kl = 0.0
             for i in range(n):
-                kl += rows[k, a, n + i] * lam[i]
-            c = rows[k, a, 2 * n] - kl
+                kl += rows[r, n + i] * lam[i]
+            c = rows[r, 2 * n] - kl
             for i in range(n):
-                lam[i] += rows[k, a, i] * c
+                lam[i] += rows[r, i] * c
         transition_transposed(phi[k], idx, lam, mu)
         p = cov[k - 1]
         for i in range(n):
@@ -173,7 +185,7 @@ def smooth_segment(record, lo, hi, idx, use_ext, quat, vel, pos, gyro_bias, acc_
 @njit
 def smooth_segments(record, ends, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn."""
-    n = (record[2].shape[2] - 1) // 2
+    n = (record[2].shape[1] - 1) // 2
     lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
     for s in ends:
         smooth_segment(record, lo, s, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
-from ..filters.stepwise import RECORD_KEYS
+from ..filters.stepwise import RECORD_KEYS, ROWS_KEY
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
@@ -271,6 +271,8 @@ class KalmanStage:
         self.prev: Chunk | None = None  # the last sample the engine has processed (its row 0 of a chunk)
         self.stepwise = smoother == "stepwise"
         self.open = Columns()  # step-wise smoother: the open segment's samples, forward estimates and record
+        self.open_rows = Columns()  # ... and its update rows (record_first: absolute row numbers)
+        self.rows_before = 0  # rows of the samples released (the absolute number of open_rows' first row)
 
     def _advance(self, state: Any, chunk: Chunk, prev: Chunk | None, record: bool = False) -> dict[str, np.ndarray]:
         """Run the engine over ``chunk`` from ``state`` (the state of ``prev``, or the initial one)."""
@@ -283,7 +285,10 @@ class KalmanStage:
                                   record=record)
         skip = 0 if prev is None else 1
         keys = ("quat", "vel", "pos", "acc_nav", *(("gyro_bias", "acc_bias", *RECORD_KEYS) if record else ()))
-        return {k: out[k][skip:] for k in keys}
+        done = {k: out[k][skip:] for k in keys}
+        if record:
+            done[ROWS_KEY] = out[ROWS_KEY][:int(out["record_first"][-1] + out["record_count"][-1])]
+        return done
 
     def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
         if length(chunk):
@@ -291,7 +296,10 @@ class KalmanStage:
             self.prev = take(chunk, length(chunk) - 1)
             if not self.stepwise:
                 return {**chunk, **out}
+            rows = out.pop(ROWS_KEY)
+            out["record_first"] = out["record_first"] + (self.rows_before + len(self.open_rows))
             self.open.append({**chunk, **out})
+            self.open_rows.append({"row": rows})
         return self._close_segments(finish) if self.stepwise else {}
 
     def _close_segments(self, closed: bool) -> Chunk:
@@ -299,11 +307,16 @@ class KalmanStage:
         if not len(self.open):
             return {}
         rows = self.open.view()
-        n_final = self.engine.smooth_stepwise(rows, rows["stance"].astype(bool), closed)
+        held = {**rows, "record_first": rows["record_first"] - self.rows_before,
+                ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else np.zeros((0, 1))}
+        n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), closed)
         if not n_final:
             return {}
         done = take(_public(rows), 0, n_final)
+        released = int(held["record_first"][n_final - 1] + held["record_count"][n_final - 1])
         self.open.drop(n_final)
+        self.open_rows.drop(released)
+        self.rows_before += released
         return done
 
     def finish(self) -> Chunk:
