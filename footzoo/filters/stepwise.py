@@ -42,7 +42,7 @@ The backward pass of a segment ``(s₀, s]``
     (:func:`footzoo.filters.smoother.correct_sample`, shared with the RTS pass).
 
 What is kept (per sample of the open segment, :func:`record_arrays`)
-    ``P⁺_k`` (its upper triangle, n(n+1)/2), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``;
+    ``P⁺_k`` (n × n), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``;
     Nguyen & La eq. 33, as :func:`footzoo.filters.eskf.transition`), and the update rows
     (``h``, ``k``, ``ν/s``: 2n+1 each, only the rows there are) — written by the
     compiled loop (:func:`footzoo.filters.kalman_fast.eskf_loop`'s ``record``), dropped once
@@ -66,12 +66,12 @@ PHI_WIDTH = 19
 def record_arrays(n_samples: int, n: int, m_max: int) -> tuple:
     """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
 
-    ``(cov (N, n(n+1)/2): P⁺ upper triangle, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
+    ``(cov (N, n, n): P⁺, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
     h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
     its number of rows)``. ``rows`` has room for ``m_max`` rows per sample; only the rows written are
     touched (the memory of a zeroed array is given when first written).
     """
-    return (np.empty((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
+    return (np.empty((n_samples, n, n)), np.zeros((n_samples, PHI_WIDTH)),
             np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
             np.zeros(n_samples, np.int64))
 
@@ -115,35 +115,36 @@ def record_row(record, k, h, gain, scaled_innovation):
 
 @njit(inline=True)
 def record_covariance(record, k, P):
-    """Keep ``P⁺_k`` (upper triangle, row by row)."""
+    """Keep ``P⁺_k``."""
     cov = record[0]
     n = P.shape[0]
-    c = 0
     for i in range(n):
-        for j in range(i, n):
-            cov[k, c] = P[i, j]
-            c += 1
+        for j in range(n):
+            cov[k, i, j] = P[i, j]
 
 
 @njit(inline=True)
-def transition_transposed(phi, idx, lam, out):
-    """``out = Φᵀ λ`` for Φ = I + Δ with the blocks of Nguyen & La eq. 33 (kept by :func:`record_transition`).
+def transition_transposed(phi, k, idx, lam, out):
+    """``out = Φ_kᵀ λ`` for Φ = I + Δ with the blocks of Nguyen & La eq. 33 (kept by :func:`record_transition`).
 
     Δ[pos, vel] = I dt, Δ[vel, att] = −[f^n×] dt, Δ[vel, acc_bias] = C dt, Δ[att, gyro_bias] = C dt.
     """
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
     for i in range(lam.shape[0]):
         out[i] = lam[i]
-    dt = phi[0]
+    dt = phi[k, 0]
     for j in range(3):
         out[vel_i + j] += dt * lam[pos_i + j]
-        for i in range(3):
-            if att >= 0:
-                out[att + j] += phi[1 + 3 * i + j] * lam[vel_i + i]
-            if ab_i >= 0:
-                out[ab_i + j] += phi[10 + 3 * i + j] * lam[vel_i + i]
-            if att >= 0 and gb_i >= 0:
-                out[gb_i + j] += phi[10 + 3 * i + j] * lam[att + i]
+    if att >= 0:
+        for j in range(3):
+            out[att + j] += phi[k, 1 + j] * lam[vel_i] + phi[k, 4 + j] * lam[vel_i + 1] + phi[k, 7 + j] * lam[vel_i + 2]
+    if ab_i >= 0:
+        for j in range(3):
+            out[ab_i + j] += (phi[k, 10 + j] * lam[vel_i] + phi[k, 13 + j] * lam[vel_i + 1]
+                              + phi[k, 16 + j] * lam[vel_i + 2])
+    if att >= 0 and gb_i >= 0:
+        for j in range(3):
+            out[gb_i + j] += phi[k, 10 + j] * lam[att] + phi[k, 13 + j] * lam[att + 1] + phi[k, 16 + j] * lam[att + 2]
 
 
 @njit
@@ -165,18 +166,13 @@ def smooth_segment(record, lo, hi, idx, use_ext, quat, vel, pos, gyro_bias, acc_
             c = rows[r, 2 * n] - kl
             for i in range(n):
                 lam[i] += rows[r, i] * c
-        transition_transposed(phi[k], idx, lam, mu)
-        p = cov[k - 1]
+        transition_transposed(phi, k, idx, lam, mu)
         for i in range(n):
             e[i] = 0.0
-        c = 0
-        for i in range(n):  # e = P⁺_{k−1} μ from the upper triangle
-            e[i] += p[c] * mu[i]
-            c += 1
-            for j in range(i + 1, n):
-                e[i] += p[c] * mu[j]
-                e[j] += p[c] * mu[i]
-                c += 1
+        for j in range(n):  # e = P⁺_{k−1} μ, as Σ_j μ_j P⁺[j, :] (P⁺ symmetric: rows, no sums to chain)
+            mj = mu[j]
+            for i in range(n):
+                e[i] += cov[k - 1, j, i] * mj
         correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         for i in range(n):
             lam[i] = mu[i]
