@@ -25,7 +25,7 @@ from ..core.params import Real
 from ..kernels import jit as _jit
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
-from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple
+from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple, segment_ends
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -211,23 +211,44 @@ class KalmanEngine:
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
+        record = self._whole_recording_record(state, stance) if smoother == "stepwise" else False
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
-                           smoother == "rts", record=smoother == "stepwise")
+                           smoother == "rts", record=record)
         out["diagnostics"] = self.diagnostics(state)
-        if smoother != "none":
-            for key in ("quat", "vel", "pos"):
-                out[f"{key}_forward"] = out[key].copy()
-        if smoother == "stepwise":
-            self.smooth_stepwise(out, stance, closed=True)
+        if smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
+            from .stepwise import smooth_copy
+
+            lo = int(record[5][1])
+            smooth_copy(record, lo, len(t) - 1, lo, self.core_offsets(), not self.carries_attitude, out["quat"],
+                        out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"])
+            for key, smoothed in zip(("quat", "vel", "pos", "gyro_bias", "acc_bias"), record[6], strict=True):
+                if key in ("quat", "vel", "pos"):
+                    out[f"{key}_forward"] = out[key]
+                    out[key] = smoothed
+                elif self.layout.has(key):  # else the forward value (the state's, constant)
+                    out[key] = smoothed
         if smoother == "rts":
             from .smoother import rts_backward
 
+            for key in ("quat", "vel", "pos"):
+                out[f"{key}_forward"] = out[key].copy()
             core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
             rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
                          out["pos"], out["gyro_bias"], out["acc_bias"])
-        for key in ("gains", "dxs", ROWS_KEY, *RECORD_KEYS):
+        for key in ("gains", "dxs", "record", ROWS_KEY, *RECORD_KEYS):
             out.pop(key, None)
         return out
+
+    def _whole_recording_record(self, state: Any, stance: np.ndarray) -> tuple:
+        """The step-wise smoother's record for a whole recording, smoothed in the loop: the longest segment's rows."""
+        from .stepwise import record_arrays
+
+        if self.engine == "reference":
+            raise ConfigError("smoother: stepwise runs on the compiled engine; engine='reference' smooths with "
+                              "smoother: rts only (use engine='auto' or 'fast')")
+        ends = segment_ends(stance, True)
+        longest = int(np.max(np.diff(ends, prepend=-1))) if ends.size else max(len(stance), 1)
+        return record_arrays(longest, self.layout.n, state.core[4], in_loop=len(stance))
 
     def core_offsets(self) -> np.ndarray:
         """Offsets of the INS core's blocks (att, gyro_bias, pos, vel, acc_bias; −1 if absent)."""
@@ -241,12 +262,12 @@ class KalmanEngine:
         first sample after the last segment end, aligned with ``stance``. The segments end where :func:`footzoo.filters.stepwise.segment_ends`
         says (``closed``: the data ends at the last row); the rows up to the last end are final.
         """
-        from .stepwise import segment_ends, smooth_segments
+        from .stepwise import smooth_segments
 
         ends = segment_ends(stance, closed)
         if not ends.size:
             return 0
-        smooth_segments(record_tuple(rows), ends, 0, self.core_offsets(), not self.carries_attitude,
+        smooth_segments(record_tuple(rows), ends, 0, 0, self.core_offsets(), not self.carries_attitude,
                         rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"], rows["acc_bias"])
         return int(ends[-1]) + 1
 
@@ -259,12 +280,13 @@ class KalmanEngine:
         return self.pack(nav0)
 
     def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
-                covariance: bool = True, smoother: bool = False, record: bool = False) -> dict[str, np.ndarray]:
+                covariance: bool = True, smoother: bool = False, record: bool | tuple = False) -> dict[str, np.ndarray]:
         """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state.
 
         ``smoother``: also the RTS gains (``gains``, ``dxs``); ``record``: also the step-wise
-        smoother's record of every row (``record_cov``, ``record_phi``, ``record_rows``,
-        ``record_count``: :func:`footzoo.filters.stepwise.record_arrays`).
+        smoother's record of every row (``record_cov``, ``record_phi``, ``record_first``,
+        ``record_count``, ``record_rows``: :func:`footzoo.filters.stepwise.record_arrays`), or
+        the loop writes into the record given (one made ``in_loop``).
         """
         n = len(t)
         if record and self.engine == "reference":
@@ -280,12 +302,13 @@ class KalmanEngine:
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
-        if record:
+        if record is True:
             from .stepwise import record_arrays
 
-            cov, phi, rows, first, count = record_arrays(n, nx, state.core[4])
+            cov, phi, rows, first, count, *_ = record_arrays(n, nx, state.core[4])
             out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
             out[ROWS_KEY] = rows
+        out["record"] = record_tuple(out) if record is True else record or None
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
@@ -367,7 +390,7 @@ class KalmanEngine:
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
-        record = record_tuple(out) if ROWS_KEY in out else None  # step-wise smoother
+        record = out.get("record")  # step-wise smoother
         if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
                          k0, work, record)

@@ -25,7 +25,7 @@ import numpy as np
 from ..kernels import jit as _jit
 from ..kernels.jit import njit
 from .smoother import feed_back_attitude
-from .stepwise import record_covariance, record_row, record_transition
+from .stepwise import close_segment, record_covariance, record_row, record_transition
 from .strapdown import quat_product, rotvec_quat
 
 
@@ -96,7 +96,9 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother, record):
     record : tuple or None
         For the step-wise smoother (:mod:`footzoo.filters.stepwise`), from
         :func:`footzoo.filters.stepwise.record_arrays` with a row per sample: each sample's
-        ``P⁺``, Φ's blocks and update rows are written. ``None``: compiled without that code.
+        ``P⁺``, Φ's blocks and update rows are written (made ``in_loop``: each segment is smoothed
+        in place as soon as it has closed, the last one left to the caller). ``None``: compiled
+        without that code.
     """
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max, impact = core
@@ -163,6 +165,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother, record):
     if record is not None:  # step-wise smoother: P⁺ of the incoming state
         record_covariance(record, 0, P)
     for k in range(1, N):
+        if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
+            close_segment(record, k, stance, idx, use_ext, quat, vel, pos, gb_out, ab_out)
         dt = t[k] - t[k - 1]
         for i in range(3):
             w[i] = gyr[k, i] - nav[10 + i]

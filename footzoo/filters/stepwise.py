@@ -63,17 +63,26 @@ WAITS_FOR = "the end of the next stance"
 PHI_WIDTH = 19
 
 
-def record_arrays(n_samples: int, n: int, m_max: int) -> tuple:
+def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
     """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
 
     ``(cov (N, n, n): P⁺, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
     h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
-    its number of rows)``. ``rows`` has room for ``m_max`` rows per sample; only the rows written are
-    touched (the memory of a zeroed array is given when first written).
+    its number of rows, segment (2,) int: smoothed by the loop itself, first sample of the open
+    segment, smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for
+    ``m_max`` rows per sample; only the rows written are touched.
+
+    ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
+    as soon as it has closed (:func:`close_segment`), while its record is in the cache, into
+    ``smoothed`` (the loop's outputs stay the forward pass's), and the record holds the open
+    segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
+    segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths.
     """
+    m = int(in_loop)
+    smoothed = (np.zeros((m, 4)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)))
     return (np.empty((n_samples, n, n)), np.zeros((n_samples, PHI_WIDTH)),
             np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
-            np.zeros(n_samples, np.int64))
+            np.zeros(n_samples, np.int64), np.array([int(m > 0), 0], np.int64), smoothed)
 
 
 #: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
@@ -82,45 +91,49 @@ ROWS_KEY = "record_rows"
 
 
 def record_tuple(out: dict[str, np.ndarray]) -> tuple:
-    """The record in the order of :func:`record_arrays` from a dict of its arrays."""
+    """The record (of a live chunk) in the order of :func:`record_arrays` from a dict of its arrays."""
     cov, phi, first, count = (out[k] for k in RECORD_KEYS)
-    return cov, phi, out[ROWS_KEY], first, count
+    none = np.zeros((0, 3))
+    return cov, phi, out[ROWS_KEY], first, count, np.zeros(2, np.int64), (np.zeros((0, 4)), none, none, none, none)
 
 
 @njit(inline=True)
 def record_transition(record, k, dt, sdt, cdt):
     """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
     phi, first, count = record[1], record[3], record[4]
-    phi[k, 0] = dt
+    r = k - record[5][1]
+    phi[r, 0] = dt
     for i in range(3):
         for j in range(3):
-            phi[k, 1 + 3 * i + j] = sdt[i, j]
-            phi[k, 10 + 3 * i + j] = cdt[i, j]
-    first[k] = first[k - 1] + count[k - 1]
-    count[k] = 0
+            phi[r, 1 + 3 * i + j] = sdt[i, j]
+            phi[r, 10 + 3 * i + j] = cdt[i, j]
+    first[r] = first[r - 1] + count[r - 1] if r > 0 else 0
+    count[r] = 0
 
 
 @njit(inline=True)
 def record_row(record, k, h, gain, scaled_innovation):
     """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
     rows, first, count = record[2], record[3], record[4]
-    r = first[k] + count[k]
+    s = k - record[5][1]
+    r = first[s] + count[s]
     n = h.shape[0]
     for i in range(n):
         rows[r, i] = h[i]
         rows[r, n + i] = gain[i]
     rows[r, 2 * n] = scaled_innovation
-    count[k] += 1
+    count[s] += 1
 
 
 @njit(inline=True)
 def record_covariance(record, k, P):
     """Keep ``P⁺_k``."""
     cov = record[0]
+    r = k - record[5][1]
     n = P.shape[0]
     for i in range(n):
         for j in range(n):
-            cov[k, i, j] = P[i, j]
+            cov[r, i, j] = P[i, j]
 
 
 @njit(inline=True)
@@ -148,44 +161,75 @@ def transition_transposed(phi, k, idx, lam, out):
 
 
 @njit
-def smooth_segment(record, lo, hi, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
+def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
     """Smooth samples ``lo … hi − 1`` in place, the segment ending at ``hi`` (``e_hi = 0``; module docstring).
 
-    ``record`` (:func:`record_arrays`) holds samples ``lo … hi`` at the same indices as the
-    trajectories; ``lam``, ``mu``, ``e`` (n,) are work arrays.
+    ``record`` (:func:`record_arrays`) holds samples ``lo … hi``, sample k in its row ``k − off``;
+    ``lam``, ``mu``, ``e`` (n,) are work arrays.
     """
-    cov, phi, rows, first, count = record
+    cov, phi, rows, first, count = record[0], record[1], record[2], record[3], record[4]
     n = lam.shape[0]
     for i in range(n):
         lam[i] = 0.0
-    for k in range(hi, lo, -1):
-        for r in range(first[k] + count[k] - 1, first[k] - 1, -1):  # the update of sample k, last row first
+    for j_ in range(hi - off, lo - off, -1):
+        k = j_ + off
+        for r in range(first[j_] + count[j_] - 1, first[j_] - 1, -1):  # the update of sample k, last row first
             kl = 0.0
             for i in range(n):
                 kl += rows[r, n + i] * lam[i]
             c = rows[r, 2 * n] - kl
             for i in range(n):
                 lam[i] += rows[r, i] * c
-        transition_transposed(phi, k, idx, lam, mu)
+        transition_transposed(phi, j_, idx, lam, mu)
         for i in range(n):
             e[i] = 0.0
         for j in range(n):  # e = P⁺_{k−1} μ, as Σ_j μ_j P⁺[j, :] (P⁺ symmetric: rows, no sums to chain)
             mj = mu[j]
             for i in range(n):
-                e[i] += cov[k - 1, j, i] * mj
+                e[i] += cov[j_ - 1, j, i] * mj
         correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         for i in range(n):
             lam[i] = mu[i]
 
 
 @njit
-def smooth_segments(record, ends, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
-    """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn."""
+def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn (record rows ``k − off``)."""
     n = (record[2].shape[1] - 1) // 2
     lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
     for s in ends:
-        smooth_segment(record, lo, s, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
+        smooth_segment(record, lo, s, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
         lo = s + 1
+
+
+@njit(inline=True)
+def close_segment(record, k, stance, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """In the loop over a whole recording, before sample k: smooth the segment that sample k − 1 ended.
+
+    The rule of :func:`segment_ends` (``stance[k − 1]`` and not ``stance[k]``); the record then
+    starts afresh at sample k. Nothing unless the record was made ``in_loop``.
+    """
+    segment = record[5]
+    if segment[0] and stance[k - 1] and not stance[k]:
+        lo = segment[1]
+        smooth_copy(record, lo, k - 1, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
+        segment[1] = k
+
+
+@njit
+def smooth_copy(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """Samples ``lo … hi`` of the forward trajectories into the record's smoothed ones, smoothed there."""
+    sq, sv, sp, sg, sa = record[6]
+    for k in range(lo, hi + 1):
+        for i in range(4):
+            sq[k, i] = quat[k, i]
+        for i in range(3):
+            sv[k, i] = vel[k, i]
+            sp[k, i] = pos[k, i]
+            sg[k, i] = gyro_bias[k, i]
+            sa[k, i] = acc_bias[k, i]
+    n = record[0].shape[1]
+    smooth_segment(record, lo, hi, off, idx, use_ext, sq, sv, sp, sg, sa, np.empty(n), np.empty(n), np.empty(n))
 
 
 def segment_ends(stance: np.ndarray, closed: bool) -> np.ndarray:
