@@ -27,7 +27,7 @@ def live_config(name: str) -> Pipeline:
     """The shipped config, with a whole-recording smoother replaced by the one that streams."""
     p = Pipeline.from_yaml(name)
     if p.smoother == "rts":
-        p.smoother = "stepwise" if "stepwise" in Pipeline.SMOOTHERS else "none"
+        p.smoother = "stepwise"
     return p
 
 
@@ -113,6 +113,8 @@ def test_latency_is_declared_for_every_shipped_config_and_printed_by_validate(ca
         lat = live_config(config).latency(ctx)
         assert isinstance(lat, Latency) and lat.live, config
     assert Pipeline.from_yaml("recommended").latency(ctx).until[-1] == WHOLE_RECORDING  # rts: offline
+    stepwise = live_config("recommended").latency(ctx)  # a stride is final a sample after its stance's end
+    assert stepwise.until[-1] == "the end of the next stance" and "the end of the next stance" in str(stepwise)
     assert main(["validate", "nguyen2016"]) == 0
     out = capsys.readouterr().out
     assert "latency" in out and "0.02 s" in out
@@ -207,16 +209,25 @@ def test_distance_readings_missing_on_some_samples_count_as_no_reading(walk):
 
 
 def test_the_stream_keeps_only_what_is_pending(walk):
-    """Memory is bounded by the latency: after every packet, only a few strides of samples wait."""
+    """Memory is bounded by the latency: after every packet, only a few strides of samples wait; the
+    step-wise smoother holds one stride at most (the samples after the last stance's end)."""
+    from footzoo.filters.stepwise import segment_ends
+    from footzoo.runtime.stages import KalmanStage
+
     long = simulate(n_strides=150, profile="physical", rate=100.0, noise=NoiseModel(seed=2))
-    s = Stream(live_config("recommended"), rate=long.rate, guess=False)
-    held = []
+    p = live_config("recommended")
+    s = Stream(p, rate=long.rate, guess=False)
+    held, smoother_held = [], []
     for k in range(0, long.n, 50):
         s.extend(long.t[k:k + 50], long.acc[k:k + 50], long.gyr[k:k + 50])
         s.final()
         held.append(s.pending())
+        smoother_held += [st.held() for st in s._stages if isinstance(st, KalmanStage)]
     assert max(held[10:]) < 4 * long.rate  # seconds of samples held, however long the walk
     assert max(held[10:]) <= 2 * np.median(held[10:]) + long.rate
+    ends = segment_ends(p.run(long).stance, closed=True)
+    longest_stride = int(np.diff(ends).max())  # samples between two ends of stance
+    assert 0 < max(smoother_held) <= longest_stride + 50  # a stride, and the packet that closed it
 
 
 def test_a_kept_stream_gives_the_batch_result_with_its_strides(walk):
