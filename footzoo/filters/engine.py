@@ -259,8 +259,10 @@ class KalmanEngine:
 
         ``rows``: per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and the record
         (:meth:`advance` with ``record``; ``record_first`` indexing ``record_rows``), its row 0 the
-        first sample after the last segment end, aligned with ``stance``. The segments end where :func:`footzoo.filters.stepwise.segment_ends`
-        says (``closed``: the data ends at the last row); the rows up to the last end are final.
+        first sample after the last segment end, aligned with ``stance``. The segments end where
+        :func:`footzoo.filters.stepwise.segment_ends` says (``closed``: the data ends at the last row);
+        the rows up to the last end are final. A live stream's stage calls it (the batch run smooths
+        in the loop, by the same rule and kernel).
         """
         from .stepwise import smooth_segments
 
