@@ -22,7 +22,7 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
-from ..filters.stepwise import RECORD_KEYS, ROWS_KEY
+from ..filters.stepwise import RECORD_KEYS, ROWS_KEY, segment_ends
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
@@ -307,6 +307,8 @@ class KalmanStage:
         if not len(self.open):
             return {}
         rows = self.open.view()
+        if not segment_ends(rows["stance"], closed).size:  # most packets end no stance: nothing to smooth
+            return {}
         held = {**rows, "record_first": rows["record_first"] - self.rows_before,
                 ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else np.zeros((0, 1))}
         n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), closed)
