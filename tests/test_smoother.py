@@ -191,6 +191,12 @@ def test_stepwise_smoothing_improves_on_the_filter_and_comes_close_to_rts(walk):
         np.testing.assert_allclose(runs["stepwise"].pos[-1], runs["none"].pos[-1], atol=1e-12)
 
 
-def test_stepwise_needs_the_compiled_engine(walk):
-    with pytest.raises(ConfigError, match="smoother: stepwise runs on the compiled engine"):
-        _pipeline("duong2015_zupt", "stepwise").run(walk, engine="reference")
+@pytest.mark.parametrize("name", ["duong2015_zupt", "nguyen2016"])
+def test_both_engines_smooth_stride_by_stride_alike(walk, name):
+    """The compiled loop smooths each stride as it closes; the reference (filterpy) after the loop."""
+    p = _pipeline(name, "stepwise")
+    fast, ref = p.run(walk, engine="fast"), p.run(walk, engine="reference")
+    scale = np.abs(ref.pos).max()
+    assert np.abs(fast.pos - ref.pos).max() <= 1e-9 * scale
+    assert np.abs(fast.quat - ref.quat).max() <= 1e-9
+    np.testing.assert_allclose(ref.diagnostics["pos_forward"], fast.diagnostics["pos_forward"], atol=1e-9 * scale)

@@ -215,7 +215,11 @@ class KalmanEngine:
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
                            smoother == "rts", record=record)
         out["diagnostics"] = self.diagnostics(state)
-        if smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
+        if smoother == "stepwise" and record is True:  # the reference engine: every segment after the loop
+            for key in ("quat", "vel", "pos"):
+                out[f"{key}_forward"] = out[key].copy()
+            self.smooth_stepwise(out, stance, closed=True)
+        elif smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
             from .stepwise import smooth_copy
 
             lo = int(record[5][1])
@@ -243,9 +247,8 @@ class KalmanEngine:
         """The step-wise smoother's record for a whole recording, smoothed in the loop: the longest segment's rows."""
         from .stepwise import record_arrays
 
-        if self.engine == "reference":
-            raise ConfigError("smoother: stepwise runs on the compiled engine; engine='reference' smooths with "
-                              "smoother: rts only (use engine='auto' or 'fast')")
+        if self.engine == "reference":  # a row per sample, smoothed after the loop
+            return True
         ends = segment_ends(stance, True)
         longest = int(np.max(np.diff(ends, prepend=-1))) if ends.size else max(len(stance), 1)
         return record_arrays(longest, self.layout.n, state.core[4], in_loop=len(stance))
@@ -291,14 +294,17 @@ class KalmanEngine:
         the loop writes into the record given (one made ``in_loop``).
         """
         n = len(t)
-        if record and self.engine == "reference":
-            raise ConfigError("smoother: stepwise runs on the compiled engine; engine='reference' smooths with "
-                              "smoother: rts only (use engine='auto' or 'fast')")
         if self.engine == "reference":
             from .kalman_reference import run_reference
+            from .stepwise import record_arrays
 
-            return run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
-                                 state["nav"], self.gravity, data, k0, smoother)
+            arrays = record_arrays(n, self.layout.n, sum(m.max_rows for m in state["models"])) if record else None
+            out = run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
+                                state["nav"], self.gravity, data, k0, smoother, arrays)
+            if record:
+                out.update(zip(RECORD_KEYS, (arrays[0], arrays[1], arrays[3], arrays[4]), strict=True))
+                out[ROWS_KEY] = arrays[2]
+            return out
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
