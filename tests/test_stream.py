@@ -225,7 +225,7 @@ def test_the_stream_keeps_only_what_is_pending(walk):
         smoother_held += [st.held() for st in s._stages if isinstance(st, KalmanStage)]
     assert max(held[10:]) < 4 * long.rate  # seconds of samples held, however long the walk
     assert max(held[10:]) <= 2 * np.median(held[10:]) + long.rate
-    ends = segment_ends(p.run(long).stance, closed=True)
+    ends = segment_ends(p.run(long).stance, long.t, closed=True)
     longest_stride = int(np.diff(ends).max())  # samples between two ends of stance
     assert 0 < max(smoother_held) <= longest_stride + 50  # a stride, and the packet that closed it
 
@@ -247,3 +247,27 @@ def test_stream_is_exported_at_the_top_level():
     from footzoo.runtime.stream import Stream as S
 
     assert footzoo.Stream is S and "Stream" in footzoo.__all__
+
+
+def test_the_stepwise_smoother_closes_a_long_stance_after_max_segment_seconds():
+    """Standing still: the stance is split every MAX_SEGMENT seconds, so the stream holds a few
+    seconds of samples, not the whole stand, and still gives the batch run's numbers."""
+    from footzoo.filters.stepwise import MAX_SEGMENT, segment_ends
+    from footzoo.runtime.stages import KalmanStage
+
+    rec = simulate(n_strides=6, profile="physical", rate=100.0, noise=NoiseModel(seed=4), stand_start=12.0,
+                   stand_end=9.0)
+    p = live_config("recommended")
+    batch = p.run(rec)
+    ends = segment_ends(batch.stance, rec.t, closed=True)
+    assert np.diff(rec.t[ends]).max() <= MAX_SEGMENT + 1.5  # the stands are cut into segments
+    s = Stream(p, rate=rec.rate, guess=False)
+    held, parts = [], []
+    for k in range(0, rec.n, 25):
+        s.extend(rec.t[k:k + 25], rec.acc[k:k + 25], rec.gyr[k:k + 25], rec.mag[k:k + 25])
+        parts.append(s.final())
+        held += [st.held() for st in s._stages if isinstance(st, KalmanStage)]
+    parts.append(s.close())
+    final = {key: np.concatenate([q[key] for q in parts]) for key in parts[0]}
+    assert max(held) <= (MAX_SEGMENT + 1.5) * rec.rate + 25
+    assert_final_equals_batch(final, batch, "recommended (stepwise), standing")

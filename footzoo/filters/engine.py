@@ -211,14 +211,14 @@ class KalmanEngine:
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
-        record = self._whole_recording_record(state, stance) if smoother == "stepwise" else False
+        record = self._whole_recording_record(state, stance, t) if smoother == "stepwise" else False
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
                            smoother == "rts", record=record)
         out["diagnostics"] = self.diagnostics(state)
         if smoother == "stepwise" and record is True:  # the reference engine: every segment after the loop
             for key in ("quat", "vel", "pos"):
                 out[f"{key}_forward"] = out[key].copy()
-            self.smooth_stepwise(out, stance, closed=True)
+            self.smooth_stepwise(out, stance, t, closed=True)
         elif smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
             from .stepwise import smooth_copy
 
@@ -243,13 +243,13 @@ class KalmanEngine:
             out.pop(key, None)
         return out
 
-    def _whole_recording_record(self, state: Any, stance: np.ndarray) -> tuple:
+    def _whole_recording_record(self, state: Any, stance: np.ndarray, t: np.ndarray) -> tuple:
         """The step-wise smoother's record for a whole recording, smoothed in the loop: the longest segment's rows."""
         from .stepwise import record_arrays
 
         if self.engine == "reference":  # a row per sample, smoothed after the loop
             return True
-        ends = segment_ends(stance, True)
+        ends = segment_ends(stance, t, True)
         longest = int(np.max(np.diff(ends, prepend=-1))) if ends.size else max(len(stance), 1)
         return record_arrays(longest, self.layout.n, state.core[4], in_loop=len(stance))
 
@@ -257,19 +257,19 @@ class KalmanEngine:
         """Offsets of the INS core's blocks (att, gyro_bias, pos, vel, acc_bias; −1 if absent)."""
         return np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
 
-    def smooth_stepwise(self, rows: dict[str, np.ndarray], stance: np.ndarray, closed: bool) -> int:
+    def smooth_stepwise(self, rows: dict[str, np.ndarray], stance: np.ndarray, t: np.ndarray, closed: bool) -> int:
         """Step-wise smoothing of the segments that have closed in ``rows`` (in place); how many rows are final.
 
         ``rows``: per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and the record
         (:meth:`advance` with ``record``; ``record_first`` indexing ``record_rows``), its row 0 the
-        first sample after the last segment end, aligned with ``stance``. The segments end where
+        first sample after the last segment end, aligned with ``stance`` and ``t`` (s). The segments end where
         :func:`footzoo.filters.stepwise.segment_ends` says (``closed``: the data ends at the last row);
         the rows up to the last end are final. A live stream's stage calls it (the batch run smooths
         in the loop, by the same rule and kernel).
         """
         from .stepwise import smooth_segments
 
-        ends = segment_ends(stance, closed)
+        ends = segment_ends(stance, t, closed)
         if not ends.size:
             return 0
         smooth_segments(record_tuple(rows), ends, 0, 0, self.core_offsets(), not self.carries_attitude,

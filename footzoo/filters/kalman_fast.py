@@ -166,7 +166,7 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother, record):
         record_covariance(record, 0, P)
     for k in range(1, N):
         if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
-            close_segment(record, k, stance, idx, use_ext, quat, vel, pos, gb_out, ab_out)
+            close_segment(record, k, stance, t, idx, use_ext, quat, vel, pos, gb_out, ab_out)
         dt = t[k] - t[k - 1]
         for i in range(3):
             w[i] = gyr[k, i] - nav[10 + i]

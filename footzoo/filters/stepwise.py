@@ -15,7 +15,9 @@ Where a segment ends
     recording. There the forward filter has used every zero-velocity update of the stance;
     its estimate is taken as the smoothed one (``e_k = 0``). A segment holds the samples after
     the previous end up to this one: a swing and the stance after it (the first segment, the
-    still start too). :func:`segment_ends` is the rule; the batch run
+    still start too). A stance that goes on (standing) also ends a segment at its first sample
+    :data:`MAX_SEGMENT` seconds or more after the segment's first, so that memory and latency
+    stay bounded when the wearer stands still. :func:`segment_ends` is the rule; the batch run
     (:meth:`footzoo.filters.engine.KalmanEngine.run`) and the live stage
     (:class:`footzoo.runtime.stages.KalmanStage`) both use it, so a stream's final estimates
     equal the batch run's.
@@ -63,6 +65,10 @@ from .smoother import correct_sample
 
 #: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
 WAITS_FOR = "the end of the next stance"
+
+#: Longest segment (s) before a stance sample closes it although the stance goes on (standing still);
+#: a walking stride with its stance lasts about 1–1.5 s.
+MAX_SEGMENT = 3.0
 
 #: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
 PHI_WIDTH = 19
@@ -208,14 +214,37 @@ def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bi
 
 
 @njit(inline=True)
-def close_segment(record, k, stance, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+def ends_segment(stance, t, k, lo):
+    """Whether sample k (not the last) ends the segment that began at sample ``lo`` (module docstring)."""
+    return stance[k] and (not stance[k + 1] or t[k] - t[lo] >= MAX_SEGMENT)
+
+
+@njit
+def _segment_ends(stance, t, closed):
+    n = stance.shape[0]
+    out = np.empty(n, np.int64)
+    m = 0
+    lo = 0
+    for k in range(n - 1):
+        if ends_segment(stance, t, k, lo):
+            out[m] = k
+            m += 1
+            lo = k + 1
+    if closed and n > 0 and (m == 0 or out[m - 1] != n - 1):
+        out[m] = n - 1
+        m += 1
+    return out[:m]
+
+
+@njit(inline=True)
+def close_segment(record, k, stance, t, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """In the loop over a whole recording, before sample k: smooth the segment that sample k − 1 ended.
 
-    The rule of :func:`segment_ends` (``stance[k − 1]`` and not ``stance[k]``); the record then
-    starts afresh at sample k. Nothing unless the record was made ``in_loop``.
+    The rule of :func:`segment_ends` (:func:`ends_segment`); the record then starts afresh at
+    sample k. Nothing unless the record was made ``in_loop``.
     """
     segment = record[5]
-    if segment[0] and stance[k - 1] and not stance[k]:
+    if segment[0] and ends_segment(stance, t, k - 1, segment[1]):
         lo = segment[1]
         smooth_copy(record, lo, k - 1, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         segment[1] = k
@@ -237,14 +266,13 @@ def smooth_copy(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, ac
     smooth_segment(record, lo, hi, off, idx, use_ext, sq, sv, sp, sg, sa, np.empty(n), np.empty(n), np.empty(n))
 
 
-def segment_ends(stance: np.ndarray, closed: bool) -> np.ndarray:
-    """Indices of the samples that end a segment: the last sample of each stance (module docstring).
+def segment_ends(stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
+    """Indices of the samples that end a segment, the first segment starting at sample 0 (module docstring).
 
-    Sample k ends one when ``stance[k]`` and not ``stance[k + 1]``; the last sample of ``stance``
-    only when ``closed`` (the end of the data; live, its successor is not known yet).
+    Sample k ends one when ``stance[k]`` and not ``stance[k + 1]``, or when ``stance[k]`` and
+    ``stance[k + 1]`` but ``t[k]`` (s) is :data:`MAX_SEGMENT` or more after the segment's first
+    sample; the last sample only when ``closed`` (the end of the data; live, its successor is
+    not known yet).
     """
-    s = np.asarray(stance, dtype=bool)
-    ends = np.flatnonzero(s[:-1] & ~s[1:]).astype(np.int64)
-    if closed and s.size and (ends.size == 0 or ends[-1] != s.size - 1):
-        ends = np.append(ends, np.int64(s.size - 1))
-    return ends
+    return _segment_ends(np.ascontiguousarray(stance, dtype=np.bool_), np.ascontiguousarray(t, dtype=float),
+                         bool(closed))

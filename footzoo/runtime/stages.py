@@ -307,11 +307,11 @@ class KalmanStage:
         if not len(self.open):
             return {}
         rows = self.open.view()
-        if not segment_ends(rows["stance"], closed).size:  # most packets end no stance: nothing to smooth
+        if not segment_ends(rows["stance"], rows["t"], closed).size:  # most packets end no stance: nothing to do
             return {}
         held = {**rows, "record_first": rows["record_first"] - self.rows_before,
                 ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else np.zeros((0, 1))}
-        n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), closed)
+        n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), rows["t"], closed)
         if not n_final:
             return {}
         done = take(_public(rows), 0, n_final)
