@@ -206,7 +206,7 @@ def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias,
 @njit
 def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn (record rows ``k − off``)."""
-    n = (record[2].shape[1] - 1) // 2
+    n = record[0].shape[1]
     lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
     for s in ends:
         smooth_segment(record, lo, s, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
