@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/stream_memory.py [--minutes 60] [--rate 100] [--packet 10] [--configs a,b] [--out FILE.md]
 
-A simulated walk of ``--minutes`` is pushed into a :class:`footzoo.Stream` in packets of
+A simulated walk of ``--minutes`` (laps of a 437.5 m track) is pushed into a :class:`footzoo.Stream` in packets of
 ``--packet`` samples (as a wireless sensor delivers them), the final estimates taken after
 every packet. Every ``--every`` simulated minutes the benchmark records the samples the stream
 holds (``Stream.pending()``) and the Python heap it has allocated beyond the start
@@ -28,18 +28,20 @@ sys.path.insert(0, str(ROOT))
 import footzoo  # noqa: E402
 from footzoo.sim import NoiseModel, simulate  # noqa: E402
 
+#: ``recommended`` runs live with the step-wise smoother (its whole-recording RTS smoother is offline).
 DEFAULT = ["nguyen2016", "yun2012", "duong2015_zupt", "recommended"]
 
 
 def live_pipeline(name: str) -> footzoo.Pipeline:
     p = footzoo.Pipeline.from_yaml(name)
     if p.smoother == "rts":  # the whole-recording smoother is offline: live, the step-wise one
-        p.smoother = "stepwise" if "stepwise" in p.SMOOTHERS else "none"
+        p.smoother = "stepwise"
     return p
 
 
 def measure(name: str, rec: footzoo.Recording, packet: int, every: int) -> dict[str, float]:
-    stream = footzoo.Stream(live_pipeline(name), rate=rec.rate, guess=False, warmup=60.0)
+    pipeline = live_pipeline(name)
+    stream = footzoo.Stream(pipeline, rate=rec.rate, guess=False, warmup=60.0)
     tracemalloc.start()
     base = tracemalloc.get_traced_memory()[0]
     readings = []
@@ -56,7 +58,8 @@ def measure(name: str, rec: footzoo.Recording, packet: int, every: int) -> dict[
     tracemalloc.stop()
     held = np.array([r[1] for r in readings[2:]])
     heap = np.array([r[2] for r in readings[2:]])
-    return {"config": name, "minutes": rec.t[-1] / 60, "held_first": int(held[0]), "held_last": int(held[-1]),
+    label = name + (f" (smoother: {pipeline.smoother})" if pipeline.smoother != "none" else "")
+    return {"config": label, "minutes": rec.t[-1] / 60, "held_first": int(held[0]), "held_last": int(held[-1]),
             "held_max": int(held.max()), "heap_first_kB": heap[0] / 1e3, "heap_last_kB": heap[-1] / 1e3,
             "heap_max_kB": heap.max() / 1e3, "peak_kB": peak / 1e3, "us_per_sample": elapsed / rec.n * 1e6}
 
@@ -70,8 +73,9 @@ def main() -> None:
     ap.add_argument("--out", type=Path)
     args = ap.parse_args()
     warnings.simplefilter("ignore")
-    strides = int(args.minutes * 60 / 1.1)
-    rec = simulate(path="track", n_strides=strides, rate=args.rate, profile="physical", noise=NoiseModel(seed=0))
+    lap = simulate(path="track", rate=args.rate, profile="physical", noise=NoiseModel(seed=0))  # one lap, 437.5 m
+    laps = max(int(np.ceil(args.minutes * 60 / lap.t[-1])), 1)
+    rec = simulate(path="track", laps=laps, rate=args.rate, profile="physical", noise=NoiseModel(seed=0))
     every = max(int(60 * args.rate / args.packet), 1)  # one reading per simulated minute
     rows = [measure(name, rec, args.packet, every) for name in args.configs.split(",")]
     lines = [f"### Live stream memory: {rec.t[-1] / 60:.0f} min simulated walk at {args.rate:g} Hz, packets of "

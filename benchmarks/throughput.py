@@ -2,6 +2,7 @@
 
 Usage: python benchmarks/throughput.py [--samples 1e6] [--repeat 5] [--slow-samples 20000]
                                         [--scaling] [--cold] [--import-time] [--no-table] [--out FILE.md]
+                                        [--configs recommended,...]
 
 Every item runs on the same simulated 100 Hz walk (distance sensors included), interleaved:
 each repetition runs every item once, in the same order, so load on the machine hits all of
@@ -13,7 +14,8 @@ less). Items:
 * (a) the hardware limit: a minimal compiled strapdown loop that stores attitude, velocity
   and position for every sample (benchmarks/hardware_limit.py);
 * every config shipped with footzoo end to end (``Pipeline.run``: detector, alignment, orientation,
-  corrections, the sample table and the step table);
+  corrections, the sample table and the step table); a config with a smoother also with the other
+  smoother (RTS over the whole recording, step-wise) and with its forward filter alone;
 * each orientation filter and each detector alone;
 * (b) plain filterpy loops: a 9-state (position, velocity, attitude) and a 15-state (plus gyro
   and accelerometer biases) zero-velocity-aided error-state filter written directly on
@@ -105,9 +107,13 @@ def kalman_states(p) -> int:
     return int(assemble(p.orientation.carried_by_filter, blocks, p.navigation)[0].n)
 
 
-def config_items(rec, warm) -> list[Item]:
+#: The smoothers a config with one is also timed with (label).
+SMOOTHERS = {"rts": "RTS", "stepwise": "step-wise"}
+
+
+def config_items(rec, warm, names: list[str] | None = None) -> list[Item]:
     items = []
-    for name in CONFIGS:
+    for name in names or CONFIGS:
         p = footzoo.Pipeline.from_yaml(ROOT / "footzoo" / "config" / "builtin" / f"{name}.yaml")
         p.run(warm)  # compile / load the compiled kernels
         n_states = kalman_states(p)
@@ -115,10 +121,13 @@ def config_items(rec, warm) -> list[Item]:
             "-state Kalman"
         label = f"config {name}" + (f" ({n_states} states)" if n_states else "")
         if p.smoother != "none":
-            # a smoother adds a backward pass the targets do not cover: shown apart, with the
-            # same config's forward filter alone judged against its kind's target
-            items.append(Item(f"{label} + {p.smoother.upper()} smoother", f"{kind} + smoother",
-                              lambda p=p: p.run(rec), rec.n))
+            # a smoother adds a backward pass the targets do not cover: shown apart (the config's
+            # own and the other one), with the same config's forward filter alone judged against its kind's target
+            for smoother in (p.smoother, *(s for s in SMOOTHERS if s != p.smoother)):
+                q = footzoo.Pipeline.from_dict({**p.to_dict(), "smoother": smoother})
+                q.run(warm)
+                items.append(Item(f"{label} + {SMOOTHERS[smoother]} smoother", f"{kind} + smoother",
+                                  lambda q=q: q.run(rec), rec.n))
             d = p.to_dict()
             d["smoother"] = "none"
             p = footzoo.Pipeline.from_dict(d)
@@ -258,11 +267,13 @@ def baseline_items(rec, slow: int) -> list[Item]:
     return items
 
 
-def main_table(n: int, repeat: int, slow: int) -> tuple[list[str], dict]:
+def main_table(n: int, repeat: int, slow: int, configs: list[str] | None = None) -> tuple[list[str], dict]:
     rec = walk(n)
     warm = walk(20_000)
     hw = hardware_item(rec)
-    items = [hw] + config_items(rec, warm) + plugin_items(rec, warm) + baseline_items(rec, min(slow, n))
+    items = [hw] + config_items(rec, warm, configs)
+    if not configs:
+        items += plugin_items(rec, warm) + baseline_items(rec, min(slow, n))
     for it in items[1:]:
         if it.n < n:
             it.note = f"first {it.n // 1000} k samples"
@@ -446,11 +457,13 @@ def main() -> None:
     parser.add_argument("--import-time", action="store_true")
     parser.add_argument("--no-table", action="store_true", help="only the optional sections")
     parser.add_argument("--out", type=Path, help="also write the Markdown here")
+    parser.add_argument("--configs", help="only these configs (comma-separated), without the plug-ins and libraries")
     parser.add_argument("--json", type=Path, help="write the main table's numbers here")
     args = parser.parse_args()
     sections = []
     if not args.no_table:
-        lines, results = main_table(int(args.samples), args.repeat, args.slow_samples)
+        lines, results = main_table(int(args.samples), args.repeat, args.slow_samples,
+                                    args.configs.split(",") if args.configs else None)
         sections.append(("Throughput", lines))
         _emit(sections[-1])
         if args.json:

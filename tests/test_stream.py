@@ -27,7 +27,7 @@ def live_config(name: str) -> Pipeline:
     """The shipped config, with a whole-recording smoother replaced by the one that streams."""
     p = Pipeline.from_yaml(name)
     if p.smoother == "rts":
-        p.smoother = "stepwise" if "stepwise" in Pipeline.SMOOTHERS else "none"
+        p.smoother = "stepwise"
     return p
 
 
@@ -113,6 +113,8 @@ def test_latency_is_declared_for_every_shipped_config_and_printed_by_validate(ca
         lat = live_config(config).latency(ctx)
         assert isinstance(lat, Latency) and lat.live, config
     assert Pipeline.from_yaml("recommended").latency(ctx).until[-1] == WHOLE_RECORDING  # rts: offline
+    stepwise = live_config("recommended").latency(ctx)  # a stride is final a sample after its stance's end
+    assert stepwise.until[-1] == "the end of the next stance" and "the end of the next stance" in str(stepwise)
     assert main(["validate", "nguyen2016"]) == 0
     out = capsys.readouterr().out
     assert "latency" in out and "0.02 s" in out
@@ -207,16 +209,25 @@ def test_distance_readings_missing_on_some_samples_count_as_no_reading(walk):
 
 
 def test_the_stream_keeps_only_what_is_pending(walk):
-    """Memory is bounded by the latency: after every packet, only a few strides of samples wait."""
+    """Memory is bounded by the latency: after every packet, only a few strides of samples wait; the
+    step-wise smoother holds one stride at most (the samples after the last stance's end)."""
+    from footzoo.filters.stepwise import segment_ends
+    from footzoo.runtime.stages import KalmanStage
+
     long = simulate(n_strides=150, profile="physical", rate=100.0, noise=NoiseModel(seed=2))
-    s = Stream(live_config("recommended"), rate=long.rate, guess=False)
-    held = []
+    p = live_config("recommended")
+    s = Stream(p, rate=long.rate, guess=False)
+    held, smoother_held = [], []
     for k in range(0, long.n, 50):
         s.extend(long.t[k:k + 50], long.acc[k:k + 50], long.gyr[k:k + 50])
         s.final()
         held.append(s.pending())
+        smoother_held += [st.held() for st in s._stages if isinstance(st, KalmanStage)]
     assert max(held[10:]) < 4 * long.rate  # seconds of samples held, however long the walk
     assert max(held[10:]) <= 2 * np.median(held[10:]) + long.rate
+    ends = segment_ends(p.run(long).stance, long.t, closed=True)
+    longest_stride = int(np.diff(ends).max())  # samples between two ends of stance
+    assert 0 < max(smoother_held) <= longest_stride + 50  # a stride, and the packet that closed it
 
 
 def test_a_kept_stream_gives_the_batch_result_with_its_strides(walk):
@@ -236,3 +247,27 @@ def test_stream_is_exported_at_the_top_level():
     from footzoo.runtime.stream import Stream as S
 
     assert footzoo.Stream is S and "Stream" in footzoo.__all__
+
+
+def test_the_stepwise_smoother_closes_a_long_stance_after_max_segment_seconds():
+    """Standing still: the stance is split every MAX_SEGMENT seconds, so the stream holds a few
+    seconds of samples, not the whole stand, and still gives the batch run's numbers."""
+    from footzoo.filters.stepwise import MAX_SEGMENT, segment_ends
+    from footzoo.runtime.stages import KalmanStage
+
+    rec = simulate(n_strides=6, profile="physical", rate=100.0, noise=NoiseModel(seed=4), stand_start=12.0,
+                   stand_end=9.0)
+    p = live_config("recommended")
+    batch = p.run(rec)
+    ends = segment_ends(batch.stance, rec.t, closed=True)
+    assert np.diff(rec.t[ends]).max() <= MAX_SEGMENT + 1.5  # the stands are cut into segments
+    s = Stream(p, rate=rec.rate, guess=False)
+    held, parts = [], []
+    for k in range(0, rec.n, 25):
+        s.extend(rec.t[k:k + 25], rec.acc[k:k + 25], rec.gyr[k:k + 25], rec.mag[k:k + 25])
+        parts.append(s.final())
+        held += [st.held() for st in s._stages if isinstance(st, KalmanStage)]
+    parts.append(s.close())
+    final = {key: np.concatenate([q[key] for q in parts]) for key in parts[0]}
+    assert max(held) <= (MAX_SEGMENT + 1.5) * rec.rate + 25
+    assert_final_equals_batch(final, batch, "recommended (stepwise), standing")

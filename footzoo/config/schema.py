@@ -34,7 +34,8 @@ TOP_LEVEL_KEYS: dict[str, str] = {
     "detector": "stance detector plug-in {type: ..., params}",
     "corrections": "list of correction plug-ins [{type: ..., params}, ...]",
     "analysis": "list of analysis plug-ins [{type: huang_fpa, ...}] run on the result",
-    "smoother": "none (default) or rts: Rauch-Tung-Striebel smoothing of the Kalman filter (offline)",
+    "smoother": "none (default), rts: Rauch-Tung-Striebel smoothing of the Kalman filter over the whole recording "
+                "(offline), or stepwise: the same smoothing stride by stride (runs live)",
     "navigation": "process noise and initial uncertainty of the Kalman filter's INS core: {velocity_noise: 0.01, "
                   "...} (footzoo list --kind settings)",
     "guards": "what happens when the detector misses stances: {max_swing: 1.5, max_speed: 50, ...} "

@@ -25,6 +25,7 @@ from ..core.params import Real
 from ..kernels import jit as _jit
 from .eskf import ErrorStateFilter, Layout
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
+from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple, segment_ends
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -199,19 +200,38 @@ class KalmanEngine:
 
     # ------------------------------------------------------------------ runs
     def run(self, t, acc, gyr, stance, q0, quat_ext=None, covariance: bool = True,
-            smoother: bool = False) -> dict[str, Any]:
+            smoother: bool | str = False) -> dict[str, Any]:
         """Filter a whole recording; returns the trajectories and each model's diagnostics.
 
-        With ``smoother`` the trajectories are the RTS-smoothed ones (:mod:`footzoo.filters.smoother`)
-        and the forward pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
+        With ``smoother`` (``"rts"`` or True: :mod:`footzoo.filters.smoother`; ``"stepwise"``:
+        :mod:`footzoo.filters.stepwise`) the trajectories are the smoothed ones and the forward
+        pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
         """
+        smoother = {True: "rts", False: "none"}.get(smoother, smoother)
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
+        record = self._whole_recording_record(state, stance, t) if smoother == "stepwise" else False
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
-                           smoother)
+                           smoother == "rts", record=record)
         out["diagnostics"] = self.diagnostics(state)
-        if smoother:
+        if smoother == "stepwise" and record is True:  # the reference engine: every segment after the loop
+            for key in ("quat", "vel", "pos"):
+                out[f"{key}_forward"] = out[key].copy()
+            self.smooth_stepwise(out, stance, t, closed=True)
+        elif smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
+            from .stepwise import smooth_copy
+
+            lo = int(record[5][1])
+            smooth_copy(record, lo, len(t) - 1, lo, self.core_offsets(), not self.carries_attitude, out["quat"],
+                        out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"])
+            for key, smoothed in zip(("quat", "vel", "pos", "gyro_bias", "acc_bias"), record[6], strict=True):
+                if key in ("quat", "vel", "pos"):
+                    out[f"{key}_forward"] = out[key]
+                    out[key] = smoothed
+                elif self.layout.has(key):  # else the forward value (the state's, constant)
+                    out[key] = smoothed
+        if smoother == "rts":
             from .smoother import rts_backward
 
             for key in ("quat", "vel", "pos"):
@@ -219,8 +239,42 @@ class KalmanEngine:
             core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
             rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
                          out["pos"], out["gyro_bias"], out["acc_bias"])
-        del out["gains"], out["dxs"]
+        for key in ("gains", "dxs", "record", ROWS_KEY, *RECORD_KEYS):
+            out.pop(key, None)
         return out
+
+    def _whole_recording_record(self, state: Any, stance: np.ndarray, t: np.ndarray) -> tuple:
+        """The step-wise smoother's record for a whole recording, smoothed in the loop: the longest segment's rows."""
+        from .stepwise import record_arrays
+
+        if self.engine == "reference":  # a row per sample, smoothed after the loop
+            return True
+        ends = segment_ends(stance, t, True)
+        longest = int(np.max(np.diff(ends, prepend=-1))) if ends.size else max(len(stance), 1)
+        return record_arrays(longest, self.layout.n, state.core[4], in_loop=len(stance))
+
+    def core_offsets(self) -> np.ndarray:
+        """Offsets of the INS core's blocks (att, gyro_bias, pos, vel, acc_bias; −1 if absent)."""
+        return np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
+
+    def smooth_stepwise(self, rows: dict[str, np.ndarray], stance: np.ndarray, t: np.ndarray, closed: bool) -> int:
+        """Step-wise smoothing of the segments that have closed in ``rows`` (in place); how many rows are final.
+
+        ``rows``: per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and the record
+        (:meth:`advance` with ``record``; ``record_first`` indexing ``record_rows``), its row 0 the
+        first sample after the last segment end, aligned with ``stance`` and ``t`` (s). The segments end where
+        :func:`footzoo.filters.stepwise.segment_ends` says (``closed``: the data ends at the last row);
+        the rows up to the last end are final. A live stream's stage calls it (the batch run smooths
+        in the loop, by the same rule and kernel).
+        """
+        from .stepwise import smooth_segments
+
+        ends = segment_ends(stance, t, closed)
+        if not ends.size:
+            return 0
+        smooth_segments(record_tuple(rows), ends, 0, 0, self.core_offsets(), not self.carries_attitude,
+                        rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"], rows["acc_bias"])
+        return int(ends[-1]) + 1
 
     def start(self, nav0: np.ndarray) -> Any:
         """The filter's state before sample 0 (resumable with :meth:`advance`)."""
@@ -231,19 +285,38 @@ class KalmanEngine:
         return self.pack(nav0)
 
     def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
-                covariance: bool = True, smoother: bool = False) -> dict[str, np.ndarray]:
-        """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state."""
+                covariance: bool = True, smoother: bool = False, record: bool | tuple = False) -> dict[str, np.ndarray]:
+        """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state.
+
+        ``smoother``: also the RTS gains (``gains``, ``dxs``); ``record``: also the step-wise
+        smoother's record of every row (``record_cov``, ``record_phi``, ``record_first``,
+        ``record_count``, ``record_rows``: :func:`footzoo.filters.stepwise.record_arrays`), or
+        the loop writes into the record given (one made ``in_loop``).
+        """
         n = len(t)
         if self.engine == "reference":
             from .kalman_reference import run_reference
+            from .stepwise import record_arrays
 
-            return run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
-                                 state["nav"], self.gravity, data, k0, smoother)
+            arrays = record_arrays(n, self.layout.n, sum(m.max_rows for m in state["models"])) if record else None
+            out = run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
+                                state["nav"], self.gravity, data, k0, smoother, arrays)
+            if record:
+                out.update(zip(RECORD_KEYS, (arrays[0], arrays[1], arrays[3], arrays[4]), strict=True))
+                out[ROWS_KEY] = arrays[2]
+            return out
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
                "P_diag": np.empty((n if covariance else 0, nx)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
+        if record is True:
+            from .stepwise import record_arrays
+
+            cov, phi, rows, first, count, *_ = record_arrays(n, nx, state.core[4])
+            out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
+            out[ROWS_KEY] = rows
+        out["record"] = record_tuple(out) if record is True else record or None
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
@@ -325,14 +398,15 @@ class KalmanEngine:
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
+        record = out.get("record")  # step-wise smoother
         if packed.bound is not None and not out["gains"].shape[0]:
             packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
-                         k0, work)
+                         k0, work, record)
             return
         measures, feedbacks, afters = packed.functions
         smoother = smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0] else None
         eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0, work, smoother)
+                                                data_off, hooks), outputs, k0, work, smoother, record)
 
 
 _BOUND: dict[tuple, Any] = {}
@@ -413,10 +487,10 @@ def _bound_loop(functions: tuple) -> Any:
         eskf_loop = _jit.compiled(lazy_loop)
         measures, feedbacks, afters = functions
 
-        def bound(signals, core, state, arrays, out, k0, work):
+        def bound(signals, core, state, arrays, out, k0, work, record):
             m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
             eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0, work, None)
+                                             data_off, hooks), out, k0, work, None, record)
 
         import numba
 

@@ -25,6 +25,7 @@ import numpy as np
 from ..kernels import jit as _jit
 from ..kernels.jit import njit
 from .smoother import feed_back_attitude
+from .stepwise import close_segment, record_covariance, record_row, record_transition
 from .strapdown import quat_product, rotvec_quat
 
 
@@ -61,7 +62,7 @@ if _jit.HAVE_NUMBA:
 
 
 @njit
-def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
+def eskf_loop(signals, core, state, models, out, k0, scratch, smoother, record):
     """Run samples 1… of ``signals`` from ``state`` (updated in place); outputs into ``out``.
 
     Parameters
@@ -92,6 +93,12 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
         For an RTS smoother (:mod:`footzoo.filters.smoother`), from :func:`smoother_arrays`: its
         gains ``A_k`` (N, n, n) and fed-back errors (N, n) are written. ``None`` (no smoother):
         numba compiles the loop without the smoother's code.
+    record : tuple or None
+        For the step-wise smoother (:mod:`footzoo.filters.stepwise`), from
+        :func:`footzoo.filters.stepwise.record_arrays` with a row per sample: each sample's
+        ``P⁺``, Φ's blocks and update rows are written (made ``in_loop``: each segment is smoothed
+        in place as soon as it has closed, the last one left to the caller). ``None``: compiled
+        without that code.
     """
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max, impact = core
@@ -155,7 +162,11 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
     if keep_p:
         for i in range(n):
             pdiag[0, i] = P[i, i]
+    if record is not None:  # step-wise smoother: P⁺ of the incoming state
+        record_covariance(record, 0, P)
     for k in range(1, N):
+        if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
+            close_segment(record, k, stance, t, idx, use_ext, quat, vel, pos, gb_out, ab_out)
         dt = t[k] - t[k - 1]
         for i in range(3):
             w[i] = gyr[k, i] - nav[10 + i]
@@ -199,6 +210,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
         sdt[0, 0], sdt[0, 1], sdt[0, 2] = 0.0, dt * fn2, -dt * fn1
         sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * fn2, 0.0, dt * fn0
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * fn1, -dt * fn0, 0.0
+        if record is not None:  # step-wise smoother: Φ's blocks
+            record_transition(record, k, dt, sdt, cdt)
         # Φ P in place, rows in the order pos (reads vel), vel (reads att, acc_bias), att (reads gyro_bias)
         for i in range(3):
             for j in range(n):
@@ -285,10 +298,13 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
                 for e in range(cnt):
                     b = nzc[e]
                     hu += H[a, b] * u[b]
-                    H[a, b] = 0.0  # leave H all zero for the next sample
                 s_ = hu + rdiag[a]
                 for i in range(n):
                     kv[i] = u[i] / s_
+                if record is not None:  # step-wise smoother: the row, its gain, ν / s
+                    record_row(record, k, H[a], kv, innov / s_)
+                for e in range(cnt):
+                    H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
                 for i in range(n):
                     g[i] = u[i] - kv[i] * s_
                     dx[i] += kv[i] * innov
@@ -331,6 +347,8 @@ def eskf_loop(signals, core, state, models, out, k0, scratch, smoother):
         if keep_p:
             for i in range(n):
                 pdiag[k, i] = P[i, i]
+        if record is not None:  # step-wise smoother: P⁺_k
+            record_covariance(record, k, P)
 
 
 def scratch(n: int, m_max: int) -> tuple:

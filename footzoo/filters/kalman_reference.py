@@ -30,6 +30,7 @@ def run_reference(
     data: list[np.ndarray] | None = None,
     k0: int = 0,
     smooth: bool = False,
+    record: tuple | None = None,
 ) -> dict[str, np.ndarray]:
     """Strapdown mechanisation with error-state Kalman corrections (Nguyen & La 2016, eqs. 37–52).
 
@@ -61,6 +62,10 @@ def run_reference(
         Index of sample 0 in the whole recording (a stream's running count).
     smooth : bool
         Also return ``gains`` (N, n, n) and ``dxs`` (N, n) for :mod:`footzoo.filters.smoother`.
+    record : tuple, optional
+        The step-wise smoother's record (:func:`footzoo.filters.stepwise.record_arrays`, a row per
+        sample), filled as the compiled loop fills it (:func:`record_update` gives filterpy's stacked
+        update as the compiled loop's scalar rows).
 
     Returns
     -------
@@ -83,6 +88,8 @@ def run_reference(
     work = (np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)),
             np.empty(layout.n, dtype=np.int64))
     _store(out, 0, nav, np.zeros(3), kf.P)
+    if record is not None:
+        record[0][0] = kf.P
     for k in range(1, n):
         dt = t[k] - t[k - 1]
         w = gyr[k] - nav[10:13]
@@ -102,6 +109,8 @@ def run_reference(
         kf.predict(F, dt, float(a_n @ a_n))
         if smooth:
             smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
+        if record is not None:
+            record_transition(record, k, F, layout, c, dt)
         z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
         m = 0
         st = bool(stance[k])
@@ -109,6 +118,8 @@ def run_reference(
             row = d[k] if d is not None and d.shape[1] else np.zeros(0)
             m = int(model.measure(k0 + k, float(t[k]), nav, w, f, st, ix, model.par, model.mem, row, z, H, R, m))
         if m:
+            if record is not None:
+                record_update(record, k, kf.P, z[:m], H[:m], R[:m])
             dx = kf.update(z[:m], H[:m], np.diag(R[:m]))
             if ins:
                 qn = quat_mul(quat_from_rotvec(-dx[layout["att"]]), nav[:4])
@@ -126,7 +137,40 @@ def run_reference(
         for model, ix in zip(models, idx, strict=True):
             model.after(k0 + k, nav, st, ix, model.par, model.mem)
         _store(out, k, nav, a_n, kf.P)
+        if record is not None:
+            record[0][k] = kf.P
     return out
+
+
+def record_transition(record: tuple, k: int, F: np.ndarray, layout: Layout, c: np.ndarray, dt: float) -> None:
+    """Φ_k's blocks into the step-wise smoother's record (as :func:`footzoo.filters.stepwise.record_transition`)."""
+    phi, first, count = record[1], record[3], record[4]
+    phi[k, 0] = dt
+    if layout.has("att"):
+        phi[k, 1:10] = F[layout["vel"], layout["att"]].ravel()
+    phi[k, 10:19] = (dt * c).ravel()
+    first[k] = first[k - 1] + count[k - 1]
+    count[k] = 0
+
+
+def record_update(record: tuple, k: int, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> None:
+    """The update of sample k as scalar rows (h, gain, ν / s) from the prior ``P``, into the record.
+
+    filterpy updates with the stacked rows; one row at a time (R diagonal) gives the same estimate
+    and covariance, and the rows the compiled loop records.
+    """
+    rows, first, count = record[2], record[3], record[4]
+    n = P.shape[0]
+    Pa, dx = P.copy(), np.zeros(n)
+    for a in range(len(z)):
+        u = Pa @ H[a]
+        s = float(H[a] @ u + R[a])
+        gain = u / s
+        nu = float(z[a] - H[a] @ dx)
+        dx += gain * nu
+        Pa -= np.outer(gain, u)
+        rows[first[k] + a] = np.concatenate([H[a], gain, [nu / s]])
+    count[k] = len(z)
 
 
 def _store(out: dict[str, np.ndarray], k: int, nav: np.ndarray, a_n: np.ndarray, P: np.ndarray) -> None:

@@ -91,10 +91,24 @@ def feed_back_attitude(q, ex, ey, ez):
 
 
 @njit
+def correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """Apply the smoothed error ``e`` of sample k as the feedback is (``p ← p − e_p``, ``q ← exp(−e_φ) ⊗ q``, ...)."""
+    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
+    for i in range(3):
+        pos[k, i] -= e[pos_i + i]
+        vel[k, i] -= e[vel_i + i]
+        if gb_i >= 0:
+            gyro_bias[k, i] += e[gb_i + i]
+        if ab_i >= 0:
+            acc_bias[k, i] += e[ab_i + i]
+    if att >= 0 and not use_ext:
+        feed_back_attitude(quat[k], e[att], e[att + 1], e[att + 2])
+
+
+@njit
 def rts_backward(A, dxs, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Backward pass: correct the forward trajectories in place (see the module docstring)."""
     N, n = dxs.shape
-    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
     e = np.zeros(n)
     s = np.empty(n)
     for k in range(N - 2, -1, -1):
@@ -105,12 +119,4 @@ def rts_backward(A, dxs, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
             for j in range(n):
                 acc_ += A[k, i, j] * s[j]
             e[i] = acc_
-        for i in range(3):
-            pos[k, i] -= e[pos_i + i]
-            vel[k, i] -= e[vel_i + i]
-            if gb_i >= 0:
-                gyro_bias[k, i] += e[gb_i + i]
-            if ab_i >= 0:
-                acc_bias[k, i] += e[ab_i + i]
-        if att >= 0 and not use_ext:
-            feed_back_attitude(quat[k], e[att], e[att + 1], e[att + 2])
+        correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)

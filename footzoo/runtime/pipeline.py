@@ -28,6 +28,7 @@ from ..core.data import Recording, Result
 from ..core.errors import ConfigError, RecordingError
 from ..core.table import samples_frame
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
+from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from ..plugins.base import (
     AccelerationCorrection,
@@ -72,10 +73,13 @@ class Pipeline:
         Run on the finished trajectory.
     navigation : NavigationNoise or dict, optional
         Process noise and initial uncertainty of the INS core of the Kalman filter.
-    smoother : {"none", "rts"}
+    smoother : {"none", "rts", "stepwise"}
         ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
-        (:mod:`footzoo.filters.smoother`; offline only). The forward trajectory stays in
-        ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
+        over the whole recording (:mod:`footzoo.filters.smoother`; offline only). ``stepwise``:
+        the same backward pass over each stride, from the last sample of a stance back to the
+        previous one (Colomar, Nilsson & Händel 2012; :mod:`footzoo.filters.stepwise`): it runs
+        live, each stride final once the stance after it has ended. The forward trajectory
+        stays in ``Result.diagnostics['pos_forward']`` (and ``vel_forward``, ``quat_forward``).
     plugins : list of str, optional
         External plug-in modules or ``.py`` files (absolute paths) the config needs; recorded in
         :meth:`to_dict` (loading them is :meth:`from_dict`'s job, see :mod:`footzoo.plugins.extensions`).
@@ -89,7 +93,7 @@ class Pipeline:
         ``Result.diagnostics["calibration"]``.
     """
 
-    SMOOTHERS = ("none", "rts")
+    SMOOTHERS = ("none", "rts", "stepwise")
 
     def __init__(
         self,
@@ -201,6 +205,8 @@ class Pipeline:
         parts += [b.latency(ctx) for b in self.blocks() if b is not self.detector and not isinstance(b, Calibration)]
         if self.smoother == "rts":
             parts.append(Latency(until=(WHOLE_RECORDING,)))
+        elif self.smoother == "stepwise":  # a stride closes at its stance's last sample, seen at the next one
+            parts.append(Latency(ctx.seconds(1), (STEPWISE_WAIT,)))
         if any(not c.is_fitted() for c in self.calibration):
             parts.append(Latency(warmup=STREAM_WARMUP))
         return total(parts)
@@ -347,7 +353,7 @@ class Pipeline:
         if kalman:
             samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
             eng = self.kalman_engine(kalman, samples, engine)
-            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother == "rts")
+            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother)
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
             if covariance:
                 out["diagnostics"]["P_diag"] = out["P_diag"]

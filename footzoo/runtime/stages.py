@@ -22,6 +22,7 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
+from ..filters.stepwise import RECORD_KEYS, ROWS_KEY, segment_ends
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
@@ -250,9 +251,17 @@ class OrientationStage:
 
 
 class KalmanStage:
-    """The error-state Kalman engine, advanced sample by sample from its carried state."""
+    """The error-state Kalman engine, advanced sample by sample from its carried state.
 
-    def __init__(self, engine: Any, corrections: list[KalmanCorrection], q0: np.ndarray, external_attitude: bool):
+    With ``smoother="stepwise"`` (:mod:`footzoo.filters.stepwise`) the engine also records each
+    sample for the backward pass; the samples wait in the open segment until the segment closes
+    (the first sample after a stance has been seen, or the end of the data), are smoothed as
+    the batch run smooths them (:meth:`KalmanEngine.smooth_stepwise`, the same rule and kernel)
+    and become final. Their provisional estimates are the forward filter's.
+    """
+
+    def __init__(self, engine: Any, corrections: list[KalmanCorrection], q0: np.ndarray, external_attitude: bool,
+                 smoother: str = "none"):
         self.engine = engine
         self.corrections = corrections
         nav0 = np.zeros(16)
@@ -260,36 +269,80 @@ class KalmanStage:
         self.state = engine.live(engine.start(nav0))
         self.external = external_attitude
         self.prev: Chunk | None = None  # the last sample the engine has processed (its row 0 of a chunk)
+        self.stepwise = smoother == "stepwise"
+        self.open = Columns()  # step-wise smoother: the open segment's samples, forward estimates and record
+        self.open_rows = Columns()  # ... and its update rows (record_first: absolute row numbers)
+        self.rows_before = 0  # rows of the samples released (the absolute number of open_rows' first row)
 
-    def _advance(self, state: Any, chunk: Chunk, prev: Chunk | None) -> dict[str, np.ndarray]:
+    def _advance(self, state: Any, chunk: Chunk, prev: Chunk | None, record: bool = False) -> dict[str, np.ndarray]:
         """Run the engine over ``chunk`` from ``state`` (the state of ``prev``, or the initial one)."""
         rows = concat([prev, chunk]) if prev is not None else chunk
         samples = Samples(rows["t"], rows["acc"], rows["gyr"], rows.get("mag"), rows.get("dist"),
                           rows["init"].astype(bool))
         data = [np.ascontiguousarray(c.sample_data(samples), dtype=float) for c in self.corrections]
         out = self.engine.advance(state, rows["t"], rows["acc"], rows["gyr"], rows["stance"].astype(bool),
-                                  rows["quat"] if self.external else None, data, int(rows["k"][0]), covariance=False)
+                                  rows["quat"] if self.external else None, data, int(rows["k"][0]), covariance=False,
+                                  record=record)
         skip = 0 if prev is None else 1
-        return {k: v[skip:] for k, v in out.items() if k in ("quat", "vel", "pos", "acc_nav")}
+        keys = ("quat", "vel", "pos", "acc_nav", *(("gyro_bias", "acc_bias", *RECORD_KEYS) if record else ()))
+        done = {k: out[k][skip:] for k in keys}
+        if record:
+            done[ROWS_KEY] = out[ROWS_KEY][:int(out["record_first"][-1] + out["record_count"][-1])]
+        return done
 
     def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
-        if not length(chunk):
+        if length(chunk):
+            out = self._advance(self.state, chunk, self.prev, record=self.stepwise)
+            self.prev = take(chunk, length(chunk) - 1)
+            if not self.stepwise:
+                return {**chunk, **out}
+            rows = out.pop(ROWS_KEY)
+            out["record_first"] = out["record_first"] + (self.rows_before + len(self.open_rows))
+            self.open.append({**chunk, **out})
+            self.open_rows.append({"row": rows})
+        return self._close_segments(finish) if self.stepwise else {}
+
+    def _close_segments(self, closed: bool) -> Chunk:
+        """The samples of the segments that have closed, smoothed (``closed``: the data ends here)."""
+        if not len(self.open):
             return {}
-        out = self._advance(self.state, chunk, self.prev)
-        self.prev = take(chunk, length(chunk) - 1)
-        return {**chunk, **out}
+        rows = self.open.view()
+        if not segment_ends(rows["stance"], rows["t"], closed).size:  # most packets end no stance: nothing to do
+            return {}
+        no_rows = np.zeros((0, 1 + 2 * rows["record_cov"].shape[1]))
+        held = {**rows, "record_first": rows["record_first"] - self.rows_before,
+                ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else no_rows}
+        n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), rows["t"], closed)
+        if not n_final:
+            return {}
+        done = take(_public(rows), 0, n_final)
+        released = int(held["record_first"][n_final - 1] + held["record_count"][n_final - 1])
+        self.open.drop(n_final)
+        self.open_rows.drop(released)
+        self.rows_before += released
+        return done
 
     def finish(self) -> Chunk:
-        return {}
+        return self._close_segments(True) if self.stepwise else {}
 
     def held(self) -> int:
-        return 0
+        """Samples of the open segment (step-wise smoother), waiting for the end of the next stance."""
+        return len(self.open)
 
     def guess(self, extra: Chunk) -> Chunk:
-        if not length(extra):
-            return {}
-        state = self.engine.fork(self.state)
-        return {**extra, **self._advance(state, extra, self.prev)}
+        parts = [_public(self.open.view())] if len(self.open) else []
+        if length(extra):
+            state = self.engine.fork(self.state)
+            parts.append({**extra, **self._advance(state, extra, self.prev)})
+        if len(parts) > 1:
+            keys = set(parts[0]) & set(parts[1])
+            parts = [{k: v for k, v in p.items() if k in keys} for p in parts]
+        return concat(parts)
+
+
+def _public(rows: Chunk) -> Chunk:
+    """The columns of a sample (without the step-wise smoother's record and the bias estimates)."""
+    return {k: v for k, v in rows.items() if k not in RECORD_KEYS and k not in ("gyro_bias", "acc_bias")}
 
 
 class BatchNavigationStage:

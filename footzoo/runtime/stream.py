@@ -367,7 +367,8 @@ class Stream:
             samples = Samples(b["t"], calibrated["acc"], calibrated["gyr"], calibrated.get("mag"), b.get("dist"),
                               b["init"])
             engine = pipe.kalman_engine(kalman, samples, self.engine)
-            stages.append(KalmanStage(engine, kalman, q0, external_attitude=not pipe.orientation.carried_by_filter))
+            stages.append(KalmanStage(engine, kalman, q0, external_attitude=not pipe.orientation.carried_by_filter,
+                                      smoother=pipe.smoother))
         else:
             stages.append(BatchNavigationStage(pipe.corrections, self.ctx, pipe.gravity))
         self._stages = stages
