@@ -64,3 +64,14 @@ def test_a_moved_module_still_imports_under_its_old_name_with_a_warning(old, new
     assert module is importlib.import_module(new)
     assert module.__spec__.name == new  # the module keeps its own identity
     assert any(issubclass(w.category, DeprecationWarning) and new in str(w.message) for w in caught)
+
+
+def test_the_live_twin_of_recommended_differs_only_in_its_smoother():
+    """recommended_live is recommended with the step-wise smoother, which streams; the two cannot drift apart."""
+    from footzoo import Pipeline, Stream
+
+    offline, live = Pipeline.from_yaml("recommended").to_dict(), Pipeline.from_yaml("recommended_live").to_dict()
+    assert (offline.pop("smoother"), live.pop("smoother")) == ("rts", "stepwise")
+    assert (offline.pop("name"), live.pop("name")) == ("recommended", "recommended_live")
+    assert offline == live
+    assert Stream(Pipeline.from_yaml("recommended_live"), rate=100.0).latency.live
