@@ -230,7 +230,8 @@ class Pipeline:
             reasons.append(f"fits: {len(fits)} calibration fit(s) for {len(self.calibration)} calibration(s)")
         if self.smoother == "rts":
             reasons.append("smoother 'rts' runs backwards over the whole recording: use smoother: stepwise (it "
-                           "closes each stride once the next stance has been seen) or smoother: none")
+                           "closes each stride once the next stance has been seen; the shipped 'recommended_live' is "
+                           "'recommended' so) or smoother: none")
         return reasons
 
     def with_fits(self, fits: Any) -> Pipeline:
