@@ -43,6 +43,12 @@ print(json.dumps({{"compiled": compiled, "pos": result.pos[-1].tolist()}}))
 """.replace("RECORDING", 'simulate(n_strides=6, rate=100.0, profile="physical")')
 
 
+@pytest.fixture(autouse=True)
+def no_inherited_shipped_kernels(monkeypatch):
+    """These tests choose the shipped folder of each process themselves: not the installed wheel's (conftest.py)."""
+    monkeypatch.delenv("FOOTZOO_SHIPPED_KERNELS", raising=False)
+
+
 def _run(code_or_args: str | list[str], cache: Path, shipped: Path | None = None) -> subprocess.CompletedProcess:
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
     env.pop("FOOTZOO_SHIPPED_KERNELS", None)
