@@ -40,6 +40,15 @@ class PluginError(FootzooError):
         self.method = method
 
 
+class PluginImportError(PluginError, ConfigError):
+    """A plug-in module or file listed under ``plugins:`` failed while it was imported (raised, or exited).
+
+    Both a :class:`PluginError` (the fault is in the plug-in's code; the command line exits with
+    the plug-in error's code) and a :class:`ConfigError` (the config names it: ``footzoo
+    validate`` and a study report it as a problem of the config).
+    """
+
+
 class FootzooWarning(UserWarning):
     """A warning from footzoo: the result is computed but something in the input deserves a look."""
 

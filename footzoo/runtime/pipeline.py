@@ -24,7 +24,7 @@ from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
-from ..core.errors import ConfigError, RecordingError
+from ..core.errors import ConfigError, PluginError, RecordingError
 from ..core.table import samples_frame
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -452,8 +452,9 @@ def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np
         if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
             what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
                     else "NaN/inf")
-            raise RecordingError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
-                                 f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)")
+            raise PluginError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
+                              f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)",
+                              plugin=f"calibration {c.name!r}", method="calibrate")
         out.append(after)
     return tuple(out)
 
