@@ -24,7 +24,7 @@ from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
-from ..core.errors import ConfigError, PluginError, RecordingError
+from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
 from ..core.table import samples_frame
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -150,7 +150,7 @@ class Pipeline:
         try:
             return cls.from_dict(d, base_dir=path.parent)
         except ConfigError as err:
-            raise ConfigError(f"{path}: {err}") from None
+            raise prefixed(err, path) from err.__cause__
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved configuration, every parameter explicit."""
