@@ -49,6 +49,12 @@ SATURATION_FLOOR = {"acc": 2.0 * GRAVITY, "gyr": 2.0}
 PLATEAU_FRACTION = 0.25
 #: Height of a single-sample gyroscope spike above its neighbours' change reported as a glitch (rad/s).
 GLITCH_JUMP = 15.0
+#: Height of an accelerometer burst above its surroundings reported as a glitch (m/s²): above any foot impact
+#: a body-worn sensor measures (the largest jump between two samples of the real recordings in the data
+#: folder — PyShoe walking, running and stairs, x-io, gaitmap, Köroğlu — is 256 m/s², gaitmap's heel strikes).
+ACC_GLITCH_JUMP = 400.0
+#: Longest burst of samples reported as a glitch (a longer excursion is motion, or saturation).
+GLITCH_MAX_LEN = 3
 _AXES = "xyz"
 
 
@@ -105,18 +111,60 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
     return found
 
 
-def find_glitches(gyr: np.ndarray) -> np.ndarray:
-    """Samples whose angular rate spikes alone by more than :data:`GLITCH_JUMP` (indices)."""
-    if len(gyr) < 3:
+def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np.ndarray:
+    """Samples of bursts of 1 to ``max_len`` samples that stand out from the samples around them by more than ``jump``.
+
+    A burst ``x[k:k+L]`` is a glitch when every one of its samples differs from both the sample
+    before (``x[k-1]``) and the sample after (``x[k+L]``) by more than ``jump`` plus the change
+    between those two (a real peak rises and falls over its samples; a glitch jumps and returns).
+    For ``L = 1`` this is the single-sample spike test.
+
+    Parameters
+    ----------
+    x : (N, 3) array
+        Angular rate (rad/s) or specific force (m/s²).
+    jump : float
+        Height above the surrounding change, in the unit of ``x``.
+    max_len : int
+        Longest burst (samples).
+
+    Returns
+    -------
+    (k,) int array
+        The glitch samples, sorted.
+    """
+    n = len(x)
+    if n < 3:
         return np.zeros(0, dtype=int)
-    step = np.diff(gyr, axis=0)
-    step2 = np.einsum("ij,ij->i", step, step)
-    # a spike jumps by more than GLITCH_JUMP on both sides: only those samples need the full test
-    k = np.flatnonzero((step2[:-1] > GLITCH_JUMP**2) & (step2[1:] > GLITCH_JUMP**2)) + 1
-    mid, before, after = gyr[k], gyr[k - 1], gyr[k + 1]
-    jump = np.minimum(np.linalg.norm(mid - before, axis=1), np.linalg.norm(mid - after, axis=1))
-    spike = jump - np.linalg.norm(after - before, axis=1)
-    return k[spike > GLITCH_JUMP]
+    step = np.diff(x, axis=0)
+    big = np.einsum("ij,ij->i", step, step) > jump**2  # big[i]: x jumps between samples i and i+1
+    found = []
+    for length in range(1, max_len + 1):
+        if n < length + 2:
+            break
+        # a burst starts with a jump into it (k-1 -> k) and ends with one out of it (k+L-1 -> k+L)
+        k = np.flatnonzero(big[: n - length - 1] & big[length:]) + 1
+        if not len(k):
+            continue
+        before, after = x[k - 1], x[k + length]
+        height = np.full(len(k), np.inf)
+        for j in range(length):
+            mid = x[k + j]
+            height = np.minimum(height, np.minimum(np.linalg.norm(mid - before, axis=1),
+                                                   np.linalg.norm(mid - after, axis=1)))
+        k = k[height - np.linalg.norm(after - before, axis=1) > jump]
+        found.extend((k[:, None] + np.arange(length)).ravel().tolist())
+    return np.unique(np.asarray(found, dtype=int))
+
+
+def find_glitches(gyr: np.ndarray) -> np.ndarray:
+    """Samples of gyroscope bursts (1 to :data:`GLITCH_MAX_LEN` samples) above :data:`GLITCH_JUMP` (indices)."""
+    return find_bursts(gyr, GLITCH_JUMP)
+
+
+def find_acc_glitches(acc: np.ndarray) -> np.ndarray:
+    """Samples of accelerometer bursts (1 to :data:`GLITCH_MAX_LEN` samples) above :data:`ACC_GLITCH_JUMP`."""
+    return find_bursts(acc, ACC_GLITCH_JUMP)
 
 
 def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording") -> dict[str, Any]:
@@ -135,16 +183,32 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
             "underestimated there; use a sensor with a larger range. Details in meta['sanity']",
             SensorWarning, stacklevel=4,
         )
-    glitches = find_glitches(gyr)
-    if len(glitches):
-        report["gyro_glitches"] = [int(k) for k in glitches]
-        shown = ", ".join(f"{int(k)} (t = {t[k]:.3f} s, |ω| = {np.linalg.norm(gyr[k]):.1f} rad/s)"
-                          for k in glitches[:5])
-        more = f" and {len(glitches) - 5} more" if len(glitches) > 5 else ""
+    report.update(warn_glitches(t, acc, gyr, name, stacklevel=5))
+    return report
+
+
+def warn_glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording",
+                  offset: int = 0, stacklevel: int = 4) -> dict[str, list[int]]:
+    """Warn about gyroscope and accelerometer glitches (:func:`find_bursts`); ``{"gyro_glitches": [...], ...}``.
+
+    ``offset`` is added to the sample numbers (a live chunk's first sample's index in the stream).
+    """
+    report: dict[str, list[int]] = {}
+    for key, label, arr, bound, unit in (("gyro_glitches", "gyroscope", gyr, GLITCH_JUMP, "rad/s"),
+                                         ("acc_glitches", "accelerometer", acc, ACC_GLITCH_JUMP, "m/s²")):
+        found = find_bursts(arr, bound)
+        if not len(found):
+            continue
+        report[key] = [int(k) + offset for k in found]
+        shown = ", ".join(f"{int(k) + offset} (t = {t[k]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
+                          f"{np.linalg.norm(arr[k]):.1f} {unit})" for k in found[:5])
+        more = f" and {len(found) - 5} more" if len(found) > 5 else ""
+        effect = ("a glitch turns the attitude and misplaces the track" if key[0] == "g" else
+                  "a glitch kicks the velocity and misplaces the track")
         warnings.warn(
-            f"{name}: {len(glitches)} isolated gyroscope spike(s) above {GLITCH_JUMP:g} rad/s at sample(s) "
-            f"{shown}{more}: a glitch turns the attitude and misplaces the track. Repair those samples "
-            "(e.g. replace each by its neighbours' mean). Details in meta['sanity']",
-            SensorWarning, stacklevel=4,
+            f"{name}: {len(found)} isolated {label} spike(s) above {bound:g} {unit} at sample(s) {shown}{more} "
+            f"(bursts of 1 to {GLITCH_MAX_LEN} samples): {effect}. Repair those samples (e.g. replace them by the "
+            "neighbours' mean). Details in meta['sanity']",
+            SensorWarning, stacklevel=stacklevel,
         )
     return report
