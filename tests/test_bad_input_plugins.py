@@ -47,7 +47,7 @@ def _still(gyr):
 class Raising(Detector):
     """Raises a ZeroDivisionError (a bug in a plug-in)."""
 
-    name = "fault_raising"
+    name = "test_fault_raising"
 
     def detect(self, t, acc, gyr, ctx=None):
         return 1 / 0
@@ -57,7 +57,7 @@ class Raising(Detector):
 class Exiting(Detector):
     """Calls sys.exit() in its action method."""
 
-    name = "fault_exiting"
+    name = "test_fault_exiting"
 
     def detect(self, t, acc, gyr, ctx=None):
         raise SystemExit(0)
@@ -67,7 +67,7 @@ class Exiting(Detector):
 class NoReturn(Detector):
     """Forgets ``return self``."""
 
-    name = "fault_no_return"
+    name = "test_fault_no_return"
 
     def detect(self, t, acc, gyr, ctx=None):
         self.stance_ = _still(gyr)
@@ -78,7 +78,7 @@ class NoReturn(Detector):
 class NanStance(Detector):
     """A float stance with NaN where it did not decide (NaN would read as True in a bool cast)."""
 
-    name = "fault_nan_stance"
+    name = "test_fault_nan_stance"
 
     def detect(self, t, acc, gyr, ctx=None):
         stance = _still(gyr).astype(float)
@@ -91,7 +91,7 @@ class NanStance(Detector):
 class ShortStance(Detector):
     """One sample short."""
 
-    name = "fault_short_stance"
+    name = "test_fault_short_stance"
 
     def detect(self, t, acc, gyr, ctx=None):
         self.stance_, self.statistic_ = _still(gyr)[:-1], np.linalg.norm(gyr, axis=1)
@@ -102,7 +102,7 @@ class ShortStance(Detector):
 class Mutating(Detector):
     """Writes into its input (gyr[:] = 0) instead of a copy."""
 
-    name = "fault_mutating"
+    name = "test_fault_mutating"
 
     def detect(self, t, acc, gyr, ctx=None):
         gyr -= gyr.mean(axis=0)
@@ -114,7 +114,7 @@ class Mutating(Detector):
 class LiveNanStance(AngularRateFSM):
     """Yun's FSM whose live chunks carry a NaN stance (a float column)."""
 
-    name = "fault_live_nan_stance"
+    name = "test_fault_live_nan_stance"
 
     def step(self, t, acc, gyr):
         out = dict(super().step(t, acc, gyr))
@@ -129,7 +129,7 @@ class LiveNanStance(AngularRateFSM):
 class LiveMutating(AngularRateFSM):
     """Yun's FSM that, live, removes the chunk's mean rate in place."""
 
-    name = "fault_live_mutating"
+    name = "test_fault_live_mutating"
 
     def step(self, t, acc, gyr):
         gyr -= gyr.mean(axis=0)
@@ -140,7 +140,7 @@ class LiveMutating(AngularRateFSM):
 class Scaled(Madgwick):
     """Madgwick's filter whose quaternions are multiplied by ``scale`` (not unit when scale ≠ 1)."""
 
-    name = "fault_scaled_quat"
+    name = "test_fault_scaled_quat"
 
     def __init__(self, scale: float = 1.5):
         super().__init__(use_magnetometer=False)
@@ -155,7 +155,7 @@ class Scaled(Madgwick):
 class NanVelocity(VelocityCorrection):
     """Returns NaN velocities."""
 
-    name = "fault_nan_velocity"
+    name = "test_fault_nan_velocity"
 
     def apply(self, t, acc_nav, stance, ctx=None):
         self.vel_ = np.full((len(t), 3), np.nan)
@@ -167,7 +167,7 @@ class NanVelocity(VelocityCorrection):
 class RaisingAnalysis(Analysis):
     """Raises KeyError in analyze."""
 
-    name = "fault_analysis"
+    name = "test_fault_analysis"
 
     def analyze(self, t, quat, pos, stance, meta):
         return meta["no such key"]
@@ -180,7 +180,7 @@ class RaisingAnalysis(Analysis):
 class WrongCalibration(Calibration):
     """Returns the accelerometer with a column missing."""
 
-    name = "fault_calibration"
+    name = "test_fault_calibration"
 
     def calibrate(self, t, acc, gyr, mag):
         self.acc_, self.gyr_, self.mag_, self.report_ = acc[:, :2], gyr, mag, {}
@@ -194,16 +194,16 @@ def _config(**parts):
 
 
 BATCH = [
-    ("raising", _config(detector={"type": "fault_raising"}), "detect", "ZeroDivisionError"),
-    ("exiting", _config(detector={"type": "fault_exiting"}), "detect", "never exit the process"),
-    ("no_return", _config(detector={"type": "fault_no_return"}), "detect", "return self"),
-    ("nan_stance", _config(detector={"type": "fault_nan_stance"}), "detect", "NaN is not stance"),
-    ("short_stance", _config(detector={"type": "fault_short_stance"}), "detect", r"shape \(\d+,\)"),
-    ("mutating", _config(detector={"type": "fault_mutating"}), "detect", "copy it first"),
-    ("non_unit_quat", _config(orientation={"type": "fault_scaled_quat"}), "step", "non-unit quaternions"),
-    ("nan_velocity", _config(corrections=[{"type": "fault_nan_velocity"}]), "apply", "non-finite"),
-    ("analysis", _config(analysis=[{"type": "fault_analysis"}]), "analyze", "KeyError"),
-    ("calibration", _config(calibration=[{"type": "fault_calibration"}]), "calibrate", r"shape \(\d+, 2\)"),
+    ("raising", _config(detector={"type": "test_fault_raising"}), "detect", "ZeroDivisionError"),
+    ("exiting", _config(detector={"type": "test_fault_exiting"}), "detect", "never exit the process"),
+    ("no_return", _config(detector={"type": "test_fault_no_return"}), "detect", "return self"),
+    ("nan_stance", _config(detector={"type": "test_fault_nan_stance"}), "detect", "NaN is not stance"),
+    ("short_stance", _config(detector={"type": "test_fault_short_stance"}), "detect", r"shape \(\d+,\)"),
+    ("mutating", _config(detector={"type": "test_fault_mutating"}), "detect", "copy it first"),
+    ("non_unit_quat", _config(orientation={"type": "test_fault_scaled_quat"}), "step", "non-unit quaternions"),
+    ("nan_velocity", _config(corrections=[{"type": "test_fault_nan_velocity"}]), "apply", "non-finite"),
+    ("analysis", _config(analysis=[{"type": "test_fault_analysis"}]), "analyze", "KeyError"),
+    ("calibration", _config(calibration=[{"type": "test_fault_calibration"}]), "calibrate", r"shape \(\d+, 2\)"),
 ]
 
 
@@ -223,26 +223,26 @@ def test_a_faulty_plugin_is_a_plugin_error_naming_it_and_the_recording_is_unchan
 
 def test_the_original_error_is_chained(walk):
     with pytest.raises(PluginError) as info:
-        Pipeline.from_dict(_config(detector={"type": "fault_raising"})).run(walk)
+        Pipeline.from_dict(_config(detector={"type": "test_fault_raising"})).run(walk)
     assert isinstance(info.value.__cause__, ZeroDivisionError)
 
 
 def test_tiny_quaternion_drift_is_accepted_and_the_numbers_are_those_of_the_filter(walk):
     drift = 1 + QUAT_NORM_TOL / 10
-    ok = Pipeline.from_dict(_config(orientation={"type": "fault_scaled_quat", "scale": drift})).run(walk)
-    ref = Pipeline.from_dict(_config(orientation={"type": "fault_scaled_quat", "scale": 1.0})).run(walk)
+    ok = Pipeline.from_dict(_config(orientation={"type": "test_fault_scaled_quat", "scale": drift})).run(walk)
+    ref = Pipeline.from_dict(_config(orientation={"type": "test_fault_scaled_quat", "scale": 1.0})).run(walk)
     assert np.isfinite(ok.pos).all() and np.abs(ok.quat - ref.quat * drift).max() < 1e-12
 
 
 def test_live_a_nan_stance_chunk_is_a_plugin_error(walk):
-    stream = Stream(Pipeline.from_dict(_config(detector={"type": "fault_live_nan_stance"})), rate=walk.rate)
+    stream = Stream(Pipeline.from_dict(_config(detector={"type": "test_fault_live_nan_stance"})), rate=walk.rate)
     with pytest.raises(PluginError, match="NaN is not stance") as info:
         stream.run(walk)
     assert info.value.method == "step"
 
 
 def test_live_a_mutating_plugin_cannot_change_the_pushed_samples(walk):
-    stream = Stream(Pipeline.from_dict(_config(detector={"type": "fault_live_mutating"})), rate=walk.rate)
+    stream = Stream(Pipeline.from_dict(_config(detector={"type": "test_fault_live_mutating"})), rate=walk.rate)
     gyr = walk.gyr.copy()
     with pytest.raises(PluginError, match="copy it first"):
         stream.run(walk)
@@ -290,14 +290,14 @@ def test_a_faulty_plugin_in_a_study_fails_its_cells_only():
     study = Study.from_dict({
         "name": "faulty",
         "base": _config(),
-        "factors": {"detector.type": ["angular_rate_fsm", "fault_raising"]},
+        "factors": {"detector.type": ["angular_rate_fsm", "test_fault_raising"]},
         "recordings": [{"simulate": {"path": "straight", "n_strides": 4, "rate": 50}, "seeds": [0]}],
         "metrics": ["path_length_m"],
     })
     table = run_study(study)
-    good, bad = table[table["detector.type"] == "angular_rate_fsm"], table[table["detector.type"] == "fault_raising"]
+    good, bad = table[table["detector.type"] == "angular_rate_fsm"], table[table["detector.type"] == "test_fault_raising"]
     assert len(good) and good["error"].isna().all() and np.isfinite(good["value"].astype(float)).all()
-    assert len(bad) and bad["error"].str.contains("PluginError: detector 'fault_raising'").all()
+    assert len(bad) and bad["error"].str.contains("PluginError: detector 'test_fault_raising'").all()
     assert bad["error"].str.contains("ZeroDivisionError").all()
 
 
@@ -336,12 +336,12 @@ def test_property_quaternions_beyond_the_tolerance_are_refused(scale, k):
                             ZeroDivisionError, AssertionError, RecursionError, SystemExit]))
 def test_property_any_exception_of_a_plugin_is_a_plugin_error(exc):
     class Any_(Orientation):
-        name = "fault_any"
+        name = "test_fault_any"
 
         def estimate(self, t, acc, gyr, mag, stance, q0, ctx=None):
             raise exc("boom")
 
     t = np.arange(10) / 100.0
-    with pytest.raises(PluginError, match=f"fault_any.*estimate.*{exc.__name__}") as info:
+    with pytest.raises(PluginError, match=f"test_fault_any.*estimate.*{exc.__name__}") as info:
         Any_().estimate(t, np.zeros((10, 3)), np.zeros((10, 3)), None, np.ones(10, bool), np.array([1.0, 0, 0, 0]))
     assert isinstance(info.value.__cause__, exc)

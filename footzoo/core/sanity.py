@@ -188,27 +188,176 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
 
 
 def warn_glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording",
-                  offset: int = 0, stacklevel: int = 4) -> dict[str, list[int]]:
-    """Warn about gyroscope and accelerometer glitches (:func:`find_bursts`); ``{"gyro_glitches": [...], ...}``.
+                  stacklevel: int = 4) -> dict[str, list[int]]:
+    """Warn about gyroscope and accelerometer glitches (:func:`find_bursts`); ``{"gyro_glitches": [...], ...}``."""
+    found = _glitches(t, acc, gyr)
+    _warn_found(t, acc, gyr, found, name, 0, stacklevel + 1)
+    return found
 
-    ``offset`` is added to the sample numbers (a live chunk's first sample's index in the stream).
-    """
-    report: dict[str, list[int]] = {}
+
+def _warn_found(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, found: dict[str, list[int]], name: str,
+                offset: int = 0, stacklevel: int = 5) -> None:
+    """The warnings of glitches ``found`` (absolute sample numbers; ``offset``: that of the arrays' first sample)."""
     for key, label, arr, bound, unit in (("gyro_glitches", "gyroscope", gyr, GLITCH_JUMP, "rad/s"),
                                          ("acc_glitches", "accelerometer", acc, ACC_GLITCH_JUMP, "m/s²")):
-        found = find_bursts(arr, bound)
-        if not len(found):
+        ks = found.get(key)
+        if not ks:
             continue
-        report[key] = [int(k) + offset for k in found]
-        shown = ", ".join(f"{int(k) + offset} (t = {t[k]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
-                          f"{np.linalg.norm(arr[k]):.1f} {unit})" for k in found[:5])
-        more = f" and {len(found) - 5} more" if len(found) > 5 else ""
+        shown = ", ".join(f"{k} (t = {t[k - offset]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
+                          f"{np.linalg.norm(arr[k - offset]):.1f} {unit})" for k in ks[:5])
+        more = f" and {len(ks) - 5} more" if len(ks) > 5 else ""
         effect = ("a glitch turns the attitude and misplaces the track" if key[0] == "g" else
                   "a glitch kicks the velocity and misplaces the track")
         warnings.warn(
-            f"{name}: {len(found)} isolated {label} spike(s) above {bound:g} {unit} at sample(s) {shown}{more} "
+            f"{name}: {len(ks)} isolated {label} spike(s) above {bound:g} {unit} at sample(s) {shown}{more} "
             f"(bursts of 1 to {GLITCH_MAX_LEN} samples): {effect}. Repair those samples (e.g. replace them by the "
             "neighbours' mean). Details in meta['sanity']",
             SensorWarning, stacklevel=stacklevel,
         )
-    return report
+
+
+# --------------------------------------------------------------------------- the scans of a run (batch and live)
+#: Still by the data: |ω| below this (rad/s) and |‖f‖ − g| below :data:`STILL_ACC` (m/s²).
+STILL_GYR = 0.2
+#: Largest |‖f‖ − g| of a still sample (m/s²).
+STILL_ACC = 0.5
+#: Shortest still period (s) whose estimated displacement is checked.
+STILL_MIN_DURATION = 5.0
+#: Displacement of the estimate over a still period above which it is reported as drift (m).
+STILL_MAX_DRIFT = 0.25
+#: Shortest motion after the still start (s) for which "no stance at all" is reported.
+NO_STANCE_MIN_DURATION = 5.0
+
+
+class SignalScan:
+    """Glitches in the signals, chunk by chunk: the same findings as :func:`warn_glitches` on the whole recording.
+
+    Each chunk is scanned with the last :data:`GLITCH_MAX_LEN` + 1 samples of the one before (a
+    burst needs the sample before it and the one after it), and a glitch is reported once.
+    """
+
+    def __init__(self, name: str = "stream"):
+        self.name = name
+        self.report: dict[str, list[int]] = {}
+        self._tail: tuple[np.ndarray, ...] | None = None
+        self._k0 = 0  # absolute index of the tail's first sample
+        self._done = -1  # last sample already reported
+
+    def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, list[int]]:
+        """Scan the next samples; the new findings (also added to :attr:`report`)."""
+        if self._tail is not None:
+            t, acc, gyr = (np.concatenate([a, b]) for a, b in zip(self._tail, (t, acc, gyr), strict=True))
+        keep = GLITCH_MAX_LEN + 1
+        new: dict[str, list[int]] = {}
+        if len(t) >= 3 and (np.abs(np.diff(gyr, axis=0)).max() > GLITCH_JUMP / 2
+                            or np.abs(np.diff(acc, axis=0)).max() > ACC_GLITCH_JUMP / 2):
+            fresh = {key: [k for k in ks if k > self._done]
+                     for key, ks in _glitches(t, acc, gyr, self._k0).items()}
+            fresh = {key: ks for key, ks in fresh.items() if ks}
+            if fresh:
+                _warn_found(t, acc, gyr, fresh, self.name, self._k0)
+                for key, ks in fresh.items():
+                    self.report.setdefault(key, []).extend(ks)
+                self._done = max(max(ks) for ks in fresh.values())
+                new = fresh
+        self._k0 += max(len(t) - keep, 0)
+        self._tail = (t[-keep:], acc[-keep:], gyr[-keep:])
+        return new
+
+
+def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) -> dict[str, list[int]]:
+    out = {}
+    for key, arr, bound in (("gyro_glitches", gyr, GLITCH_JUMP), ("acc_glitches", acc, ACC_GLITCH_JUMP)):
+        found = find_bursts(arr, bound)
+        if len(found):
+            out[key] = [int(k) + offset for k in found]
+    return out
+
+
+class EstimateScan:
+    """Physics of the estimate, fed the final estimates chunk by chunk (a batch run: one chunk of all).
+
+    * **no stance at all** — no stance sample after the still start, over more than
+      :data:`NO_STANCE_MIN_DURATION` s of motion: the velocity was never reset and the track is
+      pure strapdown drift (a detector that never fires on this motion, with the guard off).
+    * **drift while still** — the data say the sensor lies still (|ω| < :data:`STILL_GYR`,
+      |‖f‖ − g| < :data:`STILL_ACC`) for :data:`STILL_MIN_DURATION` s or longer, and the estimate
+      moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness.
+
+    Findings are warned (:class:`~footzoo.core.errors.SensorWarning`, with the samples and the
+    fix) as soon as they are known, and kept in :attr:`report`.
+    """
+
+    def __init__(self, t_start: float, gravity: float = GRAVITY, name: str = "recording", detector: str = "detector"):
+        self.t_start, self.gravity, self.name, self.detector = t_start, gravity, name, detector
+        self.report: dict[str, Any] = {}
+        self._stance = 0
+        self._first: tuple[float, np.ndarray] | None = None  # (t, pos) of the first sample after the still start
+        self._last: tuple[float, np.ndarray] | None = None
+        self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
+
+    def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+             pos: np.ndarray) -> None:
+        """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m)."""
+        if not len(t):
+            return
+        moving = t > self.t_start
+        if moving.any():
+            self._stance += int(np.count_nonzero(stance[moving]))
+            if self._first is None:
+                i = int(np.argmax(moving))
+                self._first = (float(t[i]), pos[i].copy())
+        self._last = (float(t[-1]), pos[-1].copy())
+        still = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (
+            np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STILL_ACC)
+        if not still[0] and self._run is not None:  # the open run ended at the chunk's start
+            self._close(self._run)
+            self._run = None
+        edges = np.flatnonzero(np.diff(np.concatenate([[False], still, [False]]).astype(np.int8)))
+        for s, e in zip(edges[::2], edges[1::2], strict=True):
+            run = self._run if (s == 0 and self._run is not None) else {
+                "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0}
+            run["drift"] = max(run["drift"], float(np.linalg.norm(pos[s:e] - run["pos0"], axis=1).max()))
+            run["last"], run["t1"] = int(k[e - 1]), float(t[e - 1])
+            if e == len(t):
+                self._run = run
+            else:
+                self._close(run)
+                self._run = None
+
+    def _close(self, run: dict[str, Any]) -> None:
+        duration = run["t1"] - run["t0"]
+        if duration < STILL_MIN_DURATION or run["drift"] <= STILL_MAX_DRIFT:
+            return
+        finding = {"first": run["first"], "last": run["last"], "t0": run["t0"], "t1": run["t1"],
+                   "duration_s": duration, "drift_m": run["drift"]}
+        self.report.setdefault("still_drift", []).append(finding)
+        warnings.warn(
+            f"{self.name}: the sensor lies still from t = {run['t0']:.2f} s to {run['t1']:.2f} s (samples "
+            f"{run['first']}–{run['last']}, {duration:.1f} s: |ω| < {STILL_GYR:g} rad/s, |a| ≈ g) but the estimate "
+            f"moves {run['drift']:.2f} m meanwhile: the detector {self.detector!r} misses this stillness, so the "
+            "velocity drifts. Raise its threshold, choose another detector, or keep the stance guard on "
+            "(guards.max_swing). Details in diagnostics['sensor']",
+            SensorWarning, stacklevel=5,
+        )
+
+    def finish(self) -> dict[str, Any]:
+        """End of the data: the still run open at the end, no stance at all; the findings."""
+        if self._run is not None:
+            self._close(self._run)
+            self._run = None
+        if self._first is not None and self._last is not None and self._stance == 0:
+            duration = self._last[0] - self._first[0]
+            if duration > NO_STANCE_MIN_DURATION:
+                moved = float(np.linalg.norm(self._last[1] - self._first[1]))
+                self.report["no_stance"] = {"t0": self._first[0], "t1": self._last[0], "distance_m": moved}
+                warnings.warn(
+                    f"{self.name}: no stance from t = {self._first[0]:.2f} s to the end ({duration:.1f} s): the "
+                    f"detector {self.detector!r} never fired after the still start and the velocity was never "
+                    f"reset, so the track ({moved:.1f} m from there to the end) is pure drift (or, with a dedrift, "
+                    "never corrected). Choose a detector made "
+                    "for this motion or tune its threshold, and keep the stance guard on (guards.max_swing). Details "
+                    "in diagnostics['sensor']",
+                    SensorWarning, stacklevel=4,
+                )
+        return self.report

@@ -25,6 +25,7 @@ from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
 from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
+from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -267,8 +268,11 @@ class Pipeline:
         nav = self.navigate(rec, stance, q0, quat, engine, covariance, ctx)
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
+        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
+        scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
         diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
-                       "guards": guard_report, **nav["diagnostics"]}
+                       "guards": guard_report, **nav["diagnostics"],
+                       "sensor": {**rec.meta.get("sanity", {}), **scan.finish()}}
         if self.calibration:
             diagnostics["calibration"] = calibration
         config = self.to_dict()

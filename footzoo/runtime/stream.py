@@ -34,7 +34,9 @@ import numpy as np
 
 from ..core.checks import validate_block, validate_sample
 from ..core.context import RunContext
+from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
+from ..core.sanity import EstimateScan, SignalScan
 from ..plugins.base import Samples
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
@@ -124,6 +126,8 @@ class Stream:
         self._warned: set[str] = set()
         self.keep = bool(keep)
         self._kept: list[Chunk] = []
+        self._signals = SignalScan("stream")  # glitches, as a batch run's Recording scans them
+        self._estimates: EstimateScan | None = None  # no stance, drift while still (from the start)
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
@@ -155,6 +159,7 @@ class Stream:
             row["dist"] = d[None, :]
         self._k += 1
         self._t_prev = t
+        self._signals.push(row["t"], row["acc"], row["gyr"])
         return self._take(row)
 
     def extend(self, t: Any, acc: Any, gyr: Any, mag: Any = None, dist: Any = None) -> dict[str, Any] | None:
@@ -186,6 +191,7 @@ class Stream:
             rows["dist"] = d
         self._k += n
         self._t_prev = float(t[-1])
+        self._signals.push(t, acc, gyr)
         return self._take(rows)
 
     def pending(self) -> int:
@@ -208,7 +214,19 @@ class Stream:
                 self._feed(self._raw.take(np.iinfo(np.int64).max))
             if self._stages:
                 self._feed({}, finish=True)
+            if self._estimates is not None:
+                self._estimates.finish()
         return self.final()
+
+    @property
+    def sensor(self) -> dict[str, Any]:
+        """The sensor and physics findings so far (as a batch run's ``Result.diagnostics["sensor"]``).
+
+        Glitches (``gyro_glitches``, ``acc_glitches``: sample numbers), drift while still
+        (``still_drift``) and, after :meth:`close`, ``no_stance`` (:mod:`footzoo.core.sanity`); each
+        was also warned with a :class:`~footzoo.core.errors.SensorWarning` when found.
+        """
+        return {**self._signals.report, **(self._estimates.report if self._estimates is not None else {})}
 
     def result(self, meta: dict[str, Any] | None = None) -> Any:
         """The whole run as a :class:`~footzoo.Result` (after :meth:`close`; needs ``keep=True``).
@@ -232,6 +250,7 @@ class Stream:
         steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
         config = {**self.pipeline.to_dict(), "engine": "stream"}
         diagnostics = {"calibration": self.fits} if self.fits is not None else {}
+        diagnostics["sensor"] = self.sensor
         return Result(samples=samples_frame(k["t"], k["quat"], k["pos"], k["vel"], k["acc_nav"], stance),
                       steps=steps, config=config, versions=versions(), recording=dict(rec.meta),
                       diagnostics=diagnostics)
@@ -286,6 +305,7 @@ class Stream:
         for stage in self._stages:
             out = stage.push(out, finish=finish) if (length(out) or finish) else {}
         if length(out):
+            self._estimates.push(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
             if self.keep:
                 self._kept.append({k: v for k, v in out.items() if k in ("k", *COLUMNS, "acc", "gyr", "mag")})
@@ -332,6 +352,7 @@ class Stream:
             if t[-1] - t[0] <= self.max_wait:
                 return False
             raise RecordingError(self._no_start_message()) from None
+        check_units(b["acc"], b["gyr"])  # an accelerometer in g, a gyroscope in deg/s: refused as a batch run does
         pipe = self.pipeline
         channels = {"acc", "gyr", *(["mag"] if self._has_mag else []), *(["dist"] if self._dist_width else [])}
         needs_fit = any(not c.is_fitted() and channels & set(c.fits_on) for c in self._calibrations())
@@ -345,6 +366,7 @@ class Stream:
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
                           FootzooWarning, stacklevel=4)
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
+        self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
         b = self._with_init(take(b, 0))  # a copy, with the still-start flag
         self._raw = Queue()
         self._raw.put(b)
