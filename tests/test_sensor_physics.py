@@ -123,6 +123,42 @@ def test_an_accelerometer_in_g_pushed_live_is_refused_as_in_a_batch_run(walk):
             stream.push(walk.t[k], walk.acc[k] / 9.80665, walk.gyr[k])
 
 
+# --------------------------------------------------------------------------- (c) rate and (d) axis map
+@pytest.fixture(scope="module")
+def long_walk() -> Recording:
+    return simulate("rectangle", n_strides=20, rate=100.0, noise=NoiseModel(seed=5))
+
+
+def test_a_gyroscope_axis_of_the_wrong_sign_is_named_batch_and_live(long_walk):
+    rec = _with(long_walk, gyr=long_walk.gyr * [1.0, -1.0, 1.0])  # a left-handed axis map
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["consistency"]
+    assert finding["cause"] == "gyr_y has the wrong sign" and finding["residual"] > 0.5
+    assert finding["explained_residual"] < 0.05  # undoing the flip makes the sensors agree again
+    assert any("gyr_y has the wrong sign: negate gyr_y" in m for m in found)
+    stream = Stream(Pipeline.from_dict(BASE), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([1, 13, 2, 40])))
+    assert stream.sensor["consistency"] == finding  # the same swings, the same numbers
+    assert any("gyr_y has the wrong sign" in m for m in live)
+
+
+def test_a_recording_stamped_at_half_its_rate_is_named(long_walk):
+    # a 100 Hz recording stamped at 50 Hz: every rotation and every duration doubles (67 m for a 12 m walk)
+    rec = Recording(t=long_walk.t * 2.0, acc=long_walk.acc, gyr=long_walk.gyr, meta={"name": "stamped"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    assert res.diagnostics["sensor"]["consistency"]["cause"] == "the time stamps are at half the sensor's rate"
+    assert any("samples twice as fast as the time stamps say" in m for m in found)
+
+
+@pytest.mark.skipif(not (DATA / "pyshoe_vicon" / "2017-11-22-11-22-03.mat").exists(), reason="../shared/data absent")
+def test_a_real_recording_with_a_flipped_axis_or_the_wrong_rate_is_named():
+    rec = footzoo.load(DATA / "pyshoe_vicon" / "2017-11-22-11-22-03.mat")
+    for faulty, cause in ((_with(rec, gyr=rec.gyr * [1.0, -1.0, 1.0]), "gyr_y has the wrong sign"),
+                          (Recording(t=rec.t * 2.0, acc=rec.acc, gyr=rec.gyr), "half the sensor's rate")):
+        res, _ = _sensor_warnings(lambda r=faulty: Pipeline.from_dict(BASE).run(r))
+        assert cause in res.diagnostics["sensor"]["consistency"]["cause"]
+
+
 # --------------------------------------------------------------------------- (e) no stance at all
 def test_a_detector_that_never_fires_with_the_guard_off_is_reported(walk):
     config = {**BASE, "orientation": {"type": "ins"}, "corrections": [{"type": "zupt"}],

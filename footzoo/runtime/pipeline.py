@@ -27,6 +27,7 @@ from ..core.data import Recording, Result
 from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
+from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from ..plugins.base import (
@@ -270,9 +271,13 @@ class Pipeline:
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
+        axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
+        axes.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr)
+        sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
+        if axes.finish():
+            sensor["consistency"] = axes.report
         diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
-                       "guards": guard_report, **nav["diagnostics"],
-                       "sensor": {**rec.meta.get("sanity", {}), **scan.finish()}}
+                       "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
         if self.calibration:
             diagnostics["calibration"] = calibration
         config = self.to_dict()

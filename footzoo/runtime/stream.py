@@ -37,6 +37,7 @@ from ..core.context import RunContext
 from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..core.sanity import EstimateScan, SignalScan
+from ..filters.consistency import ConsistencyScan
 from ..plugins.base import Samples
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
@@ -128,6 +129,7 @@ class Stream:
         self._kept: list[Chunk] = []
         self._signals = SignalScan("stream")  # glitches, as a batch run's Recording scans them
         self._estimates: EstimateScan | None = None  # no stance, drift while still (from the start)
+        self._axes: ConsistencyScan | None = None  # gyroscope-accelerometer consistency (rate, axis map)
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
@@ -216,6 +218,7 @@ class Stream:
                 self._feed({}, finish=True)
             if self._estimates is not None:
                 self._estimates.finish()
+                self._axes.finish()
         return self.final()
 
     @property
@@ -226,7 +229,10 @@ class Stream:
         (``still_drift``) and, after :meth:`close`, ``no_stance`` (:mod:`footzoo.core.sanity`); each
         was also warned with a :class:`~footzoo.core.errors.SensorWarning` when found.
         """
-        return {**self._signals.report, **(self._estimates.report if self._estimates is not None else {})}
+        out = {**self._signals.report, **(self._estimates.report if self._estimates is not None else {})}
+        if self._axes is not None and self._axes.report:
+            out["consistency"] = self._axes.report
+        return out
 
     def result(self, meta: dict[str, Any] | None = None) -> Any:
         """The whole run as a :class:`~footzoo.Result` (after :meth:`close`; needs ``keep=True``).
@@ -306,6 +312,7 @@ class Stream:
             out = stage.push(out, finish=finish) if (length(out) or finish) else {}
         if length(out):
             self._estimates.push(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
+            self._axes.push(out["k"], out["t"], out["acc"], out["gyr"])
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
             if self.keep:
                 self._kept.append({k: v for k, v in out.items() if k in ("k", *COLUMNS, "acc", "gyr", "mag")})
@@ -367,6 +374,7 @@ class Stream:
                           FootzooWarning, stacklevel=4)
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
         self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
+        self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
         b = self._with_init(take(b, 0))  # a copy, with the still-start flag
         self._raw = Queue()
         self._raw.put(b)
