@@ -32,6 +32,7 @@ Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording``
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
@@ -56,6 +57,7 @@ ACC_GLITCH_JUMP = 400.0
 #: Longest burst of samples reported as a glitch (a longer excursion is motion, or saturation).
 GLITCH_MAX_LEN = 3
 _AXES = "xyz"
+_SQRT3 = math.sqrt(3.0)
 
 
 def check_impossible(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
@@ -230,39 +232,122 @@ NO_STANCE_MIN_DURATION = 5.0
 
 
 class SignalScan:
-    """Glitches in the signals, chunk by chunk: the same findings as :func:`warn_glitches` on the whole recording.
+    """Glitches and saturation in the signals, chunk by chunk (live), as :func:`scan` finds them in a recording.
 
-    Each chunk is scanned with the last :data:`GLITCH_MAX_LEN` + 1 samples of the one before (a
-    burst needs the sample before it and the one after it), and a glitch is reported once.
+    Each chunk is scanned for glitches with the last :data:`GLITCH_MAX_LEN` + 1 samples of the one
+    before (a burst needs the sample before it and the one after it); each glitch is reported
+    once, with the batch run's numbers. Saturation live: an axis that sits at its largest (or
+    smallest) value so far, exactly, for :data:`SATURATION_MIN_RUN` samples, beyond
+    :data:`SATURATION_FLOOR`, while the axis is not piecewise constant (the exact repeats of its
+    consecutive samples elsewhere are at most :data:`PLATEAU_FRACTION`) — the batch rule with
+    "so far" for the whole recording; reported once per axis.
     """
 
     def __init__(self, name: str = "stream"):
         self.name = name
-        self.report: dict[str, list[int]] = {}
-        self._tail: tuple[np.ndarray, ...] | None = None
+        self.report: dict[str, Any] = {}
+        self._t = np.zeros(0)  # the last GLITCH_MAX_LEN + 1 samples: time, and [acc | gyr] (m, 6)
+        self._x = np.zeros((0, 6))
         self._k0 = 0  # absolute index of the tail's first sample
         self._done = -1  # last sample already reported
+        # per axis (acc x, y, z, gyr x, y, z): the rails so far and the run at each ending at the last sample;
+        # consecutive pairs and exact repeats seen (for the plateau rule)
+        self._rails = [[-math.inf] * 6, [math.inf] * 6]
+        self._runs = [[0] * 6, [0] * 6]
+        self._pairs = 0
+        self._repeats = [0] * 6
+        self._saturated = [[False] * 6, [False] * 6]
+        self._floor = [SATURATION_FLOOR["acc"]] * 3 + [SATURATION_FLOOR["gyr"]] * 3
 
-    def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, list[int]]:
+    def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, Any]:
         """Scan the next samples; the new findings (also added to :attr:`report`)."""
-        if self._tail is not None:
-            t, acc, gyr = (np.concatenate([a, b]) for a, b in zip(self._tail, (t, acc, gyr), strict=True))
-        keep = GLITCH_MAX_LEN + 1
-        new: dict[str, list[int]] = {}
-        if len(t) >= 3 and (np.abs(np.diff(gyr, axis=0)).max() > GLITCH_JUMP / 2
-                            or np.abs(np.diff(acc, axis=0)).max() > ACC_GLITCH_JUMP / 2):
+        x = np.hstack([acc, gyr])
+        k0 = self._k0 + len(self._t)  # absolute index of the chunk's first sample
+        joined_t, joined = np.concatenate([self._t, t]), np.vstack([self._x, x])
+        step = joined[max(len(self._t) - 1, 0):]
+        step = np.abs(step[1:] - step[:-1])
+        new = self._saturation(t, x, k0, step)
+        # a burst jumps by more than its height into it: some component by more than height / √3
+        if len(step) and (step[:, 3:].max() > GLITCH_JUMP / _SQRT3 or step[:, :3].max() > ACC_GLITCH_JUMP / _SQRT3):
             fresh = {key: [k for k in ks if k > self._done]
-                     for key, ks in _glitches(t, acc, gyr, self._k0).items()}
+                     for key, ks in _glitches(joined_t, joined[:, :3], joined[:, 3:], self._k0).items()}
             fresh = {key: ks for key, ks in fresh.items() if ks}
             if fresh:
-                _warn_found(t, acc, gyr, fresh, self.name, self._k0)
+                _warn_found(joined_t, joined[:, :3], joined[:, 3:], fresh, self.name, self._k0)
                 for key, ks in fresh.items():
                     self.report.setdefault(key, []).extend(ks)
                 self._done = max(max(ks) for ks in fresh.values())
-                new = fresh
-        self._k0 += max(len(t) - keep, 0)
-        self._tail = (t[-keep:], acc[-keep:], gyr[-keep:])
+                new.update(fresh)
+        keep = GLITCH_MAX_LEN + 1
+        self._k0 += max(len(joined_t) - keep, 0)
+        self._t, self._x = joined_t[-keep:], joined[-keep:]
         return new
+
+    def _saturation(self, t: np.ndarray, x: np.ndarray, k0: int, step: np.ndarray) -> dict[str, Any]:
+        """Runs at each axis's rails so far (vectorised over the chunk and the axes; one sample: scalar)."""
+        self._pairs += len(step)
+        found: list[dict[str, Any]] = []
+        if len(x) == 1:  # a pushed sample: the same rule in scalars (numpy's per-call cost dominates here)
+            row, rails, runs = x[0].tolist(), self._rails, self._runs
+            for j, d in enumerate(step[0].tolist() if len(step) else ()):
+                if d == 0.0:
+                    self._repeats[j] += 1
+            for side in (0, 1):
+                for j in range(6):
+                    v, r = row[j], rails[side][j]
+                    if (v > r) if side == 0 else (v < r):
+                        rails[side][j], runs[side][j] = v, 1
+                    elif v == r:
+                        runs[side][j] += 1
+                    else:
+                        runs[side][j] = 0
+                    if runs[side][j] >= SATURATION_MIN_RUN and not self._saturated[side][j]:
+                        self._hit(side, j, v, runs[side][j], k0, t[0], found)
+        else:
+            self._repeats = [n + int(c) for n, c in zip(self._repeats, (step == 0).sum(axis=0), strict=True)]
+            for side, pick in ((0, np.maximum), (1, np.minimum)):
+                rail = pick(np.asarray(self._rails[side]), (x.max(axis=0) if side == 0 else x.min(axis=0)))
+                before = np.asarray(self._runs[side])
+                before[rail != np.asarray(self._rails[side])] = 0
+                at = x == rail
+                touched = np.flatnonzero(at.any(axis=0))  # only the axes with a sample at the rail have a run
+                self._rails[side] = rail.tolist()
+                runs = [0] * 6
+                if len(touched):
+                    idx = np.arange(len(x))[:, None]
+                    # the run at the rail ending at each sample: its index minus that of the last sample off it
+                    run = idx - np.maximum.accumulate(np.where(at[:, touched], -1 - before[None, touched], idx),
+                                                      axis=0)
+                    for c, j in enumerate(touched.tolist()):
+                        runs[j] = int(run[-1, c])
+                        longest = int(run[:, c].max())
+                        if longest >= SATURATION_MIN_RUN and not self._saturated[side][j]:
+                            i = int(np.argmax(run[:, c] >= SATURATION_MIN_RUN))
+                            self._hit(side, j, float(rail[j]), longest, k0 + i, t[i], found)
+                self._runs[side] = runs
+        if not found:
+            return {}
+        self.report.setdefault("saturation", []).extend(found)
+        parts = [f"{f['axis']} at {f['value']:.6g} for {SATURATION_MIN_RUN} samples or more from sample {f['first']} "
+                 f"(t = {f['t']:.3f} s at sample {f['first'] + SATURATION_MIN_RUN - 1})" for f in found]
+        warnings.warn(
+            f"{self.name}: sensor saturated (clipped): {'; '.join(parts)}. Velocity and position are "
+            "underestimated there; use a sensor with a larger range. Details in Stream.sensor",
+            SensorWarning, stacklevel=4,
+        )
+        return {"saturation": found}
+
+    def _hit(self, side: int, j: int, rail: float, longest: int, k: int, t: float, found: list[dict[str, Any]]) -> None:
+        """Report axis ``j`` at its rail (sample ``k`` the run's third, at time ``t``) unless the floor or the
+        plateau rule excuses it."""
+        if abs(rail) < self._floor[j]:
+            return
+        away = self._pairs - longest
+        if away > 0 and (self._repeats[j] - (longest - 1)) / away > PLATEAU_FRACTION:
+            return  # flat tops are the signal's shape (noise-free simulation), not clipping
+        self._saturated[side][j] = True
+        found.append({"axis": f"{'acc' if j < 3 else 'gyr'}_{_AXES[j % 3]}", "value": rail,
+                      "first": k - (SATURATION_MIN_RUN - 1), "t": float(t)})
 
 
 def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) -> dict[str, list[int]]:
@@ -314,16 +399,21 @@ class EstimateScan:
             self._close(self._run)
             self._run = None
         edges = np.flatnonzero(np.diff(np.concatenate([[False], still, [False]]).astype(np.int8)))
-        for s, e in zip(edges[::2], edges[1::2], strict=True):
+        starts, ends = edges[::2], edges[1::2]
+        # only the runs that can be long enough: the open ones at either end, and the long ones in between
+        long = (t[ends - 1] - t[starts] >= STILL_MIN_DURATION) | (starts == 0) | (ends == len(t))
+        for s, e in zip(starts[long].tolist(), ends[long].tolist(), strict=True):
             run = self._run if (s == 0 and self._run is not None) else {
                 "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0}
-            run["drift"] = max(run["drift"], float(np.linalg.norm(pos[s:e] - run["pos0"], axis=1).max()))
+            moved = pos[s:e] - run["pos0"]
+            run["drift"] = max(run["drift"], float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max())))
             run["last"], run["t1"] = int(k[e - 1]), float(t[e - 1])
             if e == len(t):
                 self._run = run
             else:
                 self._close(run)
-                self._run = None
+                if s == 0:
+                    self._run = None
 
     def _close(self, run: dict[str, Any]) -> None:
         duration = run["t1"] - run["t0"]

@@ -15,11 +15,12 @@ at 50 Hz turns every rotation by twice its angle), turns the attitude by tens of
 every swing: 0.3–1.0.
 
 :class:`ConsistencyScan` integrates every swing with the signals as given and with each
-:data:`CANDIDATES` fault undone (an axis negated, the time scaled by 2 or 1/2). When the
-median residual exceeds :data:`RESIDUAL_LIMIT` and undoing one fault halves it, that fault is
-reported (a :class:`~footzoo.core.errors.SensorWarning` naming it, the swings and the fix);
-one compiled pass per swing and candidate. It runs in batch (one push of the recording) and
-live (:class:`footzoo.Stream`, chunk by chunk), on the same swings.
+:data:`CANDIDATES` fault undone (an axis negated, the time scaled by 2 or 1/2). When most
+swings' residuals exceed :data:`RESIDUAL_LIMIT` and undoing one fault halves their median,
+that fault is reported (a :class:`~footzoo.core.errors.SensorWarning` naming it, the swings
+and the fix); one compiled pass per swing, and one per candidate on an inconsistent swing only.
+It runs in batch (one push of the recording) and live (:class:`footzoo.Stream`, chunk by
+chunk), on the same swings.
 """
 
 from __future__ import annotations
@@ -60,6 +61,14 @@ SWING_RANGE = (0.15, 3.0)
 
 
 @njit
+def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray,
+               scale: np.ndarray, signs: np.ndarray, g: float, out: np.ndarray) -> None:
+    """``out[s, c]``: the residual of swing ``s`` (samples ``first[s]`` to ``last[s]``) with candidate ``c``."""
+    for s in range(first.shape[0]):
+        _swing_residuals(t, acc, gyr, first[s], last[s], scale, signs, g, out[s])
+
+
+@njit(inline=True)
 def _swing_residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, scale: np.ndarray,
                      signs: np.ndarray, g: float, out: np.ndarray) -> None:
     """``out[c] = |v(b)| / (g T)``: strapdown from sample ``a`` (tilt from ``acc[a]``) to ``b`` per candidate c."""
@@ -138,8 +147,8 @@ class ConsistencyScan:
                 cut = int(starts[0])
                 starts, ends = starts - cut, ends - cut
                 buf = {n: v[cut:] for n, v in buf.items()}
-            for i in range(1, len(starts)):  # the swing from the end of run i-1 to the start of run i
-                self._swing(buf, int(ends[i - 1]) - 1, int(starts[i]))
+            # the swings: from the last sample of each run to the sample after the first of the next
+            self._swings(buf, ends[:-1] - 1, np.minimum(starts[1:] + 1, len(buf["t"]) - 1))
             last = int(starts[-1])
             if ends[-1] == len(buf["t"]):  # the last run is still open: keep its last samples only
                 last = max(last, len(buf["t"]) - self.min_static)
@@ -152,31 +161,46 @@ class ConsistencyScan:
             self._anchored = False
         self._buf = buf
 
-    def _swing(self, buf: dict[str, np.ndarray], a: int, b: int) -> None:
-        b = min(b + 1, len(buf["t"]) - 1)
-        duration = buf["t"][b] - buf["t"][a]
-        if not SWING_RANGE[0] <= duration <= SWING_RANGE[1]:
+    def _swings(self, buf: dict[str, np.ndarray], first: np.ndarray, last: np.ndarray) -> None:
+        """The residuals of the swings ``first[i]``–``last[i]`` of ``buf`` (those of a swing's duration)."""
+        duration = buf["t"][last] - buf["t"][first]
+        ok = (duration >= SWING_RANGE[0]) & (duration <= SWING_RANGE[1])
+        first, last = first[ok].astype(np.int64), last[ok].astype(np.int64)
+        if not len(first):
             return
-        out = np.empty(len(_SCALE))
-        _swing_residuals(buf["t"], buf["acc"], buf["gyr"], a, b, _SCALE, _SIGNS, self.gravity, out)
-        self.residuals.append(out)
-        self.swings.append((int(buf["k"][a]), int(buf["k"][b])))
-        if not self.report and len(self.residuals) % MIN_SWINGS == 0:  # the same swings decide, batch and live
-            self._decide()
+        out = np.full((len(first), len(_SCALE)), np.nan)
+        _residuals(buf["t"], buf["acc"], buf["gyr"], first, last, _SCALE[:1], _SIGNS[:1], self.gravity, out)
+        bad = np.flatnonzero(out[:, 0] > RESIDUAL_LIMIT)
+        if len(bad):  # the inconsistent swings: which fault, undone, explains them?
+            tried = np.empty((len(bad), len(_SCALE)))
+            _residuals(buf["t"], buf["acc"], buf["gyr"], first[bad], last[bad], _SCALE, _SIGNS, self.gravity, tried)
+            out[bad] = tried
+        before = len(self.residuals)
+        self.residuals.extend(out)
+        self.swings.extend(zip(buf["k"][first].tolist(), buf["k"][last].tolist(), strict=True))
+        for m in range((before // MIN_SWINGS + 1) * MIN_SWINGS, len(self.residuals) + 1, MIN_SWINGS):
+            if not self.report:  # the same swings decide, batch and live
+                self._decide(m)
 
-    def _decide(self) -> None:
-        r = np.median(np.asarray(self.residuals), axis=0)
+    def _decide(self, m: int) -> None:
+        """Decide on the first ``m`` swings."""
+        residuals = np.asarray(self.residuals[:m])
+        bad = residuals[residuals[:, 0] > RESIDUAL_LIMIT]
+        if 2 * len(bad) <= len(residuals):  # the median swing is consistent
+            return
+        r = np.median(bad, axis=0)  # over the inconsistent swings (the candidates are tried on those only)
         best = int(np.argmin(r[1:])) + 1
-        if r[0] <= RESIDUAL_LIMIT or r[best] * EXPLAINED_RATIO > r[0]:
+        if r[best] * EXPLAINED_RATIO > r[0]:
             return
         cause, _, _, fix = CANDIDATES[best - 1]
         first = self.swings[:3]
         self.report = {"cause": cause, "residual": float(r[0]), "explained_residual": float(r[best]),
-                       "swings": len(self.residuals), "first_swings": [list(s) for s in first]}
+                       "swings": len(residuals), "inconsistent_swings": len(bad),
+                       "first_swings": [list(s) for s in first]}
         shown = ", ".join(f"{a}–{b}" for a, b in first)
         warnings.warn(
-            f"{self.name}: the gyroscope and the accelerometer disagree: integrated over each of "
-            f"{len(self.residuals)} swings (samples {shown}, ...), the gyroscope's attitude leaves a velocity of "
+            f"{self.name}: the gyroscope and the accelerometer disagree: integrated over {len(bad)} of "
+            f"{len(residuals)} swings (samples {shown}, ...), the gyroscope's attitude leaves a velocity of "
             f"{r[0]:.2f} g × the swing's duration where the foot stops (real sensors: below {RESIDUAL_LIMIT:g}); "
             f"with {cause.replace('has the', 'of the')} undone it is {r[best]:.2f}. Most likely {cause}: {fix}. "
             "Details in diagnostics['sensor']['consistency']",
@@ -186,5 +210,5 @@ class ConsistencyScan:
     def finish(self) -> dict[str, Any]:
         """End of the data: decide on every swing seen (when there are enough); the finding (empty: consistent)."""
         if not self.report and len(self.residuals) >= MIN_SWINGS:
-            self._decide()
+            self._decide(len(self.residuals))
         return self.report

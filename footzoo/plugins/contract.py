@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import inspect
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -214,27 +215,29 @@ def _shape(spec: Output, n: int | None) -> str:
 
 def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, n: int | None) -> None:
     """One output array against its declaration (raises :class:`PluginError` naming the plug-in)."""
-    arr = np.asarray(value) if not isinstance(value, np.ndarray) else value
-    expected = _shape(spec, n)
-    if arr.dtype.kind not in "biuf":
-        raise broken(plugin, method, f"set {label} of dtype {arr.dtype}; it must be a {expected} "
+    arr = value if isinstance(value, np.ndarray) else np.asarray(value)
+    kind = arr.dtype.kind
+    if kind not in "biuf":
+        raise broken(plugin, method, f"set {label} of dtype {arr.dtype}; it must be a {_shape(spec, n)} "
                                      f"{'bool' if spec.what == 'bool' else 'float'} array")
     width_ok = arr.ndim == 1 if not spec.width else (arr.ndim == 2 and arr.shape[1] == spec.width)
     if not width_ok or (n is not None and len(arr) != n):
-        raise broken(plugin, method, f"set {label} of shape {arr.shape}; it must be {expected}: one row per "
+        raise broken(plugin, method, f"set {label} of shape {arr.shape}; it must be {_shape(spec, n)}: one row per "
                                      "input sample")
     if spec.what == "bool":
-        if arr.dtype.kind != "b" and not np.isin(arr, (0, 1)).all():
+        if kind != "b" and not np.isin(arr, (0, 1)).all():
             bad = np.flatnonzero(~np.isin(arr, (0, 1)))
             raise broken(plugin, method, f"set {label} with {len(bad)} value(s) that are neither 0 nor 1 (first "
                                          f"{arr[bad[0]]!r} at sample {int(bad[0])}): a stance mask is bool; NaN is "
                                          "not stance — decide each sample (stance_ = statistic < threshold)")
         return
-    if (spec.finite or spec.what == "quat") and arr.dtype.kind == "f" and not np.isfinite(arr).all():
+    if kind != "f" or not len(arr):
+        return
+    if (spec.finite or spec.what == "quat") and not math.isfinite(float(arr.sum())) and not np.isfinite(arr).all():
         bad = np.flatnonzero(~np.isfinite(arr).reshape(len(arr), -1).all(axis=1))
         raise broken(plugin, method, f"set {label} with {len(bad)} non-finite sample(s) (NaN or inf), first at sample "
                                      f"{int(bad[0])}")
-    if spec.what == "quat" and len(arr):
+    if spec.what == "quat":
         err = np.abs(np.einsum("ij,ij->i", arr, arr) - 1.0)  # |q|² - 1 ≈ 2 (|q| - 1)
         if err.max() > 2 * QUAT_NORM_TOL:
             k = int(np.argmax(err))

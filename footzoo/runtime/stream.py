@@ -51,6 +51,8 @@ from .stages import (
     Queue,
 )
 
+#: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
+SCAN_BLOCK = 32
 #: The per-sample columns of the final estimates.
 COLUMNS = ("t", "quat", "pos", "vel", "acc_nav", "stance")
 
@@ -130,6 +132,8 @@ class Stream:
         self._signals = SignalScan("stream")  # glitches, as a batch run's Recording scans them
         self._estimates: EstimateScan | None = None  # no stance, drift while still (from the start)
         self._axes: ConsistencyScan | None = None  # gyroscope-accelerometer consistency (rate, axis map)
+        self._scan_raw = Blocks(self._signals.push)
+        self._scan_final: Blocks | None = None
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
@@ -161,7 +165,7 @@ class Stream:
             row["dist"] = d[None, :]
         self._k += 1
         self._t_prev = t
-        self._signals.push(row["t"], row["acc"], row["gyr"])
+        self._scan_raw.add(row["t"], row["acc"], row["gyr"])
         return self._take(row)
 
     def extend(self, t: Any, acc: Any, gyr: Any, mag: Any = None, dist: Any = None) -> dict[str, Any] | None:
@@ -193,7 +197,7 @@ class Stream:
             rows["dist"] = d
         self._k += n
         self._t_prev = float(t[-1])
-        self._signals.push(t, acc, gyr)
+        self._scan_raw.add(t, acc, gyr)
         return self._take(rows)
 
     def pending(self) -> int:
@@ -216,7 +220,9 @@ class Stream:
                 self._feed(self._raw.take(np.iinfo(np.int64).max))
             if self._stages:
                 self._feed({}, finish=True)
+            self._scan_raw.flush()
             if self._estimates is not None:
+                self._scan_final.flush()
                 self._estimates.finish()
                 self._axes.finish()
         return self.final()
@@ -229,6 +235,9 @@ class Stream:
         (``still_drift``) and, after :meth:`close`, ``no_stance`` (:mod:`footzoo.core.sanity`); each
         was also warned with a :class:`~footzoo.core.errors.SensorWarning` when found.
         """
+        self._scan_raw.flush()
+        if self._scan_final is not None:
+            self._scan_final.flush()
         out = {**self._signals.report, **(self._estimates.report if self._estimates is not None else {})}
         if self._axes is not None and self._axes.report:
             out["consistency"] = self._axes.report
@@ -311,8 +320,7 @@ class Stream:
         for stage in self._stages:
             out = stage.push(out, finish=finish) if (length(out) or finish) else {}
         if length(out):
-            self._estimates.push(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
-            self._axes.push(out["k"], out["t"], out["acc"], out["gyr"])
+            self._scan_final.add(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
             if self.keep:
                 self._kept.append({k: v for k, v in out.items() if k in ("k", *COLUMNS, "acc", "gyr", "mag")})
@@ -375,6 +383,13 @@ class Stream:
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
         self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
         self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
+
+        def scan_final(k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+                       pos: np.ndarray) -> None:
+            self._estimates.push(k, t, acc, gyr, stance, pos)
+            self._axes.push(k, t, acc, gyr)
+
+        self._scan_final = Blocks(scan_final)
         b = self._with_init(take(b, 0))  # a copy, with the still-start flag
         self._raw = Queue()
         self._raw.put(b)
@@ -428,6 +443,27 @@ class Stream:
             raise RecordingError(f"dist has {row.size} readings, earlier samples had {self._dist_width}: push the "
                                  "same sensors every time (NaN where one has no reading)")
         return row
+
+
+class Blocks:
+    """Feeds a scan its samples in blocks of at least ``every`` (the scans' findings do not depend on how the
+    samples are chunked, their cost per call does): :meth:`add` the next samples' arrays, :meth:`flush` the rest."""
+
+    def __init__(self, push: Any, every: int = SCAN_BLOCK):
+        self.push, self.every = push, every
+        self.parts: list[tuple[np.ndarray, ...]] = []
+        self.n = 0
+
+    def add(self, *arrays: np.ndarray) -> None:
+        self.parts.append(arrays)
+        self.n += len(arrays[0])
+        if self.n >= self.every:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.parts:
+            parts, self.parts, self.n = self.parts, [], 0
+            self.push(*(np.concatenate(column) for column in zip(*parts, strict=True)))
 
 
 def _fit_reports(fits: Any) -> list[dict[str, Any]] | None:
