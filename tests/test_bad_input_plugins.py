@@ -295,7 +295,8 @@ def test_a_faulty_plugin_in_a_study_fails_its_cells_only():
         "metrics": ["path_length_m"],
     })
     table = run_study(study)
-    good, bad = table[table["detector.type"] == "angular_rate_fsm"], table[table["detector.type"] == "test_fault_raising"]
+    by = table["detector.type"]
+    good, bad = table[by == "angular_rate_fsm"], table[by == "test_fault_raising"]
     assert len(good) and good["error"].isna().all() and np.isfinite(good["value"].astype(float)).all()
     assert len(bad) and bad["error"].str.contains("PluginError: detector 'test_fault_raising'").all()
     assert bad["error"].str.contains("ZeroDivisionError").all()

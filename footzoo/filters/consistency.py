@@ -63,35 +63,29 @@ SWING_RANGE = (0.15, 3.0)
 @njit
 def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray,
                scale: np.ndarray, signs: np.ndarray, g: float, out: np.ndarray) -> None:
-    """``out[s, c]``: the residual of swing ``s`` (samples ``first[s]`` to ``last[s]``) with candidate ``c``."""
+    """``out[s, c] = |v| / (g T)`` of swing ``s``: strapdown from sample ``first[s]`` (tilt from its ``acc``) to
+    ``last[s]``, with the time scaled by ``scale[c]`` and the gyroscope axes signed by ``signs[c]``."""
     for s in range(first.shape[0]):
-        _swing_residuals(t, acc, gyr, first[s], last[s], scale, signs, g, out[s])
-
-
-@njit(inline=True)
-def _swing_residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, scale: np.ndarray,
-                     signs: np.ndarray, g: float, out: np.ndarray) -> None:
-    """``out[c] = |v(b)| / (g T)``: strapdown from sample ``a`` (tilt from ``acc[a]``) to ``b`` per candidate c."""
-    fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
-    roll = math.atan2(-fy, -fz)
-    pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
-    cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
-    for c in range(scale.shape[0]):
-        w, x, y, z = cp * cr, cp * sr, sp * cr, -sp * sr
-        vx = vy = vz = 0.0
-        for i in range(a, b):
-            dt = (t[i + 1] - t[i]) * scale[c]
-            nx, ny, nz = rotate(w, x, y, z, acc[i, 0], acc[i, 1], acc[i, 2])
-            vx += nx * dt
-            vy += ny * dt
-            vz += (nz + g) * dt
-            d0, d1, d2, d3 = rotvec_quat(gyr[i, 0] * signs[c, 0] * dt, gyr[i, 1] * signs[c, 1] * dt,
-                                         gyr[i, 2] * signs[c, 2] * dt)
-            w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
-            n = math.sqrt(w * w + x * x + y * y + z * z)
-            w, x, y, z = w / n, x / n, y / n, z / n
-        duration = (t[b] - t[a]) * scale[c]
-        out[c] = math.sqrt(vx * vx + vy * vy + vz * vz) / (g * duration)
+        a, b = first[s], last[s]
+        fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
+        roll = math.atan2(-fy, -fz)
+        pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
+        cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+        for c in range(scale.shape[0]):
+            w, x, y, z = cp * cr, cp * sr, sp * cr, -sp * sr
+            vx = vy = vz = 0.0
+            for i in range(a, b):
+                dt = (t[i + 1] - t[i]) * scale[c]
+                nx, ny, nz = rotate(w, x, y, z, acc[i, 0], acc[i, 1], acc[i, 2])
+                vx += nx * dt
+                vy += ny * dt
+                vz += (nz + g) * dt
+                d0, d1, d2, d3 = rotvec_quat(gyr[i, 0] * signs[c, 0] * dt, gyr[i, 1] * signs[c, 1] * dt,
+                                             gyr[i, 2] * signs[c, 2] * dt)
+                w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
+                n = math.sqrt(w * w + x * x + y * y + z * z)
+                w, x, y, z = w / n, x / n, y / n, z / n
+            out[s, c] = math.sqrt(vx * vx + vy * vy + vz * vz) / (g * (t[b] - t[a]) * scale[c])
 
 
 _SCALE = np.array([1.0] + [c[1] for c in CANDIDATES])
