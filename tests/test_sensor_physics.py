@@ -192,6 +192,20 @@ def test_a_sensor_lying_still_for_ten_minutes_drifting_is_reported():
     assert any("lies still" in m for m in found)
 
 
+def test_drift_while_still_and_no_stance_are_found_live_as_in_batch():
+    rec = simulate(n_strides=3, rate=50.0, stand_end=20.0, noise=NoiseModel(seed=6))
+    blind = {**BASE, "orientation": {"type": "ins"}, "corrections": [{"type": "zupt"}],
+             "detector": {"type": "angular_rate_fsm", "threshold": 1e-4}, "guards": {"max_swing": 0}}
+    batch, _ = _sensor_warnings(lambda: Pipeline.from_dict(blind).run(rec))
+    stream = Stream(Pipeline.from_dict(blind), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([1, 9, 30])))
+    expected = batch.diagnostics["sensor"]
+    assert set(expected) == {"still_drift", "no_stance"} and set(stream.sensor) == set(expected)
+    for a, b in zip(stream.sensor["still_drift"], expected["still_drift"], strict=True):
+        assert (a["first"], a["last"]) == (b["first"], b["last"]) and a["drift_m"] == pytest.approx(b["drift_m"])
+    assert any("lies still" in m for m in live) and any("no stance from" in m for m in live)
+
+
 # --------------------------------------------------------------------------- no false alarms
 def test_a_clean_simulated_walk_raises_no_sensor_warning_batch_or_live(walk):
     for config in (BASE, {**BASE, "guards": {"max_swing": 0}}):
