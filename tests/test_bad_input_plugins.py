@@ -43,7 +43,29 @@ def _still(gyr):
 
 
 # --------------------------------------------------------------------------- the faulty plug-ins
-@footzoo.register
+FAULTY: list[type] = []
+
+
+def faulty(cls: type) -> type:
+    """A faulty plug-in of this module: registered while its tests run only (studies of every registered
+    combination in other test modules must not meet it)."""
+    FAULTY.append(cls)
+    return cls
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _registered():
+    from footzoo.plugins import registry
+
+    for cls in FAULTY:
+        footzoo.register(cls)
+    yield
+    for cls in FAULTY:
+        registry._REGISTRY[cls.kind].pop(cls.name, None)
+    registry._REGISTRY["detector"].pop("cli_boom", None)
+
+
+@faulty
 class Raising(Detector):
     """Raises a ZeroDivisionError (a bug in a plug-in)."""
 
@@ -53,7 +75,7 @@ class Raising(Detector):
         return 1 / 0
 
 
-@footzoo.register
+@faulty
 class Exiting(Detector):
     """Calls sys.exit() in its action method."""
 
@@ -63,7 +85,7 @@ class Exiting(Detector):
         raise SystemExit(0)
 
 
-@footzoo.register
+@faulty
 class NoReturn(Detector):
     """Forgets ``return self``."""
 
@@ -74,7 +96,7 @@ class NoReturn(Detector):
         self.statistic_ = np.linalg.norm(gyr, axis=1)
 
 
-@footzoo.register
+@faulty
 class NanStance(Detector):
     """A float stance with NaN where it did not decide (NaN would read as True in a bool cast)."""
 
@@ -87,7 +109,7 @@ class NanStance(Detector):
         return self
 
 
-@footzoo.register
+@faulty
 class ShortStance(Detector):
     """One sample short."""
 
@@ -98,7 +120,7 @@ class ShortStance(Detector):
         return self
 
 
-@footzoo.register
+@faulty
 class Mutating(Detector):
     """Writes into its input (gyr[:] = 0) instead of a copy."""
 
@@ -110,7 +132,7 @@ class Mutating(Detector):
         return self
 
 
-@footzoo.register
+@faulty
 class LiveNanStance(AngularRateFSM):
     """Yun's FSM whose live chunks carry a NaN stance (a float column)."""
 
@@ -125,7 +147,7 @@ class LiveNanStance(AngularRateFSM):
         return out
 
 
-@footzoo.register
+@faulty
 class LiveMutating(AngularRateFSM):
     """Yun's FSM that, live, removes the chunk's mean rate in place."""
 
@@ -136,7 +158,7 @@ class LiveMutating(AngularRateFSM):
         return super().step(t, acc, gyr)
 
 
-@footzoo.register
+@faulty
 class Scaled(Madgwick):
     """Madgwick's filter whose quaternions are multiplied by ``scale`` (not unit when scale ≠ 1)."""
 
@@ -151,7 +173,7 @@ class Scaled(Madgwick):
         return {**out, "quat": out["quat"] * self.scale}
 
 
-@footzoo.register
+@faulty
 class NanVelocity(VelocityCorrection):
     """Returns NaN velocities."""
 
@@ -163,7 +185,7 @@ class NanVelocity(VelocityCorrection):
         return self
 
 
-@footzoo.register
+@faulty
 class RaisingAnalysis(Analysis):
     """Raises KeyError in analyze."""
 
@@ -176,7 +198,7 @@ class RaisingAnalysis(Analysis):
         return steps
 
 
-@footzoo.register
+@faulty
 class WrongCalibration(Calibration):
     """Returns the accelerometer with a column missing."""
 
