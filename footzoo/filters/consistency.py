@@ -18,7 +18,8 @@ every swing: 0.3–1.0.
 :data:`CANDIDATES` fault undone (an axis negated, the time scaled by 2 or 1/2). When most
 swings' residuals exceed :data:`RESIDUAL_LIMIT` and undoing one fault halves their median,
 that fault is reported (a :class:`~footzoo.core.errors.SensorWarning` naming it, the swings
-and the fix); one compiled pass per swing, and one per candidate on an inconsistent swing only.
+and the fix); one compiled pass per swing, and one per candidate on an inconsistent swing only, over the
+first :data:`MAX_SWINGS` swings.
 It runs in batch (one push of the recording) and live (:class:`footzoo.Stream`, chunk by
 chunk), on the same swings.
 """
@@ -50,8 +51,11 @@ CANDIDATES: tuple[tuple[str, float, tuple[float, float, float], str], ...] = (
 RESIDUAL_LIMIT = 0.25
 #: A fault is named when undoing it divides the median residual by at least this.
 EXPLAINED_RATIO = 2.0
-#: Fewest swings the scan decides on.
+#: Fewest swings the scan decides on (and it decides again after each as many more).
 MIN_SWINGS = 8
+#: Swings after which a consistent recording is not scanned further (a rate or an axis map does not change
+#: within a recording): the scan's cost is bounded, whatever the recording's length.
+MAX_SWINGS = 64
 #: Quasi-static sample: |ω| below this (rad/s) and |‖f‖ − g| below :data:`STATIC_ACC` (m/s²).
 STATIC_GYR = 0.6
 STATIC_ACC = 1.5
@@ -116,7 +120,7 @@ class ConsistencyScan:
 
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
         """The next samples (absolute indices ``k``, time (s), FRD specific force (m/s²), rate (rad/s))."""
-        if not len(t):
+        if not len(t) or self.report or len(self.residuals) >= MAX_SWINGS:
             return
         static = (np.einsum("ij,ij->i", gyr, gyr) < STATIC_GYR**2) & (
             np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STATIC_ACC)
@@ -160,6 +164,7 @@ class ConsistencyScan:
         duration = buf["t"][last] - buf["t"][first]
         ok = (duration >= SWING_RANGE[0]) & (duration <= SWING_RANGE[1])
         first, last = first[ok].astype(np.int64), last[ok].astype(np.int64)
+        first, last = first[:MAX_SWINGS - len(self.residuals)], last[:MAX_SWINGS - len(self.residuals)]
         if not len(first):
             return
         out = np.full((len(first), len(_SCALE)), np.nan)
