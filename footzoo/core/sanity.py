@@ -1,4 +1,4 @@
-"""Sensor sanity: impossible values, saturated (clipped) axes and isolated gyroscope spikes.
+"""Sensor sanity: impossible values, saturated (clipped) axes, glitches; the physics of a run's estimate.
 
 Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.core.data.Recording`
 (FRD, SI) after the time and unit checks:
@@ -19,13 +19,19 @@ Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.co
   :class:`~footzoo.core.errors.SensorWarning` naming the axis, the value, the sample
   and time ranges; the estimate is computed but its velocity and position
   underestimate the motion in those samples.
-* **Gyro glitches** — a single sample whose angular rate differs from both
-  neighbours by more than :data:`GLITCH_JUMP` (15 rad/s) while the neighbours
-  agree (the spike height above the neighbours' change exceeds 15 rad/s). On the
-  real recordings the largest such single-sample peak is 5.7 rad/s (gaitmap
-  example, 204.8 Hz; PyShoe ≤ 1.7 rad/s, x-io 1.0 rad/s); one 40 rad/s spike in a
-  walk turns the attitude by 0.2–0.4 rad and misplaces the end by metres.
-  Reported with a :class:`~footzoo.core.errors.SensorWarning` listing the samples.
+* **Glitches** — a burst of 1 to :data:`GLITCH_MAX_LEN` samples whose angular rate differs
+  from both the sample before and the sample after it by more than :data:`GLITCH_JUMP`
+  (15 rad/s) plus the change between those two (:func:`find_bursts`); the same for the
+  specific force with :data:`ACC_GLITCH_JUMP` (400 m/s²). On the real recordings the largest
+  such single-sample peak is 5.7 rad/s (gaitmap example, 204.8 Hz; PyShoe ≤ 1.7 rad/s, x-io
+  1.0 rad/s) and no burst is found in any; one 40 rad/s spike in a walk turns the attitude by
+  0.2–0.4 rad and misplaces the end by metres. Reported with a
+  :class:`~footzoo.core.errors.SensorWarning` listing the samples.
+
+Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording`` and
+``Result.diagnostics["sensor"]``). Live, :class:`SignalScan` finds the same glitches chunk by
+chunk, and saturation against each axis's extremes so far. :class:`EstimateScan` checks a
+run's estimate (batch and live): no stance at all, and drift while the data say still.
 
 Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording``).
 """
