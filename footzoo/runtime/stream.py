@@ -52,7 +52,7 @@ from .stages import (
 )
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
-SCAN_BLOCK = 32
+SCAN_BLOCK = 128
 #: The per-sample columns of the final estimates.
 COLUMNS = ("t", "quat", "pos", "vel", "acc_nav", "stance")
 
