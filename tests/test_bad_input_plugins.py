@@ -368,3 +368,23 @@ def test_property_any_exception_of_a_plugin_is_a_plugin_error(exc):
     with pytest.raises(PluginError, match=f"test_fault_any.*estimate.*{exc.__name__}") as info:
         Any_().estimate(t, np.zeros((10, 3)), np.zeros((10, 3)), None, np.ones(10, bool), np.array([1.0, 0, 0, 0]))
     assert isinstance(info.value.__cause__, exc)
+
+
+def test_a_reader_that_exits_is_a_plugin_error(tmp_path, monkeypatch, walk):
+    from footzoo.io import registry
+    from footzoo.io.base import Reader
+
+    class ExitingReader(Reader):
+        """Calls sys.exit() instead of raising."""
+
+        name = "test_exiting"
+
+        def open(self, path, **options):
+            raise SystemExit(1)
+
+    readers = registry.available()
+    monkeypatch.setitem(readers._readers, "test_exiting", ExitingReader())
+    monkeypatch.setitem(readers.origins, "test_exiting", "a test package")
+    data = write(walk, tmp_path / "w.csv")
+    with pytest.raises(PluginError, match=r"the test_exiting reader \(a test package\).*never exit the process"):
+        footzoo.load(data, format="test_exiting")
