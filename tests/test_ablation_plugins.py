@@ -261,7 +261,8 @@ def test_a_plugin_that_writes_into_its_input_fails_its_cells_not_the_others(tmp_
     d["factors"] = {"detector.type": [name, "angular_rate_fsm"]}  # the vandal runs first on each recording
     table = run_study(Study.from_dict(d, root=tmp_path))
     mine = table[table["detector.type"] == name]
-    assert mine["error"].str.contains("a plug-in wrote into the recording's arrays").all()
+    expected = f"PluginError: detector '{name}'.*writes into an input array.*copy it first"
+    assert mine["error"].str.contains(expected).all()
     clean = run_study(Study.from_dict({**d, "factors": {"detector.type": ["angular_rate_fsm"]}}, root=tmp_path))
     builtin = table[table["detector.type"] == "angular_rate_fsm"]
     np.testing.assert_array_equal(builtin["value"].to_numpy(), clean["value"].to_numpy())

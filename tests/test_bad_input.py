@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 import scipy.io as sio
 
-from footzoo import ConfigError, FormatError, Pipeline, RecordingError
+from footzoo import ConfigError, FormatError, Pipeline, PluginError, RecordingError
 from footzoo.analysis.foot_vector import FootVector
 from footzoo.apps.cli import EXIT_DATA, EXIT_INTERNAL, EXIT_USAGE, main
 from footzoo.config import load_yaml
@@ -129,6 +129,39 @@ def _study(tmp: Path, text: str) -> Callable[[], object]:
     (tmp / "yun.yaml").write_text(YUN)
     p = _text(tmp, "study.yaml", text)
     return lambda: Study.from_yaml(p)
+
+
+PLUGIN_FILE = '''
+import numpy as np
+import footzoo
+from footzoo.plugins.base import Detector
+
+
+@footzoo.register
+class Faulty(Detector):
+    """A detector with a bug (a bad-input case)."""
+
+    name = "{name}"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        {body}
+'''
+
+
+def _faulty_plugin(tmp: Path, walk: Recording, name: str, body: str) -> Callable[[], object]:
+    """A run of a config whose detector, from a plug-in file, has ``body`` as its detect."""
+    from footzoo.plugins import registry
+
+    (tmp / f"{name}.py").write_text(PLUGIN_FILE.format(name=name, body=body))
+    config = {"plugins": [str(tmp / f"{name}.py")], "orientation": {"type": "madgwick", "use_magnetometer": False},
+              "detector": {"type": name}, "corrections": [{"type": "zvu_dedrift"}]}
+
+    def run():
+        try:
+            return Pipeline.from_dict(config).run(walk)
+        finally:  # registered for this case only: a study of every registered combination must not meet it
+            registry._REGISTRY["detector"].pop(name, None)
+    return run
 
 
 def _push(walk: Recording, *pushes) -> Callable[[], object]:
@@ -345,6 +378,24 @@ CASES = [
                                                     "sweep: {points: many}\n"), ConfigError, "sweep.points"),
     Case("study-path-not-text", lambda d, w: _study(d, "base: yun.yaml\nrecordings: [{path: 3}]\n"), ConfigError,
          "path must be a file path or glob"),
+    Case("stream-acc-in-g", lambda d, w: _push(w, *[(w.t[k], w.acc[k] / 9.80665, w.gyr[k]) for k in range(w.n)]),
+         RecordingError, "this looks like g, not m/s²"),
+    # ---------------------------------------------------------------- plug-ins (more: test_bad_input_plugins.py)
+    Case("plugin-raises", lambda d, w: _faulty_plugin(d, w, "test_case_raises", "return 1 / 0"), PluginError,
+         "detector 'test_case_raises' (footzoo_plugin_"),
+    Case("plugin-exits", lambda d, w: _faulty_plugin(d, w, "test_case_exits", "raise SystemExit(3)"), PluginError,
+         "never exit the process"),
+    Case("plugin-no-return", lambda d, w: _faulty_plugin(
+        d, w, "test_case_no_return", "self.stance_ = self.statistic_ = np.zeros(len(t))"), PluginError,
+         "returned None: end detect() with 'return self'"),
+    Case("plugin-nan-stance", lambda d, w: _faulty_plugin(
+        d, w, "test_case_nan_stance", "self.stance_ = np.full(len(t), np.nan); self.statistic_ = t; return self"),
+         PluginError, "NaN is not stance"),
+    Case("plugin-writes-input", lambda d, w: _faulty_plugin(
+        d, w, "test_case_writes", "gyr[0] = 0.0; return self"), PluginError, "copy it first"),
+    Case("plugin-file-exits-on-import", lambda d, w: (lambda: Pipeline.from_dict(
+        {"plugins": [str(_text(d, "exits.py", "import sys\nsys.exit()\n"))], "orientation": {"type": "madgwick"},
+         "detector": {"type": "shoe"}})), PluginError, "called sys.exit(None)"),
     # ---------------------------------------------------------------- stream
     Case("stream-7-samples", lambda d, w: _push(w, (w.t[0], w.acc[:7], w.gyr[:7])), RecordingError,
          "push them one at a time"),
@@ -514,7 +565,7 @@ def test_cli_console_script_has_no_traceback(tmp_path):
     assert proc.stderr.startswith("footzoo: error:") and "Traceback" not in proc.stderr
     helptext = subprocess.run([sys.executable, "-m", "footzoo", "--help"], capture_output=True, text=True, cwd=ROOT,
                               env=env).stdout
-    assert "exit codes:" in helptext and "3    data error" in helptext
+    assert "exit codes:" in helptext and "3    data error" in helptext and "4    plug-in error" in helptext
 
 
 # --------------------------------------------------------------------------- parameters, from their declarations

@@ -11,6 +11,9 @@ code  meaning
 1     internal error: a bug in footzoo (rerun with ``--debug`` and report it)
 2     usage or configuration error: bad arguments, config, study or calibration file
 3     data error: unreadable, malformed or implausible recording; unwritable output
+4     plug-in error: a plug-in (built-in or yours) raised, exited or broke its contract
+      (a wrong shape, NaN, a non-unit quaternion, a forgotten ``return self``); the
+      message names the plug-in, the method and the cause
 130   interrupted (Ctrl-C)
 ====  ==============================================================================
 """
@@ -27,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.conventions import ACC_UNITS, GYR_UNITS
-from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, RecordingError
+from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -64,6 +67,7 @@ EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
 EXIT_DATA = 3
+EXIT_PLUGIN = 4
 EXIT_INTERRUPTED = 130
 
 EXIT_CODES_HELP = """exit codes:
@@ -71,6 +75,7 @@ EXIT_CODES_HELP = """exit codes:
   1    internal error (a bug in footzoo: rerun with --debug and report it)
   2    usage or configuration error (arguments, config, study or calibration file)
   3    data error (unreadable, malformed or implausible recording; unwritable output)
+  4    plug-in error (a plug-in raised or broke its contract: the message names it and the cause)
   130  interrupted
 """
 
@@ -614,6 +619,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def _classify(err: Exception) -> tuple[int, str]:
     """Exit code and message for an exception leaving a command."""
+    if isinstance(err, PluginError):
+        return EXIT_PLUGIN, f"plug-in error: {err}"
     if isinstance(err, (RecordingError, FormatError, OutputError)):
         return EXIT_DATA, f"error: {err}"
     if isinstance(err, (ConfigError, FootzooError)):

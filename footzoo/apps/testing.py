@@ -53,7 +53,7 @@ import numpy as np
 import yaml
 
 from ..core.context import RunContext
-from ..core.errors import ConfigError, FootzooError
+from ..core.errors import ConfigError, FootzooError, PluginError
 from ..core.params import Real
 from ..plugins.base import (
     AccelerationCorrection,
@@ -141,6 +141,18 @@ def check_plugin(cls: type[Plugin], verbose: bool | None = None) -> CheckReport:
     report.passed("get_params/set_params")
     _check_round_trip(cls, instance)
     report.passed("YAML round trip and clone")
+    try:
+        _check_behaviour(instance, report)
+    except PluginError as err:  # the contract enforced at every call (footzoo.plugins.contract) names the fault
+        edit = " (the action method modified its input arrays)" if "read-only" in str(err) else ""
+        raise AssertionError(f"{cls.__name__}: {err}{edit}") from err
+    if verbose if verbose is not None else _interactive():
+        print(report)
+    return report
+
+
+def _check_behaviour(instance: Plugin, report: CheckReport) -> None:
+    """The kind's behaviour checks on a simulated walk."""
     if isinstance(instance, Calibration):
         _check_calibration(instance)
         report.passed("calibrate on a simulated walk, with and without magnetometer, NaN refused")
@@ -163,9 +175,6 @@ def check_plugin(cls: type[Plugin], verbose: bool | None = None) -> CheckReport:
     elif isinstance(instance, Analysis):
         _check_analysis(instance)
         report.passed("analyze and annotate on a simulated walk, NaN refused")
-    if verbose if verbose is not None else _interactive():
-        print(report)
-    return report
 
 
 def _interactive() -> bool:

@@ -525,8 +525,16 @@ def _report_gaps(rec: Recording) -> None:
 
 
 def _check_units(rec: Recording) -> None:
-    acc_norm = np.linalg.norm(rec.acc, axis=1)
-    gyr_norm = np.linalg.norm(rec.gyr, axis=1)
+    check_units(rec.acc, rec.gyr)
+
+
+def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
+    """Refuse an accelerometer in g or mg and a gyroscope in deg/s declared as SI (a RecordingError with the fix).
+
+    Run on every recording and, live, on a stream's first samples (:class:`footzoo.Stream`).
+    """
+    acc_norm = np.linalg.norm(acc, axis=1)
+    gyr_norm = np.linalg.norm(gyr, axis=1)
     # the stillest tenth of the samples tells the unit of the accelerometer
     still = gyr_norm <= np.quantile(gyr_norm, 0.1)
     rest = float(np.median(acc_norm[still]))

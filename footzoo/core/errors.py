@@ -1,5 +1,6 @@
 """Exceptions footzoo raises; every message names the problem and the fix."""
 
+import copy
 import difflib
 
 
@@ -40,6 +41,15 @@ class PluginError(FootzooError):
         self.method = method
 
 
+class PluginImportError(PluginError, ConfigError):
+    """A plug-in module or file listed under ``plugins:`` failed while it was imported (raised, or exited).
+
+    Both a :class:`PluginError` (the fault is in the plug-in's code; the command line exits with
+    the plug-in error's code) and a :class:`ConfigError` (the config names it: ``footzoo
+    validate`` and a study report it as a problem of the config).
+    """
+
+
 class FootzooWarning(UserWarning):
     """A warning from footzoo: the result is computed but something in the input deserves a look."""
 
@@ -60,3 +70,13 @@ def did_you_mean(word: str, options: list[str]) -> str:
     """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
     close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def prefixed(err: FootzooError, where: object) -> FootzooError:
+    """The same error (its class and attributes kept) with ``where: `` before its message.
+
+    Raise it ``from err.__cause__`` to keep the original cause (a plug-in's exception).
+    """
+    out = copy.copy(err)
+    out.args = (f"{where}: {err}",)
+    return out

@@ -1,4 +1,4 @@
-"""Sensor sanity: impossible values, saturated (clipped) axes and isolated gyroscope spikes.
+"""Sensor sanity: impossible values, saturated (clipped) axes, glitches; the physics of a run's estimate.
 
 Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.core.data.Recording`
 (FRD, SI) after the time and unit checks:
@@ -19,19 +19,26 @@ Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.co
   :class:`~footzoo.core.errors.SensorWarning` naming the axis, the value, the sample
   and time ranges; the estimate is computed but its velocity and position
   underestimate the motion in those samples.
-* **Gyro glitches** — a single sample whose angular rate differs from both
-  neighbours by more than :data:`GLITCH_JUMP` (15 rad/s) while the neighbours
-  agree (the spike height above the neighbours' change exceeds 15 rad/s). On the
-  real recordings the largest such single-sample peak is 5.7 rad/s (gaitmap
-  example, 204.8 Hz; PyShoe ≤ 1.7 rad/s, x-io 1.0 rad/s); one 40 rad/s spike in a
-  walk turns the attitude by 0.2–0.4 rad and misplaces the end by metres.
-  Reported with a :class:`~footzoo.core.errors.SensorWarning` listing the samples.
+* **Glitches** — a burst of 1 to :data:`GLITCH_MAX_LEN` samples whose angular rate differs
+  from both the sample before and the sample after it by more than :data:`GLITCH_JUMP`
+  (15 rad/s) plus the change between those two (:func:`find_bursts`); the same for the
+  specific force with :data:`ACC_GLITCH_JUMP` (400 m/s²). On the real recordings the largest
+  such single-sample peak is 5.7 rad/s (gaitmap example, 204.8 Hz; PyShoe ≤ 1.7 rad/s, x-io
+  1.0 rad/s) and no burst is found in any; one 40 rad/s spike in a walk turns the attitude by
+  0.2–0.4 rad and misplaces the end by metres. Reported with a
+  :class:`~footzoo.core.errors.SensorWarning` listing the samples.
+
+Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording`` and
+``Result.diagnostics["sensor"]``). Live, :class:`SignalScan` finds the same glitches chunk by
+chunk, and saturation against each axis's extremes so far. :class:`EstimateScan` checks a
+run's estimate (batch and live): no stance at all, and drift while the data say still.
 
 Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording``).
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
@@ -49,7 +56,14 @@ SATURATION_FLOOR = {"acc": 2.0 * GRAVITY, "gyr": 2.0}
 PLATEAU_FRACTION = 0.25
 #: Height of a single-sample gyroscope spike above its neighbours' change reported as a glitch (rad/s).
 GLITCH_JUMP = 15.0
+#: Height of an accelerometer burst above its surroundings reported as a glitch (m/s²): above any foot impact
+#: a body-worn sensor measures (the largest jump between two samples of the real recordings in the data
+#: folder — PyShoe walking, running and stairs, x-io, gaitmap, Köroğlu — is 256 m/s², gaitmap's heel strikes).
+ACC_GLITCH_JUMP = 400.0
+#: Longest burst of samples reported as a glitch (a longer excursion is motion, or saturation).
+GLITCH_MAX_LEN = 3
 _AXES = "xyz"
+_SQRT3 = math.sqrt(3.0)
 
 
 def check_impossible(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
@@ -105,18 +119,60 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
     return found
 
 
-def find_glitches(gyr: np.ndarray) -> np.ndarray:
-    """Samples whose angular rate spikes alone by more than :data:`GLITCH_JUMP` (indices)."""
-    if len(gyr) < 3:
+def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np.ndarray:
+    """Samples of bursts of 1 to ``max_len`` samples that stand out from the samples around them by more than ``jump``.
+
+    A burst ``x[k:k+L]`` is a glitch when every one of its samples differs from both the sample
+    before (``x[k-1]``) and the sample after (``x[k+L]``) by more than ``jump`` plus the change
+    between those two (a real peak rises and falls over its samples; a glitch jumps and returns).
+    For ``L = 1`` this is the single-sample spike test.
+
+    Parameters
+    ----------
+    x : (N, 3) array
+        Angular rate (rad/s) or specific force (m/s²).
+    jump : float
+        Height above the surrounding change, in the unit of ``x``.
+    max_len : int
+        Longest burst (samples).
+
+    Returns
+    -------
+    (k,) int array
+        The glitch samples, sorted.
+    """
+    n = len(x)
+    if n < 3:
         return np.zeros(0, dtype=int)
-    step = np.diff(gyr, axis=0)
-    step2 = np.einsum("ij,ij->i", step, step)
-    # a spike jumps by more than GLITCH_JUMP on both sides: only those samples need the full test
-    k = np.flatnonzero((step2[:-1] > GLITCH_JUMP**2) & (step2[1:] > GLITCH_JUMP**2)) + 1
-    mid, before, after = gyr[k], gyr[k - 1], gyr[k + 1]
-    jump = np.minimum(np.linalg.norm(mid - before, axis=1), np.linalg.norm(mid - after, axis=1))
-    spike = jump - np.linalg.norm(after - before, axis=1)
-    return k[spike > GLITCH_JUMP]
+    step = np.diff(x, axis=0)
+    big = np.einsum("ij,ij->i", step, step) > jump**2  # big[i]: x jumps between samples i and i+1
+    found = []
+    for length in range(1, max_len + 1):
+        if n < length + 2:
+            break
+        # a burst starts with a jump into it (k-1 -> k) and ends with one out of it (k+L-1 -> k+L)
+        k = np.flatnonzero(big[: n - length - 1] & big[length:]) + 1
+        if not len(k):
+            continue
+        before, after = x[k - 1], x[k + length]
+        height = np.full(len(k), np.inf)
+        for j in range(length):
+            mid = x[k + j]
+            height = np.minimum(height, np.minimum(np.linalg.norm(mid - before, axis=1),
+                                                   np.linalg.norm(mid - after, axis=1)))
+        k = k[height - np.linalg.norm(after - before, axis=1) > jump]
+        found.extend((k[:, None] + np.arange(length)).ravel().tolist())
+    return np.unique(np.asarray(found, dtype=int))
+
+
+def find_glitches(gyr: np.ndarray) -> np.ndarray:
+    """Samples of gyroscope bursts (1 to :data:`GLITCH_MAX_LEN` samples) above :data:`GLITCH_JUMP` (indices)."""
+    return find_bursts(gyr, GLITCH_JUMP)
+
+
+def find_acc_glitches(acc: np.ndarray) -> np.ndarray:
+    """Samples of accelerometer bursts (1 to :data:`GLITCH_MAX_LEN` samples) above :data:`ACC_GLITCH_JUMP`."""
+    return find_bursts(acc, ACC_GLITCH_JUMP)
 
 
 def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording") -> dict[str, Any]:
@@ -135,16 +191,269 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
             "underestimated there; use a sensor with a larger range. Details in meta['sanity']",
             SensorWarning, stacklevel=4,
         )
-    glitches = find_glitches(gyr)
-    if len(glitches):
-        report["gyro_glitches"] = [int(k) for k in glitches]
-        shown = ", ".join(f"{int(k)} (t = {t[k]:.3f} s, |ω| = {np.linalg.norm(gyr[k]):.1f} rad/s)"
-                          for k in glitches[:5])
-        more = f" and {len(glitches) - 5} more" if len(glitches) > 5 else ""
+    report.update(warn_glitches(t, acc, gyr, name, stacklevel=5))
+    return report
+
+
+def warn_glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording",
+                  stacklevel: int = 4) -> dict[str, list[int]]:
+    """Warn about gyroscope and accelerometer glitches (:func:`find_bursts`); ``{"gyro_glitches": [...], ...}``."""
+    found = _glitches(t, acc, gyr)
+    _warn_found(t, acc, gyr, found, name, 0, stacklevel + 1)
+    return found
+
+
+def _warn_found(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, found: dict[str, list[int]], name: str,
+                offset: int = 0, stacklevel: int = 5) -> None:
+    """The warnings of glitches ``found`` (absolute sample numbers; ``offset``: that of the arrays' first sample)."""
+    for key, label, arr, bound, unit in (("gyro_glitches", "gyroscope", gyr, GLITCH_JUMP, "rad/s"),
+                                         ("acc_glitches", "accelerometer", acc, ACC_GLITCH_JUMP, "m/s²")):
+        ks = found.get(key)
+        if not ks:
+            continue
+        shown = ", ".join(f"{k} (t = {t[k - offset]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
+                          f"{np.linalg.norm(arr[k - offset]):.1f} {unit})" for k in ks[:5])
+        more = f" and {len(ks) - 5} more" if len(ks) > 5 else ""
+        effect = ("a glitch turns the attitude and misplaces the track" if key[0] == "g" else
+                  "a glitch kicks the velocity and misplaces the track")
         warnings.warn(
-            f"{name}: {len(glitches)} isolated gyroscope spike(s) above {GLITCH_JUMP:g} rad/s at sample(s) "
-            f"{shown}{more}: a glitch turns the attitude and misplaces the track. Repair those samples "
-            "(e.g. replace each by its neighbours' mean). Details in meta['sanity']",
+            f"{name}: {len(ks)} isolated {label} spike(s) above {bound:g} {unit} at sample(s) {shown}{more} "
+            f"(bursts of 1 to {GLITCH_MAX_LEN} samples): {effect}. Repair those samples (e.g. replace them by the "
+            "neighbours' mean). Details in meta['sanity']",
+            SensorWarning, stacklevel=stacklevel,
+        )
+
+
+# --------------------------------------------------------------------------- the scans of a run (batch and live)
+#: Still by the data: |ω| below this (rad/s) and |‖f‖ − g| below :data:`STILL_ACC` (m/s²).
+STILL_GYR = 0.2
+#: Largest |‖f‖ − g| of a still sample (m/s²).
+STILL_ACC = 0.5
+#: Shortest still period (s) whose estimated displacement is checked.
+STILL_MIN_DURATION = 5.0
+#: Displacement of the estimate over a still period above which it is reported as drift (m).
+STILL_MAX_DRIFT = 0.25
+#: Shortest motion after the still start (s) for which "no stance at all" is reported.
+NO_STANCE_MIN_DURATION = 5.0
+
+
+class SignalScan:
+    """Glitches and saturation in the signals, chunk by chunk (live), as :func:`scan` finds them in a recording.
+
+    Each chunk is scanned for glitches with the last :data:`GLITCH_MAX_LEN` + 1 samples of the one
+    before (a burst needs the sample before it and the one after it); each glitch is reported
+    once, with the batch run's numbers. Saturation live: an axis that sits at its largest (or
+    smallest) value so far, exactly, for :data:`SATURATION_MIN_RUN` samples, beyond
+    :data:`SATURATION_FLOOR`, while the axis is not piecewise constant (the exact repeats of its
+    consecutive samples elsewhere are at most :data:`PLATEAU_FRACTION`) — the batch rule with
+    "so far" for the whole recording; reported once per axis.
+    """
+
+    def __init__(self, name: str = "stream"):
+        self.name = name
+        self.report: dict[str, Any] = {}
+        self._t = np.zeros(0)  # the last GLITCH_MAX_LEN + 1 samples: time, and [acc | gyr] (m, 6)
+        self._x = np.zeros((0, 6))
+        self._k0 = 0  # absolute index of the tail's first sample
+        self._done = -1  # last sample already reported
+        # per axis (acc x, y, z, gyr x, y, z): the rails so far and the run at each ending at the last sample;
+        # consecutive pairs and exact repeats seen (for the plateau rule)
+        self._rails = [[-math.inf] * 6, [math.inf] * 6]
+        self._runs = [[0] * 6, [0] * 6]
+        self._pairs = 0
+        self._repeats = [0] * 6
+        self._saturated = [[False] * 6, [False] * 6]
+        self._floor = [SATURATION_FLOOR["acc"]] * 3 + [SATURATION_FLOOR["gyr"]] * 3
+
+    def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, Any]:
+        """Scan the next samples; the new findings (also added to :attr:`report`)."""
+        x = np.hstack([acc, gyr])
+        k0 = self._k0 + len(self._t)  # absolute index of the chunk's first sample
+        joined_t, joined = np.concatenate([self._t, t]), np.vstack([self._x, x])
+        step = joined[max(len(self._t) - 1, 0):]
+        step = np.abs(step[1:] - step[:-1])
+        new = self._saturation(t, x, k0, step)
+        # a burst jumps by more than its height into it: some component by more than height / √3
+        if len(step) and (step[:, 3:].max() > GLITCH_JUMP / _SQRT3 or step[:, :3].max() > ACC_GLITCH_JUMP / _SQRT3):
+            fresh = {key: [k for k in ks if k > self._done]
+                     for key, ks in _glitches(joined_t, joined[:, :3], joined[:, 3:], self._k0).items()}
+            fresh = {key: ks for key, ks in fresh.items() if ks}
+            if fresh:
+                _warn_found(joined_t, joined[:, :3], joined[:, 3:], fresh, self.name, self._k0)
+                for key, ks in fresh.items():
+                    self.report.setdefault(key, []).extend(ks)
+                self._done = max(max(ks) for ks in fresh.values())
+                new.update(fresh)
+        keep = GLITCH_MAX_LEN + 1
+        self._k0 += max(len(joined_t) - keep, 0)
+        self._t, self._x = joined_t[-keep:], joined[-keep:]
+        return new
+
+    def _saturation(self, t: np.ndarray, x: np.ndarray, k0: int, step: np.ndarray) -> dict[str, Any]:
+        """Runs at each axis's rails so far (vectorised over the chunk and the axes; one sample: scalar)."""
+        self._pairs += len(step)
+        found: list[dict[str, Any]] = []
+        if len(x) == 1:  # a pushed sample: the same rule in scalars (numpy's per-call cost dominates here)
+            row, rails, runs = x[0].tolist(), self._rails, self._runs
+            for j, d in enumerate(step[0].tolist() if len(step) else ()):
+                if d == 0.0:
+                    self._repeats[j] += 1
+            for side in (0, 1):
+                for j in range(6):
+                    v, r = row[j], rails[side][j]
+                    if (v > r) if side == 0 else (v < r):
+                        rails[side][j], runs[side][j] = v, 1
+                    elif v == r:
+                        runs[side][j] += 1
+                    else:
+                        runs[side][j] = 0
+                    if runs[side][j] >= SATURATION_MIN_RUN and not self._saturated[side][j]:
+                        self._hit(side, j, v, runs[side][j], k0, t[0], found)
+        else:
+            self._repeats = [n + int(c) for n, c in zip(self._repeats, (step == 0).sum(axis=0), strict=True)]
+            for side, pick in ((0, np.maximum), (1, np.minimum)):
+                rail = pick(np.asarray(self._rails[side]), (x.max(axis=0) if side == 0 else x.min(axis=0)))
+                before = np.asarray(self._runs[side])
+                before[rail != np.asarray(self._rails[side])] = 0
+                at = x == rail
+                touched = np.flatnonzero(at.any(axis=0))  # only the axes with a sample at the rail have a run
+                self._rails[side] = rail.tolist()
+                runs = [0] * 6
+                if len(touched):
+                    idx = np.arange(len(x))[:, None]
+                    # the run at the rail ending at each sample: its index minus that of the last sample off it
+                    run = idx - np.maximum.accumulate(np.where(at[:, touched], -1 - before[None, touched], idx),
+                                                      axis=0)
+                    for c, j in enumerate(touched.tolist()):
+                        runs[j] = int(run[-1, c])
+                        longest = int(run[:, c].max())
+                        if longest >= SATURATION_MIN_RUN and not self._saturated[side][j]:
+                            i = int(np.argmax(run[:, c] >= SATURATION_MIN_RUN))
+                            self._hit(side, j, float(rail[j]), longest, k0 + i, t[i], found)
+                self._runs[side] = runs
+        if not found:
+            return {}
+        self.report.setdefault("saturation", []).extend(found)
+        parts = [f"{f['axis']} at {f['value']:.6g} for {SATURATION_MIN_RUN} samples or more from sample {f['first']} "
+                 f"(t = {f['t']:.3f} s at sample {f['first'] + SATURATION_MIN_RUN - 1})" for f in found]
+        warnings.warn(
+            f"{self.name}: sensor saturated (clipped): {'; '.join(parts)}. Velocity and position are "
+            "underestimated there; use a sensor with a larger range. Details in Stream.sensor",
             SensorWarning, stacklevel=4,
         )
-    return report
+        return {"saturation": found}
+
+    def _hit(self, side: int, j: int, rail: float, longest: int, k: int, t: float, found: list[dict[str, Any]]) -> None:
+        """Report axis ``j`` at its rail (sample ``k`` the run's third, at time ``t``) unless the floor or the
+        plateau rule excuses it."""
+        if abs(rail) < self._floor[j]:
+            return
+        away = self._pairs - longest
+        if away > 0 and (self._repeats[j] - (longest - 1)) / away > PLATEAU_FRACTION:
+            return  # flat tops are the signal's shape (noise-free simulation), not clipping
+        self._saturated[side][j] = True
+        found.append({"axis": f"{'acc' if j < 3 else 'gyr'}_{_AXES[j % 3]}", "value": rail,
+                      "first": k - (SATURATION_MIN_RUN - 1), "t": float(t)})
+
+
+def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) -> dict[str, list[int]]:
+    out = {}
+    for key, arr, bound in (("gyro_glitches", gyr, GLITCH_JUMP), ("acc_glitches", acc, ACC_GLITCH_JUMP)):
+        found = find_bursts(arr, bound)
+        if len(found):
+            out[key] = [int(k) + offset for k in found]
+    return out
+
+
+class EstimateScan:
+    """Physics of the estimate, fed the final estimates chunk by chunk (a batch run: one chunk of all).
+
+    * **no stance at all** — no stance sample after the still start, over more than
+      :data:`NO_STANCE_MIN_DURATION` s of motion: the velocity was never reset and the track is
+      pure strapdown drift (a detector that never fires on this motion, with the guard off).
+    * **drift while still** — the data say the sensor lies still (|ω| < :data:`STILL_GYR`,
+      |‖f‖ − g| < :data:`STILL_ACC`) for :data:`STILL_MIN_DURATION` s or longer, and the estimate
+      moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness.
+
+    Findings are warned (:class:`~footzoo.core.errors.SensorWarning`, with the samples and the
+    fix) as soon as they are known, and kept in :attr:`report`.
+    """
+
+    def __init__(self, t_start: float, gravity: float = GRAVITY, name: str = "recording", detector: str = "detector"):
+        self.t_start, self.gravity, self.name, self.detector = t_start, gravity, name, detector
+        self.report: dict[str, Any] = {}
+        self._stance = 0
+        self._first: tuple[float, np.ndarray] | None = None  # (t, pos) of the first sample after the still start
+        self._last: tuple[float, np.ndarray] | None = None
+        self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
+
+    def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+             pos: np.ndarray) -> None:
+        """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m)."""
+        if not len(t):
+            return
+        moving = t > self.t_start
+        if moving.any():
+            self._stance += int(np.count_nonzero(stance[moving]))
+            if self._first is None:
+                i = int(np.argmax(moving))
+                self._first = (float(t[i]), pos[i].copy())
+        self._last = (float(t[-1]), pos[-1].copy())
+        still = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (
+            np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STILL_ACC)
+        if not still[0] and self._run is not None:  # the open run ended at the chunk's start
+            self._close(self._run)
+            self._run = None
+        edges = np.flatnonzero(np.diff(np.concatenate([[False], still, [False]]).astype(np.int8)))
+        starts, ends = edges[::2], edges[1::2]
+        # only the runs that can be long enough: the open ones at either end, and the long ones in between
+        long = (t[ends - 1] - t[starts] >= STILL_MIN_DURATION) | (starts == 0) | (ends == len(t))
+        for s, e in zip(starts[long].tolist(), ends[long].tolist(), strict=True):
+            run = self._run if (s == 0 and self._run is not None) else {
+                "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0}
+            moved = pos[s:e] - run["pos0"]
+            run["drift"] = max(run["drift"], float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max())))
+            run["last"], run["t1"] = int(k[e - 1]), float(t[e - 1])
+            if e == len(t):
+                self._run = run
+            else:
+                self._close(run)
+                if s == 0:
+                    self._run = None
+
+    def _close(self, run: dict[str, Any]) -> None:
+        duration = run["t1"] - run["t0"]
+        if duration < STILL_MIN_DURATION or run["drift"] <= STILL_MAX_DRIFT:
+            return
+        finding = {"first": run["first"], "last": run["last"], "t0": run["t0"], "t1": run["t1"],
+                   "duration_s": duration, "drift_m": run["drift"]}
+        self.report.setdefault("still_drift", []).append(finding)
+        warnings.warn(
+            f"{self.name}: the sensor lies still from t = {run['t0']:.2f} s to {run['t1']:.2f} s (samples "
+            f"{run['first']}–{run['last']}, {duration:.1f} s: |ω| < {STILL_GYR:g} rad/s, |a| ≈ g) but the estimate "
+            f"moves {run['drift']:.2f} m meanwhile: the detector {self.detector!r} misses this stillness, so the "
+            "velocity drifts. Raise its threshold, choose another detector, or keep the stance guard on "
+            "(guards.max_swing). Details in diagnostics['sensor']",
+            SensorWarning, stacklevel=5,
+        )
+
+    def finish(self) -> dict[str, Any]:
+        """End of the data: the still run open at the end, no stance at all; the findings."""
+        if self._run is not None:
+            self._close(self._run)
+            self._run = None
+        if self._first is not None and self._last is not None and self._stance == 0:
+            duration = self._last[0] - self._first[0]
+            if duration > NO_STANCE_MIN_DURATION:
+                moved = float(np.linalg.norm(self._last[1] - self._first[1]))
+                self.report["no_stance"] = {"t0": self._first[0], "t1": self._last[0], "distance_m": moved}
+                warnings.warn(
+                    f"{self.name}: no stance from t = {self._first[0]:.2f} s to the end ({duration:.1f} s): the "
+                    f"detector {self.detector!r} never fired after the still start and the velocity was never "
+                    f"reset, so the track ({moved:.1f} m from there to the end) is pure drift (or, with a dedrift, "
+                    "never corrected). Choose a detector made "
+                    "for this motion or tune its threshold, and keep the stance guard on (guards.max_swing). Details "
+                    "in diagnostics['sensor']",
+                    SensorWarning, stacklevel=4,
+                )
+        return self.report

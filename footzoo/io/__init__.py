@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.data import Recording
-from ..core.errors import FootzooError, FormatError, RecordingError
+from ..core.errors import FootzooError, FormatError, PluginError, RecordingError
 from .base import REQUIRED, Option, Reader
 from .metadata import read_facts
 from .registry import GROUP, available, refresh
@@ -167,6 +167,12 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         raise FormatError(
             f"{p}: not UTF-8 text (byte offset {err.start}); is it really a {fmt} file? Pass format= if not"
         ) from err
+    except (KeyboardInterrupt, MemoryError):
+        raise
+    except (SystemExit, GeneratorExit) as err:  # never a parse failure: the reader's own fault
+        raise PluginError(f"the {fmt} reader ({origin}) called sys.exit() / raised {type(err).__name__} while reading "
+                          f"{p}; a reader must raise an exception, never exit the process (fix the reader)",
+                          plugin=f"reader {fmt!r}", method="open") from err
     except Exception as err:  # parsing untrusted bytes: any library error means "not this format"
         who = f"{fmt}" if origin == "footzoo" else f"{fmt} (reader from {origin})"
         raise FormatError(

@@ -52,6 +52,7 @@ from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocab
     validated_init,
 )
 from ..filters.measurement import MeasurementModel, StateBlock
+from .contract import GUARDED, Output, guard
 from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
 
 #: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
@@ -70,26 +71,18 @@ def _all_finite(value: np.ndarray) -> bool:
     return bool(np.isfinite(value).all())
 
 
-def _checked(method: Callable[..., Any]) -> Callable[..., Any]:
-    """Wrap an action method: a non-finite or non-numeric array argument raises a clear RecordingError."""
-    names = [p for p in inspect.signature(method).parameters if p != "self"]
-
-    @functools.wraps(method)
-    def action(self, *args, **kwargs):
-        for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
-            if isinstance(value, np.ndarray) and value.dtype.kind in "fc" and not _all_finite(value):
-                bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
-                raise RecordingError(
-                    f"{self.kind} {self.name!r}: input {name!r} has {len(bad)} non-finite sample(s) (NaN or inf), "
-                    f"first at index {int(bad[0])}; repair or drop them before running (footzoo.Recording does)"
-                )
-            if isinstance(value, np.ndarray) and value.dtype.kind not in "fcbiu":
-                raise RecordingError(f"{self.kind} {self.name!r}: input {name!r} must be numeric, got dtype "
-                                     f"{value.dtype}")
-        return method(self, *args, **kwargs)
-
-    action.__footzoo_checked__ = True
-    return action
+def _check_inputs(plugin: Plugin, names: list[str], args: tuple, kwargs: dict[str, Any]) -> None:
+    """An action method's array inputs: a non-finite or non-numeric array argument raises a clear RecordingError."""
+    for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
+        if isinstance(value, np.ndarray) and value.dtype.kind in "fc" and not _all_finite(value):
+            bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
+            raise RecordingError(
+                f"{plugin.kind} {plugin.name!r}: input {name!r} has {len(bad)} non-finite sample(s) (NaN or inf), "
+                f"first at index {int(bad[0])}; repair or drop them before running (footzoo.Recording does)"
+            )
+        if isinstance(value, np.ndarray) and value.dtype.kind not in "fcbiu":
+            raise RecordingError(f"{plugin.kind} {plugin.name!r}: input {name!r} must be numeric, got dtype "
+                                 f"{value.dtype}")
 
 
 class Plugin:
@@ -106,14 +99,17 @@ class Plugin:
     needs_truth: ClassVar[bool] = False
     needs_distance: ClassVar[bool] = False
     causal: ClassVar[bool] = False
+    #: The per-sample outputs of the kind (attributes ``<name>_`` of the action method, columns of ``step``),
+    #: checked on return (:mod:`footzoo.plugins.contract`).
+    outputs: ClassVar[dict[str, Output]] = {}
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         _declare(cls)
-        for action in ACTIONS:
-            method = cls.__dict__.get(action)
-            if callable(method) and not getattr(method, "__footzoo_checked__", False):
-                setattr(cls, action, _checked(method))
+        for name in GUARDED:  # the contract around every method a plug-in defines (plugins/contract.py)
+            method = cls.__dict__.get(name)
+            if inspect.isfunction(method) and not getattr(method, "__footzoo_checked__", False):
+                setattr(cls, name, guard(method, name, _check_inputs if name in ACTIONS else None))
 
     @classmethod
     def param_names(cls) -> list[str]:
@@ -315,6 +311,8 @@ class Calibration(Plugin):
     """
 
     kind: ClassVar[str] = "calibration"
+    outputs: ClassVar[dict[str, Output]] = {"acc": Output(width=3), "gyr": Output(width=3),
+                                            "mag": Output(width=3, required=False)}
     #: The signals the fit is made from: without any of them there is nothing to fit (nor to wait for, live).
     fits_on: ClassVar[tuple[str, ...]] = ("acc", "gyr", "mag")
 
@@ -359,6 +357,7 @@ class Orientation(Plugin):
     """
 
     kind: ClassVar[str] = "orientation"
+    outputs: ClassVar[dict[str, Output]] = {"quat": Output("quat", width=4)}
     carried_by_filter: ClassVar[bool] = False
     needs_stance: ClassVar[bool] = False
     use_magnetometer: bool = False
@@ -402,6 +401,7 @@ class Detector(Plugin):
     """
 
     kind: ClassVar[str] = "detector"
+    outputs: ClassVar[dict[str, Output]] = {"stance": Output("bool"), "statistic": Output(finite=False, required=False)}
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> Detector:
         """Set ``stance_`` and ``statistic_`` (and the step outputs' other arrays); returns ``self``."""
@@ -431,6 +431,8 @@ class VelocityCorrection(Correction):
     ``apply(t, acc_nav, stance)`` sets ``vel_`` and ``pos_`` ((N, 3), m/s and m). At most one per
     pipeline, and not together with Kalman corrections (both would set the velocity).
     """
+
+    outputs: ClassVar[dict[str, Output]] = {"vel": Output(width=3), "pos": Output(width=3)}
 
     def apply(self, t: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray,
               ctx: RunContext | None = None) -> VelocityCorrection:

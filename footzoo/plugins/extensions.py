@@ -21,7 +21,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from ..core.errors import ConfigError
+from ..core.errors import ConfigError, PluginImportError
 
 ENTRY_POINT_GROUP = "footzoo.plugins"
 
@@ -148,10 +148,12 @@ def load_entry_points() -> list[dict[str, Any]]:
             dist = getattr(getattr(ep, "dist", None), "name", None) or "an installed package"
             try:
                 ep.load()
-            except Exception as err:  # any failure of third-party code becomes a named footzoo error
-                raise ConfigError(
+            except (KeyboardInterrupt, MemoryError):
+                raise
+            except BaseException as err:  # noqa: BLE001 - any failure of third-party code is a named footzoo error
+                raise PluginImportError(
                     f"the plug-in entry point {ep.name!r} ({ep.value}) of {dist} failed to load: "
-                    f"{type(err).__name__}: {err}; fix or uninstall {dist}") from None
+                    f"{_cause(err)}; fix or uninstall {dist}", plugin=dist, method="import") from err
             loaded.append({"name": ep.name, "value": ep.value, "distribution": dist})
         _ENTRY_POINTS = loaded
         return list(loaded)
@@ -215,13 +217,13 @@ def _load_file(path: Path, label: str) -> dict[str, Any]:
     sys.modules[name] = module  # before executing: dataclasses, pickling and registration look it up
     try:
         exec(code, module.__dict__)
-    except Exception as err:  # a plug-in's import failure becomes a named footzoo error
-        if previous is None:
-            sys.modules.pop(name, None)
-        else:
-            sys.modules[name] = previous
-        raise ConfigError(f"{label}: importing plug-in file {str(path)!r} failed{_where(err, path)}: "
-                          f"{type(err).__name__}: {err}") from None
+    except (KeyboardInterrupt, MemoryError):
+        _restore(name, previous)
+        raise
+    except BaseException as err:  # noqa: BLE001 - a plug-in's import failure (sys.exit() too) is a named error
+        _restore(name, previous)
+        raise PluginImportError(f"{label}: importing plug-in file {str(path)!r} failed{_where(err, path)}: "
+                                f"{_cause(err)}", plugin=str(path), method="import") from err
     _LOADED[name] = digest
     return info
 
@@ -237,14 +239,33 @@ def _load_module(name: str, label: str) -> dict[str, Any]:
     except SyntaxError as err:
         raise ConfigError(f"{label}: syntax error in plug-in module {name!r}, file {err.filename}, line {err.lineno}: "
                           f"{err.msg}; fix the file") from None
-    except Exception as err:  # a plug-in's import failure becomes a named footzoo error
-        raise ConfigError(f"{label}: importing plug-in module {name!r} failed: {type(err).__name__}: {err}") from None
+    except (KeyboardInterrupt, MemoryError):
+        raise
+    except BaseException as err:  # noqa: BLE001 - a plug-in's import failure (sys.exit() too) is a named error
+        raise PluginImportError(f"{label}: importing plug-in module {name!r} failed: {_cause(err)}",
+                                plugin=name, method="import") from err
     path = getattr(module, "__file__", None)
     files = _source_files(name, label)
     h = hashlib.sha256()
     for f in files:
         h.update(f.read_bytes())
     return {"spec": name, "module": module.__name__, "path": path, "sha256": h.hexdigest()}
+
+
+def _restore(name: str, previous: Any) -> None:
+    """Put back the module a failed import replaced in ``sys.modules`` (or remove the half-imported one)."""
+    if previous is None:
+        sys.modules.pop(name, None)
+    else:
+        sys.modules[name] = previous
+
+
+def _cause(err: BaseException) -> str:
+    """The exception as text; a ``SystemExit`` with the fix (a plug-in must not exit the process)."""
+    if isinstance(err, SystemExit):
+        return (f"it called sys.exit({err.code!r}) (SystemExit) while being imported; a plug-in must raise an "
+                "exception, never exit the process: remove the exit")
+    return f"{type(err).__name__}: {err}"
 
 
 def _where(err: BaseException, path: Path) -> str:

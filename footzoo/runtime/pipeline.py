@@ -25,8 +25,10 @@ from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording, Result
-from ..core.errors import ConfigError, RecordingError
+from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
+from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
+from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -155,7 +157,7 @@ class Pipeline:
         try:
             return cls.from_dict(d, base_dir=path.parent)
         except ConfigError as err:
-            raise ConfigError(f"{path}: {err}") from None
+            raise prefixed(err, path) from err.__cause__
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved configuration, every parameter explicit."""
@@ -279,8 +281,15 @@ class Pipeline:
         nav = self.navigate(rec, stance, q0, quat, engine, covariance, ctx)
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
+        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
+        scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
+        axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
+        axes.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr)
+        sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
+        if axes.finish():
+            sensor["consistency"] = axes.report
         diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
-                       "guards": guard_report, **nav["diagnostics"]}
+                       "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
         if self.calibration:
             diagnostics["calibration"] = calibration
         diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], real_stances(stance, nav["pos"]))
@@ -471,8 +480,9 @@ def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np
         if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
             what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
                     else "NaN/inf")
-            raise RecordingError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
-                                 f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)")
+            raise PluginError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
+                              f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)",
+                              plugin=f"calibration {c.name!r}", method="calibrate")
         out.append(after)
     return tuple(out)
 

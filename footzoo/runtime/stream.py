@@ -34,7 +34,10 @@ import numpy as np
 
 from ..core.checks import validate_block, validate_sample
 from ..core.context import RunContext
+from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
+from ..core.sanity import EstimateScan, SignalScan
+from ..filters.consistency import ConsistencyScan
 from ..plugins.base import Samples
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
@@ -48,6 +51,8 @@ from .stages import (
     Queue,
 )
 
+#: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
+SCAN_BLOCK = 128
 #: The per-sample columns of the final estimates.
 COLUMNS = ("t", "quat", "pos", "vel", "acc_nav", "stance")
 
@@ -124,6 +129,11 @@ class Stream:
         self._warned: set[str] = set()
         self.keep = bool(keep)
         self._kept: list[Chunk] = []
+        self._signals = SignalScan("stream")  # glitches, as a batch run's Recording scans them
+        self._estimates: EstimateScan | None = None  # no stance, drift while still (from the start)
+        self._axes: ConsistencyScan | None = None  # gyroscope-accelerometer consistency (rate, axis map)
+        self._scan_raw = Blocks(self._signals.push)
+        self._scan_final: Blocks | None = None
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
@@ -155,6 +165,7 @@ class Stream:
             row["dist"] = d[None, :]
         self._k += 1
         self._t_prev = t
+        self._scan_raw.add(row["t"], row["acc"], row["gyr"])
         return self._take(row)
 
     def extend(self, t: Any, acc: Any, gyr: Any, mag: Any = None, dist: Any = None) -> dict[str, Any] | None:
@@ -186,6 +197,7 @@ class Stream:
             rows["dist"] = d
         self._k += n
         self._t_prev = float(t[-1])
+        self._scan_raw.add(t, acc, gyr)
         return self._take(rows)
 
     def pending(self) -> int:
@@ -208,7 +220,28 @@ class Stream:
                 self._feed(self._raw.take(np.iinfo(np.int64).max))
             if self._stages:
                 self._feed({}, finish=True)
+            self._scan_raw.flush()
+            if self._estimates is not None:
+                self._scan_final.flush()
+                self._estimates.finish()
+                self._axes.finish()
         return self.final()
+
+    @property
+    def sensor(self) -> dict[str, Any]:
+        """The sensor and physics findings so far (as a batch run's ``Result.diagnostics["sensor"]``).
+
+        Glitches (``gyro_glitches``, ``acc_glitches``: sample numbers), drift while still
+        (``still_drift``) and, after :meth:`close`, ``no_stance`` (:mod:`footzoo.core.sanity`); each
+        was also warned with a :class:`~footzoo.core.errors.SensorWarning` when found.
+        """
+        self._scan_raw.flush()
+        if self._scan_final is not None:
+            self._scan_final.flush()
+        out = {**self._signals.report, **(self._estimates.report if self._estimates is not None else {})}
+        if self._axes is not None and self._axes.report:
+            out["consistency"] = self._axes.report
+        return out
 
     def result(self, meta: dict[str, Any] | None = None) -> Any:
         """The whole run as a :class:`~footzoo.Result` (after :meth:`close`; needs ``keep=True``).
@@ -232,6 +265,7 @@ class Stream:
         steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
         config = {**self.pipeline.to_dict(), "engine": "stream"}
         diagnostics = {"calibration": self.fits} if self.fits is not None else {}
+        diagnostics["sensor"] = self.sensor
         return Result(samples=samples_frame(k["t"], k["quat"], k["pos"], k["vel"], k["acc_nav"], stance),
                       steps=steps, config=config, versions=versions(), recording=dict(rec.meta),
                       diagnostics=diagnostics)
@@ -286,6 +320,7 @@ class Stream:
         for stage in self._stages:
             out = stage.push(out, finish=finish) if (length(out) or finish) else {}
         if length(out):
+            self._scan_final.add(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
             if self.keep:
                 self._kept.append({k: v for k, v in out.items() if k in ("k", *COLUMNS, "acc", "gyr", "mag")})
@@ -332,6 +367,7 @@ class Stream:
             if t[-1] - t[0] <= self.max_wait:
                 return False
             raise RecordingError(self._no_start_message()) from None
+        check_units(b["acc"], b["gyr"])  # an accelerometer in g, a gyroscope in deg/s: refused as a batch run does
         pipe = self.pipeline
         channels = {"acc", "gyr", *(["mag"] if self._has_mag else []), *(["dist"] if self._dist_width else [])}
         needs_fit = any(not c.is_fitted() and channels & set(c.fits_on) for c in self._calibrations())
@@ -345,6 +381,15 @@ class Stream:
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
                           FootzooWarning, stacklevel=4)
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
+        self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
+        self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
+
+        def scan_final(k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+                       pos: np.ndarray) -> None:
+            self._estimates.push(k, t, acc, gyr, stance, pos)
+            self._axes.push(k, t, acc, gyr)
+
+        self._scan_final = Blocks(scan_final)
         b = self._with_init(take(b, 0))  # a copy, with the still-start flag
         self._raw = Queue()
         self._raw.put(b)
@@ -399,6 +444,27 @@ class Stream:
             raise RecordingError(f"dist has {row.size} readings, earlier samples had {self._dist_width}: push the "
                                  "same sensors every time (NaN where one has no reading)")
         return row
+
+
+class Blocks:
+    """Feeds a scan its samples in blocks of at least ``every`` (the scans' findings do not depend on how the
+    samples are chunked, their cost per call does): :meth:`add` the next samples' arrays, :meth:`flush` the rest."""
+
+    def __init__(self, push: Any, every: int = SCAN_BLOCK):
+        self.push, self.every = push, every
+        self.parts: list[tuple[np.ndarray, ...]] = []
+        self.n = 0
+
+    def add(self, *arrays: np.ndarray) -> None:
+        self.parts.append(arrays)
+        self.n += len(arrays[0])
+        if self.n >= self.every:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.parts:
+            parts, self.parts, self.n = self.parts, [], 0
+            self.push(*(np.concatenate(column) for column in zip(*parts, strict=True)))
 
 
 def _fit_reports(fits: Any) -> list[dict[str, Any]] | None:

@@ -17,7 +17,7 @@ from typing import Any
 from ..config.library import is_name, resolve
 from ..config.library import path as library_path
 from ..config.schema import load_yaml
-from ..core.errors import ConfigError, did_you_mean
+from ..core.errors import ConfigError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
 
@@ -172,7 +172,7 @@ class Study:
         try:
             return cls.from_dict(data, root=p.parent)
         except ConfigError as err:
-            raise ConfigError(f"{p}: {err}") from None
+            raise prefixed(err, p) from err.__cause__
 
     def code_identity(self) -> str:
         """footzoo's version and source, and every plug-in's source (SHA-256): part of every cache key.

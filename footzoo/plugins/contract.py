@@ -1,0 +1,246 @@
+"""The plug-in contract, enforced at every call: read-only inputs, faults named, results checked on return.
+
+:class:`footzoo.plugins.base.Plugin` wraps each method of :data:`GUARDED` that a plug-in class
+defines with :func:`guard` (once, when the class is defined), so that every caller — a batch
+run, a :class:`footzoo.Stream`, a study, a test — gets the same guarantees:
+
+* **inputs are read-only**: every array argument is passed as a ``writeable=False`` view (and
+  the arrays of a :class:`~footzoo.plugins.base.Samples`). A plug-in that writes into its input
+  raises, and the caller's recording never changes; the fix is to copy first
+  (``acc = np.array(acc)``).
+* **faults are the plug-in's**: any exception raised inside the method (``SystemExit`` and
+  other ``BaseException`` included; ``KeyboardInterrupt`` and ``MemoryError`` excepted) becomes
+  a :class:`~footzoo.core.errors.PluginError` naming the plug-in, its class and file, the
+  method and the original error, chained (``raise ... from err``). footzoo's own errors
+  (:class:`~footzoo.core.errors.FootzooError`: a plug-in's deliberate "this recording is too
+  short") pass unchanged.
+* **results are checked on return**: a method that must return the plug-in (``detect``,
+  ``estimate``, ``apply``, ``calibrate``, ``analyze``, ``begin``) and returns ``None`` (a
+  forgotten ``return self``) is named; the kind's declared outputs (:class:`Output`, the
+  ``outputs`` of each base class) are checked for presence, shape (one row per input sample),
+  dtype, finiteness, unit quaternions (:data:`QUAT_NORM_TOL`) and boolean stance (a float
+  stance holding NaN, or values other than 0 and 1, is refused: NaN must never read as stance).
+  The chunks of ``step``/``finish``/``provisional`` are checked the same way (their length is
+  the samples that became final, so only their columns' agreement is checked).
+
+The checks only read; the numbers of a plug-in that keeps its contract are unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import inspect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import FootzooError, PluginError
+
+#: Methods whose faults are the plug-in's: each one a plug-in class defines is wrapped by :func:`guard`.
+GUARDED = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze", "annotate", "check",
+           "begin", "step", "step_acceleration", "finish", "provisional", "fixed", "latency",
+           "model", "sample_data", "state_blocks", "requires_attitude_state")
+#: Methods that return the plug-in itself (``return self``).
+RETURNS_SELF = ("calibrate", "estimate", "detect", "apply", "analyze", "begin")
+#: Methods that return a chunk of per-sample outputs (:data:`footzoo.plugins.incremental.Chunk`).
+RETURNS_CHUNK = ("step", "step_acceleration", "finish", "provisional")
+#: Largest accepted | |q| - 1 | of an attitude quaternion a plug-in returns (numerical drift is fine).
+QUAT_NORM_TOL = 1e-6
+#: Exceptions that are not a plug-in's fault: passed on unchanged.
+PASSED_ON: tuple[type[BaseException], ...] = (FootzooError, KeyboardInterrupt, MemoryError, GeneratorExit)
+
+
+@dataclass(frozen=True)
+class Output:
+    """One per-sample output a plug-in kind returns (``stance`` of a detector, ``quat`` of an orientation...).
+
+    Parameters
+    ----------
+    what : {"float", "bool", "quat"}
+        A real array, a stance mask (bool, or 0/1 numbers) or unit quaternions (width 4).
+    width : int
+        0 for (N,), else the columns of (N, width).
+    finite : bool
+        Every value finite (no NaN or inf).
+    required : bool
+        Set by the action method, and a column of every non-empty chunk of ``step``.
+    """
+
+    what: str = "float"
+    width: int = 0
+    finite: bool = True
+    required: bool = True
+
+
+def guard(method: Callable[..., Any], name: str, check_inputs: Callable[..., None] | None = None) -> Callable[..., Any]:
+    """``method`` (a plug-in's method ``name``) with the contract of this module around it.
+
+    ``check_inputs(plugin, names, args, kwargs)`` runs first when given (the action methods' input checks).
+    """
+    names = [p for p in inspect.signature(method).parameters if p != "self"]
+
+    @functools.wraps(method)
+    def guarded(self, *args, **kwargs):
+        if check_inputs is not None:
+            check_inputs(self, names, args, kwargs)
+        args = tuple(read_only(a) for a in args)
+        kwargs = {k: read_only(v) for k, v in kwargs.items()}
+        try:
+            result = method(self, *args, **kwargs)
+        except PASSED_ON:
+            raise
+        except BaseException as err:  # noqa: BLE001 - SystemExit in a plug-in is its fault too
+            raise fault(self, name, err) from err
+        return returned(self, name, names, args, kwargs, result)
+
+    guarded.__footzoo_checked__ = True  # type: ignore[attr-defined]
+    return guarded
+
+
+def read_only(value: Any) -> Any:
+    """A ``writeable=False`` view of an array (of each array of a dataclass such as ``Samples``); others as they are."""
+    if isinstance(value, np.ndarray):
+        if not value.flags.writeable:
+            return value
+        view = value.view()
+        view.flags.writeable = False
+        return view
+    if dataclasses.is_dataclass(value) and not isinstance(value, type) and any(
+            isinstance(getattr(value, f.name), np.ndarray) for f in dataclasses.fields(value)):
+        return dataclasses.replace(value, **{f.name: read_only(getattr(value, f.name))
+                                             for f in dataclasses.fields(value) if f.init})
+    return value
+
+
+def who(plugin: Any) -> str:
+    """``"<kind> '<name>'"`` of a plug-in."""
+    return f"{getattr(plugin, 'kind', '') or 'plug-in'} {getattr(plugin, 'name', '') or type(plugin).__name__!r}"
+
+
+def _where(plugin: Any) -> str:
+    cls = type(plugin)
+    try:
+        path = inspect.getsourcefile(cls)
+    except (TypeError, OSError):
+        path = None
+    return f"{cls.__module__}.{cls.__qualname__}" + (f" in {Path(path).name}" if path else "")
+
+
+def fault(plugin: Any, method: str, err: BaseException) -> PluginError:
+    """The :class:`PluginError` for an exception ``err`` raised in ``plugin.method``."""
+    text = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
+    hint = "fix the plug-in"
+    if isinstance(err, ValueError) and "read-only" in str(err):
+        hint = ("it writes into an input array, which footzoo passes read-only (the caller's recording must not "
+                "change): copy it first, e.g. acc = np.array(acc)")
+    elif isinstance(err, SystemExit):
+        hint = "a plug-in must raise an exception, never exit the process"
+    return PluginError(f"{who(plugin)} ({_where(plugin)}) failed in {method}(): {text}; {hint}",
+                       plugin=who(plugin), method=method)
+
+
+def broken(plugin: Any, method: str, problem: str) -> PluginError:
+    """A :class:`PluginError` for a result of ``plugin.method`` that breaks the contract."""
+    return PluginError(f"{who(plugin)} ({_where(plugin)}): {method}() {problem}", plugin=who(plugin), method=method)
+
+
+def returned(plugin: Any, method: str, names: list[str], args: tuple, kwargs: dict[str, Any], result: Any) -> Any:
+    """Check what ``plugin.method(*args, **kwargs)`` returned (see the module docstring); return it."""
+    if method in RETURNS_SELF:
+        if result is None:
+            raise broken(plugin, method, f"returned None: end {method}() with 'return self'")
+        if getattr(result, "kind", None) != plugin.kind or not hasattr(result, "get_params"):
+            raise broken(plugin, method, f"returned {type(result).__name__}, not the plug-in: end {method}() with "
+                                         "'return self'")
+        if method != "begin":
+            check_attributes(result, method, _samples(names, args, kwargs))
+    elif method in RETURNS_CHUNK:
+        check_chunk(plugin, method, result)
+    elif method == "apply_acceleration":
+        n = _samples(names, args, kwargs)
+        check_array(plugin, method, "the returned acceleration", result, Output(width=3), n)
+    return result
+
+
+def _samples(names: list[str], args: tuple, kwargs: dict[str, Any]) -> int | None:
+    """The number of samples of a call: the length of its first array argument."""
+    for value in [*args, *kwargs.values()]:
+        if isinstance(value, np.ndarray) and value.ndim:
+            return len(value)
+    return None
+
+
+def check_attributes(plugin: Any, method: str, n: int | None) -> None:
+    """The kind's declared outputs, as the attributes ``<name>_`` an action method sets."""
+    for key, spec in getattr(plugin, "outputs", {}).items():
+        value = getattr(plugin, f"{key}_", None)
+        if value is None:
+            if spec.required:
+                raise broken(plugin, method, f"did not set {key}_ (a {_shape(spec, n)} array)")
+            continue
+        check_array(plugin, method, f"{key}_", value, spec, n)
+
+
+def check_chunk(plugin: Any, method: str, chunk: Any) -> None:
+    """A chunk of ``step``/``finish``/``provisional``: a dict of the kind's columns, all of one length."""
+    if not isinstance(chunk, dict):
+        raise broken(plugin, method, f"returned {type(chunk).__name__}; it must return a dict of per-sample arrays "
+                                     "(an empty dict when no sample became final)")
+    if not chunk:
+        return
+    outputs = getattr(plugin, "outputs", {})
+    if method == "step_acceleration":
+        outputs = {"acc_nav": Output(width=3)}
+    lengths = {k: len(v) for k, v in chunk.items() if hasattr(v, "__len__")}
+    if len(set(lengths.values())) > 1:
+        raise broken(plugin, method, f"returned columns of different lengths {lengths}; every column has one row "
+                                     "per sample that became final")
+    n = next(iter(lengths.values()), None)
+    for key, spec in outputs.items():
+        if key in chunk and chunk[key] is not None:
+            check_array(plugin, method, f"the column {key!r}", chunk[key], spec, n)
+        elif spec.required and n and method != "provisional":
+            raise broken(plugin, method, f"returned no column {key!r} with its {n} samples")
+
+
+def _shape(spec: Output, n: int | None) -> str:
+    rows = "N" if n is None else str(n)
+    return f"({rows},)" if not spec.width else f"({rows}, {spec.width})"
+
+
+def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, n: int | None) -> None:
+    """One output array against its declaration (raises :class:`PluginError` naming the plug-in)."""
+    arr = value if isinstance(value, np.ndarray) else np.asarray(value)
+    kind = arr.dtype.kind
+    if kind not in "biuf":
+        raise broken(plugin, method, f"set {label} of dtype {arr.dtype}; it must be a {_shape(spec, n)} "
+                                     f"{'bool' if spec.what == 'bool' else 'float'} array")
+    width_ok = arr.ndim == 1 if not spec.width else (arr.ndim == 2 and arr.shape[1] == spec.width)
+    if not width_ok or (n is not None and len(arr) != n):
+        raise broken(plugin, method, f"set {label} of shape {arr.shape}; it must be {_shape(spec, n)}: one row per "
+                                     "input sample")
+    if spec.what == "bool":
+        if kind != "b" and not np.isin(arr, (0, 1)).all():
+            bad = np.flatnonzero(~np.isin(arr, (0, 1)))
+            raise broken(plugin, method, f"set {label} with {len(bad)} value(s) that are neither 0 nor 1 (first "
+                                         f"{arr[bad[0]]!r} at sample {int(bad[0])}): a stance mask is bool; NaN is "
+                                         "not stance — decide each sample (stance_ = statistic < threshold)")
+        return
+    if kind != "f" or not len(arr):
+        return
+    if (spec.finite or spec.what == "quat") and not math.isfinite(float(arr.sum())) and not np.isfinite(arr).all():
+        bad = np.flatnonzero(~np.isfinite(arr).reshape(len(arr), -1).all(axis=1))
+        raise broken(plugin, method, f"set {label} with {len(bad)} non-finite sample(s) (NaN or inf), first at sample "
+                                     f"{int(bad[0])}")
+    if spec.what == "quat":
+        err = np.abs(np.einsum("ij,ij->i", arr, arr) - 1.0)  # |q|² - 1 ≈ 2 (|q| - 1)
+        if err.max() > 2 * QUAT_NORM_TOL:
+            k = int(np.argmax(err))
+            raise broken(plugin, method, f"set {label} with non-unit quaternions (|q| = {np.linalg.norm(arr[k]):.9g} "
+                                         f"at sample {k}, tolerance {QUAT_NORM_TOL:g}): normalise each attitude "
+                                         "(q / |q|)")

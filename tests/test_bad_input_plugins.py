@@ -1,0 +1,390 @@
+"""Bad plug-ins: whatever a plug-in does, the process does not crash, the caller's data does not change, and no
+broken result passes as one.
+
+Each case is a small plug-in that breaks one rule of the contract (footzoo.plugins.contract): it raises, exits,
+forgets ``return self``, returns a wrong shape, NaN, a non-unit quaternion or a NaN "stance", or writes into its
+input. Each must give a PluginError naming the plug-in, the method and the cause (chained), in a batch run, live
+and on the command line (exit code 4, never "internal error"); in a study only its cells fail.
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import footzoo
+from footzoo import Pipeline, PluginError
+from footzoo.apps.cli import EXIT_PLUGIN, main
+from footzoo.core.errors import ConfigError, PluginImportError
+from footzoo.detectors.angular_rate_fsm import AngularRateFSM
+from footzoo.io.canonical import write
+from footzoo.orientation.madgwick import Madgwick
+from footzoo.plugins.base import Analysis, Calibration, Detector, Orientation, VelocityCorrection
+from footzoo.plugins.contract import QUAT_NORM_TOL
+from footzoo.plugins.extensions import load_plugins
+from footzoo.runtime.stream import Stream
+from footzoo.sim import NoiseModel, simulate
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return simulate(n_strides=4, rate=100.0, noise=NoiseModel(seed=1))
+
+
+def _still(gyr):
+    return np.linalg.norm(gyr, axis=1) < 0.6
+
+
+# --------------------------------------------------------------------------- the faulty plug-ins
+FAULTY: list[type] = []
+
+
+def faulty(cls: type) -> type:
+    """A faulty plug-in of this module: registered while its tests run only (studies of every registered
+    combination in other test modules must not meet it)."""
+    FAULTY.append(cls)
+    return cls
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _registered():
+    from footzoo.plugins import registry
+
+    for cls in FAULTY:
+        footzoo.register(cls)
+    yield
+    for cls in FAULTY:
+        registry._REGISTRY[cls.kind].pop(cls.name, None)
+    registry._REGISTRY["detector"].pop("cli_boom", None)
+
+
+@faulty
+class Raising(Detector):
+    """Raises a ZeroDivisionError (a bug in a plug-in)."""
+
+    name = "test_fault_raising"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        return 1 / 0
+
+
+@faulty
+class Exiting(Detector):
+    """Calls sys.exit() in its action method."""
+
+    name = "test_fault_exiting"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        raise SystemExit(0)
+
+
+@faulty
+class NoReturn(Detector):
+    """Forgets ``return self``."""
+
+    name = "test_fault_no_return"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        self.stance_ = _still(gyr)
+        self.statistic_ = np.linalg.norm(gyr, axis=1)
+
+
+@faulty
+class NanStance(Detector):
+    """A float stance with NaN where it did not decide (NaN would read as True in a bool cast)."""
+
+    name = "test_fault_nan_stance"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        stance = _still(gyr).astype(float)
+        stance[::7] = np.nan
+        self.stance_, self.statistic_ = stance, np.linalg.norm(gyr, axis=1)
+        return self
+
+
+@faulty
+class ShortStance(Detector):
+    """One sample short."""
+
+    name = "test_fault_short_stance"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        self.stance_, self.statistic_ = _still(gyr)[:-1], np.linalg.norm(gyr, axis=1)
+        return self
+
+
+@faulty
+class Mutating(Detector):
+    """Writes into its input (gyr[:] = 0) instead of a copy."""
+
+    name = "test_fault_mutating"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        gyr -= gyr.mean(axis=0)
+        self.stance_, self.statistic_ = _still(gyr), np.linalg.norm(gyr, axis=1)
+        return self
+
+
+@faulty
+class LiveNanStance(AngularRateFSM):
+    """Yun's FSM whose live chunks carry a NaN stance (a float column)."""
+
+    name = "test_fault_live_nan_stance"
+
+    def step(self, t, acc, gyr):
+        out = dict(super().step(t, acc, gyr))
+        if len(out.get("stance", ())):
+            stance = out["stance"].astype(float)
+            stance[0] = np.nan
+            out["stance"] = stance
+        return out
+
+
+@faulty
+class LiveMutating(AngularRateFSM):
+    """Yun's FSM that, live, removes the chunk's mean rate in place."""
+
+    name = "test_fault_live_mutating"
+
+    def step(self, t, acc, gyr):
+        gyr -= gyr.mean(axis=0)
+        return super().step(t, acc, gyr)
+
+
+@faulty
+class Scaled(Madgwick):
+    """Madgwick's filter whose quaternions are multiplied by ``scale`` (not unit when scale ≠ 1)."""
+
+    name = "test_fault_scaled_quat"
+
+    def __init__(self, scale: float = 1.5):
+        super().__init__(use_magnetometer=False)
+        self.scale = scale
+
+    def step(self, t, acc, gyr, mag, stance):
+        out = super().step(t, acc, gyr, mag, stance)
+        return {**out, "quat": out["quat"] * self.scale}
+
+
+@faulty
+class NanVelocity(VelocityCorrection):
+    """Returns NaN velocities."""
+
+    name = "test_fault_nan_velocity"
+
+    def apply(self, t, acc_nav, stance, ctx=None):
+        self.vel_ = np.full((len(t), 3), np.nan)
+        self.pos_ = np.zeros((len(t), 3))
+        return self
+
+
+@faulty
+class RaisingAnalysis(Analysis):
+    """Raises KeyError in analyze."""
+
+    name = "test_fault_analysis"
+
+    def analyze(self, t, quat, pos, stance, meta):
+        return meta["no such key"]
+
+    def annotate(self, steps, t):
+        return steps
+
+
+@faulty
+class WrongCalibration(Calibration):
+    """Returns the accelerometer with a column missing."""
+
+    name = "test_fault_calibration"
+
+    def calibrate(self, t, acc, gyr, mag):
+        self.acc_, self.gyr_, self.mag_, self.report_ = acc[:, :2], gyr, mag, {}
+        return self
+
+
+def _config(**parts):
+    base = {"name": "faulty", "orientation": {"type": "madgwick", "use_magnetometer": False},
+            "detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
+    return {**base, **parts}
+
+
+BATCH = [
+    ("raising", _config(detector={"type": "test_fault_raising"}), "detect", "ZeroDivisionError"),
+    ("exiting", _config(detector={"type": "test_fault_exiting"}), "detect", "never exit the process"),
+    ("no_return", _config(detector={"type": "test_fault_no_return"}), "detect", "return self"),
+    ("nan_stance", _config(detector={"type": "test_fault_nan_stance"}), "detect", "NaN is not stance"),
+    ("short_stance", _config(detector={"type": "test_fault_short_stance"}), "detect", r"shape \(\d+,\)"),
+    ("mutating", _config(detector={"type": "test_fault_mutating"}), "detect", "copy it first"),
+    ("non_unit_quat", _config(orientation={"type": "test_fault_scaled_quat"}), "step", "non-unit quaternions"),
+    ("nan_velocity", _config(corrections=[{"type": "test_fault_nan_velocity"}]), "apply", "non-finite"),
+    ("analysis", _config(analysis=[{"type": "test_fault_analysis"}]), "analyze", "KeyError"),
+    ("calibration", _config(calibration=[{"type": "test_fault_calibration"}]), "calibrate", r"shape \(\d+, 2\)"),
+]
+
+
+@pytest.mark.parametrize("config, method, cause", [c[1:] for c in BATCH], ids=[c[0] for c in BATCH])
+def test_a_faulty_plugin_is_a_plugin_error_naming_it_and_the_recording_is_unchanged(config, method, cause, walk):
+    before = {k: getattr(walk, k).copy() for k in ("t", "acc", "gyr")}
+    with pytest.raises(PluginError, match=cause) as info:
+        Pipeline.from_dict(config).run(walk)
+    err = info.value
+    assert err.method == method and "internal error" not in str(err)
+    faulty = [p for p in (config["detector"], config["orientation"], *config["corrections"],
+                          *config.get("analysis", []), *config.get("calibration", [])) if "fault" in p["type"]]
+    assert faulty[0]["type"] in err.plugin and faulty[0]["type"] in str(err)
+    for k, v in before.items():
+        np.testing.assert_array_equal(getattr(walk, k), v)
+
+
+def test_the_original_error_is_chained(walk):
+    with pytest.raises(PluginError) as info:
+        Pipeline.from_dict(_config(detector={"type": "test_fault_raising"})).run(walk)
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+
+
+def test_tiny_quaternion_drift_is_accepted_and_the_numbers_are_those_of_the_filter(walk):
+    drift = 1 + QUAT_NORM_TOL / 10
+    ok = Pipeline.from_dict(_config(orientation={"type": "test_fault_scaled_quat", "scale": drift})).run(walk)
+    ref = Pipeline.from_dict(_config(orientation={"type": "test_fault_scaled_quat", "scale": 1.0})).run(walk)
+    assert np.isfinite(ok.pos).all() and np.abs(ok.quat - ref.quat * drift).max() < 1e-12
+
+
+def test_live_a_nan_stance_chunk_is_a_plugin_error(walk):
+    stream = Stream(Pipeline.from_dict(_config(detector={"type": "test_fault_live_nan_stance"})), rate=walk.rate)
+    with pytest.raises(PluginError, match="NaN is not stance") as info:
+        stream.run(walk)
+    assert info.value.method == "step"
+
+
+def test_live_a_mutating_plugin_cannot_change_the_pushed_samples(walk):
+    stream = Stream(Pipeline.from_dict(_config(detector={"type": "test_fault_live_mutating"})), rate=walk.rate)
+    gyr = walk.gyr.copy()
+    with pytest.raises(PluginError, match="copy it first"):
+        stream.run(walk)
+    np.testing.assert_array_equal(walk.gyr, gyr)
+
+
+def test_a_plugin_file_that_exits_on_import_is_a_plugin_error(tmp_path):
+    bad = tmp_path / "exits.py"
+    bad.write_text("import sys\nsys.exit(0)\n")
+    with pytest.raises(PluginImportError, match=r"sys.exit\(0\).*never exit the process") as info:
+        load_plugins([str(bad)])
+    assert isinstance(info.value, ConfigError) and info.value.method == "import"
+
+
+def test_cli_a_faulty_plugin_exits_4_without_traceback_and_names_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "boom.py").write_text(textwrap.dedent('''
+        import footzoo
+        from footzoo.plugins.base import Detector
+
+        @footzoo.register
+        class Boom(Detector):
+            """Divides by zero."""
+            name = "cli_boom"
+            def detect(self, t, acc, gyr, ctx=None):
+                return 1 / 0
+    '''))
+    cfg = _config(detector={"type": "cli_boom"}, plugins=["boom.py"])
+    (tmp_path / "c.yaml").write_text(yaml.safe_dump(cfg))
+    sim = tmp_path / "walk.csv"
+    write(simulate(n_strides=3, rate=100.0), sim)
+    assert main(["run", str(tmp_path / "c.yaml"), "--data", str(sim)]) == EXIT_PLUGIN
+    err = capsys.readouterr().err
+    assert "detector 'cli_boom'" in err and "detect()" in err and "ZeroDivisionError" in err
+    assert "internal error" not in err and "Traceback" not in err
+    (tmp_path / "exits.py").write_text("import sys\nsys.exit(0)\n")
+    (tmp_path / "e.yaml").write_text(yaml.safe_dump(_config(plugins=["exits.py"])))
+    assert main(["run", str(tmp_path / "e.yaml"), "--data", str(sim)]) == EXIT_PLUGIN
+    assert "never exit the process" in capsys.readouterr().err
+
+
+def test_a_faulty_plugin_in_a_study_fails_its_cells_only():
+    from footzoo.studies import Study, run_study
+
+    study = Study.from_dict({
+        "name": "faulty",
+        "base": _config(),
+        "factors": {"detector.type": ["angular_rate_fsm", "test_fault_raising"]},
+        "recordings": [{"simulate": {"path": "straight", "n_strides": 4, "rate": 50}, "seeds": [0]}],
+        "metrics": ["path_length_m"],
+    })
+    table = run_study(study)
+    by = table["detector.type"]
+    good, bad = table[by == "angular_rate_fsm"], table[by == "test_fault_raising"]
+    assert len(good) and good["error"].isna().all() and np.isfinite(good["value"].astype(float)).all()
+    assert len(bad) and bad["error"].str.contains("PluginError: detector 'test_fault_raising'").all()
+    assert bad["error"].str.contains("ZeroDivisionError").all()
+
+
+# --------------------------------------------------------------------------- properties
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(values=st.lists(st.sampled_from([0.0, 1.0, np.nan, 0.5, 2.0, -1.0]), min_size=30, max_size=30))
+def test_property_a_stance_array_is_accepted_only_when_every_sample_is_decided(values):
+    from footzoo.plugins.contract import Output, check_array
+
+    arr = np.asarray(values)
+    det = Raising()
+    if np.isin(arr, (0.0, 1.0)).all():
+        check_array(det, "detect", "stance_", arr, Output("bool"), len(arr))
+    else:
+        with pytest.raises(PluginError, match="neither 0 nor 1"):
+            check_array(det, "detect", "stance_", arr, Output("bool"), len(arr))
+
+
+@settings(max_examples=40, deadline=None)
+@given(scale=st.floats(0.5, 1.5), k=st.integers(0, 19))
+def test_property_quaternions_beyond_the_tolerance_are_refused(scale, k):
+    from footzoo.plugins.contract import Output, check_array
+
+    q = np.tile([1.0, 0.0, 0.0, 0.0], (20, 1))
+    q[k] *= scale
+    det = Raising()
+    if abs(scale - 1.0) <= QUAT_NORM_TOL / 2:
+        check_array(det, "estimate", "quat_", q, Output("quat", 4), 20)
+    elif abs(scale - 1.0) > 2 * QUAT_NORM_TOL:
+        with pytest.raises(PluginError, match=f"at sample {k}"):
+            check_array(det, "estimate", "quat_", q, Output("quat", 4), 20)
+
+
+@settings(max_examples=25, deadline=None)
+@given(exc=st.sampled_from([ValueError, TypeError, IndexError, KeyError, RuntimeError, AttributeError,
+                            ZeroDivisionError, AssertionError, RecursionError, SystemExit]))
+def test_property_any_exception_of_a_plugin_is_a_plugin_error(exc):
+    class Any_(Orientation):
+        name = "test_fault_any"
+
+        def estimate(self, t, acc, gyr, mag, stance, q0, ctx=None):
+            raise exc("boom")
+
+    t = np.arange(10) / 100.0
+    with pytest.raises(PluginError, match=f"test_fault_any.*estimate.*{exc.__name__}") as info:
+        Any_().estimate(t, np.zeros((10, 3)), np.zeros((10, 3)), None, np.ones(10, bool), np.array([1.0, 0, 0, 0]))
+    assert isinstance(info.value.__cause__, exc)
+
+
+def test_a_reader_that_exits_is_a_plugin_error(tmp_path, monkeypatch, walk):
+    from footzoo.io import registry
+    from footzoo.io.base import Reader
+
+    class ExitingReader(Reader):
+        """Calls sys.exit() instead of raising."""
+
+        name = "test_exiting"
+
+        def open(self, path, **options):
+            raise SystemExit(1)
+
+    readers = registry.available()
+    monkeypatch.setitem(readers._readers, "test_exiting", ExitingReader())
+    monkeypatch.setitem(readers.origins, "test_exiting", "a test package")
+    data = write(walk, tmp_path / "w.csv")
+    with pytest.raises(PluginError, match=r"the test_exiting reader \(a test package\).*never exit the process"):
+        footzoo.load(data, format="test_exiting")
