@@ -376,20 +376,38 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     from ..studies.report import summarise, to_markdown
 
     out = args.out or f"ablation_{Path(args.study).stem}"
-    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
+    if args.quiet:
+        warnings.simplefilter("ignore")
+    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
+                      max_cells=args.max_cells, quiet=args.quiet)
     a = table.attrs
     notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
              if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
     notes = "".join(f", {n}" for n in notes if n)
     print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
           f"{a['failed']} failed{notes}); results in {out}/")
-    factors = [c for c in table.columns if c not in ("run", "base", "recording", "metric", "value", "error")]
+    total = a["computed"] + a["cached"]
+    if a["causes"]:
+        print(f"{'every' if a['failed'] == total else a['failed']} run{'' if a['failed'] == 1 else 's'} failed; "
+              "the distinct causes:", file=sys.stderr)
+        for cause, n in list(a["causes"].items())[:5]:
+            print(f"  - {cause} ({n} run{'' if n == 1 else 's'})", file=sys.stderr)
+    if total and a["failed"] == total:
+        return _failed_exit_code(a["causes"])
+    factors = [c for c in table.columns
+               if c not in ("run", "base", "recording", "metric", "value", "error", "note")]
     for f in factors[:3]:
         s = summarise(table, f)
         keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
     return 0
+
+
+def _failed_exit_code(causes: dict[str, int]) -> int:
+    """The exit code of a study whose every run failed: data error when a recording is at fault, else usage."""
+    kinds = {c.partition(":")[0] for c in causes}
+    return EXIT_DATA if kinds & {"RecordingError", "FormatError", "OutputError"} else EXIT_USAGE
 
 
 def cmd_formats(args: argparse.Namespace) -> int:
@@ -529,13 +547,17 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--out", required=True, type=_output, help="YAML file to write (never over the recording)")
     cal.set_defaults(func=cmd_calibrate)
 
-    abl = sub.add_parser("ablate", help="run an ablation study (configs x recordings) and write tables and plots")
+    abl = sub.add_parser("ablate", aliases=["study"],
+                         help="run an ablation study (configs x recordings) and write tables and plots")
     abl.add_argument("study", help="study YAML, e.g. study_quick")
-    abl.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib); -1 = all cores")
+    abl.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores (default: the "
+                     "study's jobs, else 1)")
+    abl.add_argument("--max-cells", type=_number(1, 1e15, integer=True), metavar="N",
+                     help="allow a grid of up to N runs (default: the study's max_cells, else 10000)")
     abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
-    abl.add_argument("--quiet", action="store_true", help="no progress bar")
+    abl.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
     abl.set_defaults(func=cmd_ablate)
 
     lst = sub.add_parser("list", help="list plug-ins with their parameters (default, unit, accepted range, meaning, "

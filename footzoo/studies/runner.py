@@ -50,25 +50,17 @@ class CacheWarning(UserWarning):
 # --------------------------------------------------------------------------- metrics of one run
 
 
-def _metrics(rec, res, metric_names: list[str] | None) -> dict[str, float]:
-    from ..evaluation.metrics import stance_scores, step_detection, trajectory_metrics
+def _metrics(rec, res, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
+    """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
+    from ..evaluation.metrics import run_metrics
+    from ..evaluation.validity import checked_metrics, reference_problems
 
-    truth = rec.truth
-    closed = bool(truth is not None and truth.closed_loop)
-    m = trajectory_metrics(res.pos, truth.pos if truth is not None else None, closed)
-    m["steps"] = float(len(res.steps))
-    if truth is not None and truth.stance is not None:
-        m.update({f"stance_{k}": v for k, v in stance_scores(res.stance, truth.stance).items()})
-        sd = step_detection(res.stance, truth.stance, rec.t)
-        m["gait_phase_error_rate"] = sd["error_rate"]
-        m["step_count_error"] = float(sd["step_count_error"])
-    if "fpa_rad" in res.steps:
-        fpa = res.steps["fpa_rad"].dropna()
-        if len(fpa):
-            m["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
+    m = run_metrics(rec.t, res.pos, res.steps, res.stance, rec.truth)
+    m, notes = checked_metrics(m, reference_problems(rec.t, rec.truth), rec.truth)
     if metric_names:
         m = {k: v for k, v in m.items() if k in metric_names}
-    return {k: float(v) for k, v in m.items()}
+        notes = {k: v for k, v in notes.items() if k in metric_names}
+    return {k: float(v) for k, v in m.items()}, notes
 
 
 def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
@@ -165,7 +157,8 @@ def _read_only(rec):
 
 def _new_record(cell: Cell, key: str) -> dict[str, Any]:
     return {"key": key, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
-            "error": None, "metrics": {}, "trajectory": [], "roc": [], "code_fingerprint": code_fingerprint()}
+            "error": None, "metrics": {}, "notes": {}, "trajectory": [], "roc": [],
+            "code_fingerprint": code_fingerprint()}
 
 
 def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
@@ -179,11 +172,16 @@ def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
 
 def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_points: int) -> dict[str, Any]:
     out = _new_record(cell, key)
+    caught: list[warnings.WarningMessage] = []
     try:
         from ..runtime.pipeline import Pipeline
 
-        res = Pipeline.from_dict(cell.config).run(rec)
-        out["metrics"] = _metrics(rec, res, metric_names)
+        with warnings.catch_warnings(record=True) as caught:  # sent back with the record (see _replay_warnings)
+            warnings.simplefilter("always")
+            start = time.perf_counter()
+            res = Pipeline.from_dict(cell.config).run(rec)
+            out["metrics"], out["notes"] = _metrics(rec, res, metric_names)
+            out["run_s"] = round(time.perf_counter() - start, 6)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
         out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
@@ -192,6 +190,7 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
             out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
     except Exception as err:  # one failing run is reported, not fatal
         _fail(out, err)
+    out["warnings"] = list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught))[:5]
     return out
 
 
@@ -254,11 +253,13 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
 
 def run_study(
     study: Study | str | Path,
-    jobs: int = 1,
+    jobs: int | None = None,
     scheduler: str | None = None,
     out: str | Path | None = None,
     progress: bool = False,
     max_runs: int | None = None,
+    max_cells: int | None = None,
+    quiet: bool = False,
 ) -> pd.DataFrame:
     """Run every cell of a study and return the tidy table (one row per run × metric).
 
@@ -266,8 +267,9 @@ def run_study(
     ----------
     study : Study or path
         The study (or its YAML file).
-    jobs : int
-        Local worker processes (joblib); 1 runs serially, -1 uses every core.
+    jobs : int, optional
+        Local worker processes (joblib); 1 runs serially, -1 uses every core. Default: the
+        study file's ``jobs``, else 1.
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``); the runs go
         to its workers through ``dask.distributed``.
@@ -282,37 +284,80 @@ def run_study(
         Show one progress bar over the whole command (loading, runs, report).
     max_runs : int, optional
         Stop after this many new runs (what an interruption leaves behind).
+    max_cells : int, optional
+        Largest grid allowed (default: the study's ``max_cells``, else
+        :data:`footzoo.studies.study.MAX_CELLS`); a larger one is refused before anything runs.
+    quiet : bool
+        Do not repeat the runs' warnings (each distinct warning of the workers is otherwise
+        issued once here, with the number of runs that gave it).
 
     Returns
     -------
     pandas.DataFrame
         Columns ``run``, ``base``, one per factor, ``recording``, ``metric``, ``value``,
         ``error``. ``attrs`` holds counts only: ``computed``, ``cached``, ``failed``, and
-        ``recomputed`` (damaged cache entries: key -> problem) and ``retried`` (failed
-        cells run again because footzoo's source changed: keys). Trajectories and
+        ``recomputed`` (damaged cache entries: key -> problem), ``retried`` (failed
+        cells run again because footzoo's source changed: keys), ``causes`` (the distinct
+        errors of the failed runs, most frequent first) and ``refused`` (the distinct reasons of
+        refused metrics, :mod:`footzoo.evaluation.validity`). Every config and reader option is
+        validated before any run (:meth:`Study.check`): an invalid study raises ConfigError. Trajectories and
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
+    if not isinstance(study, Study):
+        study = Study.from_yaml(study, max_cells=max_cells)
+    if jobs is None:
+        jobs = study.jobs or 1
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
         from ..core.errors import ConfigError
 
         raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+    study.check(max_cells)
     bar = _Progress(progress, "study")
     try:
         if scheduler is None:
-            return _run_study(study, jobs, None, out, max_runs, bar)
-        cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
-        try:
-            return _run_study(study, jobs, cluster, out, max_runs, bar)
-        finally:
-            cluster.close()
+            table = _run_study(study, jobs, None, out, max_runs, bar)
+        else:
+            cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
+            try:
+                table = _run_study(study, jobs, cluster, out, max_runs, bar)
+            finally:
+                cluster.close()
     finally:
         bar.close()
+    if not quiet:
+        _replay_warnings(table.attrs.pop("warnings", {}), table.attrs["refused"])
+    table.attrs.pop("warnings", None)
+    return table
+
+
+def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
+    """Issue each distinct warning of the runs once, with the number of runs that gave it."""
+    import builtins
+
+    from ..core import errors
+    from ..evaluation.validity import MetricWarning
+
+    for text, n in worker.items():
+        name, _, message = text.partition(": ")
+        category = MetricWarning if name == "MetricWarning" else (getattr(errors, name, None)
+                                                                  or getattr(builtins, name, None))
+        if not (isinstance(category, type) and issubclass(category, Warning)):
+            category = UserWarning
+        warnings.warn(f"{n} run(s): {message}" if n > 1 else message, category, stacklevel=3)
+    if refused:
+        text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
+        warnings.warn(f"metrics refused (NaN, see the table's note column): {text}", MetricWarning, stacklevel=3)
+
+
+def _counts(values) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for v in values:
+        out[v] = out.get(v, 0) + 1
+    return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
 def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.DataFrame:
     bar.phase("loading")
-    if not isinstance(study, Study):
-        study = Study.from_yaml(study)
     bar.set_description(study.name)
     cells = study.cells()
     report_steps = 4 if out is not None else 0
@@ -375,6 +420,9 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
     table.attrs["failed"] = sum(1 for r in runs if r.get("error"))
     table.attrs["recomputed"] = dict(recomputed)
     table.attrs["retried"] = list(retried)
+    table.attrs["causes"] = _counts(r["error"] for r in runs if r.get("error"))
+    table.attrs["refused"] = _counts(why for r in runs for why in set((r.get("notes") or {}).values()))
+    table.attrs["warnings"] = _counts(w for r in runs if not r.get("cached") for w in r.get("warnings") or [])
     if out is not None:
         from .report import write_outputs
 
@@ -516,16 +564,21 @@ def _log_damaged(out: Path, recomputed: dict[str, str]) -> None:
 
 
 def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
-    """One row per run × metric (a failed run gives one row with its error)."""
+    """One row per run × metric (a failed run gives one row with its error).
+
+    ``note`` gives the reason of a metric refused (NaN) because the recording's reference cannot
+    score it (:mod:`footzoo.evaluation.validity`); it is empty for every other row.
+    """
     rows = []
     for r in runs:
         base = {"run": r["key"], "base": r["base"], **{f: _cell_value(r["levels"].get(f)) for f in factors},
                 "recording": r["recording"]}
         if r["error"]:
-            rows.append({**base, "metric": None, "value": np.nan, "error": r["error"]})
+            rows.append({**base, "metric": None, "value": np.nan, "error": r["error"], "note": None})
+        notes = r.get("notes") or {}
         for name, value in sorted(r["metrics"].items()):
-            rows.append({**base, "metric": name, "value": value, "error": None})
-    cols = ["run", "base", *factors, "recording", "metric", "value", "error"]
+            rows.append({**base, "metric": name, "value": value, "error": None, "note": notes.get(name)})
+    cols = ["run", "base", *factors, "recording", "metric", "value", "error", "note"]
     return pd.DataFrame(rows, columns=cols)
 
 

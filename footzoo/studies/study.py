@@ -19,7 +19,11 @@ from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, did_you_mean
 from ..core.yamlsafe import load_file
+from ..evaluation.metrics import METRICS, metric_name
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
+
+#: Largest grid (bases × factor levels × recordings) a study runs unless its ``max_cells`` says more.
+MAX_CELLS = 10_000
 
 STUDY_KEYS = {
     "name": "study name",
@@ -30,25 +34,8 @@ STUDY_KEYS = {
     "metrics": "list of metric names to keep (default: all)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
     "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
-}
-
-# what a run can measure (footzoo.studies.runner computes them); a study's ``metrics`` picks among them
-METRICS: dict[str, str] = {
-    "path_length_m": "horizontal path length (m)",
-    "loop_closure_xy_m": "horizontal end-to-start distance of a closed walk (m)",
-    "loop_closure_3d_m": "3-D end-to-start distance of a closed walk (m)",
-    "loop_closure_xy_pct": "horizontal end-to-start distance, % of the path length",
-    "loop_closure_3d_pct": "3-D end-to-start distance, % of the path length",
-    "armse_3d_m": "RMS position error after yaw alignment, against the reference (m)",
-    "pyshoe_error_m": "PyShoe's position error against the reference (m)",
-    "steps": "number of detected steps",
-    "stance_precision": "per-sample stance precision against the true stance",
-    "stance_recall": "per-sample stance recall against the true stance",
-    "stance_f1": "per-sample stance F1 against the true stance",
-    "stance_accuracy": "per-sample stance accuracy against the true stance",
-    "gait_phase_error_rate": "wrong or missed steps per true step",
-    "step_count_error": "detected minus true steps",
-    "fpa_mean_deg": "mean foot progression angle (deg)",
+    "jobs": "local worker processes (1 = serial, -1 = every core); the command line's --jobs overrides it",
+    "max_cells": f"largest number of runs (bases x factor levels x recordings) allowed, default {MAX_CELLS}",
 }
 
 _FILE_DIGESTS: dict[tuple[str, int, int], str] = {}  # (path, size, mtime_ns) -> sha256 of the content
@@ -161,16 +148,18 @@ class Study:
     metrics: list[str] | None = None
     sweep_points: int = 0
     plugins: list[str] = field(default_factory=list)
+    jobs: int | None = None
+    max_cells: int = MAX_CELLS
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> Study:
+    def from_yaml(cls, path: str | Path, max_cells: int | None = None) -> Study:
         """Read and check a study file; paths in it are relative to the file."""
         p = resolve(path)
         data = load_file(p, ConfigError, "study file")
         if not isinstance(data, dict):
             raise ConfigError(f"{p}: a study must be a mapping with base, factors, recordings")
         try:
-            return cls.from_dict(data, root=p.parent)
+            return cls.from_dict(data, root=p.parent, max_cells=max_cells)
         except ConfigError as err:
             raise ConfigError(f"{p}: {err}") from None
 
@@ -186,8 +175,8 @@ class Study:
                            "plugins": source_hash(self.plugins)}, sort_keys=True)
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
-        """Build from a mapping (see :data:`STUDY_KEYS`)."""
+    def from_dict(cls, d: dict[str, Any], root: str | Path = ".", max_cells: int | None = None) -> Study:
+        """Build from a mapping (see :data:`STUDY_KEYS`); ``max_cells`` overrides the study's grid limit."""
         root = Path(root)
         for key in d:
             if key not in STUDY_KEYS:
@@ -219,6 +208,10 @@ class Study:
             if not isinstance(k, str) or not k:
                 raise ConfigError(f"factor names must be dotted paths like detector.threshold, got {k!r}")
         factors = {k: (v if isinstance(v, list) else [v]) for k, v in factors.items()}
+        for k, v in factors.items():
+            if not v:
+                raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
+                                  "or remove it")
         recordings = []
         if not isinstance(d["recordings"] or [], list):
             raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
@@ -232,33 +225,132 @@ class Study:
                 metrics = [metrics]
             if not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics):
                 raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}; valid: {list(METRICS)}")
+            named = []
             for m in metrics:
-                if m not in METRICS:
+                try:
+                    named.append(metric_name(m))
+                except KeyError:
                     raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}; "
-                                      f"valid metrics: {list(METRICS)}")
+                                      f"valid metrics: {list(METRICS)}") from None
+            metrics = list(dict.fromkeys(named))
         sweep = d.get("sweep") or {}
         if not isinstance(sweep, dict) or set(sweep) - {"points"}:
             raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
         points = sweep.get("points", 0)
         if isinstance(points, bool) or not isinstance(points, int) or points < 0:
             raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
-        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins)
+        jobs = d.get("jobs")
+        if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0):
+            raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+        max_cells = d.get("max_cells", MAX_CELLS) if max_cells is None else max_cells
+        if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
+            raise ConfigError(f"max_cells must be a whole number >= 1, got {max_cells!r}")
+        study = cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins, jobs,
+                    max_cells)
+        study.check_size()
+        return study
 
-    def cells(self) -> list[Cell]:
-        """Every base × factor combination × recording."""
-        # type changes first: they reset the plug-in's parameters, which other factors may then set
+    @property
+    def size(self) -> int:
+        """Number of runs: bases × the product of the factors' level counts × recordings (no cell is built)."""
+        n = len(self.bases) * len(self.recordings)
+        for levels in self.factors.values():
+            n *= len(levels)
+        return n
+
+    def check_size(self, max_cells: int | None = None) -> None:
+        """A ConfigError when the grid has more runs than ``max_cells`` (default: the study's own limit)."""
+        limit = self.max_cells if max_cells is None else max_cells
+        if self.size > limit:
+            levels = " x ".join(f"{len(v)} {k}" for k, v in self.factors.items()) or "no factors"
+            raise ConfigError(
+                f"the study has {self.size:,} runs ({len(self.bases)} base(s) x {levels} x "
+                f"{len(self.recordings)} recording(s)), more than the limit of {limit:,}: shorten the factors' "
+                "level lists, or raise the limit (max_cells: N in the study file, --max-cells N on the command "
+                "line) if you mean it")
+
+    def configs(self) -> list[tuple[dict[str, Any], dict[str, Any]]]:
+        """Every distinct ``(config, levels)`` of the grid, without the recordings.
+
+        Type changes are set first: they reset the plug-in's parameters, which other factors may then set.
+        A level that cannot be set gives ``{"__invalid__": reason}`` as its config.
+        """
         names = sorted(self.factors, key=lambda n: not n.endswith(".type"))
-        code = self.code_identity()
         out = []
         for base_name, base in self.bases:
             for values in itertools.product(*(self.factors[n] for n in names)):
                 cfg = copy.deepcopy(base)
-                for n, v in zip(names, values, strict=True):
-                    set_dotted(cfg, n, v)
                 levels = {"base": base_name, **dict(zip(names, values, strict=True))}
-                for rec in self.recordings:
-                    out.append(Cell(cfg, rec, levels, base_name, code))
+                try:
+                    for n, v in zip(names, values, strict=True):
+                        set_dotted(cfg, n, v)
+                except (ConfigError, TypeError, ValueError, IndexError) as err:
+                    cfg = {"__invalid__": str(err)}
+                out.append((cfg, levels))
         return out
+
+    def check(self, max_cells: int | None = None) -> None:
+        """Validate everything before a run: the grid's size, every config of the grid, the reader options.
+
+        Raises
+        ------
+        ConfigError
+            Listing the first distinct problems, each with the factor levels that lead to it.
+        """
+        from ..runtime.validate import config_errors
+
+        self.check_size(max_cells)
+        problems: dict[str, list[dict[str, Any]]] = {}
+        configs = self.configs()
+        bad = 0
+        for cfg, levels in configs:
+            errors = [cfg["__invalid__"]] if "__invalid__" in cfg else config_errors(cfg)
+            bad += bool(errors)
+            for e in errors:
+                problems.setdefault(e, []).append(levels)
+        for rec in self.recordings:
+            problem = _reader_problem(rec)
+            if problem:
+                problems.setdefault(problem, []).append({"recording": rec.label})
+        if problems:
+            lines = [f"- {e} (e.g. {_levels_text(where[0])}; {len(where)} case(s))"
+                     for e, where in list(problems.items())[:5]]
+            more = f"\n... and {len(problems) - 5} more distinct problem(s)" if len(problems) > 5 else ""
+            raise ConfigError(f"study {self.name!r}: {bad} of {len(configs)} config(s) invalid or recordings "
+                              f"unreadable, nothing was run; the first distinct causes:\n" + "\n".join(lines) + more)
+
+    def cells(self) -> list[Cell]:
+        """Every base × factor combination × recording."""
+        # type changes first: they reset the plug-in's parameters, which other factors may then set
+        self.check_size()
+        code = self.code_identity()
+        out = []
+        for cfg, levels in self.configs():
+            if "__invalid__" in cfg:
+                raise ConfigError(f"factor levels {_levels_text(levels)}: {cfg['__invalid__']}")
+            for rec in self.recordings:
+                out.append(Cell(cfg, rec, levels, levels["base"], code))
+        return out
+
+
+def _levels_text(levels: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in levels.items())
+
+
+def _reader_problem(rec: RecordingSpec) -> str | None:
+    """Why a recording file's reader cannot take its options (unknown format or option), or None."""
+    if rec.path is None or rec.problem():
+        return rec.problem()
+    from ..core.errors import FootzooError
+    from ..io import _options_for, available
+
+    readers = available()
+    try:
+        fmt = rec.format or readers.detect(Path(rec.path))
+        _options_for(readers.get_reader(fmt), fmt, Path(rec.path), dict(rec.options))
+    except FootzooError as err:
+        return str(err)
+    return None
 
 
 def _resolve(root: Path, path: str) -> str:
