@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate | formats``.
+"""Command line: ``footzoo run | simulate | calibrate | ablate (study) | tune | list | validate | formats``.
 
 Bad input never prints a Python traceback: the message names the input, the
 problem and the fix, and the exit code says which kind of problem it was
@@ -352,7 +352,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """Foot vector from a calibration recording (Huang et al. 2016, eq. 11), saved as YAML."""
     import numpy as np
 
-    from ..analysis.foot_vector import calibrate_foot_vector
+    from ..analysis.foot_vector import calibrate_foot_vector, calibration_trial_problems
     from ..core.atomic import atomic_path, refuse_inputs
 
     target = _writable_file(args.out)
@@ -360,6 +360,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     refuse_inputs([target], _inputs(args, rec), "--out")
     fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
                                flex=tuple(args.flex) if args.flex else None)
+    problems = calibration_trial_problems(rec, fv)
+    if problems:
+        raise RecordingError(f"{rec.name} is not a calibration trial (stand still, then slow dorsi-/plantar-flexions "
+                             "about the ankle, e.g. footzoo simulate calibration): " + "; ".join(problems)
+                             + ". Record one, or give its periods with --still T0 T1 --flex T0 T1")
     with atomic_path(target, inputs=_inputs(args, rec), what="--out") as tmp:
         fv.save(tmp)
     yaw = np.degrees(np.arctan2(-fv.vector[1], fv.vector[0]))
@@ -402,6 +407,28 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
     return 0
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    """Choose a setting by leave-one-group-out cross-validation; write it as a config YAML."""
+    from ..studies.report import to_markdown
+    from ..studies.tune import load_tune_file, tune
+
+    study, spec = load_tune_file(args.study)
+    out = _writable_dir(args.out or f"tune_{Path(args.study).stem}")
+    if args.config:
+        spec.config = str(_writable_file(args.config, "--config"))
+    if args.quiet:
+        warnings.simplefilter("ignore")
+    result = tune(study, spec, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
+                  quiet=args.quiet)
+    print(f"{len(result.settings_)} settings x {len(result.values_)} recordings in {result.groups_.nunique()} "
+          f"groups; objective {spec.objective} ({spec.aggregate}, {spec.direction})")
+    print("leave-one-group-out (each group scored by the setting chosen without it):")
+    print(to_markdown(result.folds_), end="")
+    print(f"chosen on every group: {result.best_}")
+    print(f"wrote {spec.config or out / 'best.yaml'} (footzoo run it), {out}/tune_folds.csv, {out}/tune_scores.csv")
+    return EXIT_OK
 
 
 def _failed_exit_code(causes: dict[str, int]) -> int:
@@ -559,6 +586,18 @@ def build_parser() -> argparse.ArgumentParser:
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
     abl.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
     abl.set_defaults(func=cmd_ablate)
+
+    tun = sub.add_parser("tune", help="choose a setting by leave-one-group-out cross-validation (a study file "
+                         "with a tune: block) and write it as a config")
+    tun.add_argument("study", help="tune YAML: a study file with a tune: block (objective, search, group_by)")
+    tun.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores")
+    tun.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    tun.add_argument("--out", type=_output, help="output folder (default: tune_<file>): cache/, tune_folds.csv, "
+                     "tune_scores.csv, best.yaml")
+    tun.add_argument("--config", type=_output, help="write the chosen config here (default: the tune block's "
+                     "config, else OUT/best.yaml)")
+    tun.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
+    tun.set_defaults(func=cmd_tune)
 
     lst = sub.add_parser("list", help="list plug-ins with their parameters (default, unit, accepted range, meaning, "
                          "source) and papers, and the config's settings blocks")

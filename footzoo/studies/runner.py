@@ -260,6 +260,7 @@ def run_study(
     max_runs: int | None = None,
     max_cells: int | None = None,
     quiet: bool = False,
+    report: bool = True,
 ) -> pd.DataFrame:
     """Run every cell of a study and return the tidy table (one row per run × metric).
 
@@ -287,6 +288,9 @@ def run_study(
     max_cells : int, optional
         Largest grid allowed (default: the study's ``max_cells``, else
         :data:`footzoo.studies.study.MAX_CELLS`); a larger one is refused before anything runs.
+    report : bool
+        Write the report into ``out`` (tables, summaries, plots); False keeps only the cache
+        (what :func:`footzoo.studies.tune.tune` needs).
     quiet : bool
         Do not repeat the runs' warnings (each distinct warning of the workers is otherwise
         issued once here, with the number of runs that gave it).
@@ -315,11 +319,11 @@ def run_study(
     bar = _Progress(progress, "study")
     try:
         if scheduler is None:
-            table = _run_study(study, jobs, None, out, max_runs, bar)
+            table = _run_study(study, jobs, None, out, max_runs, bar, report)
         else:
             cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
             try:
-                table = _run_study(study, jobs, cluster, out, max_runs, bar)
+                table = _run_study(study, jobs, cluster, out, max_runs, bar, report)
             finally:
                 cluster.close()
     finally:
@@ -356,11 +360,11 @@ def _counts(values) -> dict[str, int]:
     return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
-def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.DataFrame:
+def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bool = True) -> pd.DataFrame:
     bar.phase("loading")
     bar.set_description(study.name)
     cells = study.cells()
-    report_steps = 4 if out is not None else 0
+    report_steps = 4 if out is not None and report else 0
     bar.add(len(study.recordings) + len(cells) + report_steps)
     bar.update(1)
 
@@ -423,7 +427,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
     table.attrs["causes"] = _counts(r["error"] for r in runs if r.get("error"))
     table.attrs["refused"] = _counts(why for r in runs for why in set((r.get("notes") or {}).values()))
     table.attrs["warnings"] = _counts(w for r in runs if not r.get("cached") for w in r.get("warnings") or [])
-    if out is not None:
+    if out is not None and report:
         from .report import write_outputs
 
         if recomputed:

@@ -30,7 +30,7 @@ STUDY_KEYS = {
     "description": "free text",
     "base": "a config path, an inline config, or a list of them",
     "factors": "mapping of dotted paths to lists of values (all combinations are run)",
-    "recordings": "list of {path: glob, format: ...} or {simulate: {...}, seeds: [...]}",
+    "recordings": "list of {path: glob, format: ..., group: ...} or {simulate: {...}, seeds: [...], group: ...}",
     "metrics": "list of metric names to keep (default: all)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
     "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
@@ -62,6 +62,7 @@ class RecordingSpec:
     options: dict[str, Any] = field(default_factory=dict)
     simulate: dict[str, Any] | None = None
     seed: int | None = None
+    group: str | None = None  # cross-validation group (subject, day, motion class): footzoo.studies.tune
 
     def identity(self) -> str:
         """What the cache key depends on: the file's content hash, or the simulator spec and seed.
@@ -338,15 +339,22 @@ def _levels_text(levels: dict[str, Any]) -> str:
 
 
 def _reader_problem(rec: RecordingSpec) -> str | None:
-    """Why a recording file's reader cannot take its options (unknown format or option), or None."""
+    """Why a recording's reader cannot take its options (an unknown format or option), or None.
+
+    A file that cannot be read (vanished, a directory, not recognised) is not a problem of the
+    study: its cells fail on their own, the other recordings run.
+    """
     if rec.path is None or rec.problem():
-        return rec.problem()
+        return None
     from ..core.errors import FootzooError
     from ..io import _options_for, available
 
     readers = available()
     try:
         fmt = rec.format or readers.detect(Path(rec.path))
+    except FootzooError:
+        return None
+    try:
         _options_for(readers.get_reader(fmt), fmt, Path(rec.path), dict(rec.options))
     except FootzooError as err:
         return str(err)
@@ -366,6 +374,10 @@ def _resolve(root: Path, path: str) -> str:
 def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
     if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
         raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
+    group = r.get("group")
+    if group is not None and not isinstance(group, (str, int)):
+        raise ConfigError(f"recordings[{i}].group must be a group name (text), got {group!r}")
+    group = None if group is None else str(group)
     if "path" in r:
         pattern = r["path"]
         if not isinstance(pattern, str) or not pattern:
@@ -375,8 +387,9 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
         if not matches:
             raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
-        opts = {k: v for k, v in r.items() if k not in ("path", "format")}
-        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts) for m in matches]
+        opts = {k: v for k, v in r.items() if k not in ("path", "format", "group")}
+        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts, group=group)
+                for m in matches]
     if not isinstance(r["simulate"], dict):
         raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
     sim = dict(r["simulate"])
@@ -388,7 +401,7 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
     seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
-    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s)) for s in seeds]
+    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
 
 
 def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
