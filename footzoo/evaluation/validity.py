@@ -19,9 +19,10 @@ The rules (each applies to the reference of one recording):
     Fewer than :data:`MIN_REFERENCE_PHASES` strides in the reference stride table: every stride
     comparison (:data:`STRIDE_COMPARISONS`) is refused.
 ``missing events``
-    A reference event column (``to_s``, ``end_s``, ``start_s``, ``stride_length_m``, ``fpa_rad``) is
-    absent, or NaN in more than :data:`MAX_MISSING_SHARE` of the strides: the comparisons that need it
-    are refused (:data:`NEEDS`).
+    A reference event column (``to_s``, ``end_s``, ``start_s``) is absent, or it or a quantity column
+    (``stride_length_m``, ``fpa_rad``) is NaN in more than :data:`MAX_MISSING_SHARE` of the strides:
+    the comparisons that need it are refused (:data:`NEEDS`). A quantity the reference does not
+    have at all is simply not compared.
 ``no matched stride``
     The reference has strides but no estimated stride pairs with one
     (:func:`footzoo.evaluation.metrics.match_strides`): the per-stride errors are NaN (the estimate's
@@ -57,6 +58,8 @@ NEEDS: dict[str, tuple[str, ...]] = {
                         "stride_length_rms_error_straight_m", "stride_length_mean_error_straight_m"),
     "fpa_rad": ("fpa_mean_error_deg", "fpa_rms_error_deg"),
 }
+#: The gait events a reference stride table is expected to have (an absent quantity column is no comparison).
+EVENTS = ("start_s", "to_s", "end_s")
 #: Every per-stride comparison with a reference stride table (not the counts).
 STRIDE_COMPARISONS = tuple(dict.fromkeys(m for ms in NEEDS.values() for m in ms))
 
@@ -100,7 +103,7 @@ def _stance_problems(t: np.ndarray, stance: np.ndarray) -> dict[str, str]:
         return dict.fromkeys((*SAMPLE_METRICS, *STEP_METRICS), why)
     phases = intervals(stance)
     dt = float(np.median(np.diff(t)))
-    durations = t[phases[:, 1] - 1] - t[phases[:, 0]] + dt
+    durations = np.round((phases[:, 1] - phases[:, 0]) * dt, 6)  # samples x the median period (to 1 µs)
     short = int(np.sum(durations < MIN_STANCE_S))
     if short > MAX_FRAGMENT_SHARE * len(phases):
         return dict.fromkeys(STEP_METRICS, (
@@ -118,6 +121,8 @@ def _stride_problems(steps) -> dict[str, str]:
                                                  f"(at least {MIN_REFERENCE_PHASES} needed)")
     out: dict[str, str] = {}
     for col, metrics in NEEDS.items():
+        if col not in steps.columns and col not in EVENTS:
+            continue  # a quantity the reference does not measure: no comparison, nothing to refuse
         if col not in steps.columns:
             why = f"the reference stride table has no {col!r} column"
         else:

@@ -387,6 +387,7 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
         if not matches:
             raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
+        matches = _without_sidecars(matches)
         opts = {k: v for k, v in r.items() if k not in ("path", "format", "group")}
         return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts, group=group)
                 for m in matches]
@@ -402,6 +403,12 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
     seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
     return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
+
+
+def _without_sidecars(paths: list[str]) -> list[str]:
+    """The matches that are not another match's sidecar (``walk.csv.steps.csv`` next to ``walk.csv``)."""
+    names = {Path(p).name for p in paths}
+    return [p for p in paths if not any(Path(p).name.startswith(n + ".") for n in names if n != Path(p).name)]
 
 
 def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:

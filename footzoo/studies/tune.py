@@ -321,8 +321,9 @@ def recording_groups(study: Study, group_by: str | None = None) -> pd.Series:
 
 
 def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = None, score: Score | None = None,
-         eligible: Callable[[str], bool] | None = None, jobs: int | None = None, scheduler: str | None = None,
-         out: str | Path | None = None, progress: bool = False, quiet: bool = False) -> TuneResult:
+         eligible: Callable[[str], bool] | None = None, groups: Callable[[str], str] | None = None,
+         jobs: int | None = None, scheduler: str | None = None, out: str | Path | None = None,
+         progress: bool = False, quiet: bool = False) -> TuneResult:
     """Choose a setting by leave-one-group-out cross-validation (see the module's docstring).
 
     Parameters
@@ -335,6 +336,8 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
         ``score(values, groups) -> float`` (lower is better) instead of the spec's aggregate.
     eligible : callable, optional
         ``eligible(setting_name) -> bool``: only those settings may be chosen (all are run).
+    groups : callable, optional
+        ``groups(recording_label) -> group`` instead of the recordings' ``group:`` / ``group_by``.
     jobs, scheduler, progress, quiet
         As :func:`footzoo.studies.run_study` (cached in ``out/cache``, parallel).
     out : path, optional
@@ -348,7 +351,10 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     if spec is None:
         raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
     spec = spec if isinstance(spec, TuneSpec) else TuneSpec.from_dict(spec)
-    groups = recording_groups(study, spec.group_by)
+    if groups is None:
+        groups = recording_groups(study, spec.group_by)
+    else:
+        groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
     cands, settings = candidate_study(study, spec)
     table = run_study(cands, jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet, report=False)
     rows = table[table["metric"] == spec.objective]
