@@ -94,3 +94,17 @@ def test_quiet_silences_the_runs_warnings():
         table = run_study(study, quiet=True)
     assert not [w for w in quiet if "hard_iron" in str(w.message)]
     assert np.isfinite(table["value"]).any()
+
+
+def test_calibrate_refuses_a_walk_and_takes_a_calibration_trial(tmp_path, capsys):
+    from footzoo.sim import simulate_calibration
+
+    write(simulate_calibration(mount_yaw=0.3, noise=NoiseModel(seed=1)), tmp_path / "cal.csv")
+    write(simulate(n_strides=10, rate=100.0, noise=NoiseModel(seed=0)), tmp_path / "walk.csv")
+    assert main(["calibrate", "--data", str(tmp_path / "cal.csv"), "--out", str(tmp_path / "fv.yaml")]) == 0
+    assert (tmp_path / "fv.yaml").exists()
+    capsys.readouterr()
+    assert main(["calibrate", "--data", str(tmp_path / "walk.csv"), "--out", str(tmp_path / "fv2.yaml")]) == 3
+    err = capsys.readouterr().err
+    assert "is not a calibration trial" in err and "rad/s" in err and "departs from gravity" in err
+    assert not (tmp_path / "fv2.yaml").exists()
