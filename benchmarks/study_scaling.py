@@ -50,7 +50,7 @@ def study(strides: int) -> Study:
         "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
                     "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
         "recordings": [{"simulate": sim, "seeds": list(range(8))}],
-        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "steps"],
+        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "strides"],
         "sweep": {"points": 25},
     })
 

@@ -108,3 +108,37 @@ def test_calibrate_refuses_a_walk_and_takes_a_calibration_trial(tmp_path, capsys
     err = capsys.readouterr().err
     assert "is not a calibration trial" in err and "rad/s" in err and "departs from gravity" in err
     assert not (tmp_path / "fv2.yaml").exists()
+
+
+def test_old_cache_entries_are_pruned(tmp_path):
+    import os
+    import time
+
+    from footzoo.studies.runner import prune_cache
+
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    now = time.time()
+    for name, age_days, size in (("fresh", 0, 100), ("old", 40, 100), ("older_kept", 50, 100), ("big", 10, 5000)):
+        f = cache / f"{name}.json"
+        f.write_bytes(b"x" * size)
+        os.utime(f, (now - age_days * 86400, now - age_days * 86400))
+    out = prune_cache(cache, keep={"older_kept"}, max_age_days=30)
+    assert out == {"removed": 1, "kept": 3, "bytes": 5200}
+    assert sorted(f.stem for f in cache.glob("*.json")) == ["big", "fresh", "older_kept"]
+    # then by size: the least recently used entry not kept goes first ("big", 10 days), until 300 bytes
+    assert prune_cache(cache, keep={"older_kept"}, max_age_days=None, max_bytes=300)["removed"] == 1
+    assert sorted(f.stem for f in cache.glob("*.json")) == ["fresh", "older_kept"]
+    assert prune_cache(cache, keep=set(), max_age_days=0)["kept"] == 0
+
+
+def test_a_study_prunes_other_studies_entries_on_request(tmp_path):
+    out = tmp_path / "out"
+    one = {**BASE, "recordings": [SIM]}
+    two = {**BASE, "recordings": [{**SIM, "seeds": [5]}]}
+    run_study(Study.from_dict(one), out=out, report=False)
+    run_study(Study.from_dict(two), out=out, report=False)
+    assert len(list((out / "cache").glob("*.json"))) == 2  # young entries stay by default
+    table = run_study(Study.from_dict(two), out=out, report=False, prune={"max_age_days": 0})
+    assert table.attrs["pruned"]["removed"] == 1 and table.attrs["cached"] == 1
+    assert len(list((out / "cache").glob("*.json"))) == 1

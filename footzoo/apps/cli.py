@@ -383,11 +383,15 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     out = args.out or f"ablation_{Path(args.study).stem}"
     if args.quiet:
         warnings.simplefilter("ignore")
+    prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
+             "max_bytes": None if args.cache_max_size is None else int(args.cache_max_size * 1e6)}
     table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
-                      max_cells=args.max_cells, quiet=args.quiet)
+                      max_cells=args.max_cells, quiet=args.quiet, prune=prune)
     a = table.attrs
     notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
              if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
+    if a.get("pruned", {}).get("removed"):
+        notes.append(f"{a['pruned']['removed']} old cache entries removed")
     notes = "".join(f", {n}" for n in notes if n)
     print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
           f"{a['failed']} failed{notes}); results in {out}/")
@@ -585,6 +589,12 @@ def build_parser() -> argparse.ArgumentParser:
     abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
     abl.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
+    abl.add_argument("--prune-cache", action="store_true",
+                     help="remove every cache entry this study did not use (other studies' runs in the same --out)")
+    abl.add_argument("--cache-max-age", type=_number(0, 1e6, "days"), default=30.0, metavar="DAYS",
+                     help="remove cache entries no study used for DAYS days (default 30)")
+    abl.add_argument("--cache-max-size", type=_number(0, 1e12, "MB"), metavar="MB",
+                     help="then remove the least recently used entries until the cache is at most MB megabytes")
     abl.set_defaults(func=cmd_ablate)
 
     tun = sub.add_parser("tune", help="choose a setting by leave-one-group-out cross-validation (a study file "

@@ -124,6 +124,66 @@ def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]
     return record, None
 
 
+#: Cache entries no study used for this many days are removed after a study (``run_study(prune=...)``).
+CACHE_MAX_AGE_DAYS = 30.0
+
+
+def prune_cache(cache_dir: str | Path, keep: set[str] | frozenset[str] = frozenset(),
+                max_age_days: float | None = CACHE_MAX_AGE_DAYS, max_bytes: int | None = None) -> dict[str, int]:
+    """Remove old cache entries: those not in ``keep`` and unused for ``max_age_days``, then, while the
+    cache is larger than ``max_bytes``, the least recently used ones not in ``keep``.
+
+    An entry's age is the time since a study last wrote or read it (its modification time; a study
+    touches every entry it reads). ``max_age_days=0`` removes every entry not in ``keep``.
+
+    Returns
+    -------
+    dict
+        ``removed`` (entries), ``kept`` (entries), ``bytes`` (the cache's size after pruning).
+    """
+    folder = Path(cache_dir)
+    entries = []
+    for f in folder.glob("*.json"):
+        try:
+            st = f.stat()
+        except OSError:
+            continue
+        entries.append((st.st_mtime, st.st_size, f))
+    for f in folder.glob("*.tmp"):  # left by a killed writer
+        with contextlib.suppress(OSError):
+            if time.time() - f.stat().st_mtime > 3600:
+                f.unlink()
+    entries.sort()  # oldest first
+    now, removed = time.time(), 0
+    alive = []
+    for mtime, size, f in entries:
+        old = max_age_days is not None and now - mtime >= max_age_days * 86400.0
+        if old and f.stem not in keep:
+            with contextlib.suppress(OSError):
+                f.unlink()
+                removed += 1
+                continue
+        alive.append((mtime, size, f))
+    total = sum(size for _, size, _ in alive)
+    if max_bytes is not None:
+        for i, (_, size, f) in enumerate(list(alive)):
+            if total <= max_bytes:
+                break
+            if f.stem not in keep:
+                with contextlib.suppress(OSError):
+                    f.unlink()
+                    removed += 1
+                    total -= size
+                    alive[i] = (0, 0, None)
+    return {"removed": removed, "kept": sum(1 for *_, f in alive if f is not None), "bytes": total}
+
+
+def _touch(path: Path) -> None:
+    """Mark a cache entry as used now (its age for :func:`prune_cache`)."""
+    with contextlib.suppress(OSError):
+        os.utime(path)
+
+
 # --------------------------------------------------------------------------- one cell, one chunk
 
 _RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
@@ -261,6 +321,7 @@ def run_study(
     max_cells: int | None = None,
     quiet: bool = False,
     report: bool = True,
+    prune: dict[str, Any] | None = None,
 ) -> pd.DataFrame:
     """Run every cell of a study and return the tidy table (one row per run × metric).
 
@@ -288,6 +349,11 @@ def run_study(
     max_cells : int, optional
         Largest grid allowed (default: the study's ``max_cells``, else
         :data:`footzoo.studies.study.MAX_CELLS`); a larger one is refused before anything runs.
+    prune : dict, optional
+        Keyword arguments of :func:`prune_cache` applied to ``out/cache`` after the study (the
+        study's own entries are always kept). Default: ``{"max_age_days": CACHE_MAX_AGE_DAYS}``,
+        entries unused for 30 days go; ``{"max_age_days": 0}`` keeps only this study's entries;
+        ``{"max_age_days": None}`` keeps everything.
     report : bool
         Write the report into ``out`` (tables, summaries, plots); False keeps only the cache
         (what :func:`footzoo.studies.tune.tune` needs).
@@ -319,11 +385,11 @@ def run_study(
     bar = _Progress(progress, "study")
     try:
         if scheduler is None:
-            table = _run_study(study, jobs, None, out, max_runs, bar, report)
+            table = _run_study(study, jobs, None, out, max_runs, bar, report, prune)
         else:
             cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
             try:
-                table = _run_study(study, jobs, cluster, out, max_runs, bar, report)
+                table = _run_study(study, jobs, cluster, out, max_runs, bar, report, prune)
             finally:
                 cluster.close()
     finally:
@@ -360,7 +426,8 @@ def _counts(values) -> dict[str, int]:
     return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
-def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bool = True) -> pd.DataFrame:
+def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bool = True,
+               prune: dict[str, Any] | None = None) -> pd.DataFrame:
     bar.phase("loading")
     bar.set_description(study.name)
     cells = study.cells()
@@ -399,6 +466,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
             retried.append(key)
             todo.append(i)
         else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
+            _touch(path)
             cell = cells[i]
             results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
                           "cached": True}
@@ -427,6 +495,9 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
     table.attrs["causes"] = _counts(r["error"] for r in runs if r.get("error"))
     table.attrs["refused"] = _counts(why for r in runs for why in set((r.get("notes") or {}).values()))
     table.attrs["warnings"] = _counts(w for r in runs if not r.get("cached") for w in r.get("warnings") or [])
+    if cache_dir is not None:
+        table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
+                                            **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
     if out is not None and report:
         from .report import write_outputs
 

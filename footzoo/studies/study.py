@@ -52,6 +52,101 @@ def code_fingerprint() -> str:
         h.update(f.read_bytes())
     return h.hexdigest()
 
+def _builtin_plugin_files() -> set[Path]:
+    """The files of footzoo that define a registered plug-in (each has its own cache identity)."""
+    from ..plugins.registry import KINDS, available
+
+    root = Path(__file__).resolve().parents[1]
+    out = set()
+    for kind in KINDS:
+        for cls in available(kind).values():
+            f = _source_file(cls)
+            if f is not None and root in f.parents:
+                out.add(f)
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def engine_fingerprint() -> str:
+    """SHA-256 over footzoo's source files but those that define plug-ins: the engine every cell uses."""
+    root = Path(__file__).resolve().parents[1]
+    plugin_files = _builtin_plugin_files()
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        if f.resolve() not in plugin_files:
+            h.update(str(f.relative_to(root)).encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def _source_file(obj: Any) -> Path | None:
+    import inspect
+
+    try:
+        f = inspect.getsourcefile(obj)
+    except (TypeError, OSError):
+        return None
+    return Path(f).resolve() if f else None
+
+
+def plugin_sources(config: dict[str, Any]) -> list[Path]:
+    """The plug-in source files a config actually uses: the modules of each plug-in's class and base
+    classes (and of the plug-ins inside it), and the plug-in modules those import from, transitively.
+    footzoo's engine (:func:`engine_fingerprint`), installed libraries and the plug-ins the config does
+    not name are not among them."""
+    import sys
+    import types
+
+    from ..plugins.base import Plugin
+    from ..runtime.pipeline import Pipeline
+
+    pipeline = Pipeline.from_dict(copy.deepcopy(config))
+    instances = [*pipeline.calibration, pipeline.orientation, pipeline.detector, *pipeline.corrections,
+                 *pipeline.analysis]
+    modules: list[str] = []
+    seen: set[int] = set()
+    while instances:
+        obj = instances.pop()
+        if obj is None or id(obj) in seen:
+            continue
+        seen.add(id(obj))
+        modules += [c.__module__ for c in type(obj).__mro__]
+        instances += [v for v in vars(obj).values() if isinstance(v, Plugin)]
+    root = Path(__file__).resolve().parents[1]
+    plugin_files = _builtin_plugin_files()
+    libraries = {Path(sys.prefix).resolve(), Path(sys.base_prefix).resolve()}
+    files: set[Path] = set()
+    done: set[str] = set()
+    while modules:
+        name = modules.pop()
+        module = sys.modules.get(name)
+        if name in done or module is None:
+            continue
+        done.add(name)
+        f = _source_file(module)
+        if f is None or (root in f.parents and f not in plugin_files) or any(p in f.parents for p in libraries):
+            continue  # the engine (in engine_fingerprint), the standard library, installed packages
+        files.add(f)
+        for v in vars(module).values():
+            modules.append(v.__name__ if isinstance(v, types.ModuleType) else str(getattr(v, "__module__", "")))
+    return sorted(files)
+
+
+def config_code(config: dict[str, Any]) -> str:
+    """A cell's code identity: footzoo's version, its engine and the source of the plug-ins the config uses.
+
+    Editing a plug-in's file changes the identity of the cells whose config uses it, and only theirs.
+    """
+    from .._version import __version__
+
+    h = hashlib.sha256()
+    for f in plugin_sources(config):
+        h.update(str(f).encode())
+        h.update(hashlib.sha256(f.read_bytes()).digest())
+    return json.dumps({"footzoo": __version__, "engine": engine_fingerprint(), "plugins": h.hexdigest()},
+                      sort_keys=True)
+
+
 @dataclass
 class RecordingSpec:
     """One recording of a study: a file or a simulator scenario with a seed."""
@@ -129,7 +224,7 @@ class Cell:
     recording: RecordingSpec
     levels: dict[str, Any]
     base: str
-    code: str = ""  # footzoo's version and the plug-ins' source hash (Study.code_identity)
+    code: str = ""  # footzoo's version, engine and the used plug-ins' source (config_code)
 
     def key(self, data: str | None = None) -> str:
         """Cache key: hash of the resolved config, the code identity and the data's identity."""
@@ -324,11 +419,14 @@ class Study:
         """Every base × factor combination × recording."""
         # type changes first: they reset the plug-in's parameters, which other factors may then set
         self.check_size()
-        code = self.code_identity()
         out = []
         for cfg, levels in self.configs():
             if "__invalid__" in cfg:
                 raise ConfigError(f"factor levels {_levels_text(levels)}: {cfg['__invalid__']}")
+            try:
+                code = config_code(cfg)
+            except (ConfigError, ValueError, TypeError):  # an invalid config's cells fail on their own
+                code = self.code_identity()
             for rec in self.recordings:
                 out.append(Cell(cfg, rec, levels, levels["base"], code))
         return out
