@@ -184,6 +184,34 @@ def _touch(path: Path) -> None:
         os.utime(path)
 
 
+#: The parts of a run record that grow with the recording: kept in its cache entry, not in memory.
+HEAVY = ("trajectory", "reference", "roc")
+
+
+def light(record: dict[str, Any], keep: bool = True) -> dict[str, Any]:
+    """A run record without its trajectories and sweeps, which its cache entry (``record["entry"]``) holds.
+
+    A study's memory then stays bounded whatever its size: the report reads them back a few runs at a
+    time (:func:`with_heavy`). A record without an entry keeps them when ``keep`` (the report needs
+    them), else they are dropped (nothing reads them).
+    """
+    if "entry" not in record and keep:
+        return record
+    return {k: v for k, v in record.items() if k not in HEAVY}
+
+
+def with_heavy(runs: list[dict[str, Any]], fields: tuple[str, ...] = HEAVY) -> list[dict[str, Any]]:
+    """The runs with their ``fields`` read back from their cache entries (see :func:`light`)."""
+    out = []
+    for r in runs:
+        if "entry" in r and any(f not in r for f in fields):
+            record, _ = read_entry(Path(r["entry"]), r["key"])
+            if record is not None:
+                r = {**r, **{f: record.get(f, []) for f in fields if f not in r}}
+        out.append(r)
+    return out
+
+
 # --------------------------------------------------------------------------- one cell, one chunk
 
 _RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
@@ -284,6 +312,7 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
         if cache_dir is not None:
             try:
                 write_entry(Path(cache_dir) / f"{key}.json", key, record)
+                record["entry"] = str(Path(cache_dir) / f"{key}.json")
             except OSError as err:  # a full or read-only cache costs the resume, not the result
                 warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning, stacklevel=2)
         record["cached"] = False
@@ -468,8 +497,8 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
             _touch(path)
             cell = cells[i]
-            results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
-                          "cached": True}
+            results[i] = light({**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                                "cached": True, "entry": str(path)}, keep=out is not None and report)
             bar.update(1)
     if recomputed:
         warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
@@ -484,7 +513,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
     args = (study.plugins, cache_dir, study.metrics, study.sweep_points)
     for idx, records in _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
         for i, r in zip(idx, records, strict=True):
-            results[i] = r
+            results[i] = light(r, keep=out is not None and report)  # the heavy parts stay on disk
     runs = [results[i] for i in sorted(results)]
     table = tidy(runs, list(study.factors))
     table.attrs["computed"] = sum(1 for r in runs if not r.get("cached"))

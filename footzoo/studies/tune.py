@@ -281,8 +281,7 @@ def candidate_study(study: Study, spec: TuneSpec) -> tuple[Study, dict[str, dict
         for n in names:
             set_dotted(cfg, n, levels[n])
         label = setting_label(levels, multiple_bases=len(study.bases) > 1)
-        cfg["name"] = label
-        bases.append((label, cfg))
+        bases.append((label, cfg))  # the config as the study runs it: the same cache entries
         named[label] = levels
     out = Study(study.name, bases, {}, study.recordings, [spec.objective], 0, study.plugins, study.jobs,
                 study.max_cells)
