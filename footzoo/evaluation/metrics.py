@@ -196,8 +196,10 @@ def reference_steps(steps: pd.DataFrame) -> pd.DataFrame:
     initial contact, ``stride_length``, ``heading``, ``fpa``) is renamed and given
     ``start_s``, the previous stride's initial contact (NaN for the first).
     """
-    out = steps.rename(columns={k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns
-                                and v not in steps.columns})
+    renames = {k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns and v not in steps.columns}
+    if not renames and "swing_end" not in steps.columns:
+        return steps  # footzoo's names already: nothing to copy
+    out = steps.rename(columns=renames)
     if "swing_end" in steps.columns:  # simulator table: its own start/end are heel-off and foot-flat
         out = out.drop(columns=[c for c in ("start", "end") if c in out.columns])
         ic = out["end_s"].to_numpy(dtype=float)

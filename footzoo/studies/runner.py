@@ -50,13 +50,32 @@ class CacheWarning(UserWarning):
 # --------------------------------------------------------------------------- metrics of one run
 
 
-def _metrics(rec, res, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
+_PROBLEMS: dict[int, tuple[Any, dict[str, str]]] = {}  # id(truth) -> (truth, its refused metrics), per process
+
+
+def _reference_problems(rec) -> dict[str, str]:
+    """:func:`footzoo.evaluation.validity.reference_problems` of a recording, once per recording and process."""
+    from ..evaluation.validity import reference_problems
+
+    with _RECORDINGS_LOCK:
+        known = _PROBLEMS.get(id(rec.truth))
+    if known is not None and known[0] is rec.truth:
+        return known[1]
+    problems = reference_problems(rec.t, rec.truth)
+    with _RECORDINGS_LOCK:
+        if len(_PROBLEMS) > 4 * RECORDINGS_PER_PROCESS:
+            _PROBLEMS.clear()
+        _PROBLEMS[id(rec.truth)] = (rec.truth, problems)
+    return problems
+
+
+def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
     """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
     from ..evaluation.metrics import run_metrics
-    from ..evaluation.validity import checked_metrics, reference_problems
+    from ..evaluation.validity import checked_metrics
 
-    m = run_metrics(rec.t, res.pos, res.steps, res.stance, rec.truth)
-    m, notes = checked_metrics(m, reference_problems(rec.t, rec.truth), rec.truth)
+    m = run_metrics(rec.t, pos, res.steps, res.stance, rec.truth)
+    m, notes = checked_metrics(m, _reference_problems(rec), rec.truth)
     if metric_names:
         m = {k: v for k, v in m.items() if k in metric_names}
         notes = {k: v for k, v in notes.items() if k in metric_names}
@@ -226,6 +245,10 @@ def _recording(cell: Cell, identity: str):
             _RECORDINGS.move_to_end(identity)
             return rec
     rec = _read_only(cell.recording.load())
+    if rec.truth is not None and rec.truth.steps is not None:  # footzoo's column names once, not per run
+        from ..evaluation.metrics import reference_steps
+
+        rec.truth.steps = reference_steps(rec.truth.steps)
     with _RECORDINGS_LOCK:
         _RECORDINGS[identity] = rec
         while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
@@ -266,12 +289,16 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
 
         with warnings.catch_warnings(record=True) as caught:  # sent back with the record (see _replay_warnings)
             warnings.simplefilter("always")
-            start = time.perf_counter()
+            # wall and CPU seconds of the pipeline itself and of its metrics (benchmarks/study_scaling.py)
+            start, cpu = time.perf_counter(), time.process_time()
             res = Pipeline.from_dict(cell.config).run(rec)
-            out["metrics"], out["notes"] = _metrics(rec, res, metric_names)
-            out["run_s"] = round(time.perf_counter() - start, 6)
+            out["run_s"], out["run_cpu_s"] = _since(start, cpu)
+            start, cpu = time.perf_counter(), time.process_time()
+            pos = res.pos
+            out["metrics"], out["notes"] = _metrics(rec, res, pos, metric_names)
+            out["metrics_s"], out["metrics_cpu_s"] = _since(start, cpu)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
-        out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
+        out["trajectory"] = np.column_stack([rec.t, pos])[::step].round(4).tolist()
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
             out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4).tolist()
         if sweep_points:
@@ -280,6 +307,10 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
         _fail(out, err)
     out["warnings"] = list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught))[:5]
     return out
+
+
+def _since(wall: float, cpu: float) -> tuple[float, float]:
+    return round(time.perf_counter() - wall, 6), round(time.process_time() - cpu, 6)
 
 
 def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[str], cache_dir: str | None,
