@@ -265,7 +265,7 @@ def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
         ``run``, ``recording``, ``threshold``, ``true_stance_rate``, ``false_stance_rate``.
     """
     def frame(field: str, cols: list[str]) -> pd.DataFrame:
-        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if r.get(field)]
+        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if _has(r, field)]
         if not parts:
             return pd.DataFrame({c: pd.Series(dtype=float if i > 1 else object) for i, c in enumerate(cols)})
         values = np.concatenate([a for _, _, a in parts])
@@ -277,6 +277,12 @@ def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
 
     return (frame("trajectory", ["run", "recording", "t_s", "north_m", "east_m", "down_m"]),
             frame("roc", ["run", "recording", "threshold", "true_stance_rate", "false_stance_rate"]))
+
+
+def _has(record: dict[str, Any], field: str) -> bool:
+    """Whether a run record holds a non-empty ``field`` (a list, or an array read back from the cache)."""
+    value = record.get(field)
+    return value is not None and len(value) > 0
 
 
 def _to_parquet(df: pd.DataFrame, path: Path) -> None:
@@ -438,14 +444,14 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
     from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
     from ..evaluation.plots import REFERENCE_STYLE, pyplot, styled
 
-    runs = [r for r in runs if r.get("trajectory")]
+    runs = [r for r in runs if _has(r, "trajectory")]
     if not runs:
         return None
 
     @styled
     def build():
         plt = pyplot()
-        ref = next((np.asarray(r["reference"], float) for r in runs if r.get("reference")), None)
+        ref = next((np.asarray(r["reference"], float) for r in runs if _has(r, "reference")), None)
         if ref is not None:
             ref = ref[:, 1:4] - ref[0, 1:4]
         curves = []

@@ -18,6 +18,7 @@ How a study runs:
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import hashlib
 import json
@@ -38,7 +39,7 @@ import pandas as pd
 from .study import Cell, Study, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
-CACHE_FORMAT = "footzoo-ablation-cache/2"
+CACHE_FORMAT = "footzoo-ablation-cache/3"
 RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
 CHUNKS_PER_WORKER = 4  # aim for this many chunks per worker (load balance vs. loading a recording again)
 
@@ -107,12 +108,26 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
 
 def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:
     """Write one cache entry atomically: a header line (format, key, checksum, size) then the JSON record."""
-    payload = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
+    payload = json.dumps(record, sort_keys=True, separators=(",", ":"), default=_pack).encode()
     header = {"format": CACHE_FORMAT, "key": key, "sha256": hashlib.sha256(payload).hexdigest(),
               "bytes": len(payload)}
     tmp = path.with_suffix(f".{os.getpid()}.{time.monotonic_ns()}.tmp")
     tmp.write_bytes(json.dumps(header).encode() + b"\n" + payload)
     tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
+
+
+def _pack(value: Any) -> Any:
+    """JSON for an array of a run record (a trajectory): its float64 bytes in base64, exact and fast."""
+    if isinstance(value, np.ndarray):
+        a = np.ascontiguousarray(value, dtype="<f8")
+        return {"__array__": base64.b64encode(a.tobytes()).decode(), "shape": list(a.shape)}
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def _unpack(d: dict[str, Any]) -> Any:
+    if "__array__" in d and "shape" in d and len(d) == 2:
+        return np.frombuffer(base64.b64decode(d["__array__"]), dtype="<f8").reshape(d["shape"])
+    return d
 
 
 def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]:
@@ -135,7 +150,7 @@ def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]
     if hashlib.sha256(payload).hexdigest() != header.get("sha256"):
         return None, "checksum mismatch (edited or damaged)"
     try:
-        record = json.loads(payload)
+        record = json.loads(payload, object_hook=_unpack)
     except ValueError:
         return None, "checksum matches but the content is not JSON"
     if not isinstance(record, dict) or record.get("key") != key:
@@ -298,9 +313,9 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
             out["metrics"], out["notes"] = _metrics(rec, res, pos, metric_names)
             out["metrics_s"], out["metrics_cpu_s"] = _since(start, cpu)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
-        out["trajectory"] = np.column_stack([rec.t, pos])[::step].round(4).tolist()
+        out["trajectory"] = np.column_stack([rec.t, pos])[::step].round(4)
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
-            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4).tolist()
+            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4)
         if sweep_points:
             out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
     except Exception as err:  # one failing run is reported, not fatal
@@ -643,8 +658,10 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
             futures = {client.submit(run_chunk, *task(idx), pure=False): idx for idx in chunks}
             for fut in as_completed(futures):
                 records = fut.result()
+                idx = futures.pop(fut)  # released: the cluster and the client forget the chunk's records
+                fut.release()
                 bar.update(len(records))
-                yield futures[fut], records
+                yield idx, records
     elif jobs != 1:
         from joblib import Parallel, delayed
 
