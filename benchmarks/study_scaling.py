@@ -3,9 +3,10 @@
 Usage: python benchmarks/study_scaling.py [--repeat 2] [--strides 0] [--no-report]
        python benchmarks/study_scaling.py --scale [--settings 50] [--recordings 40]
 
-``--scale``: a study of ``settings`` x ``recordings`` cells (default 50 x 40 = 2 000: yun2012 with
-10 detector thresholds x 5 complementary-filter gains, on simulated straight walks of 30 strides
-at 100 Hz, about 32 s each, seeds 0..39), run serially and on a Dask LocalCluster (2 processes), each from an empty
+``--scale``: a study of ``settings`` x ``recordings`` cells (default 50 x 40 = 2 000: the
+recommended config with 10 detector thresholds x 5 velocity noises, or ``--base yun2012`` with 10
+thresholds x 5 complementary-filter gains, on simulated straight walks of 30 strides at 100 Hz,
+about 32 s each, seeds 0..39), run serially and on a Dask LocalCluster (2 processes), each from an empty
 output folder without the figures (``report=False``; the runs and the cache only). It prints the
 main process's peak memory growth, and footzoo's overhead per cell: the wall time of the serial
 study minus the time of the pipeline runs themselves (``run_s`` in each cache entry), of the
@@ -87,15 +88,23 @@ def machine_check(n: int = 3_000_000, tasks: int = 8) -> float:
     return serial / (time.perf_counter() - t0)
 
 
-def scale_study(settings: int, recordings: int, strides: int = 30) -> Study:
-    """``settings`` configs (detector thresholds x filter gains) x ``recordings`` simulated walks."""
-    gains = [0.5, 0.75, 1.05, 1.3, 1.6][: max(1, min(5, settings))]
-    thresholds = [round(0.3 + 0.1 * k, 2) for k in range(max(1, settings // len(gains)))]
+def scale_study(settings: int, recordings: int, strides: int = 30, base: str = "recommended") -> Study:
+    """``settings`` configs x ``recordings`` simulated walks: for ``recommended`` (a Kalman filter with
+    RTS smoothing) detector thresholds x velocity noises, for ``yun2012`` (a complementary filter,
+    footzoo's cheapest pipeline) detector thresholds x filter gains."""
+    if base == "yun2012":
+        second = ("orientation.static_gain", [0.5, 0.75, 1.05, 1.3, 1.6])
+        thresholds = [round(0.3 + 0.1 * k, 2) for k in range(max(1, settings // 5))]
+        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012",
+               "calibration": []}
+    else:
+        second = ("navigation.velocity_noise", [0.003, 0.01, 0.03, 0.1, 0.3])
+        thresholds = [round(1000.0 + 500.0 * k, 1) for k in range(max(1, settings // 5))]
+        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml"), "name": "recommended"}
     return Study.from_dict({
         "name": "scale",
-        "base": {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012",
-                 "calibration": []},
-        "factors": {"detector.threshold": thresholds, "orientation.static_gain": gains},
+        "base": cfg,
+        "factors": {"detector.threshold": thresholds, second[0]: second[1][: max(1, min(5, settings))]},
         "recordings": [{"simulate": {"path": "straight", "n_strides": strides, "rate": 100, "noise": {"scale": 1}},
                         "seeds": list(range(recordings))}],
         "max_cells": 100_000,
@@ -108,17 +117,17 @@ def _peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def scale(settings: int, recordings: int) -> None:
+def scale(settings: int, recordings: int, base: str = "recommended") -> None:
     """The large-study figures: peak memory, overhead per cell, serial and on a Dask LocalCluster."""
     import json
 
     from dask.distributed import LocalCluster
 
-    s = scale_study(settings, recordings)
+    s = scale_study(settings, recordings, base=base)
     n = s.size
-    print(f"{n} cells ({n // recordings} settings x {recordings} recordings), {os.cpu_count()} cores, "
+    print(f"{n} cells ({n // recordings} settings of {base} x {recordings} recordings), {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
-    run_study(scale_study(2, 1, 4), quiet=True)  # imports and compiled kernels, untimed
+    run_study(scale_study(2, 1, 4, base), quiet=True)  # imports and compiled kernels, untimed
     tmp = Path(tempfile.mkdtemp(prefix="footzoo_scale_"))
     try:
         rss0 = _peak_rss_mb()
@@ -148,7 +157,7 @@ def scale(settings: int, recordings: int) -> None:
         print(f"  rerun from the cache: {time.perf_counter() - t0:.1f} s ({again.attrs['cached']} cached)", flush=True)
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                           silence_logs=logging.CRITICAL) as cluster:
-            run_study(scale_study(2, 1, 4), scheduler=cluster.scheduler_address, quiet=True)  # warm the workers
+            run_study(scale_study(2, 1, 4, base), scheduler=cluster.scheduler_address, quiet=True)  # warm
             t0 = time.perf_counter()
             dask = run_study(s, scheduler=cluster.scheduler_address, out=tmp / "dask", report=False, quiet=True)
             print(f"dask LocalCluster (2 processes): {time.perf_counter() - t0:.1f} s wall; peak memory of the "
@@ -167,9 +176,11 @@ def main() -> None:
     ap.add_argument("--scale", action="store_true", help="the large study: memory and overhead per cell")
     ap.add_argument("--settings", type=int, default=50, help="--scale: settings (default 50)")
     ap.add_argument("--recordings", type=int, default=40, help="--scale: recordings (default 40)")
+    ap.add_argument("--base", choices=["recommended", "yun2012"], default="recommended",
+                    help="--scale: the pipeline (default recommended; yun2012 is footzoo's cheapest)")
     args = ap.parse_args()
     if args.scale:
-        scale(args.settings, args.recordings)
+        scale(args.settings, args.recordings, args.base)
         return
     from dask.distributed import LocalCluster
 
