@@ -55,7 +55,7 @@ from accuracy import (  # noqa: E402
 )
 
 from footzoo.plugins.registry import available  # noqa: E402
-from footzoo.studies import Study  # noqa: E402
+from footzoo.studies import Study, tune  # noqa: E402
 from footzoo.studies.report import to_markdown  # noqa: E402
 
 #: The filter every candidate shares: INS attitude in a 9-state error-state Kalman filter with
@@ -180,28 +180,42 @@ def score(log_ratio: pd.Series, classes: pd.Series) -> float:
     return float(per_class.mean())
 
 
+def class_score(best: pd.Series):
+    """The score of a setting on a set of trials: :func:`score` of ``log(error / PyShoe's best)``, a failed run
+    counting as 1000 times PyShoe's best (a :data:`footzoo.studies.tune.Score`)."""
+    def scored(values: pd.Series, classes: pd.Series) -> float:
+        ratio = np.log(values / best.reindex(values.index)).fillna(np.log(1e3))
+        return score(ratio, classes)
+
+    return scored
+
+
 def cross_validate(err: pd.DataFrame, best: pd.Series) -> tuple[pd.DataFrame, pd.Series, str]:
-    """Leave-one-motion-class-out selection.
+    """Leave-one-motion-class-out selection (:func:`footzoo.studies.tune.cross_validate` with :func:`class_score`).
 
     Returns the per-fold choices, the held-out error of every trial and the setting chosen on all classes.
     """
+    from footzoo.studies.tune import cross_validate as leave_one_group_out_choice
+
     classes = pd.Series([motion_class(t) for t in err.index], index=err.index)
-    ratio = np.log(err.div(best, axis=0))
-    ratio = ratio.fillna(np.log(1e3))  # a run that failed counts as 1000 times PyShoe's best
-    folds, held_out = [], pd.Series(np.nan, index=err.index)
-    for c in CLASS_ORDER:
-        test = classes == c
-        if not test.any():
+    rank = classes.map({c: i for i, c in enumerate(CLASS_ORDER)}).fillna(len(CLASS_ORDER))
+    err, classes = err.loc[rank.sort_values(kind="stable").index], classes.loc[rank.sort_values(kind="stable").index]
+    folds, held_out, final = leave_one_group_out_choice(err, classes, class_score(best))
+    return _fold_table(folds, err, held_out, best), held_out, final
+
+
+def _fold_table(folds: pd.DataFrame, err: pd.DataFrame, held_out: pd.Series, best: pd.Series) -> pd.DataFrame:
+    """The folds as the selection report shows them (held-out medians in m and as ratios to PyShoe's best)."""
+    classes = pd.Series([motion_class(t) for t in err.index], index=err.index)
+    rows = []
+    for f in folds.itertuples():
+        if f.group not in CLASS_ORDER:
             continue
-        scores = {s: score(ratio.loc[~test, s], classes[~test]) for s in err.columns}
-        chosen = min(scores, key=scores.get)
-        held_out[test] = err.loc[test, chosen]
-        folds.append({"held-out class": c, "trials": int(test.sum()), "chosen on the other classes": chosen,
-                      "held-out median (m)": err.loc[test, chosen].median(),
-                      "held-out median ratio": float(np.exp(ratio.loc[test, chosen]).median())})
-    scores = {s: score(ratio[s], classes) for s in err.columns}
-    final = min(scores, key=scores.get)
-    return pd.DataFrame(folds), held_out, final
+        test = classes == f.group
+        rows.append({"held-out class": f.group, "trials": int(test.sum()), "chosen on the other classes": f.chosen,
+                     "held-out median (m)": err.loc[test, f.chosen].median(),
+                     "held-out median ratio": float((err.loc[test, f.chosen] / best[test]).median())})
+    return pd.DataFrame(rows)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -221,13 +235,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"no PyShoe trials in {folder}: nothing to select on")
         return 1
     cands = refine_candidates() if args.refine else candidates()
-    study = Study.from_dict({"name": "select_recommended", "base": cands,
-                             "recordings": [{"path": str(folder / "*.mat"), "format": "pyshoe"}],
-                             "metrics": ["pyshoe_error_m", "armse_3d_m"]})
-    table = run_cached(study, args.results / "select_recommended", args.jobs)
-    t = table[table["metric"] == "pyshoe_error_m"]
-    err = t.pivot_table(index="recording", columns="base", values="value", aggfunc="first")
-    err = err.reindex(columns=[c["name"] for c in cands])
     # rate check: PyShoe is all 200 Hz; a setting qualifies only if it also tracks the simulated
     # mixed-speed walk (0.85 to 3.2 m/s, Table II noise) at 100 and at 200 Hz within RATE_CHECK_M
     sim = Study.from_dict({"name": "select_recommended_rates", "base": cands, "metrics": ["armse_3d_m"],
@@ -235,14 +242,29 @@ def main(argv: list[str] | None = None) -> int:
                                            "label": f"mixed_speed_{r}hz"} for r in (100, 200)]})
     st = run_cached(sim, args.results / "select_recommended_rates", args.jobs)
     sim_err = st[st["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value")
-    worst_sim = sim_err.max().reindex(err.columns)
-    qualified = worst_sim[worst_sim <= RATE_CHECK_M].index
-    print(f"{len(qualified)} of {len(err.columns)} settings pass the rate check")
-    err3 = table[table["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value",
-                                                              aggfunc="first")
-    err_all, err = err, err[qualified]
-    best = pyshoe_reference(folder)["best_error_m"].reindex(err.index)
-    folds, held_out, final = cross_validate(err, best)
+    worst_sim = sim_err.max().reindex([c["name"] for c in cands])
+    qualified = set(worst_sim[worst_sim <= RATE_CHECK_M].index)
+    print(f"{len(qualified)} of {len(cands)} settings pass the rate check")
+    # the selection: footzoo.tune, leave-one-motion-class-out, among the settings that pass the rate check
+    study = Study.from_dict({"name": "select_recommended", "base": cands,
+                             "recordings": [{"path": str(folder / "*.mat"), "format": "pyshoe"}],
+                             "max_cells": len(cands) * 40})
+    best = pyshoe_reference(folder)["best_error_m"]
+    result = tune(study, {"objective": "pyshoe_error_m"}, score=class_score(best), eligible=qualified.__contains__,
+                  groups=motion_class, jobs=args.jobs, out=args.results / "select_recommended", quiet=True)
+    err_all = result.values_
+    err = err_all[[c for c in err_all.columns if c in qualified]]
+    best = best.reindex(err.index)
+    final, held_out = result.best_, result.held_out_.reindex(err.index)
+    folds = _fold_table(result.folds_, err, held_out, best)
+    err3 = None
+    if args.refine:  # the refinement's report shows the 3-D error too: the same runs, read from the cache
+        study3 = Study.from_dict({"name": "select_recommended_3d", "base": cands,
+                                  "recordings": [{"path": str(folder / "*.mat"), "format": "pyshoe"}],
+                                  "metrics": ["armse_3d_m"], "max_cells": len(cands) * 40})
+        t3 = run_cached(study3, args.results / "select_recommended_3d", args.jobs)
+        err3 = t3[t3["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value",
+                                                          aggfunc="first")
     classes = pd.Series([motion_class(x) for x in err.index], index=err.index)
     cv = {"median ratio": float((held_out / best).median()),
           **{f"{c} median (m)": float(held_out[classes == c].median()) for c in CLASS_ORDER if (classes == c).any()},

@@ -1,6 +1,18 @@
 """Speed-up of an ablation study from two local workers (joblib) and from a local Dask cluster.
 
 Usage: python benchmarks/study_scaling.py [--repeat 2] [--strides 0] [--no-report]
+       python benchmarks/study_scaling.py --scale [--settings 50] [--recordings 40]
+
+``--scale``: a study of ``settings`` x ``recordings`` cells (default 50 x 40 = 2 000: the
+recommended config with 10 detector thresholds x 5 velocity noises, or ``--base yun2012`` with 10
+thresholds x 5 complementary-filter gains, on simulated straight walks of 30 strides at 100 Hz,
+about 32 s each, seeds 0..39), run serially and on a Dask LocalCluster (2 processes), each from an empty
+output folder without the figures (``report=False``; the runs and the cache only). It prints the
+main process's peak memory growth, and footzoo's overhead per cell: the wall time of the serial
+study minus the time of the pipeline runs themselves (``run_s`` in each cache entry), of the
+metrics (``metrics_s``) and of loading or simulating the recordings, as a share of the pipeline
+runs' time (cache lookups, keys, validation, bookkeeping and writing the entries). That share is
+the figure the study runner must keep under 20 %; the metrics' cost is printed apart.
 
 The study: 4 configs (angular-rate FSM or SHOE detector x ZVU dedrift or ZUPT, on yun2012.yaml)
 x 8 simulated recordings (the hallway rectangle at 100 Hz, physical foot model, seeds 0-7), with
@@ -50,7 +62,7 @@ def study(strides: int) -> Study:
         "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
                     "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
         "recordings": [{"simulate": sim, "seeds": list(range(8))}],
-        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "steps"],
+        "metrics": ["loop_closure_xy_m", "armse_3d_m", "gait_phase_error_rate", "stance_f1", "strides"],
         "sweep": {"points": 25},
     })
 
@@ -76,13 +88,100 @@ def machine_check(n: int = 3_000_000, tasks: int = 8) -> float:
     return serial / (time.perf_counter() - t0)
 
 
+def scale_study(settings: int, recordings: int, strides: int = 30, base: str = "recommended") -> Study:
+    """``settings`` configs x ``recordings`` simulated walks: for ``recommended`` (a Kalman filter with
+    RTS smoothing) detector thresholds x velocity noises, for ``yun2012`` (a complementary filter,
+    footzoo's cheapest pipeline) detector thresholds x filter gains."""
+    if base == "yun2012":
+        second = ("orientation.static_gain", [0.5, 0.75, 1.05, 1.3, 1.6])
+        thresholds = [round(0.3 + 0.1 * k, 2) for k in range(max(1, settings // 5))]
+        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012",
+               "calibration": []}
+    else:
+        second = ("navigation.velocity_noise", [0.003, 0.01, 0.03, 0.1, 0.3])
+        thresholds = [round(1000.0 + 500.0 * k, 1) for k in range(max(1, settings // 5))]
+        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml"), "name": "recommended"}
+    return Study.from_dict({
+        "name": "scale",
+        "base": cfg,
+        "factors": {"detector.threshold": thresholds, second[0]: second[1][: max(1, min(5, settings))]},
+        "recordings": [{"simulate": {"path": "straight", "n_strides": strides, "rate": 100, "noise": {"scale": 1}},
+                        "seeds": list(range(recordings))}],
+        "max_cells": 100_000,
+    })
+
+
+def _peak_rss_mb() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def scale(settings: int, recordings: int, base: str = "recommended") -> None:
+    """The large-study figures: peak memory, overhead per cell, serial and on a Dask LocalCluster."""
+    import json
+
+    from dask.distributed import LocalCluster
+
+    s = scale_study(settings, recordings, base=base)
+    n = s.size
+    print(f"{n} cells ({n // recordings} settings of {base} x {recordings} recordings), {os.cpu_count()} cores, "
+          f"load average {os.getloadavg()[0]:.1f} at start", flush=True)
+    run_study(scale_study(2, 1, 4, base), quiet=True)  # imports and compiled kernels, untimed
+    tmp = Path(tempfile.mkdtemp(prefix="footzoo_scale_"))
+    try:
+        rss0 = _peak_rss_mb()
+        t0, c0 = time.perf_counter(), time.process_time()
+        serial = run_study(s, out=tmp / "serial", report=False, quiet=True)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        rss1 = _peak_rss_mb()
+        entries = [json.loads(f.read_bytes().partition(b"\n")[2]) for f in (tmp / "serial" / "cache").glob("*.json")]
+        t1, c1 = time.perf_counter(), time.process_time()
+        for rec in s.recordings:  # what loading (simulating) the recordings costs, once each
+            rec.load()
+        load = {"wall": time.perf_counter() - t1, "CPU": time.process_time() - c1}
+        print(f"serial: {wall:.1f} s wall, {cpu:.1f} s CPU for {n} cells", flush=True)
+        for clock, total, suffix in (("wall", wall, ""), ("CPU", cpu, "_cpu")):
+            run_s = sum(e.get(f"run{suffix}_s", 0.0) for e in entries)
+            metrics_s = sum(e.get(f"metrics{suffix}_s", 0.0) for e in entries)
+            overhead = total - run_s - metrics_s - load[clock]
+            print(f"  {clock:4s}: pipeline runs {run_s:.1f} s, metrics {metrics_s:.1f} s "
+                  f"({100 * metrics_s / run_s:.0f} % of the runs), recordings {load[clock]:.1f} s; footzoo's "
+                  f"overhead {overhead:.1f} s = {1e3 * overhead / n:.2f} ms per cell = "
+                  f"{100 * overhead / run_s:.1f} % of the pipeline runs", flush=True)
+        print(f"  peak memory of the main process grew by {rss1 - rss0:.0f} MB (peak {rss1:.0f} MB); "
+              f"cache {sum(f.stat().st_size for f in (tmp / 'serial' / 'cache').glob('*.json')) / 1e6:.0f} MB "
+              f"on disk; {serial.attrs['failed']} failed", flush=True)
+        t0 = time.perf_counter()
+        again = run_study(s, out=tmp / "serial", report=False, quiet=True)
+        print(f"  rerun from the cache: {time.perf_counter() - t0:.1f} s ({again.attrs['cached']} cached)", flush=True)
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                          silence_logs=logging.CRITICAL) as cluster:
+            run_study(scale_study(2, 1, 4, base), scheduler=cluster.scheduler_address, quiet=True)  # warm
+            t0 = time.perf_counter()
+            dask = run_study(s, scheduler=cluster.scheduler_address, out=tmp / "dask", report=False, quiet=True)
+            print(f"dask LocalCluster (2 processes): {time.perf_counter() - t0:.1f} s wall; peak memory of the "
+                  f"main process {_peak_rss_mb():.0f} MB; same table as serial: {dask.equals(serial)}", flush=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print(f"load average {os.getloadavg()[0]:.1f} at the end")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=2, help="interleaved repetitions per back end")
     ap.add_argument("--strides", type=int, default=0, help="a straight walk of this many strides instead of "
                                                            "the rectangle (0: rectangle)")
     ap.add_argument("--no-report", action="store_true", help="no output folder: runs only")
+    ap.add_argument("--scale", action="store_true", help="the large study: memory and overhead per cell")
+    ap.add_argument("--settings", type=int, default=50, help="--scale: settings (default 50)")
+    ap.add_argument("--recordings", type=int, default=40, help="--scale: recordings (default 40)")
+    ap.add_argument("--base", choices=["recommended", "yun2012"], default="recommended",
+                    help="--scale: the pipeline (default recommended; yun2012 is footzoo's cheapest)")
     args = ap.parse_args()
+    if args.scale:
+        scale(args.settings, args.recordings, args.base)
+        return
     from dask.distributed import LocalCluster
 
     from footzoo.studies import report

@@ -51,6 +51,8 @@ _EXPORTS = {
     "load": "io",
     "register": "plugins.registry",
     "check_plugin": "apps.testing",
+    "run_study": "studies.runner",
+    "tune": "studies.tune",
 }
 
 __all__ = [
@@ -71,6 +73,8 @@ __all__ = [
     "check_plugin",
     "load",
     "register",
+    "run_study",
+    "tune",
     "__version__",
 ]
 

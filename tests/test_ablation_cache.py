@@ -163,7 +163,7 @@ def test_a_one_off_run_cell_checks_the_cache_too(tmp_path):
 
 def test_unknown_metric_names_and_bad_job_counts_are_config_errors(tmp_path, capsys):
     with pytest.raises(ConfigError, match=r"unknown metric 'armse_3d' \(did you mean 'armse_3d_m'\?\); "
-                                          r"valid metrics: \['path_length_m'"):
+                                          r"valid metrics: \['duration_s', 'path_length_m'"):
         Study.from_dict({**SMALL, "metrics": ["steps", "armse_3d"]})
     with pytest.raises(ConfigError, match=r"jobs must be a number of worker processes .* got 0"):
         run_study(Study.from_dict(SMALL), jobs=0)
@@ -179,7 +179,8 @@ def test_unknown_metric_names_and_bad_job_counts_are_config_errors(tmp_path, cap
 
 def test_trajectories_are_stored_apart_from_the_table(tmp_path):
     table = run_study(Study.from_dict(SMALL), out=tmp_path)
-    assert set(table.attrs) == {"computed", "cached", "failed", "recomputed", "retried"}
+    assert set(table.attrs) == {"computed", "cached", "failed", "recomputed", "retried", "causes", "refused",
+                                "pruned"}
     traj = read_trajectories(tmp_path)
     assert set(traj["run"]) == set(table["run"])
     # checked against a pipeline run outside the study: the stored points are its positions every 0.1 s

@@ -55,7 +55,7 @@ def study_dict(plugin_spec, name):
         "factors": {"detector.type": ["angular_rate_fsm", name]},
         "recordings": [{"simulate": {"path": "straight", "n_strides": 4, "rate": 50, "noise": {"scale": 1}},
                         "seeds": [0, 1]}],
-        "metrics": ["path_length_m", "armse_3d_m", "steps", "stance_f1"],
+        "metrics": ["path_length_m", "armse_3d_m", "strides", "stance_f1"],
     }
 
 
@@ -208,7 +208,10 @@ def test_editing_the_plugin_reruns_its_cells_only(tmp_path):
     first = run_study(Study.from_dict(d, root=tmp_path), out=out, jobs=2)
     write_plugin(tmp_path, threshold=0.01)  # the edited plug-in file: a threshold below the gyro noise
     second = run_study(Study.from_dict(d, root=tmp_path), out=out, jobs=2)
-    assert first.attrs["computed"] == 4 and second.attrs["computed"] == 4 and second.attrs["cached"] == 0
+    # only the cells whose config uses the edited plug-in run again; the built-in detector's stay cached
+    assert first.attrs["computed"] == 4 and second.attrs["computed"] == 2 and second.attrs["cached"] == 2
+    rerun = set(second.loc[second["run"].isin(set(second["run"]) - set(first["run"])), "detector.type"])
+    assert rerun == {det_name(tmp_path)}
     values = by_detector(second)
     assert not np.array_equal(values["mine"], values["builtin"])  # the edit took effect
     third = run_study(Study.from_dict(d, root=tmp_path), out=out)

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import data_file
+from .conftest import DATA, data_file
 
 ROOT = Path(__file__).resolve().parents[1]
 NO_RUN = "<!-- docs: no-run -->"
@@ -71,6 +71,8 @@ def test_code_blocks_run(path, tmp_path):
             for f in data_file("gaitmap_example", "imu_sample.csv").parent.iterdir():
                 if f.is_file():
                     shutil.copy(f, tmp_path / f.name)
+    if "pyshoe_vicon" in "".join(code for _, code, _ in blocks):  # a tutorial on PyShoe's trials
+        data_file("pyshoe_vicon")
     files = []
     for line, code, _ in blocks:  # real files: numba's cache and tracebacks need them
         f = tmp_path / f"{path.stem}_block_at_line_{line}.py"
@@ -79,7 +81,7 @@ def test_code_blocks_run(path, tmp_path):
     (tmp_path / "blocks.json").write_text(json.dumps(files))
     (tmp_path / "blocks.py").write_text(RUNNER)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
-           "MPLBACKEND": "Agg"}
+           "MPLBACKEND": "Agg", "FOOTZOO_DATA": str(DATA)}
     run = subprocess.run([sys.executable, "blocks.py"], cwd=tmp_path, env=env, capture_output=True, text=True,
                          timeout=600)
     assert run.returncode == 0, (

@@ -129,3 +129,38 @@ def calibrate_foot_vector(
     f = np.cross(k, g)
     f = f / np.linalg.norm(f)
     return FootVector(f, g, k, tuple(still), tuple(flex))
+
+
+#: What makes a recording a calibration trial (Huang et al. 2016, Sec. III: stand still, slow flexions
+#: about the ankle, stand): the flexions' peak angular rate (rad/s), the 95th percentile of the specific
+#: force's departure from gravity during them (m/s², the ankle stays put), and the share of the angular
+#: rate's energy about one axis (a flexion turns about the ankle's axis only).
+CALIBRATION_TRIAL = {"max_flex_rate": 3.0, "max_acc_departure": 2.5, "min_axis_share": 0.9}
+
+
+def calibration_trial_problems(rec: Recording, fv: FootVector, gravity: float = 9.81) -> list[str]:
+    """Why ``rec`` is not a calibration trial (empty when it is one), judged on the periods ``fv`` used.
+
+    A walk has a still start too, but its "flexion period" holds swings: angular rates of 5–10 rad/s
+    and heel strikes far from 1 g; the rules are in :data:`CALIBRATION_TRIAL`.
+    """
+    t = rec.t
+    wf = (t >= fv.flex[0]) & (t <= fv.flex[1])
+    w, a = rec.gyr[wf], rec.acc[wf]
+    out = []
+    peak = float(np.max(np.linalg.norm(w, axis=1)))
+    if peak > CALIBRATION_TRIAL["max_flex_rate"]:
+        out.append(f"the foot turns at up to {peak:.1f} rad/s in the flexion period "
+                   f"{fv.flex[0]:.2f}-{fv.flex[1]:.2f} s;"
+                   f" slow flexions stay below {CALIBRATION_TRIAL['max_flex_rate']:g} rad/s")
+    departure = float(np.percentile(np.abs(np.linalg.norm(a, axis=1) - gravity), 95))
+    if departure > CALIBRATION_TRIAL["max_acc_departure"]:
+        out.append(f"the specific force departs from gravity by {departure:.1f} m/s² (95th percentile) in the flexion "
+                   f"period: the foot moves (walks?) instead of pivoting about the ankle "
+                   f"(at most {CALIBRATION_TRIAL['max_acc_departure']:g} m/s²)")
+    eig = np.linalg.eigvalsh(w.T @ w)
+    share = float(eig[-1] / eig.sum()) if eig.sum() > 0 else 0.0
+    if share < CALIBRATION_TRIAL["min_axis_share"]:
+        out.append(f"only {share:.0%} of the rotation is about one axis; flexions turn about the ankle's axis "
+                   f"(at least {CALIBRATION_TRIAL['min_axis_share']:.0%})")
+    return out

@@ -1,4 +1,4 @@
-"""Command line: ``footzoo run | simulate | calibrate | ablate | list | validate | formats``.
+"""Command line: ``footzoo run | simulate | calibrate | ablate (study) | tune | list | validate | formats``.
 
 Bad input never prints a Python traceback: the message names the input, the
 problem and the fix, and the exit code says which kind of problem it was
@@ -357,7 +357,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """Foot vector from a calibration recording (Huang et al. 2016, eq. 11), saved as YAML."""
     import numpy as np
 
-    from ..analysis.foot_vector import calibrate_foot_vector
+    from ..analysis.foot_vector import calibrate_foot_vector, calibration_trial_problems
     from ..core.atomic import atomic_path, refuse_inputs
 
     target = _writable_file(args.out)
@@ -365,6 +365,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     refuse_inputs([target], _inputs(args, rec), "--out")
     fv = calibrate_foot_vector(rec, still=tuple(args.still) if args.still else None,
                                flex=tuple(args.flex) if args.flex else None)
+    problems = calibration_trial_problems(rec, fv)
+    if problems:
+        raise RecordingError(f"{rec.name} is not a calibration trial (stand still, then slow dorsi-/plantar-flexions "
+                             "about the ankle, e.g. footzoo simulate calibration): " + "; ".join(problems)
+                             + ". Record one, or give its periods with --still T0 T1 --flex T0 T1")
     with atomic_path(target, inputs=_inputs(args, rec), what="--out") as tmp:
         fv.save(tmp)
     yaw = np.degrees(np.arctan2(-fv.vector[1], fv.vector[0]))
@@ -381,20 +386,64 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     from ..studies.report import summarise, to_markdown
 
     out = args.out or f"ablation_{Path(args.study).stem}"
-    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
+    if args.quiet:
+        warnings.simplefilter("ignore")
+    prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
+             "max_bytes": None if args.cache_max_size is None else int(args.cache_max_size * 1e6)}
+    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
+                      max_cells=args.max_cells, quiet=args.quiet, prune=prune)
     a = table.attrs
     notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
              if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
+    if a.get("pruned", {}).get("removed"):
+        notes.append(f"{a['pruned']['removed']} old cache entries removed")
     notes = "".join(f", {n}" for n in notes if n)
     print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
           f"{a['failed']} failed{notes}); results in {out}/")
-    factors = [c for c in table.columns if c not in ("run", "base", "recording", "metric", "value", "error")]
+    total = a["computed"] + a["cached"]
+    if a["causes"]:
+        print(f"{'every' if a['failed'] == total else a['failed']} run{'' if a['failed'] == 1 else 's'} failed; "
+              "the distinct causes:", file=sys.stderr)
+        for cause, n in list(a["causes"].items())[:5]:
+            print(f"  - {cause} ({n} run{'' if n == 1 else 's'})", file=sys.stderr)
+    if total and a["failed"] == total:
+        return _failed_exit_code(a["causes"])
+    factors = [c for c in table.columns
+               if c not in ("run", "base", "recording", "metric", "value", "error", "note")]
     for f in factors[:3]:
         s = summarise(table, f)
         keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
     return 0
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    """Choose a setting by leave-one-group-out cross-validation; write it as a config YAML."""
+    from ..studies.report import to_markdown
+    from ..studies.tune import load_tune_file, tune
+
+    study, spec = load_tune_file(args.study)
+    out = _writable_dir(args.out or f"tune_{Path(args.study).stem}")
+    if args.config:
+        spec.config = str(_writable_file(args.config, "--config"))
+    if args.quiet:
+        warnings.simplefilter("ignore")
+    result = tune(study, spec, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
+                  quiet=args.quiet)
+    print(f"{len(result.settings_)} settings x {len(result.values_)} recordings in {result.groups_.nunique()} "
+          f"groups; objective {spec.objective} ({spec.aggregate}, {spec.direction})")
+    print("leave-one-group-out (each group scored by the setting chosen without it):")
+    print(to_markdown(result.folds_), end="")
+    print(f"chosen on every group: {result.best_}")
+    print(f"wrote {spec.config or out / 'best.yaml'} (footzoo run it), {out}/tune_folds.csv, {out}/tune_scores.csv")
+    return EXIT_OK
+
+
+def _failed_exit_code(causes: dict[str, int]) -> int:
+    """The exit code of a study whose every run failed: data error when a recording is at fault, else usage."""
+    kinds = {c.partition(":")[0] for c in causes}
+    return EXIT_DATA if kinds & {"RecordingError", "FormatError", "OutputError"} else EXIT_USAGE
 
 
 def cmd_formats(args: argparse.Namespace) -> int:
@@ -534,14 +583,36 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--out", required=True, type=_output, help="YAML file to write (never over the recording)")
     cal.set_defaults(func=cmd_calibrate)
 
-    abl = sub.add_parser("ablate", help="run an ablation study (configs x recordings) and write tables and plots")
+    abl = sub.add_parser("ablate", aliases=["study"],
+                         help="run an ablation study (configs x recordings) and write tables and plots")
     abl.add_argument("study", help="study YAML, e.g. study_quick")
-    abl.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib); -1 = all cores")
+    abl.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores (default: the "
+                     "study's jobs, else 1)")
+    abl.add_argument("--max-cells", type=_number(1, 1e15, integer=True), metavar="N",
+                     help="allow a grid of up to N runs (default: the study's max_cells, else 10000)")
     abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
-    abl.add_argument("--quiet", action="store_true", help="no progress bar")
+    abl.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
+    abl.add_argument("--prune-cache", action="store_true",
+                     help="remove every cache entry this study did not use (other studies' runs in the same --out)")
+    abl.add_argument("--cache-max-age", type=_number(0, 1e6, "days"), default=30.0, metavar="DAYS",
+                     help="remove cache entries no study used for DAYS days (default 30)")
+    abl.add_argument("--cache-max-size", type=_number(0, 1e12, "MB"), metavar="MB",
+                     help="then remove the least recently used entries until the cache is at most MB megabytes")
     abl.set_defaults(func=cmd_ablate)
+
+    tun = sub.add_parser("tune", help="choose a setting by leave-one-group-out cross-validation (a study file "
+                         "with a tune: block) and write it as a config")
+    tun.add_argument("study", help="tune YAML: a study file with a tune: block (objective, search, group_by)")
+    tun.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores")
+    tun.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    tun.add_argument("--out", type=_output, help="output folder (default: tune_<file>): cache/, tune_folds.csv, "
+                     "tune_scores.csv, best.yaml")
+    tun.add_argument("--config", type=_output, help="write the chosen config here (default: the tune block's "
+                     "config, else OUT/best.yaml)")
+    tun.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
+    tun.set_defaults(func=cmd_tune)
 
     lst = sub.add_parser("list", help="list plug-ins with their parameters (default, unit, accepted range, meaning, "
                          "source) and papers, and the config's settings blocks")

@@ -196,8 +196,10 @@ def reference_steps(steps: pd.DataFrame) -> pd.DataFrame:
     initial contact, ``stride_length``, ``heading``, ``fpa``) is renamed and given
     ``start_s``, the previous stride's initial contact (NaN for the first).
     """
-    out = steps.rename(columns={k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns
-                                and v not in steps.columns})
+    renames = {k: v for k, v in _LEGACY_STEP_NAMES.items() if k in steps.columns and v not in steps.columns}
+    if not renames and "swing_end" not in steps.columns:
+        return steps  # footzoo's names already: nothing to copy
+    out = steps.rename(columns=renames)
     if "swing_end" in steps.columns:  # simulator table: its own start/end are heel-off and foot-flat
         out = out.drop(columns=[c for c in ("start", "end") if c in out.columns])
         ic = out["end_s"].to_numpy(dtype=float)
@@ -421,6 +423,109 @@ def stride_path_errors(t: np.ndarray, pos: np.ndarray, stride_positions: pd.Data
     return {"stride_path_rms_error_median_m": float(np.median(rms)), "stride_paths": float(len(rms))}
 
 
+#: The per-stride columns of a stride table that every run summarises by their median (``median_<column>``).
+STRIDE_QUANTITIES = ("stride_time_s", "cadence_steps_min", "stride_length_m", "stance_time_s", "swing_time_s",
+                     "speed_m_s", "max_clearance_m")
+
+
+def stance_metrics(t: np.ndarray, stance: np.ndarray, truth_stance: np.ndarray) -> dict[str, float]:
+    """A stance mask against a reference stance mask: per sample and per step (:func:`step_detection`).
+
+    Returns ``stance_precision``, ``stance_recall``, ``stance_f1``, ``stance_accuracy``,
+    ``gait_phase_error_rate``, ``step_count_error`` (detected minus reference stance phases) and
+    ``stance_onset_error_mean_s`` / ``stance_offset_error_mean_s`` (detected minus reference, s, over
+    the correctly detected phases).
+    """
+    out = {f"stance_{k}": v for k, v in stance_scores(stance, truth_stance).items()}
+    sd = step_detection(stance, truth_stance, t)
+    out["gait_phase_error_rate"] = float(sd["error_rate"])
+    out["step_count_error"] = float(sd["step_count_error"])
+    out["stance_onset_error_mean_s"] = float(sd["onset_error_mean_s"])
+    out["stance_offset_error_mean_s"] = float(sd["offset_error_mean_s"])
+    return out
+
+
+def run_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, stance: np.ndarray | None = None,
+                reference=None) -> dict[str, float]:
+    """Every metric of one run: :func:`result_metrics` (what ``footzoo run`` prints) and, with a reference
+    stance mask, :func:`stance_metrics`. A study's metrics are these, by the same names (:data:`METRICS`)."""
+    out = result_metrics(t, pos, steps, reference)
+    if stance is not None and reference is not None and reference.stance is not None:
+        out.update(stance_metrics(t, stance, reference.stance))
+    return out
+
+
+#: Every metric a run can report, with its meaning: the keys of :func:`run_metrics`, of
+#: :attr:`footzoo.core.data.Result.metrics` (all but the stance ones) and of a study's table.
+METRICS: dict[str, str] = {
+    "duration_s": "duration of the recording (s)",
+    "path_length_m": "horizontal path length (m)",
+    "loop_closure_xy_m": "horizontal end-to-start distance of a closed walk (m)",
+    "loop_closure_3d_m": "3-D end-to-start distance of a closed walk (m)",
+    "loop_closure_xy_pct": "horizontal end-to-start distance, % of the path length",
+    "loop_closure_3d_pct": "3-D end-to-start distance, % of the path length",
+    "armse_3d_m": "RMS position error after yaw alignment, against the reference (m)",
+    "pyshoe_error_m": "PyShoe's position error against the reference (m)",
+    "strides": "number of detected strides",
+    **{f"median_{c}": f"median over the strides of {c}" for c in STRIDE_QUANTITIES},
+    "fpa_mean_deg": "mean foot progression angle (deg)",
+    "median_fpa_deg": "median foot progression angle (deg)",
+    "stride_count_ref": "strides counted by hand in the reference",
+    "stride_count_error": "detected minus hand-counted strides",
+    "ref_strides": "strides of the reference stride table",
+    "matched_strides": "reference strides paired with an estimated stride",
+    "ic_error_median_abs_s": "median absolute initial-contact timing error (s)",
+    "ic_error_mean_s": "mean initial-contact timing error, estimate minus reference (s)",
+    "to_error_median_abs_s": "median absolute toe-off timing error (s)",
+    "to_error_mean_s": "mean toe-off timing error, estimate minus reference (s)",
+    "stride_time_error_median_abs_s": "median absolute stride-time error (s)",
+    "stride_length_rms_error_m": "stride-length RMS error over the matched strides (m)",
+    "stride_length_mean_error_m": "stride-length mean error over the matched strides (m)",
+    "stride_length_rms_error_straight_m": "stride-length RMS error over the straight matched strides (m)",
+    "stride_length_mean_error_straight_m": "stride-length mean error over the straight matched strides (m)",
+    "fpa_mean_error_deg": "FPA mean error over the straight matched strides (deg)",
+    "fpa_rms_error_deg": "FPA RMS error over the straight matched strides (deg)",
+    "footprints_ref": "measured footprints",
+    "footprints_est": "estimated footprints",
+    "footprint_error_mean_m": "mean footprint error after a 2-D rigid alignment (m)",
+    "footprint_error_rms_m": "RMS footprint error after a 2-D rigid alignment (m)",
+    "footprint_error_end_m": "last footprint's error after a 2-D rigid alignment (m)",
+    "stride_path_rms_error_median_m": "median per-stride 3-D path RMS error after a yaw alignment (m)",
+    "stride_paths": "reference strides with a per-stride trajectory",
+    "stance_precision": "per-sample stance precision against the reference stance",
+    "stance_recall": "per-sample stance recall against the reference stance",
+    "stance_f1": "per-sample stance F1 against the reference stance",
+    "stance_accuracy": "per-sample stance accuracy against the reference stance",
+    "gait_phase_error_rate": "wrong or missed stance phases per reference stance phase",
+    "step_count_error": "detected minus reference stance phases",
+    "stance_onset_error_mean_s": "mean stance-onset (initial contact) error against the reference stance (s)",
+    "stance_offset_error_mean_s": "mean stance-offset (toe-off) error against the reference stance (s)",
+}
+
+#: Old metric names -> their names now (accepted with a DeprecationWarning).
+METRIC_ALIASES: dict[str, str] = {"steps": "strides"}
+
+
+def metric_name(name: str) -> str:
+    """The current name of a metric: ``name`` itself, or the new name of a deprecated alias (with a warning).
+
+    Raises
+    ------
+    KeyError
+        For a name that is neither a metric nor an alias.
+    """
+    if name in METRICS:
+        return name
+    if name in METRIC_ALIASES:
+        import warnings
+
+        new = METRIC_ALIASES[name]
+        warnings.warn(f"metric {name!r} is now called {new!r} (as in footzoo run and Result.metrics); "
+                      f"use {new!r}: the old name will go", DeprecationWarning, stacklevel=3)
+        return new
+    raise KeyError(name)
+
+
 def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, reference=None) -> dict[str, float]:
     """The numbers ``footzoo run`` prints: a summary of the run and its errors against the reference.
 
@@ -445,11 +550,17 @@ def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, referenc
     out: dict[str, float] = {"duration_s": float(t[-1] - t[0])}
     out.update(trajectory_metrics(pos, ref.pos if ref is not None else None, closed))
     out["strides"] = float(len(steps))
-    for col in ("stride_time_s", "cadence_steps_min", "stride_length_m", "stance_time_s", "swing_time_s"):
+    for col in STRIDE_QUANTITIES:
         if col in steps.columns:
             v = steps[col].to_numpy(dtype=float)
             v = v[np.isfinite(v)]
             out[f"median_{col}"] = float(np.median(v)) if v.size else float("nan")
+    if "fpa_rad" in steps.columns:
+        fpa = steps["fpa_rad"].to_numpy(dtype=float)
+        fpa = fpa[np.isfinite(fpa)]
+        if fpa.size:
+            out["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
+            out["median_fpa_deg"] = float(np.degrees(np.median(fpa)))
     if ref is None:
         return out
     if ref.stride_count is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import shutil
@@ -94,7 +95,7 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
         for metric in sorted(ok["metric"].unique()):
             tasks.append(("metric", ok[ok["metric"] == metric], f, metric))
     detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
-    sweeps = [{k: r[k] for k in ("key", "recording", "roc") if k in r} for r in runs]
+    sweeps = [{k: r[k] for k in ("key", "recording", "roc", "entry") if k in r} for r in runs]
     tasks.append(("roc", sweeps, run_labels(runs, factors, only=detector_factors or None)))
     return tasks
 
@@ -112,6 +113,7 @@ def _largest_first(tasks: list[tuple]) -> list[tuple]:
 def _figure(task: tuple) -> tuple[Any, str]:
     """The figure of one task of :func:`figure_tasks` (None: nothing to draw) and its file name."""
     kind = task[0]
+    task = loaded(task)
     if kind == "trajectories":
         _, runs, labels, rec = task
         return trajectories_figure(runs, labels, rec), f"trajectories_{_safe(rec)}.png"
@@ -120,6 +122,18 @@ def _figure(task: tuple) -> tuple[Any, str]:
         return metric_figure(rows, factor, metric), f"metric_{_safe(metric)}_by_{_safe(factor)}.png"
     _, runs, labels = task
     return roc_figure(runs, labels), "roc.png"
+
+
+def loaded(task: tuple) -> tuple:
+    """A figure task with its runs' trajectories or sweeps read back from the cache (a study keeps them
+    on disk, :func:`footzoo.studies.runner.light`); a task that has them is returned as it is."""
+    from .runner import with_heavy
+
+    if task[0] == "trajectories":
+        return (task[0], with_heavy(task[1], ("trajectory", "reference")), *task[2:])
+    if task[0] == "roc":
+        return (task[0], with_heavy(task[1], ("roc",)), *task[2:])
+    return task
 
 
 def draw_figure(task: tuple, out: Path) -> Path | None:
@@ -154,12 +168,19 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
 
         connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
         with connected as client:  # the workers draw while this process writes the tables
-            futures = client.map(render_figure, _largest_first(figure_tasks(table, runs, factors)), pure=False)
+            # the workers may not see the cache: each task is sent with its runs' trajectories, a few at a time
+            tasks = iter(_largest_first(figure_tasks(table, runs, factors)))
+            window = max(2, 2 * len(client.scheduler_info().get("workers", {})))
+            pending = as_completed([client.submit(render_figure, loaded(t), pure=False)
+                                    for t in itertools.islice(tasks, window)])
             _write_tables(table, runs, factors, out, step)
-            for fut in as_completed(futures):
+            for fut in pending:
                 drawn = fut.result()
                 if drawn is not None:
                     (out / drawn[0]).write_bytes(drawn[1])
+                nxt = next(tasks, None)
+                if nxt is not None:
+                    pending.add(client.submit(render_figure, loaded(nxt), pure=False))
         step(1)
         return
     figures = None
@@ -183,9 +204,7 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     table.to_csv(out / "results.csv", index=False)
     _to_parquet(table, out / "results.parquet")
     step(1)
-    trajectories, roc = run_frames(runs)
-    _to_parquet(trajectories, out / "trajectories.parquet")
-    _to_parquet(roc, out / "roc.parquet")
+    _write_frames(runs, out)
     step(1)
     md, tex = [], []
     for f in ["base", *factors]:
@@ -200,6 +219,41 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     step(1)
 
 
+#: Runs whose trajectories are read back from the cache and written at a time (bounded memory).
+FRAME_BATCH = 200
+
+
+def _write_frames(runs: list[dict[str, Any]], out: Path) -> None:
+    """``trajectories.parquet`` and ``roc.parquet``, written :data:`FRAME_BATCH` runs at a time."""
+    from .runner import HEAVY, with_heavy
+
+    if len(runs) <= FRAME_BATCH:
+        trajectories, roc = run_frames(with_heavy(runs, HEAVY))
+        _to_parquet(trajectories, out / "trajectories.parquet")
+        _to_parquet(roc, out / "roc.parquet")
+        return
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        _to_parquet(pd.DataFrame(), out / "trajectories.parquet")  # the warning only
+        return
+    writers: dict[str, Any] = {}
+    try:
+        for k in range(0, len(runs), FRAME_BATCH):
+            frames = run_frames(with_heavy(runs[k:k + FRAME_BATCH], HEAVY))
+            for name, frame in zip(("trajectories", "roc"), frames, strict=True):
+                if len(frame) == 0 and (name in writers or k + FRAME_BATCH < len(runs)):
+                    continue
+                t = pa.Table.from_pandas(frame, preserve_index=False)
+                if name not in writers:
+                    writers[name] = pq.ParquetWriter(out / f"{name}.parquet", t.schema)
+                writers[name].write_table(t.cast(writers[name].schema))
+    finally:
+        for w in writers.values():
+            w.close()
+
+
 def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The runs' stored trajectories and threshold sweeps as two tidy tables, apart from the results table.
 
@@ -211,7 +265,7 @@ def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
         ``run``, ``recording``, ``threshold``, ``true_stance_rate``, ``false_stance_rate``.
     """
     def frame(field: str, cols: list[str]) -> pd.DataFrame:
-        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if r.get(field)]
+        parts = [(r["key"], r["recording"], np.asarray(r[field], float)) for r in runs if _has(r, field)]
         if not parts:
             return pd.DataFrame({c: pd.Series(dtype=float if i > 1 else object) for i, c in enumerate(cols)})
         values = np.concatenate([a for _, _, a in parts])
@@ -223,6 +277,12 @@ def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
 
     return (frame("trajectory", ["run", "recording", "t_s", "north_m", "east_m", "down_m"]),
             frame("roc", ["run", "recording", "threshold", "true_stance_rate", "false_stance_rate"]))
+
+
+def _has(record: dict[str, Any], field: str) -> bool:
+    """Whether a run record holds a non-empty ``field`` (a list, or an array read back from the cache)."""
+    value = record.get(field)
+    return value is not None and len(value) > 0
 
 
 def _to_parquet(df: pd.DataFrame, path: Path) -> None:
@@ -384,14 +444,14 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
     from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
     from ..evaluation.plots import REFERENCE_STYLE, pyplot, styled
 
-    runs = [r for r in runs if r.get("trajectory")]
+    runs = [r for r in runs if _has(r, "trajectory")]
     if not runs:
         return None
 
     @styled
     def build():
         plt = pyplot()
-        ref = next((np.asarray(r["reference"], float) for r in runs if r.get("reference")), None)
+        ref = next((np.asarray(r["reference"], float) for r in runs if _has(r, "reference")), None)
         if ref is not None:
             ref = ref[:, 1:4] - ref[0, 1:4]
         curves = []

@@ -18,6 +18,7 @@ How a study runs:
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import hashlib
 import json
@@ -38,7 +39,7 @@ import pandas as pd
 from .study import Cell, Study, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
-CACHE_FORMAT = "footzoo-ablation-cache/2"
+CACHE_FORMAT = "footzoo-ablation-cache/3"
 RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
 CHUNKS_PER_WORKER = 4  # aim for this many chunks per worker (load balance vs. loading a recording again)
 
@@ -50,25 +51,36 @@ class CacheWarning(UserWarning):
 # --------------------------------------------------------------------------- metrics of one run
 
 
-def _metrics(rec, res, metric_names: list[str] | None) -> dict[str, float]:
-    from ..evaluation.metrics import stance_scores, step_detection, trajectory_metrics
+_PROBLEMS: dict[int, tuple[Any, dict[str, str]]] = {}  # id(truth) -> (truth, its refused metrics), per process
 
-    truth = rec.truth
-    closed = bool(truth is not None and truth.closed_loop)
-    m = trajectory_metrics(res.pos, truth.pos if truth is not None else None, closed)
-    m["steps"] = float(len(res.steps))
-    if truth is not None and truth.stance is not None:
-        m.update({f"stance_{k}": v for k, v in stance_scores(res.stance, truth.stance).items()})
-        sd = step_detection(res.stance, truth.stance, rec.t)
-        m["gait_phase_error_rate"] = sd["error_rate"]
-        m["step_count_error"] = float(sd["step_count_error"])
-    if "fpa_rad" in res.steps:
-        fpa = res.steps["fpa_rad"].dropna()
-        if len(fpa):
-            m["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
+
+def _reference_problems(rec) -> dict[str, str]:
+    """:func:`footzoo.evaluation.validity.reference_problems` of a recording, once per recording and process."""
+    from ..evaluation.validity import reference_problems
+
+    with _RECORDINGS_LOCK:
+        known = _PROBLEMS.get(id(rec.truth))
+    if known is not None and known[0] is rec.truth:
+        return known[1]
+    problems = reference_problems(rec.t, rec.truth)
+    with _RECORDINGS_LOCK:
+        if len(_PROBLEMS) > 4 * RECORDINGS_PER_PROCESS:
+            _PROBLEMS.clear()
+        _PROBLEMS[id(rec.truth)] = (rec.truth, problems)
+    return problems
+
+
+def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
+    """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
+    from ..evaluation.metrics import run_metrics
+    from ..evaluation.validity import checked_metrics
+
+    m = run_metrics(rec.t, pos, res.steps, res.stance, rec.truth)
+    m, notes = checked_metrics(m, _reference_problems(rec), rec.truth)
     if metric_names:
         m = {k: v for k, v in m.items() if k in metric_names}
-    return {k: float(v) for k, v in m.items()}
+        notes = {k: v for k, v in notes.items() if k in metric_names}
+    return {k: float(v) for k, v in m.items()}, notes
 
 
 def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
@@ -96,12 +108,26 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
 
 def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:
     """Write one cache entry atomically: a header line (format, key, checksum, size) then the JSON record."""
-    payload = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
+    payload = json.dumps(record, sort_keys=True, separators=(",", ":"), default=_pack).encode()
     header = {"format": CACHE_FORMAT, "key": key, "sha256": hashlib.sha256(payload).hexdigest(),
               "bytes": len(payload)}
     tmp = path.with_suffix(f".{os.getpid()}.{time.monotonic_ns()}.tmp")
     tmp.write_bytes(json.dumps(header).encode() + b"\n" + payload)
     tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
+
+
+def _pack(value: Any) -> Any:
+    """JSON for an array of a run record (a trajectory): its float64 bytes in base64, exact and fast."""
+    if isinstance(value, np.ndarray):
+        a = np.ascontiguousarray(value, dtype="<f8")
+        return {"__array__": base64.b64encode(a.tobytes()).decode(), "shape": list(a.shape)}
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def _unpack(d: dict[str, Any]) -> Any:
+    if "__array__" in d and "shape" in d and len(d) == 2:
+        return np.frombuffer(base64.b64decode(d["__array__"]), dtype="<f8").reshape(d["shape"])
+    return d
 
 
 def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]:
@@ -124,12 +150,100 @@ def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]
     if hashlib.sha256(payload).hexdigest() != header.get("sha256"):
         return None, "checksum mismatch (edited or damaged)"
     try:
-        record = json.loads(payload)
+        record = json.loads(payload, object_hook=_unpack)
     except ValueError:
         return None, "checksum matches but the content is not JSON"
     if not isinstance(record, dict) or record.get("key") != key:
         return None, "checksum matches but the record is not this cell's"
     return record, None
+
+
+#: Cache entries no study used for this many days are removed after a study (``run_study(prune=...)``).
+CACHE_MAX_AGE_DAYS = 30.0
+
+
+def prune_cache(cache_dir: str | Path, keep: set[str] | frozenset[str] = frozenset(),
+                max_age_days: float | None = CACHE_MAX_AGE_DAYS, max_bytes: int | None = None) -> dict[str, int]:
+    """Remove old cache entries: those not in ``keep`` and unused for ``max_age_days``, then, while the
+    cache is larger than ``max_bytes``, the least recently used ones not in ``keep``.
+
+    An entry's age is the time since a study last wrote or read it (its modification time; a study
+    touches every entry it reads). ``max_age_days=0`` removes every entry not in ``keep``.
+
+    Returns
+    -------
+    dict
+        ``removed`` (entries), ``kept`` (entries), ``bytes`` (the cache's size after pruning).
+    """
+    folder = Path(cache_dir)
+    entries = []
+    for f in folder.glob("*.json"):
+        try:
+            st = f.stat()
+        except OSError:
+            continue
+        entries.append((st.st_mtime, st.st_size, f))
+    for f in folder.glob("*.tmp"):  # left by a killed writer
+        with contextlib.suppress(OSError):
+            if time.time() - f.stat().st_mtime > 3600:
+                f.unlink()
+    entries.sort()  # oldest first
+    now, removed = time.time(), 0
+    alive = []
+    for mtime, size, f in entries:
+        old = max_age_days is not None and now - mtime >= max_age_days * 86400.0
+        if old and f.stem not in keep:
+            with contextlib.suppress(OSError):
+                f.unlink()
+                removed += 1
+                continue
+        alive.append((mtime, size, f))
+    total = sum(size for _, size, _ in alive)
+    if max_bytes is not None:
+        for i, (_, size, f) in enumerate(list(alive)):
+            if total <= max_bytes:
+                break
+            if f.stem not in keep:
+                with contextlib.suppress(OSError):
+                    f.unlink()
+                    removed += 1
+                    total -= size
+                    alive[i] = (0, 0, None)
+    return {"removed": removed, "kept": sum(1 for *_, f in alive if f is not None), "bytes": total}
+
+
+def _touch(path: Path) -> None:
+    """Mark a cache entry as used now (its age for :func:`prune_cache`)."""
+    with contextlib.suppress(OSError):
+        os.utime(path)
+
+
+#: The parts of a run record that grow with the recording: kept in its cache entry, not in memory.
+HEAVY = ("trajectory", "reference", "roc")
+
+
+def light(record: dict[str, Any], keep: bool = True) -> dict[str, Any]:
+    """A run record without its trajectories and sweeps, which its cache entry (``record["entry"]``) holds.
+
+    A study's memory then stays bounded whatever its size: the report reads them back a few runs at a
+    time (:func:`with_heavy`). A record without an entry keeps them when ``keep`` (the report needs
+    them), else they are dropped (nothing reads them).
+    """
+    if "entry" not in record and keep:
+        return record
+    return {k: v for k, v in record.items() if k not in HEAVY}
+
+
+def with_heavy(runs: list[dict[str, Any]], fields: tuple[str, ...] = HEAVY) -> list[dict[str, Any]]:
+    """The runs with their ``fields`` read back from their cache entries (see :func:`light`)."""
+    out = []
+    for r in runs:
+        if "entry" in r and any(f not in r for f in fields):
+            record, _ = read_entry(Path(r["entry"]), r["key"])
+            if record is not None:
+                r = {**r, **{f: record.get(f, []) for f in fields if f not in r}}
+        out.append(r)
+    return out
 
 
 # --------------------------------------------------------------------------- one cell, one chunk
@@ -146,6 +260,10 @@ def _recording(cell: Cell, identity: str):
             _RECORDINGS.move_to_end(identity)
             return rec
     rec = _read_only(cell.recording.load())
+    if rec.truth is not None and rec.truth.steps is not None:  # footzoo's column names once, not per run
+        from ..evaluation.metrics import reference_steps
+
+        rec.truth.steps = reference_steps(rec.truth.steps)
     with _RECORDINGS_LOCK:
         _RECORDINGS[identity] = rec
         while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
@@ -165,7 +283,8 @@ def _read_only(rec):
 
 def _new_record(cell: Cell, key: str) -> dict[str, Any]:
     return {"key": key, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
-            "error": None, "metrics": {}, "trajectory": [], "roc": [], "code_fingerprint": code_fingerprint()}
+            "error": None, "metrics": {}, "notes": {}, "trajectory": [], "roc": [],
+            "code_fingerprint": code_fingerprint()}
 
 
 def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
@@ -179,20 +298,34 @@ def _fail(out: dict[str, Any], err: BaseException) -> dict[str, Any]:
 
 def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_points: int) -> dict[str, Any]:
     out = _new_record(cell, key)
+    caught: list[warnings.WarningMessage] = []
     try:
         from ..runtime.pipeline import Pipeline
 
-        res = Pipeline.from_dict(cell.config).run(rec)
-        out["metrics"] = _metrics(rec, res, metric_names)
+        with warnings.catch_warnings(record=True) as caught:  # sent back with the record (see _replay_warnings)
+            warnings.simplefilter("always")
+            # wall and CPU seconds of the pipeline itself and of its metrics (benchmarks/study_scaling.py)
+            start, cpu = time.perf_counter(), time.process_time()
+            res = Pipeline.from_dict(cell.config).run(rec)
+            out["run_s"], out["run_cpu_s"] = _since(start, cpu)
+            start, cpu = time.perf_counter(), time.process_time()
+            pos = res.pos
+            out["metrics"], out["notes"] = _metrics(rec, res, pos, metric_names)
+            out["metrics_s"], out["metrics_cpu_s"] = _since(start, cpu)
         step = max(int(round(TRAJECTORY_STEP * rec.rate)), 1)
-        out["trajectory"] = np.column_stack([rec.t, res.pos])[::step].round(4).tolist()
+        out["trajectory"] = np.column_stack([rec.t, pos])[::step].round(4)
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
-            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4).tolist()
+            out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4)
         if sweep_points:
             out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
     except Exception as err:  # one failing run is reported, not fatal
         _fail(out, err)
+    out["warnings"] = list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught))[:5]
     return out
+
+
+def _since(wall: float, cpu: float) -> tuple[float, float]:
+    return round(time.perf_counter() - wall, 6), round(time.process_time() - cpu, 6)
 
 
 def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[str], cache_dir: str | None,
@@ -225,6 +358,7 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
         if cache_dir is not None:
             try:
                 write_entry(Path(cache_dir) / f"{key}.json", key, record)
+                record["entry"] = str(Path(cache_dir) / f"{key}.json")
             except OSError as err:  # a full or read-only cache costs the resume, not the result
                 warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning, stacklevel=2)
         record["cached"] = False
@@ -254,11 +388,15 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
 
 def run_study(
     study: Study | str | Path,
-    jobs: int = 1,
+    jobs: int | None = None,
     scheduler: str | None = None,
     out: str | Path | None = None,
     progress: bool = False,
     max_runs: int | None = None,
+    max_cells: int | None = None,
+    quiet: bool = False,
+    report: bool = True,
+    prune: dict[str, Any] | None = None,
 ) -> pd.DataFrame:
     """Run every cell of a study and return the tidy table (one row per run × metric).
 
@@ -266,8 +404,9 @@ def run_study(
     ----------
     study : Study or path
         The study (or its YAML file).
-    jobs : int
-        Local worker processes (joblib); 1 runs serially, -1 uses every core.
+    jobs : int, optional
+        Local worker processes (joblib); 1 runs serially, -1 uses every core. Default: the
+        study file's ``jobs``, else 1.
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``); the runs go
         to its workers through ``dask.distributed``.
@@ -282,40 +421,92 @@ def run_study(
         Show one progress bar over the whole command (loading, runs, report).
     max_runs : int, optional
         Stop after this many new runs (what an interruption leaves behind).
+    max_cells : int, optional
+        Largest grid allowed (default: the study's ``max_cells``, else
+        :data:`footzoo.studies.study.MAX_CELLS`); a larger one is refused before anything runs.
+    prune : dict, optional
+        Keyword arguments of :func:`prune_cache` applied to ``out/cache`` after the study (the
+        study's own entries are always kept). Default: ``{"max_age_days": CACHE_MAX_AGE_DAYS}``,
+        entries unused for 30 days go; ``{"max_age_days": 0}`` keeps only this study's entries;
+        ``{"max_age_days": None}`` keeps everything.
+    report : bool
+        Write the report into ``out`` (tables, summaries, plots); False keeps only the cache
+        (what :func:`footzoo.studies.tune.tune` needs).
+    quiet : bool
+        Do not repeat the runs' warnings (each distinct warning of the workers is otherwise
+        issued once here, with the number of runs that gave it).
 
     Returns
     -------
     pandas.DataFrame
         Columns ``run``, ``base``, one per factor, ``recording``, ``metric``, ``value``,
         ``error``. ``attrs`` holds counts only: ``computed``, ``cached``, ``failed``, and
-        ``recomputed`` (damaged cache entries: key -> problem) and ``retried`` (failed
-        cells run again because footzoo's source changed: keys). Trajectories and
+        ``recomputed`` (damaged cache entries: key -> problem), ``retried`` (failed
+        cells run again because footzoo's source changed: keys), ``causes`` (the distinct
+        errors of the failed runs, most frequent first) and ``refused`` (the distinct reasons of
+        refused metrics, :mod:`footzoo.evaluation.validity`). Every config and reader option is
+        validated before any run (:meth:`Study.check`): an invalid study raises ConfigError. Trajectories and
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
+    if not isinstance(study, Study):
+        study = Study.from_yaml(study, max_cells=max_cells)
+    if jobs is None:
+        jobs = study.jobs or 1
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
         from ..core.errors import ConfigError
 
         raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+    study.check(max_cells)
     bar = _Progress(progress, "study")
     try:
         if scheduler is None:
-            return _run_study(study, jobs, None, out, max_runs, bar)
-        cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
-        try:
-            return _run_study(study, jobs, cluster, out, max_runs, bar)
-        finally:
-            cluster.close()
+            table = _run_study(study, jobs, None, out, max_runs, bar, report, prune)
+        else:
+            cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
+            try:
+                table = _run_study(study, jobs, cluster, out, max_runs, bar, report, prune)
+            finally:
+                cluster.close()
     finally:
         bar.close()
+    if not quiet:
+        _replay_warnings(table.attrs.pop("warnings", {}), table.attrs["refused"])
+    table.attrs.pop("warnings", None)
+    return table
 
 
-def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.DataFrame:
+def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
+    """Issue each distinct warning of the runs once, with the number of runs that gave it."""
+    import builtins
+
+    from ..core import errors
+    from ..evaluation.validity import MetricWarning
+
+    for text, n in worker.items():
+        name, _, message = text.partition(": ")
+        category = MetricWarning if name == "MetricWarning" else (getattr(errors, name, None)
+                                                                  or getattr(builtins, name, None))
+        if not (isinstance(category, type) and issubclass(category, Warning)):
+            category = UserWarning
+        warnings.warn(f"{n} run(s): {message}" if n > 1 else message, category, stacklevel=3)
+    if refused:
+        text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
+        warnings.warn(f"metrics refused (NaN, see the table's note column): {text}", MetricWarning, stacklevel=3)
+
+
+def _counts(values) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for v in values:
+        out[v] = out.get(v, 0) + 1
+    return dict(sorted(out.items(), key=lambda kv: -kv[1]))
+
+
+def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bool = True,
+               prune: dict[str, Any] | None = None) -> pd.DataFrame:
     bar.phase("loading")
-    if not isinstance(study, Study):
-        study = Study.from_yaml(study)
     bar.set_description(study.name)
     cells = study.cells()
-    report_steps = 4 if out is not None else 0
+    report_steps = 4 if out is not None and report else 0
     bar.add(len(study.recordings) + len(cells) + report_steps)
     bar.update(1)
 
@@ -350,9 +541,10 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
             retried.append(key)
             todo.append(i)
         else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
+            _touch(path)
             cell = cells[i]
-            results[i] = {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
-                          "cached": True}
+            results[i] = light({**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
+                                "cached": True, "entry": str(path)}, keep=out is not None and report)
             bar.update(1)
     if recomputed:
         warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
@@ -367,7 +559,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
     args = (study.plugins, cache_dir, study.metrics, study.sweep_points)
     for idx, records in _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
         for i, r in zip(idx, records, strict=True):
-            results[i] = r
+            results[i] = light(r, keep=out is not None and report)  # the heavy parts stay on disk
     runs = [results[i] for i in sorted(results)]
     table = tidy(runs, list(study.factors))
     table.attrs["computed"] = sum(1 for r in runs if not r.get("cached"))
@@ -375,7 +567,13 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress) -> pd.Data
     table.attrs["failed"] = sum(1 for r in runs if r.get("error"))
     table.attrs["recomputed"] = dict(recomputed)
     table.attrs["retried"] = list(retried)
-    if out is not None:
+    table.attrs["causes"] = _counts(r["error"] for r in runs if r.get("error"))
+    table.attrs["refused"] = _counts(why for r in runs for why in set((r.get("notes") or {}).values()))
+    table.attrs["warnings"] = _counts(w for r in runs if not r.get("cached") for w in r.get("warnings") or [])
+    if cache_dir is not None:
+        table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
+                                            **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
+    if out is not None and report:
         from .report import write_outputs
 
         if recomputed:
@@ -460,8 +658,10 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
             futures = {client.submit(run_chunk, *task(idx), pure=False): idx for idx in chunks}
             for fut in as_completed(futures):
                 records = fut.result()
+                idx = futures.pop(fut)  # released: the cluster and the client forget the chunk's records
+                fut.release()
                 bar.update(len(records))
-                yield futures[fut], records
+                yield idx, records
     elif jobs != 1:
         from joblib import Parallel, delayed
 
@@ -516,16 +716,21 @@ def _log_damaged(out: Path, recomputed: dict[str, str]) -> None:
 
 
 def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
-    """One row per run × metric (a failed run gives one row with its error)."""
+    """One row per run × metric (a failed run gives one row with its error).
+
+    ``note`` gives the reason of a metric refused (NaN) because the recording's reference cannot
+    score it (:mod:`footzoo.evaluation.validity`); it is empty for every other row.
+    """
     rows = []
     for r in runs:
         base = {"run": r["key"], "base": r["base"], **{f: _cell_value(r["levels"].get(f)) for f in factors},
                 "recording": r["recording"]}
         if r["error"]:
-            rows.append({**base, "metric": None, "value": np.nan, "error": r["error"]})
+            rows.append({**base, "metric": None, "value": np.nan, "error": r["error"], "note": None})
+        notes = r.get("notes") or {}
         for name, value in sorted(r["metrics"].items()):
-            rows.append({**base, "metric": name, "value": value, "error": None})
-    cols = ["run", "base", *factors, "recording", "metric", "value", "error"]
+            rows.append({**base, "metric": name, "value": value, "error": None, "note": notes.get(name)})
+    cols = ["run", "base", *factors, "recording", "metric", "value", "error", "note"]
     return pd.DataFrame(rows, columns=cols)
 
 

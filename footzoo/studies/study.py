@@ -19,36 +19,23 @@ from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
+from ..evaluation.metrics import METRICS, metric_name
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
+
+#: Largest grid (bases × factor levels × recordings) a study runs unless its ``max_cells`` says more.
+MAX_CELLS = 10_000
 
 STUDY_KEYS = {
     "name": "study name",
     "description": "free text",
     "base": "a config path, an inline config, or a list of them",
     "factors": "mapping of dotted paths to lists of values (all combinations are run)",
-    "recordings": "list of {path: glob, format: ...} or {simulate: {...}, seeds: [...]}",
+    "recordings": "list of {path: glob, format: ..., group: ...} or {simulate: {...}, seeds: [...], group: ...}",
     "metrics": "list of metric names to keep (default: all)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
     "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
-}
-
-# what a run can measure (footzoo.studies.runner computes them); a study's ``metrics`` picks among them
-METRICS: dict[str, str] = {
-    "path_length_m": "horizontal path length (m)",
-    "loop_closure_xy_m": "horizontal end-to-start distance of a closed walk (m)",
-    "loop_closure_3d_m": "3-D end-to-start distance of a closed walk (m)",
-    "loop_closure_xy_pct": "horizontal end-to-start distance, % of the path length",
-    "loop_closure_3d_pct": "3-D end-to-start distance, % of the path length",
-    "armse_3d_m": "RMS position error after yaw alignment, against the reference (m)",
-    "pyshoe_error_m": "PyShoe's position error against the reference (m)",
-    "steps": "number of detected steps",
-    "stance_precision": "per-sample stance precision against the true stance",
-    "stance_recall": "per-sample stance recall against the true stance",
-    "stance_f1": "per-sample stance F1 against the true stance",
-    "stance_accuracy": "per-sample stance accuracy against the true stance",
-    "gait_phase_error_rate": "wrong or missed steps per true step",
-    "step_count_error": "detected minus true steps",
-    "fpa_mean_deg": "mean foot progression angle (deg)",
+    "jobs": "local worker processes (1 = serial, -1 = every core); the command line's --jobs overrides it",
+    "max_cells": f"largest number of runs (bases x factor levels x recordings) allowed, default {MAX_CELLS}",
 }
 
 _FILE_DIGESTS: dict[tuple[str, int, int], str] = {}  # (path, size, mtime_ns) -> sha256 of the content
@@ -65,6 +52,101 @@ def code_fingerprint() -> str:
         h.update(f.read_bytes())
     return h.hexdigest()
 
+def _builtin_plugin_files() -> set[Path]:
+    """The files of footzoo that define a registered plug-in (each has its own cache identity)."""
+    from ..plugins.registry import KINDS, available
+
+    root = Path(__file__).resolve().parents[1]
+    out = set()
+    for kind in KINDS:
+        for cls in available(kind).values():
+            f = _source_file(cls)
+            if f is not None and root in f.parents:
+                out.add(f)
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def engine_fingerprint() -> str:
+    """SHA-256 over footzoo's source files but those that define plug-ins: the engine every cell uses."""
+    root = Path(__file__).resolve().parents[1]
+    plugin_files = _builtin_plugin_files()
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        if f.resolve() not in plugin_files:
+            h.update(str(f.relative_to(root)).encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def _source_file(obj: Any) -> Path | None:
+    import inspect
+
+    try:
+        f = inspect.getsourcefile(obj)
+    except (TypeError, OSError):
+        return None
+    return Path(f).resolve() if f else None
+
+
+def plugin_sources(config: dict[str, Any]) -> list[Path]:
+    """The plug-in source files a config actually uses: the modules of each plug-in's class and base
+    classes (and of the plug-ins inside it), and the plug-in modules those import from, transitively.
+    footzoo's engine (:func:`engine_fingerprint`), installed libraries and the plug-ins the config does
+    not name are not among them."""
+    import sys
+    import types
+
+    from ..plugins.base import Plugin
+    from ..runtime.pipeline import Pipeline
+
+    pipeline = Pipeline.from_dict(copy.deepcopy(config))
+    instances = [*pipeline.calibration, pipeline.orientation, pipeline.detector, *pipeline.corrections,
+                 *pipeline.analysis]
+    modules: list[str] = []
+    seen: set[int] = set()
+    while instances:
+        obj = instances.pop()
+        if obj is None or id(obj) in seen:
+            continue
+        seen.add(id(obj))
+        modules += [c.__module__ for c in type(obj).__mro__]
+        instances += [v for v in vars(obj).values() if isinstance(v, Plugin)]
+    root = Path(__file__).resolve().parents[1]
+    plugin_files = _builtin_plugin_files()
+    libraries = {Path(sys.prefix).resolve(), Path(sys.base_prefix).resolve()}
+    files: set[Path] = set()
+    done: set[str] = set()
+    while modules:
+        name = modules.pop()
+        module = sys.modules.get(name)
+        if name in done or module is None:
+            continue
+        done.add(name)
+        f = _source_file(module)
+        if f is None or (root in f.parents and f not in plugin_files) or any(p in f.parents for p in libraries):
+            continue  # the engine (in engine_fingerprint), the standard library, installed packages
+        files.add(f)
+        for v in vars(module).values():
+            modules.append(v.__name__ if isinstance(v, types.ModuleType) else str(getattr(v, "__module__", "")))
+    return sorted(files)
+
+
+def config_code(config: dict[str, Any]) -> str:
+    """A cell's code identity: footzoo's version, its engine and the source of the plug-ins the config uses.
+
+    Editing a plug-in's file changes the identity of the cells whose config uses it, and only theirs.
+    """
+    from .._version import __version__
+
+    h = hashlib.sha256()
+    for f in plugin_sources(config):
+        h.update(str(f).encode())
+        h.update(hashlib.sha256(f.read_bytes()).digest())
+    return json.dumps({"footzoo": __version__, "engine": engine_fingerprint(), "plugins": h.hexdigest()},
+                      sort_keys=True)
+
+
 @dataclass
 class RecordingSpec:
     """One recording of a study: a file or a simulator scenario with a seed."""
@@ -75,6 +157,7 @@ class RecordingSpec:
     options: dict[str, Any] = field(default_factory=dict)
     simulate: dict[str, Any] | None = None
     seed: int | None = None
+    group: str | None = None  # cross-validation group (subject, day, motion class): footzoo.studies.tune
 
     def identity(self) -> str:
         """What the cache key depends on: the file's content hash, or the simulator spec and seed.
@@ -141,7 +224,7 @@ class Cell:
     recording: RecordingSpec
     levels: dict[str, Any]
     base: str
-    code: str = ""  # footzoo's version and the plug-ins' source hash (Study.code_identity)
+    code: str = ""  # footzoo's version, engine and the used plug-ins' source (config_code)
 
     def key(self, data: str | None = None) -> str:
         """Cache key: hash of the resolved config, the code identity and the data's identity."""
@@ -161,16 +244,18 @@ class Study:
     metrics: list[str] | None = None
     sweep_points: int = 0
     plugins: list[str] = field(default_factory=list)
+    jobs: int | None = None
+    max_cells: int = MAX_CELLS
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> Study:
+    def from_yaml(cls, path: str | Path, max_cells: int | None = None) -> Study:
         """Read and check a study file; paths in it are relative to the file."""
         p = resolve(path)
         data = load_file(p, ConfigError, "study file")
         if not isinstance(data, dict):
             raise ConfigError(f"{p}: a study must be a mapping with base, factors, recordings")
         try:
-            return cls.from_dict(data, root=p.parent)
+            return cls.from_dict(data, root=p.parent, max_cells=max_cells)
         except ConfigError as err:
             raise prefixed(err, p) from err.__cause__
 
@@ -186,8 +271,8 @@ class Study:
                            "plugins": source_hash(self.plugins)}, sort_keys=True)
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], root: str | Path = ".") -> Study:
-        """Build from a mapping (see :data:`STUDY_KEYS`)."""
+    def from_dict(cls, d: dict[str, Any], root: str | Path = ".", max_cells: int | None = None) -> Study:
+        """Build from a mapping (see :data:`STUDY_KEYS`); ``max_cells`` overrides the study's grid limit."""
         root = Path(root)
         for key in d:
             if key not in STUDY_KEYS:
@@ -219,6 +304,10 @@ class Study:
             if not isinstance(k, str) or not k:
                 raise ConfigError(f"factor names must be dotted paths like detector.threshold, got {k!r}")
         factors = {k: (v if isinstance(v, list) else [v]) for k, v in factors.items()}
+        for k, v in factors.items():
+            if not v:
+                raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
+                                  "or remove it")
         recordings = []
         if not isinstance(d["recordings"] or [], list):
             raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
@@ -232,33 +321,142 @@ class Study:
                 metrics = [metrics]
             if not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics):
                 raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}; valid: {list(METRICS)}")
+            named = []
             for m in metrics:
-                if m not in METRICS:
+                try:
+                    named.append(metric_name(m))
+                except KeyError:
                     raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}; "
-                                      f"valid metrics: {list(METRICS)}")
+                                      f"valid metrics: {list(METRICS)}") from None
+            metrics = list(dict.fromkeys(named))
         sweep = d.get("sweep") or {}
         if not isinstance(sweep, dict) or set(sweep) - {"points"}:
             raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
         points = sweep.get("points", 0)
         if isinstance(points, bool) or not isinstance(points, int) or points < 0:
             raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
-        return cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins)
+        jobs = d.get("jobs")
+        if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0):
+            raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+        max_cells = d.get("max_cells", MAX_CELLS) if max_cells is None else max_cells
+        if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
+            raise ConfigError(f"max_cells must be a whole number >= 1, got {max_cells!r}")
+        study = cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins, jobs,
+                    max_cells)
+        study.check_size()
+        return study
 
-    def cells(self) -> list[Cell]:
-        """Every base × factor combination × recording."""
-        # type changes first: they reset the plug-in's parameters, which other factors may then set
+    @property
+    def size(self) -> int:
+        """Number of runs: bases × the product of the factors' level counts × recordings (no cell is built)."""
+        n = len(self.bases) * len(self.recordings)
+        for levels in self.factors.values():
+            n *= len(levels)
+        return n
+
+    def check_size(self, max_cells: int | None = None) -> None:
+        """A ConfigError when the grid has more runs than ``max_cells`` (default: the study's own limit)."""
+        limit = self.max_cells if max_cells is None else max_cells
+        if self.size > limit:
+            levels = " x ".join(f"{len(v)} {k}" for k, v in self.factors.items()) or "no factors"
+            raise ConfigError(
+                f"the study has {self.size:,} runs ({len(self.bases)} base(s) x {levels} x "
+                f"{len(self.recordings)} recording(s)), more than the limit of {limit:,}: shorten the factors' "
+                "level lists, or raise the limit (max_cells: N in the study file, --max-cells N on the command "
+                "line) if you mean it")
+
+    def configs(self) -> list[tuple[dict[str, Any], dict[str, Any]]]:
+        """Every distinct ``(config, levels)`` of the grid, without the recordings.
+
+        Type changes are set first: they reset the plug-in's parameters, which other factors may then set.
+        A level that cannot be set gives ``{"__invalid__": reason}`` as its config.
+        """
         names = sorted(self.factors, key=lambda n: not n.endswith(".type"))
-        code = self.code_identity()
         out = []
         for base_name, base in self.bases:
             for values in itertools.product(*(self.factors[n] for n in names)):
                 cfg = copy.deepcopy(base)
-                for n, v in zip(names, values, strict=True):
-                    set_dotted(cfg, n, v)
                 levels = {"base": base_name, **dict(zip(names, values, strict=True))}
-                for rec in self.recordings:
-                    out.append(Cell(cfg, rec, levels, base_name, code))
+                try:
+                    for n, v in zip(names, values, strict=True):
+                        set_dotted(cfg, n, v)
+                except (ConfigError, TypeError, ValueError, IndexError) as err:
+                    cfg = {"__invalid__": str(err)}
+                out.append((cfg, levels))
         return out
+
+    def check(self, max_cells: int | None = None) -> None:
+        """Validate everything before a run: the grid's size, every config of the grid, the reader options.
+
+        Raises
+        ------
+        ConfigError
+            Listing the first distinct problems, each with the factor levels that lead to it.
+        """
+        from ..runtime.validate import config_errors
+
+        self.check_size(max_cells)
+        problems: dict[str, list[dict[str, Any]]] = {}
+        configs = self.configs()
+        bad = 0
+        for cfg, levels in configs:
+            errors = [cfg["__invalid__"]] if "__invalid__" in cfg else config_errors(cfg)
+            bad += bool(errors)
+            for e in errors:
+                problems.setdefault(e, []).append(levels)
+        for rec in self.recordings:
+            problem = _reader_problem(rec)
+            if problem:
+                problems.setdefault(problem, []).append({"recording": rec.label})
+        if problems:
+            lines = [f"- {e} (e.g. {_levels_text(where[0])}; {len(where)} case(s))"
+                     for e, where in list(problems.items())[:5]]
+            more = f"\n... and {len(problems) - 5} more distinct problem(s)" if len(problems) > 5 else ""
+            raise ConfigError(f"study {self.name!r}: {bad} of {len(configs)} config(s) invalid or recordings "
+                              f"unreadable, nothing was run; the first distinct causes:\n" + "\n".join(lines) + more)
+
+    def cells(self) -> list[Cell]:
+        """Every base × factor combination × recording."""
+        # type changes first: they reset the plug-in's parameters, which other factors may then set
+        self.check_size()
+        out = []
+        for cfg, levels in self.configs():
+            if "__invalid__" in cfg:
+                raise ConfigError(f"factor levels {_levels_text(levels)}: {cfg['__invalid__']}")
+            try:
+                code = config_code(cfg)
+            except (ConfigError, ValueError, TypeError):  # an invalid config's cells fail on their own
+                code = self.code_identity()
+            for rec in self.recordings:
+                out.append(Cell(cfg, rec, levels, levels["base"], code))
+        return out
+
+
+def _levels_text(levels: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in levels.items())
+
+
+def _reader_problem(rec: RecordingSpec) -> str | None:
+    """Why a recording's reader cannot take its options (an unknown format or option), or None.
+
+    A file that cannot be read (vanished, a directory, not recognised) is not a problem of the
+    study: its cells fail on their own, the other recordings run.
+    """
+    if rec.path is None or rec.problem():
+        return None
+    from ..core.errors import FootzooError
+    from ..io import _options_for, available
+
+    readers = available()
+    try:
+        fmt = rec.format or readers.detect(Path(rec.path))
+    except FootzooError:
+        return None
+    try:
+        _options_for(readers.get_reader(fmt), fmt, Path(rec.path), dict(rec.options))
+    except FootzooError as err:
+        return str(err)
+    return None
 
 
 def _resolve(root: Path, path: str) -> str:
@@ -274,6 +472,10 @@ def _resolve(root: Path, path: str) -> str:
 def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
     if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
         raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
+    group = r.get("group")
+    if group is not None and not isinstance(group, (str, int)):
+        raise ConfigError(f"recordings[{i}].group must be a group name (text), got {group!r}")
+    group = None if group is None else str(group)
     if "path" in r:
         pattern = r["path"]
         if not isinstance(pattern, str) or not pattern:
@@ -283,8 +485,10 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
         if not matches:
             raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
-        opts = {k: v for k, v in r.items() if k not in ("path", "format")}
-        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts) for m in matches]
+        matches = _without_sidecars(matches)
+        opts = {k: v for k, v in r.items() if k not in ("path", "format", "group")}
+        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts, group=group)
+                for m in matches]
     if not isinstance(r["simulate"], dict):
         raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
     sim = dict(r["simulate"])
@@ -296,7 +500,13 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
     seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
-    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s)) for s in seeds]
+    return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
+
+
+def _without_sidecars(paths: list[str]) -> list[str]:
+    """The matches that are not another match's sidecar (``walk.csv.steps.csv`` next to ``walk.csv``)."""
+    names = {Path(p).name for p in paths}
+    return [p for p in paths if not any(Path(p).name.startswith(n + ".") for n in names if n != Path(p).name)]
 
 
 def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:

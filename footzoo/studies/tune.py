@@ -1,0 +1,409 @@
+"""Choose a setting by cross-validation over groups of recordings (subjects, days, motion classes).
+
+``tune(study_or_yaml) -> TuneResult``: the candidate settings (a grid of the study's factors, or
+settings drawn at random from a ``space``) run on every recording through the study runner (cached,
+local workers or a Dask cluster); then, for every group of recordings in turn (leave-one-group-out,
+as scikit-learn's ``LeaveOneGroupOut``), the setting with the best score on the other groups is
+chosen and scored on the held-out group. Those held-out scores are the honest figure; the setting
+chosen on every group is the result, written as a config YAML.
+
+A tune file is a study file with a ``tune:`` block::
+
+    tune:
+      objective: pyshoe_error_m    # a metric of the study (footzoo.evaluation.metrics.METRICS)
+      direction: minimize          # or maximize
+      aggregate: mean              # mean, median or gmean over recordings
+      weight: group                # every group weighs the same (or: recording)
+      search: grid                 # grid over the factors, or random over `space`
+      trials: 20                   # settings drawn by a random search
+      seed: 0
+      space: {detector.threshold: {low: 1e4, high: 1e6, log: true}, detector.window: [3, 5, 7]}
+      group_by: '^(\\d{4}-\\d{2}-\\d{2})'   # group = the regex's first group in the recording's label
+      config: best.yaml            # where the chosen setting goes (default: OUT/best.yaml)
+
+A recording's group is its ``group:`` in the study's ``recordings`` or the ``group_by`` match.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..core.errors import ConfigError, did_you_mean
+from .study import Study, set_dotted
+
+TUNE_KEYS = {
+    "objective": "the metric to optimise (a study metric)",
+    "direction": "minimize or maximize",
+    "aggregate": "mean, median or gmean of the objective over recordings",
+    "weight": "group (every group weighs the same) or recording",
+    "search": "grid (the study's factors) or random (settings drawn from `space`)",
+    "trials": "settings drawn by a random search",
+    "seed": "seed of a random search",
+    "space": "dotted path -> list of values, or {low, high, log, integer} (random search)",
+    "group_by": "regular expression on the recording's label; its first group is the recording's group",
+    "config": "file the chosen setting is written to (default: OUT/best.yaml)",
+}
+AGGREGATES: dict[str, Callable[[np.ndarray], float]] = {
+    "mean": lambda v: float(np.mean(v)),
+    "median": lambda v: float(np.median(v)),
+    "gmean": lambda v: float(np.exp(np.mean(np.log(v)))) if np.all(v > 0) else float("nan"),
+}
+
+#: A score function: the objective's values of one setting on a set of recordings (indexed by
+#: recording) and their groups -> one number (lower is better after the direction is applied).
+Score = Callable[[pd.Series, pd.Series], float]
+
+
+@dataclass
+class TuneSpec:
+    """The ``tune:`` block of a tune file (see the module's docstring)."""
+
+    objective: str
+    direction: str = "minimize"
+    aggregate: str = "mean"
+    weight: str = "group"
+    search: str = "grid"
+    trials: int = 20
+    seed: int = 0
+    space: dict[str, Any] = field(default_factory=dict)
+    group_by: str | None = None
+    config: str | None = None
+
+    @classmethod
+    def from_dict(cls, d: Any) -> TuneSpec:
+        """Check and build from a mapping."""
+        from ..evaluation.metrics import METRICS, metric_name
+
+        if not isinstance(d, dict) or "objective" not in d:
+            raise ConfigError("a tune file needs a 'tune:' block with at least 'objective: METRIC'")
+        for key in d:
+            if key not in TUNE_KEYS:
+                raise ConfigError(f"unknown tune key {key!r}{did_you_mean(str(key), list(TUNE_KEYS))}; "
+                                  f"valid keys: {list(TUNE_KEYS)}")
+        try:
+            objective = metric_name(str(d["objective"]))
+        except KeyError:
+            raise ConfigError(f"tune.objective {d['objective']!r} is not a metric"
+                              f"{did_you_mean(str(d['objective']), list(METRICS))}; valid: {list(METRICS)}") from None
+        spec = cls(objective, **{k: v for k, v in d.items() if k != "objective"})
+        for name, value, allowed in (("direction", spec.direction, ("minimize", "maximize")),
+                                     ("aggregate", spec.aggregate, tuple(AGGREGATES)),
+                                     ("weight", spec.weight, ("group", "recording")),
+                                     ("search", spec.search, ("grid", "random"))):
+            if value not in allowed:
+                raise ConfigError(f"tune.{name} must be one of {list(allowed)}, got {value!r}")
+        for name in ("trials", "seed"):
+            v = getattr(spec, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < (1 if name == "trials" else 0):
+                raise ConfigError(f"tune.{name} must be a whole number >= {1 if name == 'trials' else 0}, got {v!r}")
+        if spec.search == "random" and not spec.space:
+            raise ConfigError("tune.search: random needs tune.space (dotted path -> values or {low, high})")
+        if not isinstance(spec.space, dict):
+            raise ConfigError(f"tune.space must map dotted paths to values or ranges, got {spec.space!r}")
+        for path, dist in spec.space.items():
+            _check_distribution(path, dist)
+        if spec.group_by is not None:
+            try:
+                if re.compile(str(spec.group_by)).groups < 1:
+                    raise ConfigError(f"tune.group_by {spec.group_by!r} needs a (group) that picks the group name")
+            except re.error as err:
+                raise ConfigError(f"tune.group_by {spec.group_by!r} is not a regular expression: {err}") from None
+        return spec
+
+    def score_function(self) -> Score:
+        """The score of this spec: the aggregate over recordings (per group first when ``weight: group``)."""
+        agg = AGGREGATES[self.aggregate]
+        sign = 1.0 if self.direction == "minimize" else -1.0
+
+        def score(values: pd.Series, groups: pd.Series) -> float:
+            v = values.to_numpy(dtype=float)
+            if v.size == 0 or not np.all(np.isfinite(v)):
+                return math.inf  # a failed or refused run: never the best
+            if self.weight == "recording":
+                return sign * agg(v)
+            per_group = [agg(values[groups == g].to_numpy(dtype=float)) for g in pd.unique(groups)]
+            return sign * float(np.mean(per_group))
+
+        return score
+
+
+def _check_distribution(path: str, dist: Any) -> None:
+    if isinstance(dist, list):
+        if not dist:
+            raise ConfigError(f"tune.space.{path} has no values")
+        return
+    if not isinstance(dist, dict) or not {"low", "high"} <= set(dist) or set(dist) - {"low", "high", "log", "integer"}:
+        raise ConfigError(f"tune.space.{path} must be a list of values or {{low, high, log: bool, integer: bool}}, "
+                          f"got {dist!r}")
+    low, high = dist["low"], dist["high"]
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in (low, high)) or not low < high:
+        raise ConfigError(f"tune.space.{path}: low and high must be numbers with low < high, got {low!r}, {high!r}")
+    if dist.get("log") and low <= 0:
+        raise ConfigError(f"tune.space.{path}: a log range needs low > 0, got {low!r}")
+
+
+def sample_space(space: dict[str, Any], trials: int, seed: int) -> list[dict[str, Any]]:
+    """``trials`` distinct settings drawn from ``space`` (a list: uniform choice; a range: uniform, or log-uniform)."""
+    rng = np.random.default_rng(seed)
+    out: list[dict[str, Any]] = []
+    seen: set[str] = set()
+    for _ in range(trials * 20):
+        if len(out) == trials:
+            break
+        setting = {}
+        for path, dist in space.items():
+            if isinstance(dist, list):
+                setting[path] = dist[int(rng.integers(len(dist)))]
+                continue
+            lo, hi = float(dist["low"]), float(dist["high"])
+            x = float(np.exp(rng.uniform(np.log(lo), np.log(hi)))) if dist.get("log") else float(rng.uniform(lo, hi))
+            setting[path] = int(round(x)) if dist.get("integer") else float(f"{x:.4g}")
+        key = json.dumps(setting, sort_keys=True, default=str)
+        if key not in seen:
+            seen.add(key)
+            out.append(setting)
+    return out
+
+
+def leave_one_group_out(groups: pd.Series) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """``(group, train, test)`` boolean masks, one fold per group in order of first appearance."""
+    g = groups.to_numpy()
+    return [(str(name), g != name, g == name) for name in pd.unique(g)]
+
+
+def cross_validate(values: pd.DataFrame, groups: pd.Series, score: Score) -> tuple[pd.DataFrame, pd.Series, str]:
+    """Leave-one-group-out choice of a setting.
+
+    Parameters
+    ----------
+    values : DataFrame
+        The objective, one row per recording, one column per setting (in the order that breaks ties).
+    groups : Series
+        The group of each recording (same index).
+    score : callable
+        ``score(values_of_one_setting, groups) -> float``, lower is better.
+
+    Returns
+    -------
+    folds : DataFrame
+        Per held-out group: ``group``, ``recordings``, ``chosen``, ``train_score``, ``test_score``.
+    held_out : Series
+        Per recording: the objective of the setting chosen without its group.
+    chosen : str
+        The setting with the best score on every recording.
+    """
+    groups = groups.reindex(values.index)
+    folds, held_out = [], pd.Series(np.nan, index=values.index)
+    for name, train, test in leave_one_group_out(groups):
+        if not train.any():
+            raise ConfigError(f"cross-validation needs at least two groups; every recording is in group {name!r}")
+        scores = {s: score(values.loc[train, s], groups[train]) for s in values.columns}
+        chosen = min(scores, key=scores.get)
+        held_out[test] = values.loc[test, chosen]
+        folds.append({"group": name, "recordings": int(test.sum()), "chosen": chosen,
+                      "train_score": scores[chosen], "test_score": score(values.loc[test, chosen], groups[test])})
+    scores = {s: score(values[s], groups) for s in values.columns}
+    return pd.DataFrame(folds), held_out, min(scores, key=scores.get)
+
+
+@dataclass
+class TuneResult:
+    """What :func:`tune` found.
+
+    Attributes
+    ----------
+    best_ : str
+        Name of the setting chosen on every group.
+    best_config_ : dict
+        Its full config.
+    folds_ : DataFrame
+        One row per held-out group: ``group``, ``recordings``, ``chosen``, ``train_score``, ``test_score``.
+    held_out_ : Series
+        Per recording, the objective of the setting chosen without its group (the cross-validated figure).
+    scores_ : Series
+        Every setting's score on all recordings (lower is better), best first.
+    values_ : DataFrame
+        The objective per recording (rows) and setting (columns).
+    groups_ : Series
+        Each recording's group.
+    settings_ : dict
+        Setting name -> its factor levels.
+    """
+
+    best_: str
+    best_config_: dict[str, Any]
+    folds_: pd.DataFrame
+    held_out_: pd.Series
+    scores_: pd.Series
+    values_: pd.DataFrame
+    groups_: pd.Series
+    settings_: dict[str, dict[str, Any]]
+    objective: str = ""
+
+    def save_config(self, path: str | Path, name: str | None = None) -> Path:
+        """Write the chosen setting as a pipeline config YAML (atomically), the procedure in its header."""
+        import yaml
+
+        from ..core.atomic import json_safe, write_text
+
+        cfg = copy.deepcopy(self.best_config_)
+        cfg["name"] = name or str(cfg.get("name", "tuned"))
+        header = [f"# chosen by footzoo tune: {self.best_} ({self.objective}); leave-one-group-out over "
+                  f"{self.groups_.nunique()} groups",
+                  *(f"#   held out {r.group}: chose {r.chosen}, train score {r.train_score:.4g}, "
+                    f"test score {r.test_score:.4g}" for r in self.folds_.itertuples())]
+        body = yaml.safe_dump(json_safe(cfg), sort_keys=False, default_flow_style=None, width=120)
+        return write_text(path, "\n".join(header) + "\n" + body, what="tuned config")
+
+
+def candidate_study(study: Study, spec: TuneSpec) -> tuple[Study, dict[str, dict[str, Any]]]:
+    """The study whose bases are the candidate settings (grid of the factors, or drawn from the space)."""
+    if spec.search == "random":
+        settings = [{"base": name, **s} for name, _ in study.bases for s in sample_space(spec.space, spec.trials,
+                                                                                          spec.seed)]
+    else:
+        settings = [levels for _, levels in study.configs()]
+    bases, named = [], {}
+    base_configs = dict(study.bases)
+    for levels in settings:
+        cfg = copy.deepcopy(base_configs[levels["base"]])
+        names = sorted((k for k in levels if k != "base"), key=lambda n: not n.endswith(".type"))
+        for n in names:
+            set_dotted(cfg, n, levels[n])
+        label = setting_label(levels, multiple_bases=len(study.bases) > 1)
+        bases.append((label, cfg))  # the config as the study runs it: the same cache entries
+        named[label] = levels
+    out = Study(study.name, bases, {}, study.recordings, [spec.objective], 0, study.plugins, study.jobs,
+                study.max_cells)
+    return out, named
+
+
+def setting_label(levels: dict[str, Any], multiple_bases: bool = True) -> str:
+    """A readable name of a setting: ``base|path=value,...``."""
+    parts = [f"{k}={_short(v)}" for k, v in levels.items() if k != "base"]
+    head = [str(levels["base"])] if multiple_bases or not parts else []
+    return "|".join([*head, ",".join(parts)]) if parts else str(levels["base"])
+
+
+def _short(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:g}"
+    return v if isinstance(v, str) else json.dumps(v, sort_keys=True, default=str)
+
+
+def recording_groups(study: Study, group_by: str | None = None) -> pd.Series:
+    """The group of every recording of a study: its ``group:`` or the first group of ``group_by`` in its label."""
+    out = {}
+    for rec in study.recordings:
+        group = rec.group
+        if group_by is not None:
+            m = re.search(group_by, rec.label)
+            if m is None:
+                raise ConfigError(f"recording {rec.label!r} does not match tune.group_by {group_by!r}: "
+                                  "fix the expression or give the recording a group:")
+            group = m.group(1)
+        if group is None:
+            raise ConfigError(f"recording {rec.label!r} has no group: give its recordings entry 'group: NAME' "
+                              "or the tune block 'group_by: REGEX' (first group = the group)")
+        out[rec.label] = group
+    return pd.Series(out, name="group")
+
+
+def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = None, score: Score | None = None,
+         eligible: Callable[[str], bool] | None = None, groups: Callable[[str], str] | None = None,
+         jobs: int | None = None, scheduler: str | None = None, out: str | Path | None = None,
+         progress: bool = False, quiet: bool = False) -> TuneResult:
+    """Choose a setting by leave-one-group-out cross-validation (see the module's docstring).
+
+    Parameters
+    ----------
+    study : Study or path
+        The candidates' study (its factors are the grid) or a tune file (study + ``tune:`` block).
+    spec : TuneSpec or dict, optional
+        The ``tune:`` block (required with a Study; a tune file's own otherwise).
+    score : callable, optional
+        ``score(values, groups) -> float`` (lower is better) instead of the spec's aggregate.
+    eligible : callable, optional
+        ``eligible(setting_name) -> bool``: only those settings may be chosen (all are run).
+    groups : callable, optional
+        ``groups(recording_label) -> group`` instead of the recordings' ``group:`` / ``group_by``.
+    jobs, scheduler, progress, quiet
+        As :func:`footzoo.studies.run_study` (cached in ``out/cache``, parallel).
+    out : path, optional
+        Folder of the cache, ``tune_folds.csv``, ``tune_scores.csv`` and ``best.yaml``.
+    """
+    from .runner import run_study
+
+    if not isinstance(study, Study):
+        study, file_spec = load_tune_file(study)
+        spec = spec if spec is not None else file_spec
+    if spec is None:
+        raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
+    spec = spec if isinstance(spec, TuneSpec) else TuneSpec.from_dict(spec)
+    if groups is None:
+        groups = recording_groups(study, spec.group_by)
+    else:
+        groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
+    cands, settings = candidate_study(study, spec)
+    table = run_study(cands, jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet, report=False)
+    rows = table[table["metric"] == spec.objective]
+    values = rows.pivot_table(index="recording", columns="base", values="value", aggfunc="first", dropna=False)
+    values = values.reindex(index=list(groups.index), columns=list(settings))
+    empty = values.isna().all(axis=1)
+    if empty.all():
+        causes = "; ".join(list(table.attrs.get("causes", {}))[:3]) or "the metric was never computed"
+        raise ConfigError(f"no setting gave {spec.objective!r} on any recording ({causes})")
+    values, groups = values[~empty], groups[~empty]
+    score = score or spec.score_function()
+    chosen_from = [s for s in values.columns if eligible is None or eligible(s)]
+    if not chosen_from:
+        raise ConfigError("no setting is eligible")
+    folds, held_out, best = cross_validate(values[chosen_from], groups, score)
+    scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
+    config = dict(cands.bases)[best]
+    result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective)
+    if out is not None:
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        from ..core.atomic import write_text
+
+        write_text(folder / "tune_folds.csv", folds.to_csv(index=False), what="tune folds")
+        write_text(folder / "tune_scores.csv", scores.rename("score").to_csv(index_label="setting"),
+                   what="tune scores")
+    target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
+    if target is not None:
+        result.save_config(target, name=study.name)
+    return result
+
+
+def load_tune_file(path: str | Path) -> tuple[Study, TuneSpec]:
+    """A tune file: the study (without its ``tune:`` block) and the spec; paths relative to the file."""
+    from ..config.library import resolve
+    from ..core.yamlsafe import load_file
+
+    p = resolve(path)
+    data = load_file(p, ConfigError, "tune file")
+    if not isinstance(data, dict) or "tune" not in data:
+        raise ConfigError(f"{p}: a tune file is a study file with a 'tune:' block (objective, search, group_by, ...)")
+    data = dict(data)
+    block = data.pop("tune")
+    try:
+        spec = TuneSpec.from_dict(block)
+        if spec.search == "random":
+            data.pop("factors", None)
+        study = Study.from_dict(data, root=p.parent)
+    except ConfigError as err:
+        raise ConfigError(f"{p}: {err}") from None
+    if spec.config is not None and not Path(spec.config).is_absolute():
+        spec.config = str(p.parent / spec.config)
+    return study, spec

@@ -1,0 +1,166 @@
+"""One metric registry for footzoo run, Result.metrics and studies; refused metrics (NaN with a reason)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from footzoo import ConfigError, Pipeline
+from footzoo.core.data import Recording, Truth
+from footzoo.evaluation.metrics import METRIC_ALIASES, METRICS, run_metrics
+from footzoo.evaluation.validity import (
+    MIN_STANCE_S,
+    STEP_METRICS,
+    STRIDE_COMPARISONS,
+    MetricWarning,
+    checked_metrics,
+    reference_problems,
+)
+from footzoo.io.canonical import write
+from footzoo.sim import NoiseModel, simulate
+from footzoo.studies import Study, run_study
+
+RATE = 100.0
+
+
+def _mask(phases_s: list[tuple[float, float]], duration: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """A stance mask at 100 Hz with stance in each (start, length) of ``phases_s`` (s)."""
+    t = np.arange(0.0, duration, 1.0 / RATE)
+    mask = np.zeros(t.size, bool)
+    for start, length in phases_s:
+        mask[(t >= start - 1e-9) & (t < start + length - 1e-9)] = True
+    return t, mask
+
+
+def _strides(n: int, **drop) -> pd.DataFrame:
+    ic = np.arange(1, n + 1, dtype=float)
+    steps = pd.DataFrame({"start_s": np.r_[np.nan, ic[:-1]], "to_s": ic - 0.4, "end_s": ic,
+                          "stride_length_m": np.full(n, 1.2)})
+    for col, rows in drop.items():
+        if rows == "all":
+            steps = steps.drop(columns=col)
+        else:
+            steps.loc[: rows - 1, col] = np.nan
+    return steps
+
+
+# ------------------------------------------------------------------ the rules, each on a hand-built reference
+
+
+def test_whole_stance_phases_are_usable():
+    t, mask = _mask([(1.0 + k, 0.5) for k in range(10)])
+    assert reference_problems(t, Truth(stance=mask)) == {}
+
+
+def test_fragmented_stance_refuses_the_step_metrics_only():
+    # 8 phases: 2 short ones (25 %) are allowed, 3 (37.5 %) are not; 90 ms is short, 100 ms is not
+    ok = [(1.0 + k, 0.5) for k in range(6)] + [(7.0, 0.09), (8.0, 0.09)]
+    bad = [(1.0 + k, 0.5) for k in range(5)] + [(6.0, 0.09), (7.0, 0.09), (8.0, 0.09)]
+    edge = [(1.0 + k, 0.5) for k in range(5)] + [(6.0, MIN_STANCE_S), (7.0, MIN_STANCE_S), (8.0, MIN_STANCE_S)]
+    assert reference_problems(*_mask(ok)[:1], Truth(stance=_mask(ok)[1])) == {}
+    assert reference_problems(_mask(edge)[0], Truth(stance=_mask(edge)[1])) == {}
+    problems = reference_problems(_mask(bad)[0], Truth(stance=_mask(bad)[1]))
+    assert set(problems) == set(STEP_METRICS)
+    assert "fragmented stance reference: 3 of its 8 stance phases last less than 100 ms" in problems["step_count_error"]
+
+
+def test_no_stance_or_no_swing_refuses_every_stance_metric():
+    t = np.arange(0.0, 10.0, 0.01)
+    for mask, word in ((np.zeros(t.size, bool), "stance"), (np.ones(t.size, bool), "swing")):
+        problems = reference_problems(t, Truth(stance=mask))
+        assert "stance_f1" in problems and "step_count_error" in problems
+        assert problems["stance_f1"] == f"the reference stance mask has no {word} sample"
+
+
+def test_too_few_stance_phases():
+    t, mask = _mask([(1.0, 0.5), (2.0, 0.5)])
+    problems = reference_problems(t, Truth(stance=mask))
+    assert set(problems) == set(STEP_METRICS)
+    assert problems["gait_phase_error_rate"] == "too few reference stance phases: 2 (at least 3 needed)"
+
+
+def test_too_few_strides_refuses_every_stride_comparison():
+    t = np.arange(0.0, 10.0, 0.01)
+    problems = reference_problems(t, Truth(steps=_strides(2)))
+    assert set(problems) == set(STRIDE_COMPARISONS)
+    assert reference_problems(t, Truth(steps=_strides(3))) == {}
+
+
+def test_missing_events_refuse_the_comparisons_that_need_them():
+    t = np.arange(0.0, 10.0, 0.01)
+    problems = reference_problems(t, Truth(steps=_strides(6, to_s="all")))
+    assert set(problems) == {"to_error_median_abs_s", "to_error_mean_s"}  # no fpa_rad column: no FPA comparison
+    assert problems["to_error_mean_s"] == "the reference stride table has no 'to_s' column"
+    # 3 of 6 toe-offs missing is allowed (at most half), 4 is not
+    assert "to_error_mean_s" not in reference_problems(t, Truth(steps=_strides(6, to_s=3)))
+    assert reference_problems(t, Truth(steps=_strides(6, to_s=4)))["to_error_mean_s"] == (
+        "reference 'to_s' is missing in 4 of 6 strides")
+
+
+def test_refused_metrics_are_nan_with_their_reason():
+    values = {"step_count_error": -30.0, "stance_f1": 0.9, "matched_strides": 0.0, "ref_strides": 5.0}
+    out, notes = checked_metrics(values, {"step_count_error": "fragmented"}, Truth(steps=_strides(5)))
+    assert np.isnan(out["step_count_error"]) and notes["step_count_error"] == "fragmented"
+    assert out["stance_f1"] == 0.9 and "stance_f1" not in notes
+    assert np.isnan(out["stride_length_rms_error_m"])  # none matched: not a made-up number
+    assert notes["ic_error_median_abs_s"] == "no estimated stride matched a reference stride"
+
+
+# ------------------------------------------------------------------ one registry, footzoo run's names
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return simulate(path="straight", n_strides=8, rate=100.0, noise=NoiseModel(seed=0))
+
+
+def test_every_metric_of_a_run_is_registered_and_result_metrics_match(walk):
+    res = Pipeline.from_yaml("yun2012").run(walk)
+    m = run_metrics(walk.t, res.pos, res.steps, res.stance, walk.truth)
+    assert set(m) <= set(METRICS)
+    assert {k: v for k, v in m.items() if k in res.metrics} == pytest.approx(res.metrics, nan_ok=True)
+    assert set(m) - set(res.metrics) <= {k for k in METRICS if k.startswith("stance_")} | set(STEP_METRICS)
+    # the simulator's truth: 8 strides of 1.2 m at 1 s each
+    assert m["strides"] == walk.truth.stride_count == 8
+    assert m["median_stride_length_m"] == pytest.approx(1.2, abs=0.05)
+    assert m["median_stride_time_s"] == pytest.approx(1.0, abs=0.02)
+    assert m["median_speed_m_s"] == pytest.approx(1.2, abs=0.06)
+
+
+def test_a_study_reports_gait_metrics_by_footzoo_runs_names(walk, tmp_path):
+    base = {"simulate": {"path": "straight", "n_strides": 8, "rate": 100, "noise": {"scale": 1}}, "seeds": [0]}
+    study = Study.from_dict({"base": "yun2012", "recordings": [base],
+                             "metrics": ["median_stride_length_m", "strides", "ic_error_median_abs_s"]})
+    table = run_study(study, quiet=True)
+    values = dict(zip(table["metric"], table["value"], strict=True))
+    assert set(values) == {"median_stride_length_m", "strides", "ic_error_median_abs_s"}
+    res = Pipeline.from_yaml("yun2012").run(walk)
+    assert values["strides"] == res.metrics["strides"]
+    assert values["median_stride_length_m"] == res.metrics["median_stride_length_m"]
+    # by default a recording with stride and stance references reports every comparison
+    table = run_study(Study.from_dict({"base": "yun2012", "recordings": [base]}), quiet=True)
+    assert {"ic_error_median_abs_s", "to_error_median_abs_s", "stride_length_rms_error_m", "step_count_error",
+            "gait_phase_error_rate", "median_stance_time_s"} <= set(table["metric"])
+
+
+def test_old_metric_names_are_deprecated_aliases():
+    d = {"base": "yun2012", "recordings": [{"simulate": {"path": "straight", "n_strides": 4}}]}
+    assert METRIC_ALIASES["steps"] == "strides"
+    with pytest.warns(DeprecationWarning, match="'steps' is now called 'strides'"):
+        assert Study.from_dict({**d, "metrics": ["steps"]}).metrics == ["strides"]
+    with pytest.raises(ConfigError, match=r"unknown metric 'stride' \(did you mean 'strides'\?\)"):
+        Study.from_dict({**d, "metrics": ["stride"]})
+
+
+def test_a_fragmented_stance_reference_gives_nan_and_a_note_in_the_study_table(walk, tmp_path):
+    # the stance reference chopped into 40 ms fragments, as the VICON labels of PyShoe's running trials
+    stance = walk.truth.stance.copy()
+    stance[(np.arange(stance.size) // 4) % 2 == 1] = False
+    rec = Recording(t=walk.t, acc=walk.acc, gyr=walk.gyr, meta=dict(walk.meta), truth=Truth(stance=stance))
+    write(rec, tmp_path / "fragmented.csv")
+    study = Study.from_dict({"base": "yun2012", "recordings": [{"path": str(tmp_path / "fragmented.csv")}]})
+    with pytest.warns(MetricWarning, match="fragmented stance reference"):
+        table = run_study(study)
+    row = table.set_index("metric").loc["step_count_error"]
+    assert np.isnan(row["value"]) and row["note"].startswith("fragmented stance reference")
+    assert pd.isna(table.set_index("metric").loc["stance_f1", "note"])  # per-sample scores stay
+    assert "fragmented stance reference" in next(iter(table.attrs["refused"]))
