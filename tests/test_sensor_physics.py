@@ -35,7 +35,6 @@ BASE = {"name": "physics", "orientation": {"type": "madgwick", "use_magnetometer
         "detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
 
 
-@footzoo.register
 class Until(Detector):
     """Stance where |ω| < 0.6 rad/s, before ``until`` seconds only (a detector that stops firing)."""
 
@@ -49,6 +48,17 @@ class Until(Detector):
         self.statistic_ = np.linalg.norm(gyr, axis=1)
         self.stance_ = (self.statistic_ < 0.6) & (t < self.until)
         return self
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _registered():
+    """The test detector is registered while this module's tests run only (the contract tests of every
+    registered plug-in, in other modules, must not meet it)."""
+    from footzoo.plugins import registry
+
+    footzoo.register(Until)
+    yield
+    registry._REGISTRY[Until.kind].pop(Until.name, None)
 
 
 @pytest.fixture(scope="module")
@@ -237,5 +247,9 @@ def test_no_false_alarm_on_the_shipped_sample_and_real_recordings():
         pipe = Pipeline.from_yaml(name)
         for rec in recs:
             res, found = _sensor_warnings(lambda p=pipe, r=rec: p.run(r))
-            assert not found, (name, rec.name, found)
+            # the one true finding: PyShoe's 2018-02-22 trial has the sensor upside down (the mounting report
+            # names it, docs/gait-events.md); nothing else is flagged
+            mounting = [m for m in found if "Result.diagnostics['mounting']" in m]
+            assert not [m for m in found if m not in mounting], (name, rec.name, found)
+            assert not mounting or rec.name == "2018-02-22-10-09-36", (name, rec.name, mounting)
             assert res.diagnostics["sensor"] == {}, (name, rec.name)
