@@ -22,7 +22,6 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import minimize
 
 from .learned_zv import HIDDEN, SHIPPED_WEIGHTS, features, probability
 
@@ -75,6 +74,7 @@ def _loss(theta: np.ndarray, z: np.ndarray, y: np.ndarray, weight: np.ndarray, l
 def train(trials: Sequence[tuple[np.ndarray, np.ndarray]], l2: float = 1e-4, seed: int = 0,
           max_iter: int = 400) -> dict[str, np.ndarray]:
     """Fit the network to ``(features, labels)`` of several trials; returns the weights (see ``learned_zv``)."""
+    from scipy.optimize import minimize  # here: the plug-in registry imports this module, runs need no scipy
     x = np.concatenate([f for f, _ in trials])
     y = np.concatenate([lab for _, lab in trials]).astype(float)
     per_trial = np.concatenate([np.full(len(lab), 1.0 / len(lab)) for _, lab in trials])
