@@ -1,4 +1,4 @@
-"""The learned zero-velocity detector: features, network, weights files, training, and behaviour on data it never saw."""
+"""The learned zero-velocity detector: features, network, weights files, training, behaviour on unseen data."""
 
 from __future__ import annotations
 
