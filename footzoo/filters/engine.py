@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import functools
 import warnings
 from dataclasses import dataclass
 from typing import Any
@@ -20,11 +19,12 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import Settings
-from ..core.errors import ConfigError, FootzooWarning
+from ..core.errors import ConfigError, FootzooWarning, PluginError
 from ..core.params import Real
 from ..kernels import jit as _jit
+from ..kernels.functions import bind, capture_faults, compiled_with_signature, fixed_address, trusted
 from .eskf import ErrorStateFilter, Layout
-from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
+from .measurement import BA, BG, CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
 from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple, segment_ends
 
 ENGINES = ("auto", "fast", "reference")
@@ -295,12 +295,15 @@ class KalmanEngine:
         """
         n = len(t)
         if self.engine == "reference":
-            from .kalman_reference import run_reference
+            from .kalman_reference import ModelFault, run_reference
             from .stepwise import record_arrays
 
             arrays = record_arrays(n, self.layout.n, sum(m.max_rows for m in state["models"])) if record else None
-            out = run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"], self.idx,
-                                state["nav"], self.gravity, data, k0, smoother, arrays)
+            try:
+                out = run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"],
+                                    self.idx, state["nav"], self.gravity, data, k0, smoother, arrays)
+            except ModelFault as err:
+                raise self.fault(err.j, err.rows, err.k, [err.error] if err.error else []) from err.error
             if record:
                 out.update(zip(RECORD_KEYS, (arrays[0], arrays[1], arrays[3], arrays[4]), strict=True))
                 out[ROWS_KEY] = arrays[2]
@@ -318,7 +321,7 @@ class KalmanEngine:
             out[ROWS_KEY] = rows
         out["record"] = record_tuple(out) if record is True else record or None
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
-        for key, at in (("gyro_bias", 10), ("acc_bias", 13)):  # without its block the loop leaves a bias at 0
+        for key, at in (("gyro_bias", BG), ("acc_bias", BA)):  # without its block the loop leaves a bias at 0
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
                 out[key][:] = state.nav[at:at + 3]
         return out
@@ -355,10 +358,11 @@ class KalmanEngine:
         mem_off = np.cumsum([0] + [np.asarray(m.mem).size for m in models]).astype(np.int64)
         widths = [0 if m.data is None else m.data.shape[1] for m in models]
         data_off = np.cumsum([0] + widths).astype(np.int64)
-        functions = (tuple(_address(m.measure) for m in models), tuple(_address(m.feedback) for m in models),
-                     tuple(_address(m.after) for m in models))
+        functions = (tuple(fixed_address(m.measure) for m in models), tuple(fixed_address(m.feedback) for m in models),
+                     tuple(fixed_address(m.after) for m in models))
         hooks = np.array([[not is_no_op(m.feedback), not is_no_op(m.after)] for m in models], dtype=np.int64)
-        arrays = (m_idx, par, par_off, mem_off, data_off, hooks)
+        rows = np.array([int(m.max_rows) for m in models], dtype=np.int64)
+        arrays = (m_idx, par, par_off, mem_off, data_off, hooks, rows)
         return Packed(core, np.array(nav0, float), np.diag(self.p0).astype(float), mems, functions, arrays)
 
     @staticmethod
@@ -380,16 +384,23 @@ class KalmanEngine:
         second, at the stream's start) and each call passes arrays only.
         """
         if self.engine == "fast" and _jit.HAVE_NUMBA:
-            state.bound = _bound_loop(state.functions)
+            from .kalman_fast import eskf_loop
+
+            state.bound = bind(eskf_loop, state.functions)
         return state
 
-    @staticmethod
-    def step(packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
-        """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state."""
+    def step(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
+        """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state.
+
+        A model function that breaks its contract inside the loop (a row count it did not declare,
+        or a write outside its arrays, which a plug-in's bounds-checked code turns into an exception)
+        is raised here as that correction's :class:`~footzoo.core.errors.PluginError`.
+        """
         from .kalman_fast import eskf_loop, scratch, smoother_arrays
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
-        m_idx, par, par_off, mem_off, data_off, hooks = packed.arrays
+        m_idx, par, par_off, mem_off, data_off, hooks, rows = packed.arrays
+        arrays = (m_idx, par, par_off, mem_off, data, data_off, hooks, rows)
         signals = (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
                    np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
@@ -399,37 +410,37 @@ class KalmanEngine:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
         record = out.get("record")  # step-wise smoother
-        if packed.bound is not None and not out["gains"].shape[0]:
-            packed.bound(signals, packed.core, state, (m_idx, par, par_off, mem_off, data, data_off, hooks), outputs,
-                         k0, work, record)
-            return
-        measures, feedbacks, afters = packed.functions
-        smoother = smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0] else None
-        eskf_loop(signals, packed.core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                                data_off, hooks), outputs, k0, work, smoother, record)
+        with capture_faults() as caught:
+            if packed.bound is not None and not out["gains"].shape[0]:
+                packed.bound(signals, packed.core, state, arrays, outputs, k0, work, record)
+            else:
+                smoother = (smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0]
+                            else None)
+                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, smoother, record)
+        fault = work[-1]
+        if fault[0] >= 0 or caught:
+            raise self.fault(int(fault[0]), int(fault[1]), int(fault[2]), caught)
 
-
-_BOUND: dict[tuple, Any] = {}
-
-
-def _address(fn: Any) -> Any:
-    """A compiled measurement function as a first-class function value with a fixed address.
-
-    numba types a dispatcher passed as an argument, and looks up its machine-code address, at
-    every call of the compiled loop (about 0.2 ms each); a ``WrapperAddressProtocol`` object
-    carries the signature and the address, looked up once. Plain Python functions pass through.
-    """
-    if not _jit.HAVE_NUMBA or type(fn).__name__ != "CPUDispatcher" or len(fn.signatures) != 1:
-        return fn
-    cached = _ADDRESSES.get(id(fn))
-    if cached is None or cached.dispatcher is not fn:
-        cached = _ADDRESSES[id(fn)] = _fixed_address_type()(fn)
-    return cached
-
-
-_ADDRESSES: dict[int, Any] = {}
-_GAIN: list[Any] = []
-
+    def fault(self, j: int, rows: int, k: int, caught: list[BaseException]) -> PluginError:
+        """The :class:`PluginError` for a model that broke its contract in the loop (see :meth:`step`)."""
+        suspects = [name for name, m in zip(self.names, self.models, strict=True)
+                    if not all(trusted(fn) for fn in (m.measure, m.feedback, m.after))] or self.names
+        who = self.names[j] if j >= 0 else suspects[0] if len(suspects) == 1 else "one of " + ", ".join(suspects)
+        fix = "return m plus the rows written (at most max_rows), or raise max_rows in its MeasurementModel"
+        if caught:  # a bounds-checked write failed (the call then returns 0, which may also look like a row count)
+            err = caught[0]
+            text = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
+            where = "the reference Kalman loop" if self.engine == "reference" else "the compiled Kalman loop"
+            hint = "" if self.engine == "reference" else ", or run engine='reference' to see the failing line"
+            return PluginError(f"{who}: a measurement function failed inside {where} ({text}) at sample {k} or "
+                               "before; a write outside the rows its model declares (max_rows) or outside its "
+                               f"par/mem/data arrays is refused: fix the function{hint}", plugin=who, method="measure")
+        m = self.models[j]
+        if rows >= 0:
+            problem = f"returned {rows} rows at sample {k}, but its model declares max_rows={m.max_rows}"
+        else:
+            problem = f"returned a row count {-rows} below the first free row it was given (sample {k})"
+        return PluginError(f"{who}: its measure function {problem}; {fix}", plugin=who, method="measure")
 
 def _gain_function() -> Any:
     """The smoother's gain function for the compiled loop, compiled once with a fixed signature.
@@ -439,60 +450,10 @@ def _gain_function() -> Any:
     """
     from . import smoother
 
-    fn = _jit.compiled(smoother.smoother_gain)
-    if not _jit.HAVE_NUMBA:
-        return fn
     if not _GAIN:
-        numba = _jit.load_numba()
-        t = numba.types
-        a2 = t.float64[:, ::1]
-        signature = t.none(a2, a2, a2, a2, a2, a2, t.int64[::1])
-        _GAIN.append(_address(_jit.njit_signature(getattr(fn, "py_func", fn), signature, nogil=True)))
+        _GAIN.append(compiled_with_signature(smoother.smoother_gain, lambda t: t.none(
+            *(t.float64[:, ::1],) * 6, t.int64[::1])))
     return _GAIN[0]
 
 
-@functools.cache
-def _fixed_address_type() -> type:
-    """The class of :func:`_address`'s objects (defined at first use: it derives from a numba class)."""
-    from numba.core.types.function_type import WrapperAddressProtocol
-    from numba.experimental.function_type import _get_wrapper_address
-
-    class FixedAddress(WrapperAddressProtocol):
-        """A dispatcher compiled for one signature, seen by numba through its address."""
-
-        def __init__(self, dispatcher: Any):
-            self.dispatcher = dispatcher
-            self._signature = dispatcher.signatures[0]
-            self._sig = dispatcher.nopython_signatures[0]
-            self._address = _get_wrapper_address(dispatcher, self._sig)
-
-        def __wrapper_address__(self) -> int:
-            return self._address
-
-        def signature(self) -> Any:
-            return self._sig
-
-        def __call__(self, *args: Any) -> Any:
-            return self.dispatcher(*args)
-
-    return FixedAddress
-
-
-def _bound_loop(functions: tuple) -> Any:
-    """The compiled loop with these measurement functions as constants (compiled once per process and set)."""
-    key = tuple(id(f) for group in functions for f in group)
-    if key not in _BOUND:
-        from .kalman_fast import eskf_loop as lazy_loop
-
-        eskf_loop = _jit.compiled(lazy_loop)
-        measures, feedbacks, afters = functions
-
-        def bound(signals, core, state, arrays, out, k0, work, record):
-            m_idx, par, par_off, mem_off, data, data_off, hooks = arrays
-            eskf_loop(signals, core, state, (measures, feedbacks, afters, m_idx, par, par_off, mem_off, data,
-                                             data_off, hooks), out, k0, work, None, record)
-
-        import numba
-
-        _BOUND[key] = numba.njit(nogil=True)(bound)
-    return _BOUND[key]
+_GAIN: list[Any] = []

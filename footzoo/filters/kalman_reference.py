@@ -15,6 +15,22 @@ from .measurement import MeasurementModel
 from .smoother import smoother_gain
 
 
+class ModelFault(Exception):
+    """Model ``j`` broke its contract at sample ``k``: a row count ``rows`` it did not declare, or ``error``."""
+
+    def __init__(self, j: int, rows: int, k: int, error: BaseException | None = None):
+        super().__init__(j, rows, k, error)
+        self.j, self.rows, self.k, self.error = j, rows, k, error
+
+
+def _call(j: int, k: int, fn, *args):
+    """``fn(*args)``; an exception raised in it becomes a :class:`ModelFault` of model ``j``."""
+    try:
+        return fn(*args)
+    except Exception as err:
+        raise ModelFault(j, 0, k, err) from err
+
+
 def run_reference(
     t: np.ndarray,
     acc: np.ndarray,
@@ -114,9 +130,14 @@ def run_reference(
         z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
         m = 0
         st = bool(stance[k])
-        for model, ix, d in zip(models, idx, data, strict=True):
+        for j, (model, ix, d) in enumerate(zip(models, idx, data, strict=True)):
             row = d[k] if d is not None and d.shape[1] else np.zeros(0)
-            m = int(model.measure(k0 + k, float(t[k]), nav, w, f, st, ix, model.par, model.mem, row, z, H, R, m))
+            top = m + model.max_rows  # the rows the model declared, as in the compiled loop
+            m_new = int(_call(j, k0 + k, model.measure, k0 + k, float(t[k]), nav, w, f, st, ix, model.par, model.mem,
+                              row, z[:top], H[:top], R[:top], m))
+            if m_new < m or m_new > top:
+                raise ModelFault(j, m_new - m, k0 + k)
+            m = m_new
         if m:
             if record is not None:
                 record_update(record, k, kf.P, z[:m], H[:m], R[:m])
@@ -130,12 +151,12 @@ def run_reference(
                 nav[10:13] += dx[layout["gyro_bias"]]
             if has("acc_bias"):
                 nav[13:16] += dx[layout["acc_bias"]]
-            for model, ix in zip(models, idx, strict=True):
-                model.feedback(dx, ix, model.par, model.mem)
+            for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
+                _call(j, k0 + k, model.feedback, dx, ix, model.par, model.mem)
             if smooth:
                 out["dxs"][k] = dx
-        for model, ix in zip(models, idx, strict=True):
-            model.after(k0 + k, nav, st, ix, model.par, model.mem)
+        for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
+            _call(j, k0 + k, model.after, k0 + k, nav, st, ix, model.par, model.mem)
         _store(out, k, nav, a_n, kf.P)
         if record is not None:
             record[0][k] = kf.P

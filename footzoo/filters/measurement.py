@@ -45,8 +45,12 @@ Arguments:
     error state is estimate − truth), the **nonzero** entries of the
     measurement matrix ``H`` (the engine keeps every other entry zero) and
     the measurement noise variance ``R`` (diagonal: rows are independent; a
-    correlated measurement can be whitened first). Write at most the
-    model's ``max_rows`` rows.
+    correlated measurement can be whitened first). They end after row
+    ``m + max_rows − 1``: write at most the model's ``max_rows`` rows. A
+    plug-in's functions are compiled with bounds checks, so a write past
+    the end (or outside ``par``, ``mem``, ``data``) is refused, and so is a
+    returned row count outside ``[m, m + max_rows]``: both are the
+    plug-in's :class:`~footzoo.core.errors.PluginError`.
 ``m`` (int)
     First free row; return the next free row (``m`` when there is nothing
     to measure).
@@ -69,6 +73,7 @@ from typing import Any
 import numpy as np
 
 from ..kernels import jit as _jit
+from ..kernels.functions import NotCompilable, compile_model_function
 from ..kernels.jit import njit
 
 #: Offsets in ``nav``: quaternion, position, velocity, gyro bias, accelerometer bias.
@@ -79,51 +84,11 @@ ATT, GYRO_BIAS, POS, VEL, ACC_BIAS, OWN = 0, 1, 2, 3, 4, 5
 CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
 
 
-class NotCompilable(Exception):
-    """A measurement model's functions cannot be compiled; carries the reason."""
-
-
-@functools.cache
-def signature(role: str) -> Any:
-    """numba's signature of the engine's ``measure``, ``feedback`` or ``after`` functions (imports numba)."""
-    from numba import types as t
-
-    f1, i1, f = t.float64[::1], t.int64[::1], t.float64[:]
-    return {
-        "measure": t.int64(t.int64, t.float64, f1, f1, f1, t.boolean, i1, f, f, f, f1, t.float64[:, ::1], f1, t.int64),
-        "feedback": t.none(f1, i1, f, f),
-        "after": t.none(t.int64, f1, t.boolean, i1, f, f),
-    }[role]
-
-
 def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
-    """``fn`` compiled with the engine's signature for ``role``; raises :class:`NotCompilable` with numba's reason."""
-    numba = _jit.load_numba()
-    if numba is None:
-        return fn
+    """``fn`` compiled with the engine's signature for ``role`` (:mod:`footzoo.kernels.functions`)."""
     if isinstance(fn, ModelFunction):
         return fn.compiled()
-    sig = signature(role)
-    if isinstance(fn, numba.core.registry.CPUDispatcher):
-        if fn.signatures and all(tuple(s) == tuple(sig.args) for s in fn.signatures):
-            return fn
-        fn = fn.py_func
-    try:
-        # first without reference counting: the same machine code for a function that allocates no
-        # array (numba refuses to compile one that does, here or in a function it calls), minus the
-        # counting of every array argument at each call
-        return _jit.njit_signature(fn, sig, nogil=True, _nrt=False)
-    except Exception:  # it allocates (or numba lacks the option): with reference counting
-        pass
-    try:
-        return _jit.njit_signature(fn, sig, nogil=True)
-    except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
-        pass
-    try:
-        return numba.njit(sig, cache=False, nogil=True)(fn)
-    except Exception as err:  # numba raises many types; the message is what matters
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise NotCompilable(f"{role} function {getattr(fn, '__qualname__', fn)!r}: {first}") from None
+    return compile_model_function(fn, role)
 
 
 class ModelFunction:
