@@ -5,22 +5,35 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.errors import ConfigError
-from ..filters.measurement import ACC_BIAS, BA, BG, GYRO_BIAS, VEL, MeasurementModel, StateBlock, measurement_function
+from ..filters.measurement import (
+    ACC_BIAS,
+    BA,
+    BG,
+    GYRO_BIAS,
+    VEL,
+    MeasurementModel,
+    StateBlock,
+    V,
+    measurement_function,
+)
 from ..plugins.base import Boolean, KalmanCorrection, Real, Samples
 from ..plugins.registry import register
+
+#: Positions in the model's ``par``: σ of the velocity (m/s), zero rate on/off, σ of the rate (rad/s), the gyro
+#: and the accelerometer bias bounds (rad/s, m/s²); in ``mem``: the rows the bias guard added.
+VELOCITY_STD, ZERO_RATE, RATE_STD, GYRO_BOUND, ACC_BOUND = 0, 1, 2, 3, 4
+GUARD_ROWS = 0
 
 
 @measurement_function
 def zero_velocity_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
-    """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[1]``, ``δω = ω̂ − 0`` (eq. 30).
+    """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[ZERO_RATE]``, ``δω = ω̂ − 0`` (eq. 30).
 
-    In any sample, a bias estimate beyond its bound ``par[3]`` (gyro, rad/s) or
-    ``par[4]`` (accelerometer, m/s²) is measured at the bound, with σ a tenth
-    of the bound: ``δb = clip(b̂) − b̂`` (footzoo's bias guard; a bound of 0: none).
-
-    ``par`` = (velocity σ m/s, zero-rate on/off, rate σ rad/s, gyro bias bound, accelerometer bias bound).
+    In any sample, a bias estimate beyond its bound ``par[GYRO_BOUND]`` (rad/s) or
+    ``par[ACC_BOUND]`` (m/s²) is measured at the bound, with σ a tenth of the
+    bound: ``δb = clip(b̂) − b̂`` (footzoo's bias guard; a bound of 0: none).
     """
-    for blk, off, bound in ((GYRO_BIAS, BG, par[3]), (ACC_BIAS, BA, par[4])):
+    for blk, off, bound in ((GYRO_BIAS, BG, par[GYRO_BOUND]), (ACC_BIAS, BA, par[ACC_BOUND])):
         if idx[blk] < 0 or bound <= 0.0:
             continue
         for i in range(3):
@@ -29,29 +42,29 @@ def zero_velocity_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R,
                 H[m, idx[blk] + i] = 1.0
                 z[m] = (bound if b > 0.0 else -bound) - b
                 R[m] = (0.1 * bound) * (0.1 * bound)
-                mem[0] += 1.0
+                mem[GUARD_ROWS] += 1.0
                 m += 1
     if not stance:
         return m
     vel = idx[VEL]
     for i in range(3):
         H[m, vel + i] = 1.0
-        z[m] = nav[7 + i]
-        R[m] = par[0] * par[0]
+        z[m] = nav[V + i]
+        R[m] = par[VELOCITY_STD] * par[VELOCITY_STD]
         m += 1
-    if par[1] != 0.0:
+    if par[ZERO_RATE] != 0.0:
         gb = idx[GYRO_BIAS]
         for i in range(3):
             H[m, gb + i] = 1.0
             z[m] = w[i]
-            R[m] = par[2] * par[2]
+            R[m] = par[RATE_STD] * par[RATE_STD]
             m += 1
     return m
 
 
 def _bias_guard_report(mem: np.ndarray) -> dict[str, int]:
     """``bias_guard_rows``: how many bias-bound rows the guard added over the run (0: it never fired)."""
-    return {"bias_guard_rows": int(mem[0])}
+    return {"bias_guard_rows": int(mem[GUARD_ROWS])}
 
 
 @register

@@ -64,36 +64,41 @@ def _turn_swings(out: np.ndarray, stance: np.ndarray, ends: np.ndarray, yaw_end:
             out[k, 1] = s * n + c * east
 
 
+#: Positions in the model's ``par``: the threshold th_γ and σ_ψ (rad); in ``mem``: the previous sample was
+#: stance, its yaw (rad), the stance ends seen, the final yaws of the last two stances γ^{T_{i−1}}, γ^{T_{i−2}}.
+THRESHOLD, YAW_STD = 0, 1
+WAS_STANCE, LAST_YAW, ENDS_SEEN, YAW_1, YAW_2 = 0, 1, 2, 3, 4
+
+
 @measurement_function
 def heading_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
     """In stance: δψ of the current yaw against the two previous stances' final yaws (eqs. 23–24, 28).
 
-    ``par`` = (th_γ rad, σ_ψ rad); ``mem`` = (was stance, last yaw, stance ends seen, γ^{T_{i−1}},
-    γ^{T_{i−2}}).
+    ``par`` and ``mem``: see :data:`THRESHOLD` and :data:`WAS_STANCE`.
     """
-    if not stance or mem[2] < 2:
+    if not stance or mem[ENDS_SEEN] < 2:
         return m
-    a, b = mem[3], mem[4]
+    a, b = mem[YAW_1], mem[YAW_2]
     mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
     d = yaw_of(nav) - mean
     d = -((-d + math.pi) % (2 * math.pi) - math.pi)  # wrap to (-π, π], as conventions.wrap_angle
-    if abs(d) > par[0]:
+    if abs(d) > par[THRESHOLD]:
         return m
     H[m, idx[ATT] + 2] = 1.0
     z[m] = d
-    R[m] = par[1] * par[1]
+    R[m] = par[YAW_STD] * par[YAW_STD]
     return m + 1
 
 
 @after_function
 def heading_after(k, nav, stance, idx, par, mem):
     """Record the final heading of each stance (γ^{T_i}), after the update."""
-    if mem[0] != 0.0 and not stance and k > 1:
-        mem[4] = mem[3]
-        mem[3] = mem[1]
-        mem[2] += 1.0
-    mem[0] = 1.0 if stance else 0.0
-    mem[1] = yaw_of(nav)
+    if mem[WAS_STANCE] != 0.0 and not stance and k > 1:
+        mem[YAW_2] = mem[YAW_1]
+        mem[YAW_1] = mem[LAST_YAW]
+        mem[ENDS_SEEN] += 1.0
+    mem[WAS_STANCE] = 1.0 if stance else 0.0
+    mem[LAST_YAW] = yaw_of(nav)
 
 
 @register

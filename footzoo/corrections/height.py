@@ -32,7 +32,17 @@ import yaml
 from ..core.atomic import write_text
 from ..core.errors import ConfigError, RecordingError
 from ..core.yamlsafe import load_file
-from ..filters.measurement import ATT, OWN, POS, MeasurementModel, StateBlock, feedback_function, measurement_function
+from ..filters.measurement import (
+    ATT,
+    OWN,
+    POS,
+    MeasurementModel,
+    P,
+    Q,
+    StateBlock,
+    feedback_function,
+    measurement_function,
+)
 from ..plugins.base import Boolean, File, KalmanCorrection, Real, Samples, Vectors
 from ..plugins.registry import register
 
@@ -56,49 +66,57 @@ def _vectors(name: str, value, count: int | None = None, nonzero: bool = False) 
     return arr
 
 
+#: Positions in the distance model's ``par``: σ of a range (m), calibrate on/off, σ of the constraints, the
+#: baseline z_AB and its σ (m), the number of sensors k, the initial still period's length n_init, then its
+#: readings (n_init × k, m) and their validity (n_init × k).
+RANGE_STD, CALIBRATE, CONSTRAINT_STD, BASELINE, BASELINE_STD, N_SENSORS, N_INIT, INIT_READINGS = range(8)
+#: In its ``mem``: the floor height (m), the floor is known, then the mounting r̂ (k × 3, m) and n̂ (k × 3).
+FLOOR, FLOOR_KNOWN, MOUNTING = 0, 1, 2
+#: In its ``data`` row: in the still start, then the k readings (m), then their validity.
+IN_START, READINGS = 0, 1
+
+
 @measurement_function
 def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
     """Rows of eqs. 14–15 for each valid range reading, with eqs. 18 and 20 when calibrating.
 
-    ``par`` = (σ_range m, calibrate, σ_constraint, z_AB m, σ_AB m, k sensors, n_init, the initial
-    still period's readings (n_init × k, m) and their validity (n_init × k)); ``mem`` = (floor
-    height m, floor known, r̂ (k × 3, m), n̂ (k × 3)); ``data`` = (in the still start, the k
-    readings m, their validity); ``idx`` after the core: the offsets of r̄_j then n̄_j.
+    ``par``, ``mem`` and ``data``: see :data:`RANGE_STD`, :data:`FLOOR` and :data:`IN_START`;
+    ``idx`` after the core: the offsets of r̄_j then n̄_j.
     """
-    ks = int(par[5])
-    n_init = int(par[6])
-    calibrate = par[1] != 0.0
-    w_, x_, y_, z_ = nav[0], nav[1], nav[2], nav[3]
+    ks = int(par[N_SENSORS])
+    n_init = int(par[N_INIT])
+    calibrate = par[CALIBRATE] != 0.0
+    w_, x_, y_, z_ = nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3]
     # third row of C(q): the height component of a body vector in NED
     c0 = 2.0 * (x_ * z_ - w_ * y_)
     c1 = 2.0 * (y_ * z_ + w_ * x_)
     c2 = 1.0 - 2.0 * (x_ * x_ + y_ * y_)
-    if mem[1] == 0.0:
-        if data[0] != 0.0:
+    if mem[FLOOR_KNOWN] == 0.0:
+        if data[IN_START] != 0.0:
             return m
         total = 0.0
         count = 0
         for j in range(ks):
             for s in range(n_init):
-                if par[7 + n_init * ks + s * ks + j] != 0.0:
-                    reading = par[7 + s * ks + j]
-                    r = 2 + 3 * j
-                    nn = 2 + 3 * ks + 3 * j
+                if par[INIT_READINGS + n_init * ks + s * ks + j] != 0.0:
+                    reading = par[INIT_READINGS + s * ks + j]
+                    r = MOUNTING + 3 * j
+                    nn = MOUNTING + 3 * ks + 3 * j
                     total += (c0 * (mem[r] + mem[nn] * reading) + c1 * (mem[r + 1] + mem[nn + 1] * reading)
                               + c2 * (mem[r + 2] + mem[nn + 2] * reading))
                     count += 1
-        mem[0] = total / count
-        mem[1] = 1.0
+        mem[FLOOR] = total / count
+        mem[FLOOR_KNOWN] = 1.0
     # first two rows of C(q), for the attitude columns
     a00, a01, a02 = 1 - 2 * (y_ * y_ + z_ * z_), 2 * (x_ * y_ - w_ * z_), 2 * (x_ * z_ + w_ * y_)
     a10, a11, a12 = 2 * (x_ * y_ + w_ * z_), 1 - 2 * (x_ * x_ + z_ * z_), 2 * (y_ * z_ - w_ * x_)
     rows = 0
     for j in range(ks):
-        if data[1 + ks + j] == 0.0:
+        if data[READINGS + ks + j] == 0.0:
             continue
-        reading = data[1 + j]
-        r = 2 + 3 * j
-        nn = 2 + 3 * ks + 3 * j
+        reading = data[READINGS + j]
+        r = MOUNTING + 3 * j
+        nn = MOUNTING + 3 * ks + 3 * j
         b0 = mem[r] + mem[nn] * reading
         b1 = mem[r + 1] + mem[nn + 1] * reading
         b2 = mem[r + 2] + mem[nn + 2] * reading
@@ -114,26 +132,27 @@ def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
             cn = idx[OWN + ks + j]
             H[m, cr], H[m, cr + 1], H[m, cr + 2] = c0, c1, c2
             H[m, cn], H[m, cn + 1], H[m, cn + 2] = reading * c0, reading * c1, reading * c2
-        z[m] = mem[0] - (nav[6] + u2)
+        z[m] = mem[FLOOR] - (nav[P + 2] + u2)
         scale = c0 * mem[nn] + c1 * mem[nn + 1] + c2 * mem[nn + 2]
-        R[m] = (scale * par[0]) ** 2
+        R[m] = (scale * par[RANGE_STD]) ** 2
         m += 1
         rows += 1
     if rows > 0 and calibrate:
         for j in range(ks):  # eqs. 16-18: n̂ᵀ n̄ = 0
             cn = idx[OWN + ks + j]
-            nn = 2 + 3 * ks + 3 * j
+            nn = MOUNTING + 3 * ks + 3 * j
             H[m, cn], H[m, cn + 1], H[m, cn + 2] = mem[nn], mem[nn + 1], mem[nn + 2]
             z[m] = 0.0
-            R[m] = par[2] * par[2]
+            R[m] = par[CONSTRAINT_STD] * par[CONSTRAINT_STD]
             m += 1
-        d0, d1, d2 = mem[2] - mem[5], mem[3] - mem[6], mem[4] - mem[7]  # eqs. 19-20: ‖r_A − r_B‖ = z_AB
+        a, b = MOUNTING, MOUNTING + 3  # eqs. 19-20: ‖r_A − r_B‖ = z_AB
+        d0, d1, d2 = mem[a] - mem[b], mem[a + 1] - mem[b + 1], mem[a + 2] - mem[b + 2]
         norm = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ca, cb = idx[OWN], idx[OWN + 1]
         H[m, ca], H[m, ca + 1], H[m, ca + 2] = d0 / norm, d1 / norm, d2 / norm
         H[m, cb], H[m, cb + 1], H[m, cb + 2] = -d0 / norm, -d1 / norm, -d2 / norm
-        z[m] = par[3] - norm
-        R[m] = par[4] * par[4]
+        z[m] = par[BASELINE] - norm
+        R[m] = par[BASELINE_STD] * par[BASELINE_STD]
         m += 1
     return m
 
@@ -141,15 +160,15 @@ def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
 @feedback_function
 def distance_feedback(dx, idx, par, mem):
     """Add the calibration errors to the mounting estimates (eq. 1)."""
-    if par[1] == 0.0:
+    if par[CALIBRATE] == 0.0:
         return
-    ks = int(par[5])
+    ks = int(par[N_SENSORS])
     for j in range(ks):
         cr = idx[OWN + j]
         cn = idx[OWN + ks + j]
         for i in range(3):
-            mem[2 + 3 * j + i] += dx[cr + i]
-            mem[2 + 3 * ks + 3 * j + i] += dx[cn + i]
+            mem[MOUNTING + 3 * j + i] += dx[cr + i]
+            mem[MOUNTING + 3 * ks + 3 * j + i] += dx[cn + i]
 
 
 @register
@@ -309,8 +328,8 @@ class HeightDistance(KalmanCorrection):
             max_rows=k + (k + 1 if self.calibrate else 0),
             block_names=[b.name for b in self.state_blocks()],
             diagnostics=lambda mem: {"distance_calibration": {
-                "positions": mem[2:2 + 3 * k].reshape(k, 3).tolist(),
-                "directions": mem[2 + 3 * k:2 + 6 * k].reshape(k, 3).tolist()}},
+                "positions": mem[MOUNTING:MOUNTING + 3 * k].reshape(k, 3).tolist(),
+                "directions": mem[MOUNTING + 3 * k:MOUNTING + 6 * k].reshape(k, 3).tolist()}},
         )
 
 
@@ -334,14 +353,18 @@ def load_calibration(path: str | Path) -> dict:
     return data
 
 
+#: Position in the flat-floor model's ``par``: σ of the height (m).
+HEIGHT_STD = 0
+
+
 @measurement_function
 def flat_floor_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
     """In stance: the height error ``p̂_z − 0`` (the pipeline starts at the origin); ``par`` = (σ m,)."""
     if not stance:
         return m
     H[m, idx[POS] + 2] = 1.0
-    z[m] = nav[6]
-    R[m] = par[0] * par[0]
+    z[m] = nav[P + 2]
+    R[m] = par[HEIGHT_STD] * par[HEIGHT_STD]
     return m + 1
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
-from .measurement import MeasurementModel
+from .measurement import BA, BG, MeasurementModel, P, Q, V
 from .smoother import smoother_gain
 
 
@@ -31,23 +31,10 @@ def _call(j: int, k: int, fn, *args):
         raise ModelFault(j, 0, k, err) from err
 
 
-def run_reference(
-    t: np.ndarray,
-    acc: np.ndarray,
-    gyr: np.ndarray,
-    stance: np.ndarray,
-    quat_ext: np.ndarray | None,
-    layout: Layout,
-    kf: ErrorStateFilter,
-    models: list[MeasurementModel],
-    idx: list[np.ndarray],
-    nav0: np.ndarray,
-    gravity: float,
-    data: list[np.ndarray] | None = None,
-    k0: int = 0,
-    smooth: bool = False,
-    record: tuple | None = None,
-) -> dict[str, np.ndarray]:
+def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray, quat_ext: np.ndarray | None,
+                  layout: Layout, kf: ErrorStateFilter, models: list[MeasurementModel], idx: list[np.ndarray],
+                  nav0: np.ndarray, gravity: float, data: list[np.ndarray] | None = None, k0: int = 0,
+                  smooth: bool = False, record: tuple | None = None) -> dict[str, np.ndarray]:
     """Strapdown mechanisation with error-state Kalman corrections (Nguyen & La 2016, eqs. 37–52).
 
     Attitude: with an ``att`` block, ``q_k = q_{k-1} ⊗ exp((ω_k − b̂_g) dt)`` (the exact form
@@ -90,17 +77,12 @@ def run_reference(
         ``acc_bias`` (N, 3), ``P_diag`` (N, n).
     """
     n = t.shape[0]
-    has = layout.has
-    ins = has("att")
+    ins = layout.has("att")
     g_n = np.array([0.0, 0.0, gravity])
     nav = nav0
     data = data if data is not None else [m.data for m in models]
     m_max = sum(m.max_rows for m in models)
-    out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
-    out["quat"] = np.zeros((n, 4))
-    out["P_diag"] = np.zeros((n, layout.n))
-    out["gains"] = np.zeros((n if smooth else 0, layout.n, layout.n))
-    out["dxs"] = np.zeros((n if smooth else 0, layout.n))
+    out = _outputs(n, layout.n, smooth)
     work = (np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)),
             np.empty(layout.n, dtype=np.int64))
     _store(out, 0, nav, np.zeros(3), kf.P)
@@ -108,18 +90,7 @@ def run_reference(
         record[0][0] = kf.P
     for k in range(1, n):
         dt = t[k] - t[k - 1]
-        w = gyr[k] - nav[10:13]
-        f = acc[k] - nav[13:16]
-        q_prev = nav[:4].copy()
-        nav[:4] = quat_mul(q_prev, quat_from_rotvec(w * dt)) if ins else quat_ext[k]
-        q = nav[:4]
-        q_mid = q_prev + q if np.dot(q_prev, q) >= 0 else q - q_prev
-        c = quat_to_matrix(q_mid / np.linalg.norm(q_mid))
-        f_n = c @ f
-        a_n = f_n + g_n
-        v_prev = nav[7:10].copy()
-        nav[7:10] = v_prev + a_n * dt
-        nav[4:7] = nav[4:7] + 0.5 * (v_prev + nav[7:10]) * dt
+        w, f, c, f_n, a_n = _propagate(nav, acc[k], gyr[k], quat_ext[k] if not ins else None, g_n, dt)
         F = transition(layout, c, f_n, dt)
         p_post = kf.P.copy()
         kf.predict(F, dt, float(a_n @ a_n))
@@ -127,30 +98,13 @@ def run_reference(
             smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
         if record is not None:
             record_transition(record, k, F, layout, c, dt)
-        z, H, R = np.zeros(m_max), np.zeros((m_max, layout.n)), np.zeros(m_max)
-        m = 0
         st = bool(stance[k])
-        for j, (model, ix, d) in enumerate(zip(models, idx, data, strict=True)):
-            row = d[k] if d is not None and d.shape[1] else np.zeros(0)
-            top = m + model.max_rows  # the rows the model declared, as in the compiled loop
-            m_new = int(_call(j, k0 + k, model.measure, k0 + k, float(t[k]), nav, w, f, st, ix, model.par, model.mem,
-                              row, z[:top], H[:top], R[:top], m))
-            if m_new < m or m_new > top:
-                raise ModelFault(j, m_new - m, k0 + k)
-            m = m_new
-        if m:
+        z, H, R = _measure(models, idx, data, k, k0, float(t[k]), nav, w, f, st, m_max, layout.n)
+        if len(z):
             if record is not None:
-                record_update(record, k, kf.P, z[:m], H[:m], R[:m])
-            dx = kf.update(z[:m], H[:m], np.diag(R[:m]))
-            if ins:
-                qn = quat_mul(quat_from_rotvec(-dx[layout["att"]]), nav[:4])
-                nav[:4] = qn / np.linalg.norm(qn)
-            nav[4:7] -= dx[layout["pos"]]
-            nav[7:10] -= dx[layout["vel"]]
-            if has("gyro_bias"):
-                nav[10:13] += dx[layout["gyro_bias"]]
-            if has("acc_bias"):
-                nav[13:16] += dx[layout["acc_bias"]]
+                record_update(record, k, kf.P, z, H, R)
+            dx = kf.update(z, H, np.diag(R))
+            _feed_back(nav, dx, layout, ins)
             for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
                 _call(j, k0 + k, model.feedback, dx, ix, model.par, model.mem)
             if smooth:
@@ -161,6 +115,72 @@ def run_reference(
         if record is not None:
             record[0][k] = kf.P
     return out
+
+
+def _outputs(n: int, nx: int, smooth: bool) -> dict[str, np.ndarray]:
+    """The outputs of :func:`run_reference` for ``n`` samples of an ``nx``-state filter, zeroed."""
+    out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
+    out["quat"] = np.zeros((n, 4))
+    out["P_diag"] = np.zeros((n, nx))
+    out["gains"] = np.zeros((n if smooth else 0, nx, nx))
+    out["dxs"] = np.zeros((n if smooth else 0, nx))
+    return out
+
+
+def _propagate(nav: np.ndarray, acc_k: np.ndarray, gyr_k: np.ndarray, quat_ext_k: np.ndarray | None,
+               g_n: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
+    """The nominal state over one sample, in place (eqs. 37–40); returns ``w``, ``f``, ``C``, ``f^n``, ``a^n``.
+
+    The attitude from the rate, or ``quat_ext_k`` when the filter carries none; the velocity and
+    the position with the rotation at the middle of the interval.
+    """
+    w = gyr_k - nav[BG:BG + 3]
+    f = acc_k - nav[BA:BA + 3]
+    q_prev = nav[Q:Q + 4].copy()
+    nav[Q:Q + 4] = quat_mul(q_prev, quat_from_rotvec(w * dt)) if quat_ext_k is None else quat_ext_k
+    q = nav[Q:Q + 4]
+    q_mid = q_prev + q if np.dot(q_prev, q) >= 0 else q - q_prev
+    c = quat_to_matrix(q_mid / np.linalg.norm(q_mid))
+    f_n = c @ f
+    a_n = f_n + g_n
+    v_prev = nav[V:V + 3].copy()
+    nav[V:V + 3] = v_prev + a_n * dt
+    nav[P:P + 3] = nav[P:P + 3] + 0.5 * (v_prev + nav[V:V + 3]) * dt
+    return w, f, c, f_n, a_n
+
+
+def _measure(models: list[MeasurementModel], idx: list[np.ndarray], data: list[np.ndarray | None], k: int, k0: int,
+             t_k: float, nav: np.ndarray, w: np.ndarray, f: np.ndarray, st: bool, m_max: int,
+             n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The models' rows of sample ``k``, stacked: ``z`` (m,), ``H`` (m, n), ``R`` (m,).
+
+    Each model gets the buffers cut at the rows it declared, as in the compiled loop; a row count
+    outside them is a :class:`ModelFault`.
+    """
+    z, H, R = np.zeros(m_max), np.zeros((m_max, n)), np.zeros(m_max)
+    m = 0
+    for j, (model, ix, d) in enumerate(zip(models, idx, data, strict=True)):
+        row = d[k] if d is not None and d.shape[1] else np.zeros(0)
+        top = m + model.max_rows
+        m_new = int(_call(j, k0 + k, model.measure, k0 + k, t_k, nav, w, f, st, ix, model.par, model.mem, row,
+                          z[:top], H[:top], R[:top], m))
+        if m_new < m or m_new > top:
+            raise ModelFault(j, m_new - m, k0 + k)
+        m = m_new
+    return z[:m], H[:m], R[:m]
+
+
+def _feed_back(nav: np.ndarray, dx: np.ndarray, layout: Layout, ins: bool) -> None:
+    """The estimated error into the nominal state (eqs. 49–52): q ← exp(−δφ) ⊗ q, p ← p − δp, v ← v − δv, b ← b + δb."""
+    if ins:
+        qn = quat_mul(quat_from_rotvec(-dx[layout["att"]]), nav[Q:Q + 4])
+        nav[Q:Q + 4] = qn / np.linalg.norm(qn)
+    nav[P:P + 3] -= dx[layout["pos"]]
+    nav[V:V + 3] -= dx[layout["vel"]]
+    if layout.has("gyro_bias"):
+        nav[BG:BG + 3] += dx[layout["gyro_bias"]]
+    if layout.has("acc_bias"):
+        nav[BA:BA + 3] += dx[layout["acc_bias"]]
 
 
 def record_transition(record: tuple, k: int, F: np.ndarray, layout: Layout, c: np.ndarray, dt: float) -> None:
@@ -174,15 +194,15 @@ def record_transition(record: tuple, k: int, F: np.ndarray, layout: Layout, c: n
     count[k] = 0
 
 
-def record_update(record: tuple, k: int, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> None:
-    """The update of sample k as scalar rows (h, gain, ν / s) from the prior ``P``, into the record.
+def record_update(record: tuple, k: int, prior: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> None:
+    """The update of sample k as scalar rows (h, gain, ν / s) from the ``prior`` covariance, into the record.
 
     filterpy updates with the stacked rows; one row at a time (R diagonal) gives the same estimate
     and covariance, and the rows the compiled loop records.
     """
     rows, first, count = record[2], record[3], record[4]
-    n = P.shape[0]
-    Pa, dx = P.copy(), np.zeros(n)
+    n = prior.shape[0]
+    Pa, dx = prior.copy(), np.zeros(n)
     for a in range(len(z)):
         u = Pa @ H[a]
         s = float(H[a] @ u + R[a])
@@ -194,11 +214,11 @@ def record_update(record: tuple, k: int, P: np.ndarray, z: np.ndarray, H: np.nda
     count[k] = len(z)
 
 
-def _store(out: dict[str, np.ndarray], k: int, nav: np.ndarray, a_n: np.ndarray, P: np.ndarray) -> None:
-    out["quat"][k] = nav[:4]
-    out["pos"][k] = nav[4:7]
-    out["vel"][k] = nav[7:10]
-    out["gyro_bias"][k] = nav[10:13]
-    out["acc_bias"][k] = nav[13:16]
+def _store(out: dict[str, np.ndarray], k: int, nav: np.ndarray, a_n: np.ndarray, cov: np.ndarray) -> None:
+    out["quat"][k] = nav[Q:Q + 4]
+    out["pos"][k] = nav[P:P + 3]
+    out["vel"][k] = nav[V:V + 3]
+    out["gyro_bias"][k] = nav[BG:BG + 3]
+    out["acc_bias"][k] = nav[BA:BA + 3]
     out["acc_nav"][k] = a_n
-    out["P_diag"][k] = np.diag(P)
+    out["P_diag"][k] = np.diag(cov)

@@ -247,6 +247,6 @@ class MeasurementModel:
 @njit(inline=True)
 def yaw_of(nav: np.ndarray) -> float:
     """Z-Y-X heading of ``nav``'s attitude (rad); usable inside compiled measurement functions."""
-    w, x, y, z = nav[0], nav[1], nav[2], nav[3]
+    w, x, y, z = nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3]
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
