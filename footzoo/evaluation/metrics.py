@@ -663,6 +663,43 @@ def vertical_errors(pos: np.ndarray, ref: np.ndarray | None = None) -> dict[str,
     return out
 
 
+def nis_summary(nis: np.ndarray, rows: np.ndarray, confidence: float = 0.95) -> dict[str, float]:
+    """The Kalman filter's innovation consistency over a run (Bar-Shalom et al. 2001, Sec. 5.4.2–5.4.3).
+
+    Each update's normalised innovation squared ``ε_ν = νᵀ S⁻¹ ν`` is χ²-distributed with as many
+    degrees of freedom as it has rows for a consistent filter; it needs no ground truth, so it is the
+    consistency check on real recordings.
+
+    Parameters
+    ----------
+    nis : (N,) ndarray
+        Per sample, the update's NIS (0 without an update).
+    rows : (N,) ndarray
+        Per sample, the update's number of rows (its degrees of freedom).
+    confidence : float
+        The two-sided χ² acceptance region of one update.
+
+    Returns
+    -------
+    dict
+        ``nis_per_row``: ``Σ ε_ν / Σ rows`` (1 expected; above 1 the filter is over-confident, below
+        it is too cautious), ``nis_inside``: the share of updates inside the acceptance region
+        (``confidence`` expected), ``updates`` and ``rows``.
+    """
+    from scipy.stats import chi2
+
+    nis, rows = np.asarray(nis, dtype=float), np.asarray(rows, dtype=float)
+    used = rows > 0
+    total = float(rows[used].sum())
+    if not used.any():
+        return {"nis_per_row": float("nan"), "nis_inside": float("nan"), "updates": 0, "rows": 0}
+    tail = (1.0 - confidence) / 2.0
+    lo, hi = chi2.ppf(tail, rows[used]), chi2.ppf(1.0 - tail, rows[used])
+    inside = (nis[used] >= lo) & (nis[used] <= hi)
+    return {"nis_per_row": float(nis[used].sum() / total), "nis_inside": float(inside.mean()),
+            "updates": int(used.sum()), "rows": int(total)}
+
+
 def position_nees(pos: np.ndarray, ref: np.ndarray, var: np.ndarray) -> np.ndarray:
     """Normalised estimation error squared of the position per sample (Bar-Shalom et al. 2001, Sec. 5.4.2).
 

@@ -311,7 +311,7 @@ class KalmanEngine:
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
-               "P_diag": np.empty((n if covariance else 0, nx)),
+               "P_diag": np.empty((n if covariance else 0, nx)), "nis": np.zeros((n if covariance else 0, 2)),
                "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
         if record is True:
             from .stepwise import record_arrays
@@ -404,7 +404,7 @@ class KalmanEngine:
         signals = (np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(acc, dtype=float),
                    np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(stance, dtype=np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
-                   out["P_diag"])
+                   out["P_diag"], out["nis"])
         state = (packed.nav, packed.P, packed.mems)
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])

@@ -100,6 +100,7 @@ class ErrorStateFilter:
         self.kf.P = np.diag(np.asarray(p0, dtype=float))
         self.q = np.asarray(q, dtype=float)
         self.impact = float(impact)
+        self.nis = 0.0
 
     def predict(self, F: np.ndarray, dt: float, acc_sq: float = 0.0) -> None:
         """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates.
@@ -117,6 +118,8 @@ class ErrorStateFilter:
         self.kf.update(np.asarray(z, dtype=float).reshape(-1, 1), R=R, H=H)
         dx = self.kf.x[:, 0].copy()
         self.kf.x[:] = 0.0
+        y = self.kf.y[:, 0]
+        self.nis = float(y @ np.linalg.solve(self.kf.S, y))  # the normalised innovation squared νᵀ S⁻¹ ν
         return dx
 
     @property

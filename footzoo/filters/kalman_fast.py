@@ -46,9 +46,11 @@ The arguments of :func:`eskf_loop`:
     (L+1,), data (N, d), data_off (L+1,), hooks (L, 2) int: model j has a feedback / an after
     function, rows (L,) int: each model's max_rows)``.
 ``out``
-    ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n))``; row 0
-    receives the incoming state. A bias without its error-state block stays zero and is not
-    written: pass zeros. ``P_diag`` with 0 rows is not written.
+    ``(quat (N, 4), vel, pos, acc_nav, gyro_bias, acc_bias (N, 3), P_diag (N or 0, n), nis (N or
+    0, 2))``; row 0 receives the incoming state. A bias without its error-state block stays zero
+    and is not written: pass zeros. ``P_diag`` with 0 rows is not written, nor is ``nis``: per
+    sample, the normalised innovation squared of its update, ``Σ_a ν_a² / s_a`` over the scalar
+    rows (equal to the stacked ``νᵀ S⁻¹ ν``: R is diagonal), and the number of rows.
 ``k0``
     Index of sample 0 in the whole recording (a stream passes its running count).
 ``work``
@@ -98,8 +100,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
     functions, arrays = models
     nav_owned, P_owned, mems_owned = state
     n = P_owned.shape[0]
-    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag = out
-    keep_p = pdiag.shape[0] == t.shape[0]
+    keep_p = out[6].shape[0] == t.shape[0]
     z, H, rdiag, dx, w, f, u, kv, g, nzc, dyn, still, c, cdt, sdt, a_n, f_n, fault = work
     z, H, rdiag, dx, w, f = unowned(z), unowned(H), unowned(rdiag), unowned(dx), unowned(w), unowned(f)
     u, kv, g, nzc, dyn, still = unowned(u), unowned(kv), unowned(g), unowned(nzc), unowned(dyn), unowned(still)
@@ -119,6 +120,9 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
             H[a, b] = 0.0
     n_dyn = moving_rows(idx, n, dyn, still)
     store(0, nav, a_n, Pk, idx, out, keep_p, True)
+    if keep_p:
+        out[7][0, 0] = 0.0
+        out[7][0, 1] = 0.0
     if record is not None:  # step-wise smoother: P⁺ of the incoming state
         record_covariance(record, 0, Pk)
     for k in range(1, t.shape[0]):
@@ -147,11 +151,13 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
                 dxs[k, i] = 0.0
         st = stance[k]
         m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
+        nis = 0.0
         if m > 0:
             for i in range(n):
                 dx[i] = 0.0
             for a in range(m):
-                cnt, scaled = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
+                cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
+                nis += innov * scaled
                 if record is not None:  # step-wise smoother: the row, its gain, ν / s
                     record_row(record, k, H[a], kv, scaled)
                 for e in range(cnt):
@@ -165,6 +171,9 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
                     dxs[k, i] = dx[i]
         after(functions[2], views, k0 + k, nav, st, mems)
         store(k, nav, a_n, Pk, idx, out, keep_p, False)
+        if keep_p:  # the normalised innovation squared of the sample's update, and its rows
+            out[7][k, 0] = nis
+            out[7][k, 1] = m
         if record is not None:  # step-wise smoother: P⁺_k
             record_covariance(record, k, Pk)
 
@@ -336,7 +345,7 @@ def measure(measures, views, k, t_k, nav, w, f, st, mems, data_k, z, H, rdiag, f
 
 @njit(inline=True)
 def update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc):
-    """filterpy's update with row ``a`` of the stacked measurement; returns its nonzero count and ν / s.
+    """filterpy's update with row ``a`` of the stacked measurement; returns its nonzero count, ν / s and ν.
 
     K = P Hᵀ (H P Hᵀ + R)⁻¹ and the Joseph form (eq. 45), (I − KH) P (I − KH)ᵀ + K R Kᵀ, one row
     of H at a time: R is diagonal, so the rows are independent measurements and updating with
@@ -374,7 +383,7 @@ def update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc):
         ki, gi = kv[i], g[i]
         for j in range(n):  # whole rows (faster than the triangle: full vectors)
             Pk[i, j] -= ki * u[j] + gi * kv[j]
-    return cnt, innov / s_
+    return cnt, innov / s_, innov
 
 
 @njit(inline=True)
@@ -411,7 +420,7 @@ def after(afters, views, k, nav, st, mems):
 @njit(inline=True)
 def store(k, nav, a_n, Pk, idx, out, keep_p, first):
     """Sample ``k``'s estimates into the outputs (the motion acceleration of the incoming state: 0)."""
-    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag = out
+    quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, nis = out
     for i in range(4):
         quat[k, i] = nav[Q + i]
     for i in range(3):

@@ -74,7 +74,8 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
     -------
     dict
         ``quat`` (N, 4), ``vel``, ``pos``, ``acc_nav`` (motion acceleration), ``gyro_bias``,
-        ``acc_bias`` (N, 3), ``P_diag`` (N, n).
+        ``acc_bias`` (N, 3), ``P_diag`` (N, n), ``nis`` (N, 2): each sample's normalised innovation
+        squared ``νᵀ S⁻¹ ν`` (filterpy's ``y`` and ``S``) and its number of rows.
     """
     n = t.shape[0]
     ins = layout.has("att")
@@ -104,6 +105,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
             if record is not None:
                 record_update(record, k, kf.P, z, H, R)
             dx = kf.update(z, H, np.diag(R))
+            out["nis"][k] = kf.nis, len(z)
             _feed_back(nav, dx, layout, ins)
             for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
                 _call(j, k0 + k, model.feedback, dx, ix, model.par, model.mem)
@@ -122,6 +124,7 @@ def _outputs(n: int, nx: int, smooth: bool) -> dict[str, np.ndarray]:
     out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
     out["quat"] = np.zeros((n, 4))
     out["P_diag"] = np.zeros((n, nx))
+    out["nis"] = np.zeros((n, 2))
     out["gains"] = np.zeros((n if smooth else 0, nx, nx))
     out["dxs"] = np.zeros((n if smooth else 0, nx))
     return out

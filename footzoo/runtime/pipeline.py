@@ -28,6 +28,7 @@ from ..core.data import Recording, Result
 from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
+from ..evaluation.metrics import nis_summary
 from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
@@ -266,6 +267,9 @@ class Pipeline:
             columns ``pos_std_n``, ``pos_std_e``, ``pos_std_d``. Both are the forward
             filter's: with the RTS smoother the smoothed positions are at least as certain, so
             ``pos_std`` bounds their error from above (see benchmarks/accuracy.md, consistency).
+            Also each update's normalised innovation squared (``diagnostics['nis']``, with its rows
+            in ``diagnostics['nis_rows']``) and their summary ``diagnostics['consistency']``
+            (:func:`footzoo.evaluation.metrics.nis_summary`: 1 per row for a consistent filter).
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
@@ -367,6 +371,9 @@ class Pipeline:
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
             if covariance:
                 out["diagnostics"]["P_diag"] = out["P_diag"]
+                out["diagnostics"]["nis"] = out["nis"][:, 0]
+                out["diagnostics"]["nis_rows"] = out["nis"][:, 1].astype(int)
+                out["diagnostics"]["consistency"] = nis_summary(out["nis"][:, 0], out["nis"][:, 1])
                 if eng.layout.has("pos"):  # the forward filter's position standard deviation (m), N, E, D
                     out["diagnostics"]["pos_std"] = np.sqrt(out["P_diag"][:, eng.layout["pos"]])
             out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
