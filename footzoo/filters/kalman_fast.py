@@ -119,10 +119,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
         for b in range(n):
             H[a, b] = 0.0
     n_dyn = moving_rows(idx, n, dyn, still)
-    store(0, nav, a_n, Pk, idx, out, keep_p, True)
-    if keep_p:
-        out[7][0, 0] = 0.0
-        out[7][0, 1] = 0.0
+    store(0, nav, a_n, Pk, idx, out, keep_p, True, 0.0, 0)
     if record is not None:  # step-wise smoother: P⁺ of the incoming state
         record_covariance(record, 0, Pk)
     for k in range(1, t.shape[0]):
@@ -170,10 +167,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
                 for i in range(n):
                     dxs[k, i] = dx[i]
         after(functions[2], views, k0 + k, nav, st, mems)
-        store(k, nav, a_n, Pk, idx, out, keep_p, False)
-        if keep_p:  # the normalised innovation squared of the sample's update, and its rows
-            out[7][k, 0] = nis
-            out[7][k, 1] = m
+        store(k, nav, a_n, Pk, idx, out, keep_p, False, nis, m)
         if record is not None:  # step-wise smoother: P⁺_k
             record_covariance(record, k, Pk)
 
@@ -418,8 +412,11 @@ def after(afters, views, k, nav, st, mems):
 
 
 @njit(inline=True)
-def store(k, nav, a_n, Pk, idx, out, keep_p, first):
-    """Sample ``k``'s estimates into the outputs (the motion acceleration of the incoming state: 0)."""
+def store(k, nav, a_n, Pk, idx, out, keep_p, first, nis_k, rows_k):
+    """Sample ``k``'s estimates into the outputs (the motion acceleration of the incoming state: 0).
+
+    With the covariance kept, also its diagonal and the update's NIS and rows.
+    """
     quat, vel, pos, acc_nav, gb_out, ab_out, pdiag, nis = out
     for i in range(4):
         quat[k, i] = nav[Q + i]
@@ -434,6 +431,8 @@ def store(k, nav, a_n, Pk, idx, out, keep_p, first):
     if keep_p:
         for i in range(Pk.shape[0]):
             pdiag[k, i] = Pk[i, i]
+        nis[k, 0] = nis_k
+        nis[k, 1] = rows_k
 
 
 def scratch(n: int, m_max: int) -> tuple:
