@@ -140,7 +140,7 @@ def test_the_archive_describes_itself(result, tmp_path):
     samples = manifest["files"]["samples.csv"]
     assert samples["rows"] == len(result.samples) and samples["columns"]["stance"]["dtype"] == "bool"
     metrics = json.loads((folder / "metrics.json").read_text(), parse_constant=lambda c: pytest.fail(f"bare {c}"))
-    assert set(metrics) == {"metrics", "config", "versions", "recording"}
+    assert set(metrics) == {"metrics", "metric_notes", "config", "versions", "recording"}
     assert "samples.csv: per-sample estimates" in archive.describe(folder)
 
 

@@ -6,7 +6,7 @@ import pytest
 
 from footzoo import ConfigError, Pipeline
 from footzoo.core.data import Recording, Truth
-from footzoo.evaluation.metrics import METRIC_ALIASES, METRICS, run_metrics
+from footzoo.evaluation.metrics import METRIC_ALIASES, METRICS, result_metrics, run_metrics
 from footzoo.evaluation.validity import (
     MIN_STANCE_S,
     STEP_METRICS,
@@ -164,3 +164,35 @@ def test_a_fragmented_stance_reference_gives_nan_and_a_note_in_the_study_table(w
     assert np.isnan(row["value"]) and row["note"].startswith("fragmented stance reference")
     assert pd.isna(table.set_index("metric").loc["stance_f1", "note"])  # per-sample scores stay
     assert "fragmented stance reference" in next(iter(table.attrs["refused"]))
+
+
+def test_result_metrics_apply_the_same_rules_as_a_study(walk, tmp_path):
+    """A reference stride table too short to score: NaN with the same reason in Result.metrics, metrics.json
+    and a study cell's scores; a usable reference keeps every number (and no note)."""
+    res = Pipeline.from_yaml("yun2012").run(walk)
+    assert res.metric_notes == {}
+    assert res.metrics == pytest.approx(result_metrics(walk.t, res.pos, res.steps, walk.truth), nan_ok=True)
+
+    short = Truth(steps=walk.truth.steps.iloc[:2].copy(), stride_count=walk.truth.stride_count)
+    rec = Recording(t=walk.t, acc=walk.acc, gyr=walk.gyr, meta=dict(walk.meta), truth=short)
+    res = Pipeline.from_yaml("yun2012").run(rec)
+    with pytest.warns(MetricWarning, match="too few"):
+        m = res.metrics
+    refused = {k for k in STRIDE_COMPARISONS if k in m}
+    assert refused and all(np.isnan(m[k]) for k in refused)
+    assert set(res.metric_notes) == refused and all("too few" in why for why in res.metric_notes.values())
+    assert m["strides"] == 8 and m["stride_count_error"] == 0  # what the reference can score stays
+
+    import json
+
+    with pytest.warns(MetricWarning):
+        res.save(tmp_path / "out")
+    saved = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    assert saved["metric_notes"] == res.metric_notes and all(saved["metrics"][k] is None for k in refused)
+
+    # a study cell scores a run with the same rules (its table's value and note columns come from here)
+    from footzoo.studies.runner import _metrics
+
+    values, notes = _metrics(rec, res, res.pos, None)
+    assert {k: notes[k] for k in refused} == res.metric_notes
+    assert all(np.isnan(values[k]) for k in refused)

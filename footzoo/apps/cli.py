@@ -153,10 +153,12 @@ def _two_feet(args: argparse.Namespace) -> bool:
     return len(feet(Path(args.data))) == 2 or args.foot == "both"
 
 
-def _print_metrics(title: str, metrics: dict[str, Any]) -> None:
+def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | None = None) -> None:
     print(title)
+    notes = notes or {}
     for key, value in metrics.items():
-        print(f"  {key:32s} {value:.4f}" if isinstance(value, float) else f"  {key:32s} {value}")
+        why = f"   (refused: {notes[key]})" if key in notes else ""
+        print(f"  {key:32s} {value:.4f}{why}" if isinstance(value, float) else f"  {key:32s} {value}{why}")
 
 
 #: Files ``footzoo run --out DIR`` writes (a result archive with CSV tables, :mod:`footzoo.core.archive`).
@@ -214,7 +216,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     if "pyshoe_trial_error" in rec.meta:
         metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
     ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
-    _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics)
+    _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})", metrics,
+                   result.metric_notes)
     if out is not None:
         written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
         print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
@@ -238,7 +241,7 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
         rec = session.recordings[foot]
         ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
         _print_metrics(f"pipeline  {pipeline.name}  on  {rec.name}  ({rec.n} samples, {rec.rate:.1f} Hz{ref})",
-                       r.metrics)
+                       r.metrics, r.metric_notes)
     print("bilateral (medians; symmetry index = 100 |L - R| / mean, %)")
     print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
     if args.out is not None:

@@ -350,14 +350,17 @@ def _refuse_foreign(folder: Path, names: set[str], earlier: set[str] | None, wha
 
 
 def _metrics_payload(result: Any) -> dict[str, Any]:
+    notes: dict[str, str] = {}
     try:
         metrics: Any = result.metrics
+        notes = result.metric_notes
     except Exception as err:  # a failing metric must not lose the result
         warnings.warn(FootzooWarning(f"Result.save: the metrics could not be computed ({type(err).__name__}: {err}); "
                                      "saved without them"), stacklevel=4)
         metrics = {"error": f"{type(err).__name__}: {err}"}
     recording = {k: v for k, v in result.recording.items() if isinstance(v, (str, int, float, bool))}
-    return {"metrics": metrics, "config": result.config, "versions": result.versions, "recording": recording}
+    return {"metrics": metrics, "metric_notes": notes, "config": result.config, "versions": result.versions,
+            "recording": recording}
 
 
 def _result_files(result: Any, folder: Path, group: FileGroup, backend: str) -> dict[str, Any]:
@@ -369,8 +372,9 @@ def _result_files(result: Any, folder: Path, group: FileGroup, backend: str) -> 
         files[name] = {"holds": holds, **info}
     with group.open(folder / "metrics.json") as fh:
         fh.write(dumps_json(_metrics_payload(result)))
-    files["metrics.json"] = {"holds": "Result.metrics, config, versions and the recording's plain metadata "
-                                               "(strict JSON, NaN as null; recomputed on load)", "kind": "json"}
+    files["metrics.json"] = {"holds": "Result.metrics (with metric_notes: why a metric is null), config, "
+                                      "versions and the recording's plain metadata (strict JSON, NaN as null; "
+                                      "recomputed on load)", "kind": "json"}
     packer = _Packer()
     reference = None
     if result.reference is not None:

@@ -621,11 +621,27 @@ class Result:
         (:func:`footzoo.evaluation.metrics.stride_errors`). With footprints: per-footprint
         error after a 2-D rigid alignment. With per-stride trajectories: the
         median per-stride 3-D path RMS after a yaw alignment. See :func:`footzoo.evaluation.metrics.result_metrics`.
+
+        A metric the reference cannot score (fragmented stance labels, missing events, too few
+        strides: :mod:`footzoo.evaluation.validity`, the rules studies apply) is NaN, with a
+        :class:`~footzoo.evaluation.validity.MetricWarning`; :attr:`metric_notes` gives the reasons.
         """
-        from ..evaluation.metrics import result_metrics
+        from ..evaluation.validity import warn_refused
+
+        values, notes = self._checked_metrics()
+        warn_refused(f"{self.recording.get('name', 'recording')}", notes)
+        return values
+
+    @property
+    def metric_notes(self) -> dict[str, str]:
+        """Why each NaN of :attr:`metrics` is NaN: metric -> reason (empty when every metric could be scored)."""
+        return self._checked_metrics()[1]
+
+    def _checked_metrics(self) -> tuple[dict[str, float], dict[str, str]]:
+        from ..evaluation.validity import result_metrics_checked
 
         t = self.samples["t"].to_numpy()
-        return result_metrics(t, self.pos, self.steps, self.reference)
+        return result_metrics_checked(t, self.pos, self.steps, self.reference)
 
     def save(self, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
         """Save as a folder: tables, metrics, config, versions, metadata, diagnostics and the reference.

@@ -157,6 +157,20 @@ def checked_metrics(values: dict[str, float], problems: dict[str, str],
     return out, notes
 
 
+def result_metrics_checked(t: np.ndarray, pos: np.ndarray, steps: Any,
+                           reference: Any = None) -> tuple[dict[str, float], dict[str, str]]:
+    """:func:`footzoo.evaluation.metrics.result_metrics` under this module's rules, and the reasons of the NaN ones.
+
+    What :attr:`footzoo.core.data.Result.metrics` reports: the same keys as the unchecked metrics
+    (a refused metric is NaN, never dropped nor added), the same rules and reasons as a study's.
+    """
+    from .metrics import result_metrics
+
+    values = result_metrics(t, pos, steps, reference)
+    problems = {k: why for k, why in reference_problems(t, reference).items() if k in values}
+    return checked_metrics(values, problems, reference)
+
+
 def warn_refused(label: str, notes: dict[str, str]) -> None:
     """One :class:`MetricWarning` listing the refused metrics of one recording and their distinct reasons."""
     if not notes:
