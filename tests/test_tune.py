@@ -131,3 +131,31 @@ def test_the_tune_command(tmp_path, capsys):
     (tmp_path / "nogroup.yaml").write_text(yaml.safe_dump(nogroup))
     assert main(["tune", str(tmp_path / "nogroup.yaml"), "--out", str(tmp_path / "o2")]) == 2
     assert "has no group" in capsys.readouterr().err
+
+
+def test_optuna_search_finds_the_better_threshold_with_nested_folds(tmp_path):
+    pytest.importorskip("optuna")
+    study = {k: v for k, v in STUDY.items() if k != "factors"}
+    spec = {"objective": "armse_3d_m", "search": "optuna", "trials": 8, "seed": 3,
+            "space": {"detector.threshold": [10.0, 1.0]}}
+    result = tune(Study.from_dict(study), spec, out=tmp_path, quiet=True)
+    assert result.best_ == "detector.threshold=1" and list(result.folds_["chosen"]) == [result.best_] * 2
+    assert set(result.values_.columns) == {"detector.threshold=10", "detector.threshold=1"}  # each run once
+    assert (result.values_["detector.threshold=10"] > result.values_["detector.threshold=1"]).all()
+    # each fold's score on its held-out group is the chosen setting's own, as in the grid search
+    for row in result.folds_.itertuples():
+        held = result.groups_ == row.group
+        assert row.test_score == pytest.approx(result.values_.loc[held, row.chosen].mean())
+    assert Pipeline.from_yaml(tmp_path / "best.yaml").to_dict()["detector"]["threshold"] == 1.0
+    again = tune(Study.from_dict(study), spec, out=tmp_path, quiet=True)  # seeded: the same proposals
+    assert again.folds_.equals(result.folds_)
+
+
+def test_optuna_search_without_optuna_names_the_fix(monkeypatch):
+    monkeypatch.setitem(sys.modules, "optuna", None)  # import optuna raises ImportError
+    study = {k: v for k, v in STUDY.items() if k != "factors"}
+    spec = {"objective": "armse_3d_m", "search": "optuna", "space": {"detector.threshold": [10.0, 1.0]}}
+    with pytest.raises(ConfigError, match=r"pip install 'footzoo\[tune\]'"):
+        tune(Study.from_dict(study), spec, quiet=True)
+    with pytest.raises(ConfigError, match="optuna needs tune.space"):
+        TuneSpec.from_dict({"objective": "armse_3d_m", "search": "optuna"})

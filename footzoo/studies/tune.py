@@ -14,14 +14,21 @@ A tune file is a study file with a ``tune:`` block::
       direction: minimize          # or maximize
       aggregate: mean              # mean, median or gmean over recordings
       weight: group                # every group weighs the same (or: recording)
-      search: grid                 # grid over the factors, or random over `space`
-      trials: 20                   # settings drawn by a random search
+      search: grid                 # grid over the factors, random over `space`, or optuna (TPE) over `space`
+      trials: 20                   # settings drawn by a random search (per fold, by optuna)
       seed: 0
       space: {detector.threshold: {low: 1e4, high: 1e6, log: true}, detector.window: [3, 5, 7]}
       group_by: '^(\\d{4}-\\d{2}-\\d{2})'   # group = the regex's first group in the recording's label
       config: best.yaml            # where the chosen setting goes (default: OUT/best.yaml)
 
 A recording's group is its ``group:`` in the study's ``recordings`` or the ``group_by`` match.
+
+``search: optuna`` (``pip install 'footzoo[tune]'``) searches ``space`` sample-efficiently with
+optuna's TPE sampler (Bergstra et al. 2011; seeded, so repeatable): a search of ``trials``
+settings on the training groups of every fold (nested, so the held-out group never steers the
+search that scores it), and one on all groups for the chosen setting. Every trial runs through the
+same study runner (one cache: a setting two searches propose runs once), so it is parallel over
+the recordings as the other searches are.
 """
 
 from __future__ import annotations
@@ -46,10 +53,10 @@ TUNE_KEYS = {
     "direction": "minimize or maximize",
     "aggregate": "mean, median or gmean of the objective over recordings",
     "weight": "group (every group weighs the same) or recording",
-    "search": "grid (the study's factors) or random (settings drawn from `space`)",
-    "trials": "settings drawn by a random search",
+    "search": "grid (the study's factors), random (settings drawn from `space`) or optuna (TPE over `space`)",
+    "trials": "settings drawn by a random search, or tried by each optuna search",
     "seed": "seed of a random search",
-    "space": "dotted path -> list of values, or {low, high, log, integer} (random search)",
+    "space": "dotted path -> list of values, or {low, high, log, integer} (random and optuna search)",
     "group_by": "regular expression on the recording's label; its first group is the recording's group",
     "config": "file the chosen setting is written to (default: OUT/best.yaml)",
 }
@@ -58,6 +65,8 @@ AGGREGATES: dict[str, Callable[[np.ndarray], float]] = {
     "median": lambda v: float(np.median(v)),
     "gmean": lambda v: float(np.exp(np.mean(np.log(v)))) if np.all(v > 0) else float("nan"),
 }
+
+SEARCHES = ("grid", "random", "optuna")
 
 #: A score function: the objective's values of one setting on a set of recordings (indexed by
 #: recording) and their groups -> one number (lower is better after the direction is applied).
@@ -99,15 +108,15 @@ class TuneSpec:
         for name, value, allowed in (("direction", spec.direction, ("minimize", "maximize")),
                                      ("aggregate", spec.aggregate, tuple(AGGREGATES)),
                                      ("weight", spec.weight, ("group", "recording")),
-                                     ("search", spec.search, ("grid", "random"))):
+                                     ("search", spec.search, SEARCHES)):
             if value not in allowed:
                 raise ConfigError(f"tune.{name} must be one of {list(allowed)}, got {value!r}")
         for name in ("trials", "seed"):
             v = getattr(spec, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < (1 if name == "trials" else 0):
                 raise ConfigError(f"tune.{name} must be a whole number >= {1 if name == 'trials' else 0}, got {v!r}")
-        if spec.search == "random" and not spec.space:
-            raise ConfigError("tune.search: random needs tune.space (dotted path -> values or {low, high})")
+        if spec.search != "grid" and not spec.space:
+            raise ConfigError(f"tune.search: {spec.search} needs tune.space (dotted path -> values or {{low, high}})")
         if not isinstance(spec.space, dict):
             raise ConfigError(f"tune.space must map dotted paths to values or ranges, got {spec.space!r}")
         for path, dist in spec.space.items():
@@ -273,6 +282,11 @@ def candidate_study(study: Study, spec: TuneSpec) -> tuple[Study, dict[str, dict
                                                                                           spec.seed)]
     else:
         settings = [levels for _, levels in study.configs()]
+    return settings_study(study, spec, settings)
+
+
+def settings_study(study: Study, spec: TuneSpec, settings: list[dict[str, Any]]) -> tuple[Study, dict[str, dict]]:
+    """The study whose bases are these settings (``{"base": name, path: value, ...}`` each), and their names."""
     bases, named = [], {}
     base_configs = dict(study.bases)
     for levels in settings:
@@ -342,8 +356,6 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     out : path, optional
         Folder of the cache, ``tune_folds.csv``, ``tune_scores.csv`` and ``best.yaml``.
     """
-    from .runner import run_study
-
     if not isinstance(study, Study):
         study, file_spec = load_tune_file(study)
         spec = spec if spec is not None else file_spec
@@ -354,23 +366,21 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
         groups = recording_groups(study, spec.group_by)
     else:
         groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
-    cands, settings = candidate_study(study, spec)
-    table = run_study(cands, jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet, report=False)
-    rows = table[table["metric"] == spec.objective]
-    values = rows.pivot_table(index="recording", columns="base", values="value", aggfunc="first", dropna=False)
-    values = values.reindex(index=list(groups.index), columns=list(settings))
-    empty = values.isna().all(axis=1)
-    if empty.all():
-        causes = "; ".join(list(table.attrs.get("causes", {}))[:3]) or "the metric was never computed"
-        raise ConfigError(f"no setting gave {spec.objective!r} on any recording ({causes})")
-    values, groups = values[~empty], groups[~empty]
     score = score or spec.score_function()
-    chosen_from = [s for s in values.columns if eligible is None or eligible(s)]
-    if not chosen_from:
-        raise ConfigError("no setting is eligible")
-    folds, held_out, best = cross_validate(values[chosen_from], groups, score)
+    run = _Runner(study, spec, groups, dict(jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet))
+    if spec.search == "optuna":
+        folds, held_out, best = optuna_search(run, spec, score, eligible)
+        values, groups = run.values, run.groups
+    else:
+        run.evaluate(candidate_study(study, spec)[1])
+        values, groups = run.values, run.groups
+        chosen_from = [s for s in values.columns if eligible is None or eligible(s)]
+        if not chosen_from:
+            raise ConfigError("no setting is eligible")
+        folds, held_out, best = cross_validate(values[chosen_from], groups, score)
+    settings = run.settings
     scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
-    config = dict(cands.bases)[best]
+    config = run.configs[best]
     result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective)
     if out is not None:
         folder = Path(out)
@@ -386,6 +396,121 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     return result
 
 
+class _Runner:
+    """Runs settings through the study runner (one cache) and keeps the objective of every one run so far.
+
+    ``all_values`` (recording × setting; :attr:`values` and :attr:`groups`: the recordings that gave
+    a value), ``settings`` (name -> levels) and ``configs`` (name -> full config) grow with every
+    :meth:`evaluate`.
+    """
+
+    def __init__(self, study: Study, spec: TuneSpec, groups: pd.Series, options: dict[str, Any]):
+        self.study, self.spec, self.all_groups, self.options = study, spec, groups, options
+        self.all_values = pd.DataFrame(index=list(groups.index), dtype=float)
+        self.settings: dict[str, dict[str, Any]] = {}
+        self.configs: dict[str, dict[str, Any]] = {}
+        self.causes: list[str] = []
+
+    def evaluate(self, settings: dict[str, dict[str, Any]] | list[dict[str, Any]]) -> list[str]:
+        """Run the settings not run yet; returns the names of all of them, in order."""
+        from .runner import run_study
+
+        levels = list(settings.values()) if isinstance(settings, dict) else list(settings)
+        cands, named = settings_study(self.study, self.spec, levels)
+        new = [(name, cfg) for name, cfg in cands.bases if name not in self.all_values.columns]
+        if new:
+            part = Study(cands.name, new, {}, cands.recordings, cands.metrics, 0, cands.plugins, cands.jobs,
+                         cands.max_cells)
+            table = run_study(part, report=False, **self.options)
+            self.causes += list(table.attrs.get("causes", {}))
+            rows = table[table["metric"] == self.spec.objective]
+            got = rows.pivot_table(index="recording", columns="base", values="value", aggfunc="first", dropna=False)
+            for name, cfg in new:
+                self.all_values[name] = got[name].reindex(self.all_values.index) if name in got else np.nan
+                self.configs[name] = cfg
+        self.settings.update(named)
+        if self.all_values.isna().all(axis=None):
+            causes = "; ".join(self.causes[:3]) or "the metric was never computed"
+            raise ConfigError(f"no setting gave {self.spec.objective!r} on any recording ({causes})")
+        return list(named)
+
+    @property
+    def values(self) -> pd.DataFrame:
+        """The objective (recording × setting) of the recordings with at least one value."""
+        return self.all_values[~self.all_values.isna().all(axis=1)]
+
+    @property
+    def groups(self) -> pd.Series:
+        """The groups of the recordings with at least one value."""
+        return self.all_groups[~self.all_values.isna().all(axis=1)]
+
+
+def _suggest(trial: Any, space: dict[str, Any]) -> dict[str, Any]:
+    """One setting of ``space`` from an optuna trial (a list: categorical; a range: float or int, log or not)."""
+    setting = {}
+    for path, dist in space.items():
+        if isinstance(dist, list):
+            choice = trial.suggest_categorical(path, list(range(len(dist))))  # indices: any YAML value
+            setting[path] = dist[choice]
+        elif dist.get("integer"):
+            setting[path] = trial.suggest_int(path, int(math.ceil(dist["low"])), int(math.floor(dist["high"])),
+                                              log=bool(dist.get("log")))
+        else:
+            x = trial.suggest_float(path, dist["low"], dist["high"], log=bool(dist.get("log")))
+            setting[path] = float(f"{x:.4g}")
+    return setting
+
+
+def optuna_search(run: _Runner, spec: TuneSpec, score: Score,
+                  eligible: Callable[[str], bool] | None = None) -> tuple[pd.DataFrame, pd.Series, str]:
+    """Nested leave-one-group-out with an optuna TPE search per fold; the result of :func:`cross_validate`.
+
+    Each fold searches ``spec.trials`` settings of ``spec.space`` for the best score on its training
+    groups and scores that setting on its held-out group; a last search on every group gives the
+    chosen setting. Seeded with ``spec.seed`` (fold i: seed + i), so a rerun proposes the same settings.
+    """
+    try:
+        import optuna
+    except ImportError:
+        raise ConfigError("tune.search: optuna needs the optuna package: pip install 'footzoo[tune]' "
+                          "(or use search: random)") from None
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    base = run.study.bases[0][0]
+
+    def search(train: np.ndarray | None, seed: int) -> tuple[str, float]:
+        sampler = optuna.samplers.TPESampler(seed=seed)
+        opt = optuna.create_study(direction="minimize", sampler=sampler)
+        names: dict[int, str] = {}
+
+        def objective(trial: Any) -> float:
+            name = run.evaluate([{"base": base, **_suggest(trial, spec.space)}])[0]
+            names[trial.number] = name
+            if eligible is not None and not eligible(name):
+                return math.inf
+            v, g = run.values[name], run.groups
+            mask = np.ones(len(v), bool) if train is None else train(g)
+            value = score(v[mask], g[mask])
+            return value if math.isfinite(value) else math.inf
+
+        opt.optimize(objective, n_trials=spec.trials)
+        return names[opt.best_trial.number], float(opt.best_value)
+
+    folds, held_out = [], None
+    names = list(pd.unique(run.all_groups.to_numpy()))
+    if len(names) < 2:
+        raise ConfigError(f"cross-validation needs at least two groups; every recording is in group {names[0]!r}")
+    for i, group in enumerate(names):
+        chosen, train_score = search(lambda g, group=group: (g != group).to_numpy(), spec.seed + i)
+        v, g = run.values[chosen], run.groups
+        test = (g == group).to_numpy()
+        folds.append({"group": str(group), "recordings": int(test.sum()), "chosen": chosen,
+                      "train_score": train_score, "test_score": score(v[test], g[test])})
+        fold = pd.Series(v[test].to_numpy(), index=v.index[test])
+        held_out = fold if held_out is None else pd.concat([held_out, fold])
+    best, _ = search(None, spec.seed + len(names))
+    return pd.DataFrame(folds), held_out.reindex(run.values.index), best
+
+
 def load_tune_file(path: str | Path) -> tuple[Study, TuneSpec]:
     """A tune file: the study (without its ``tune:`` block) and the spec; paths relative to the file."""
     from ..config.library import resolve
@@ -399,7 +524,7 @@ def load_tune_file(path: str | Path) -> tuple[Study, TuneSpec]:
     block = data.pop("tune")
     try:
         spec = TuneSpec.from_dict(block)
-        if spec.search == "random":
+        if spec.search != "grid":
             data.pop("factors", None)
         study = Study.from_dict(data, root=p.parent)
     except ConfigError as err:
