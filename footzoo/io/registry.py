@@ -181,9 +181,30 @@ class Readers(Mapping[str, Any]):
         if p.suffix.lower() in (".csv", ".txt", ".tsv", "") and not head:
             raise FormatError(f"{p}: the file has no header line (it is empty or blank); check the file")
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
+        if head and ";" in head and "," not in head:
+            seen += " (its values are separated by ';': footzoo's CSV readers read ',', so convert the file or " \
+                    "describe it in a sidecar)"
+        if p.suffix.lower() == ".mat":
+            seen += f" ({_mat_contents(p)})"
         raise FormatError(f"{p}: cannot tell the format: no reader recognises this file{seen}. Formats: "
                           f"{self.listing()}. Rename the columns, describe them in a sidecar {p.name}.footzoo.yaml "
                           f"(the 'generic' format), or {how}")
+
+
+def _mat_contents(p: Path) -> str:
+    """What a ``.mat`` file no reader claims holds: its variables, or that MATLAB's format cannot list them."""
+    import scipy.io as sio
+
+    try:
+        names = [name for name, _, _ in sio.whosmat(p)]
+    except Exception as err:  # scipy raises many types for a damaged file
+        return f"MATLAB's format cannot list its variables ({type(err).__name__}): a damaged or truncated file?"
+    try:
+        sio.loadmat(p)
+    except Exception as err:
+        return (f"its variables {names[:8]} cannot be read ({type(err).__name__}: {str(err)[:80]}): a damaged or "
+                "truncated file?")
+    return f"variables {names[:12]}; PyShoe's trials have imu and ts"
 
 
 @lru_cache(maxsize=1)
