@@ -68,3 +68,21 @@ def test_a_truncated_matlab_file_is_called_damaged(tmp_path):
     savemat(other, {"x": np.zeros(3)})
     with pytest.raises(FormatError, match=r"variables \['x'\]; PyShoe's trials have imu and ts"):
         footzoo.load(other)
+
+
+@pytest.mark.parametrize("part, value, message", [
+    ("orientation", {"type": {"type": "ins"}}, r"orientation: 'type' must be the name \(text\) of one of the orientation plug-ins, got dict"),
+    ("detector", {"type": ["shoe"]}, r"detector: 'type' must be the name \(text\) of one of the detector plug-ins, got list"),
+    ("detector", {"type": 3}, r"detector: 'type' must be the name \(text\) of one of the detector plug-ins, got int"),
+])
+def test_a_type_that_is_not_a_name_is_a_config_error_in_run_and_validate(part, value, message, tmp_path):
+    from footzoo.apps.cli import main
+
+    cfg = {"name": "odd", "orientation": {"type": "ins"}, "detector": {"type": "shoe"},
+           "corrections": [{"type": "ekf_zupt"}], part: value}
+    with pytest.raises(footzoo.ConfigError, match=message):
+        footzoo.Pipeline.from_dict(cfg)
+    import yaml
+
+    (tmp_path / "odd.yaml").write_text(yaml.safe_dump(cfg))
+    assert main(["validate", str(tmp_path / "odd.yaml")]) == 2  # a config error, not "internal error"

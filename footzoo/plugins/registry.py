@@ -113,6 +113,9 @@ def available(kind: str) -> dict[str, type[Plugin]]:
 def get(kind: str, name: str, where: str = "") -> type[Plugin]:
     """The plug-in class registered as ``name`` under ``kind``."""
     plugins = available(kind)
+    if not isinstance(name, str):
+        raise ConfigError(f"{where or kind}: 'type' must be the name (text) of one of the {kind} plug-ins, got {type(name).__name__} "
+                          f"{name!r:.80}; valid types: {sorted(plugins)}")
     if name not in plugins:
         names = sorted(plugins)
         raise ConfigError(
