@@ -70,10 +70,13 @@ def test_a_truncated_matlab_file_is_called_damaged(tmp_path):
         footzoo.load(other)
 
 
+NOT_A_NAME = r"'type' must be the name \(text\) of one of the {} plug-ins, got {}"
+
+
 @pytest.mark.parametrize("part, value, message", [
-    ("orientation", {"type": {"type": "ins"}}, r"orientation: 'type' must be the name \(text\) of one of the orientation plug-ins, got dict"),
-    ("detector", {"type": ["shoe"]}, r"detector: 'type' must be the name \(text\) of one of the detector plug-ins, got list"),
-    ("detector", {"type": 3}, r"detector: 'type' must be the name \(text\) of one of the detector plug-ins, got int"),
+    ("orientation", {"type": {"type": "ins"}}, "orientation: " + NOT_A_NAME.format("orientation", "dict")),
+    ("detector", {"type": ["shoe"]}, "detector: " + NOT_A_NAME.format("detector", "list")),
+    ("detector", {"type": 3}, "detector: " + NOT_A_NAME.format("detector", "int")),
 ])
 def test_a_type_that_is_not_a_name_is_a_config_error_in_run_and_validate(part, value, message, tmp_path):
     from footzoo.apps.cli import main
