@@ -89,3 +89,13 @@ def test_a_type_that_is_not_a_name_is_a_config_error_in_run_and_validate(part, v
 
     (tmp_path / "odd.yaml").write_text(yaml.safe_dump(cfg))
     assert main(["validate", str(tmp_path / "odd.yaml")]) == 2  # a config error, not "internal error"
+
+
+def test_a_missing_yaml_file_is_called_missing_not_an_unknown_shipped_name(tmp_path, monkeypatch):
+    from footzoo.config.library import resolve
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(footzoo.ConfigError, match=r"'my_study\.yaml': no such file in .*no shipped config has that name"):
+        resolve("my_study.yaml")
+    with pytest.raises(footzoo.ConfigError, match=r"no shipped config named 'recomended' \(did you mean 'recommended'"):
+        resolve("recomended")

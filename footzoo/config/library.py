@@ -56,7 +56,12 @@ def resolve(spec: str | Path) -> Path:
     """
     p = Path(spec)
     if p.exists() or not is_name(spec):
-        if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml"):
+        if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml", ".yml"):
+            if p.suffix:  # a file name: say that the file is missing, then which names are shipped
+                known = names()
+                raise ConfigError(f"{str(spec)!r}: no such file in {str(Path.cwd())!r}, and no shipped config has that "
+                                  f"name{did_you_mean(p.stem, known)}; check the path, or use a shipped config by "
+                                  f"name: {known}")
             path(str(spec))  # a name that is not shipped: the error lists the shipped ones
         return p
     return path(str(spec))
