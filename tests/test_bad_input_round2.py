@@ -6,6 +6,8 @@ wrong recording).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -95,7 +97,70 @@ def test_a_missing_yaml_file_is_called_missing_not_an_unknown_shipped_name(tmp_p
     from footzoo.config.library import resolve
 
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(footzoo.ConfigError, match=r"'my_study\.yaml': no such file in .*no shipped config has that name"):
+    missing = r"'my_study\.yaml': no such file in .*no shipped config has that name"
+    with pytest.raises(footzoo.ConfigError, match=missing):
         resolve("my_study.yaml")
     with pytest.raises(footzoo.ConfigError, match=r"no shipped config named 'recomended' \(did you mean 'recommended'"):
         resolve("recomended")
+
+
+# --------------------------------------------------------------------------- live and in memory
+
+
+@pytest.fixture(scope="module")
+def sim_walk():
+    from footzoo.sim import NoiseModel
+
+    return simulate(n_strides=10, rate=100.0, noise=NoiseModel(seed=1))
+
+
+def test_a_stream_made_with_the_wrong_rate_refuses_at_its_start(sim_walk):
+    from footzoo import Pipeline, Stream
+
+    stream = Stream(Pipeline.from_yaml("nguyen2016"), rate=2 * sim_walk.rate)
+    with pytest.raises(RecordingError, match=r"come at 100 Hz, but the stream was made with rate=200 Hz.*rate=100"):
+        stream.run(sim_walk)
+    near = Stream(Pipeline.from_yaml("nguyen2016"), rate=sim_walk.rate * 1.05)  # a nominal rate, 5 % off: fine
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert np.isfinite(near.run(sim_walk)["pos"]).all()
+
+
+def test_an_accelerometer_unit_that_changes_mid_stream_is_warned_where_it_changes(sim_walk):
+    from footzoo import Pipeline, Stream
+    from footzoo.core.errors import SensorWarning
+
+    half = sim_walk.n // 2
+    stream = Stream(Pipeline.from_yaml("nguyen2016"), rate=sim_walk.rate)
+    with pytest.warns(SensorWarning, match=r"accelerometer reads 0\.99\d? \(≈ 1: in g\?"):
+        for i in range(sim_walk.n):
+            stream.push(sim_walk.t[i], sim_walk.acc[i] / (9.81 if i >= half else 1.0), sim_walk.gyr[i])
+        stream.close()
+    finding = stream.sensor["acc_scale"]
+    assert finding["first"] >= half and finding["magnitude"] == pytest.approx(1.0, abs=0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SensorWarning)  # the same walk in m/s² throughout: no finding
+        res = footzoo.Pipeline.from_yaml("nguyen2016").run(sim_walk)
+    assert "acc_scale" not in res.diagnostics["sensor"]
+
+
+def test_complex_samples_are_refused_not_cast():
+    t = np.arange(300) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (300, 1)) + 1j
+    with pytest.raises(RecordingError, match=r"acc holds complex numbers.*acc\.real"):
+        footzoo.Recording(t=t, acc=acc, gyr=np.zeros((300, 3)))
+
+
+def test_a_result_folder_named_like_a_file_is_refused(sim_walk, tmp_path):
+    from footzoo.core.errors import OutputError
+
+    res = footzoo.Pipeline.from_yaml("yun2012").run(sim_walk)
+    with pytest.raises(OutputError, match=r"looks like a file name \(\.xlsx\).*saved as a folder"):
+        res.save(tmp_path / "result.xlsx")
+    assert not (tmp_path / "result.xlsx").exists()
+    assert res.save(tmp_path / "result.v2").is_dir()  # a dotted folder name that is no file type is fine
+
+
+def test_running_a_path_instead_of_a_recording_says_how_to_load_it():
+    with pytest.raises(TypeError, match=r"load it first, Pipeline\.run\(footzoo\.load\('walk\.csv'\)\)"):
+        footzoo.Pipeline.from_yaml("yun2012").run("walk.csv")

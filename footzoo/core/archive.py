@@ -438,6 +438,11 @@ def _commit(folder: Path, group: FileGroup, files: dict[str, Any], earlier: set[
         group.remove(folder / stale)
 
 
+#: Extensions of single files: a result folder with one of these names is refused (a user expecting one file).
+FILE_SUFFIXES = (".csv", ".tsv", ".txt", ".json", ".parquet", ".pq", ".xlsx", ".xls", ".npz", ".npy", ".mat", ".h5",
+                 ".hdf5", ".zip", ".pkl", ".pickle")
+
+
 def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
     """Write ``result`` as a result archive folder (see the module doc); returns the folder.
 
@@ -460,6 +465,11 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     """
     backend = _backend(backend)
     what = "Result.save"
+    suffix = Path(path).suffix.lower()
+    if suffix in FILE_SUFFIXES and not Path(path).is_dir():
+        raise OutputError(f"{what}: {str(path)!r} looks like a file name ({suffix}), but a result is saved as a folder "
+                          "of tables and JSON files; give a folder name (e.g. "
+                          f"{str(Path(path).with_suffix(''))!r}). To export one table: result.samples.to_csv(...)")
     with _new_folder(path, what) as folder:
         earlier = _earlier_files(folder, FORMAT)
         with FileGroup(inputs=_inputs(result, inputs), what=what) as group:

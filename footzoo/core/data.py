@@ -337,6 +337,13 @@ def _floats(name: str, value: Any) -> np.ndarray:
     compiled kernels then see one array type whatever the reader, and compile once.
     """
     try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):  # ragged: the conversion below says so
+        kind = ""
+    if kind == "c":  # float() would drop the imaginary parts without a word
+        raise RecordingError(f"{name} holds complex numbers; footzoo needs real samples (a float array): pass "
+                             f"{name}.real if the imaginary parts are zero, else check how the array was made")
+    try:
         array = np.ascontiguousarray(value, dtype=float)
         return array if array.flags.writeable else array.copy()
     except (TypeError, ValueError) as err:

@@ -235,6 +235,8 @@ STILL_MIN_DURATION = 5.0
 STILL_MAX_DRIFT = 0.25
 #: Shortest motion after the still start (s) for which "no stance at all" is reported.
 NO_STANCE_MIN_DURATION = 5.0
+#: Shortest quiet period (s) whose specific force far from g (outside [0.5 g, 1.5 g]) is reported as a scale fault.
+SCALE_MIN_DURATION = 0.2
 
 
 class SignalScan:
@@ -374,6 +376,10 @@ class EstimateScan:
     * **drift while still** — the data say the sensor lies still (|ω| < :data:`STILL_GYR`,
       |‖f‖ − g| < :data:`STILL_ACC`) for :data:`STILL_MIN_DURATION` s or longer, and the estimate
       moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness.
+    * **accelerometer scale** — the gyroscope is quiet (|ω| < :data:`STILL_GYR`) for
+      :data:`SCALE_MIN_DURATION` s or longer while ‖f‖ stays outside [0.5 g, 1.5 g]: a foot that
+      does not turn does not fall or push at half or twice g for that long, so the accelerometer's
+      unit or scale is wrong there (e.g. a stream whose unit changed to g mid-way).
 
     Findings are warned (:class:`~footzoo.core.errors.SensorWarning`, with the samples and the
     fix) as soon as they are known, and kept in :attr:`report`.
@@ -386,6 +392,7 @@ class EstimateScan:
         self._first: tuple[float, np.ndarray] | None = None  # (t, pos) of the first sample after the still start
         self._last: tuple[float, np.ndarray] | None = None
         self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
+        self._off: tuple[int, float, float] | None = None  # a quiet run off g open at the chunk's end: (k, t, |f|)
 
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
              pos: np.ndarray) -> None:
@@ -399,6 +406,7 @@ class EstimateScan:
                 i = int(np.argmax(moving))
                 self._first = (float(t[i]), pos[i].copy())
         self._last = (float(t[-1]), pos[-1].copy())
+        self._scale(k, t, acc, gyr)
         still = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (
             np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STILL_ACC)
         if not still[0] and self._run is not None:  # the open run ended at the chunk's start
@@ -420,6 +428,34 @@ class EstimateScan:
                 self._close(run)
                 if s == 0:
                     self._run = None
+
+    def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
+        """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s."""
+        if "acc_scale" in self.report:
+            return
+        norm = np.linalg.norm(acc, axis=1)
+        off = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (np.abs(norm - self.gravity) > 0.5 * self.gravity)
+        edges = np.flatnonzero(np.diff(np.concatenate([[False], off, [False]]).astype(np.int8)))
+        carried, self._off = self._off, None
+        for s, e in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):
+            start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]), float(norm[s]))
+            if t[e - 1] - start[1] >= SCALE_MIN_DURATION:
+                self._warn_scale(start, float(t[e - 1]), float(np.median(norm[s:e])))
+                return
+            if e == len(t):  # open at the chunk's end: the next chunk may continue it
+                self._off = start
+
+    def _warn_scale(self, start: tuple[int, float, float], t1: float, level: float) -> None:
+        self.report["acc_scale"] = {"first": start[0], "t0": start[1], "magnitude": level}
+        unit = (" (≈ 1: in g? convert to m/s² by × 9.81)" if abs(level - 1.0) < 0.1 else
+                " (≈ 1000: in mg? × 0.00981)" if abs(level - 1000.0) < 100.0 else "")
+        warnings.warn(
+            f"{self.name}: from t = {start[1]:.2f} s (sample {start[0]}) the gyroscope is quiet for "
+            f"{t1 - start[1]:.1f} s while the accelerometer reads {level:.3g}{unit}, far from g = "
+            f"{self.gravity:.2f} m/s²: its unit or scale is wrong from there. Check the unit of the samples "
+            "(live: every packet in m/s²). Details in diagnostics['sensor']",
+            SensorWarning, stacklevel=6,
+        )
 
     def _close(self, run: dict[str, Any]) -> None:
         duration = run["t1"] - run["t0"]

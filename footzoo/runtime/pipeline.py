@@ -11,6 +11,7 @@ The stages read the plug-ins' base classes and declared capabilities, never thei
 from __future__ import annotations
 
 import copy
+import os
 from pathlib import Path
 from typing import Any
 
@@ -274,7 +275,9 @@ class Pipeline:
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
         if not isinstance(rec, Recording):
-            raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}")
+            hint = (f": load it first, Pipeline.run(footzoo.load({str(rec)!r}))" if isinstance(rec, (str, os.PathLike))
+                    else ": build one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
+            raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}{hint}")
         self._check_inputs(rec)
         ctx = self.context(rec)
         rec, calibration = self.calibrate(rec)

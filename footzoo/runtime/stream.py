@@ -53,6 +53,9 @@ from .stages import (
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
 SCAN_BLOCK = 128
+#: Largest relative difference between the rate a stream is made with and the rate of its time stamps over the
+#: still start (a nominal 100 Hz sensor at 98–102 Hz is fine; a 50 Hz one declared at 100 Hz is not).
+RATE_TOLERANCE = 0.2
 #: The per-sample columns of the final estimates.
 COLUMNS = ("t", "quat", "pos", "vel", "acc_nav", "stance")
 
@@ -375,8 +378,15 @@ class Stream:
             return False
         rate = self.rate
         n_init = int(np.searchsorted(t, t[0] + duration, side="right"))
+        measured = 1.0 / float(np.median(np.diff(t[:n_init])))
+        if rate is not None and abs(measured / rate - 1.0) > RATE_TOLERANCE:
+            raise RecordingError(
+                f"Stream: the time stamps of the first {t[n_init - 1] - t[0]:.2f} s come at {measured:.4g} Hz, but "
+                f"the stream was made with rate={rate:g} Hz: every window and duration would be off by "
+                f"{measured / rate:.2f}×. Pass the sensor's real rate (rate={measured:.4g}), or fix the time stamps "
+                "(seconds, of each sample)")
         if rate is None:
-            rate = 1.0 / float(np.median(np.diff(t[:n_init])))
+            rate = measured
             warnings.warn(f"Stream: no rate given; using {rate:.2f} Hz measured over the still start (a batch run "
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
                           FootzooWarning, stacklevel=4)
