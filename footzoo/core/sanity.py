@@ -392,7 +392,7 @@ class EstimateScan:
         self._first: tuple[float, np.ndarray] | None = None  # (t, pos) of the first sample after the still start
         self._last: tuple[float, np.ndarray] | None = None
         self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
-        self._off: tuple[int, float, float] | None = None  # a quiet run off g open at the chunk's end: (k, t, |f|)
+        self._off: tuple[int, float] | None = None  # a quiet run off g open at the chunk's end: (k, t)
 
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
              pos: np.ndarray) -> None:
@@ -406,9 +406,10 @@ class EstimateScan:
                 i = int(np.argmax(moving))
                 self._first = (float(t[i]), pos[i].copy())
         self._last = (float(t[-1]), pos[-1].copy())
-        self._scale(k, t, acc, gyr)
-        still = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (
-            np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STILL_ACC)
+        quiet = np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2
+        off_g = np.sqrt(np.einsum("ij,ij->i", acc, acc)) - self.gravity
+        self._scale(k, t, quiet, off_g)
+        still = quiet & (np.abs(off_g) < STILL_ACC)
         if not still[0] and self._run is not None:  # the open run ended at the chunk's start
             self._close(self._run)
             self._run = None
@@ -429,23 +430,28 @@ class EstimateScan:
                 if s == 0:
                     self._run = None
 
-    def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
-        """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s."""
+    def _scale(self, k: np.ndarray, t: np.ndarray, quiet: np.ndarray, off_g: np.ndarray) -> None:
+        """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s.
+
+        ``quiet``: |ω| < STILL_GYR per sample; ``off_g``: ‖f‖ − g (m/s²).
+        """
         if "acc_scale" in self.report:
             return
-        norm = np.linalg.norm(acc, axis=1)
-        off = (np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2) & (np.abs(norm - self.gravity) > 0.5 * self.gravity)
+        off = quiet & (np.abs(off_g) > 0.5 * self.gravity)
+        if not off.any() and self._off is None:
+            return
         edges = np.flatnonzero(np.diff(np.concatenate([[False], off, [False]]).astype(np.int8)))
         carried, self._off = self._off, None
         for s, e in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):
-            start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]), float(norm[s]))
+            start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]))
             if t[e - 1] - start[1] >= SCALE_MIN_DURATION:
-                self._warn_scale(start, float(t[e - 1]), float(np.median(norm[s:e])))
+                level = float(np.median(off_g[s:e])) + self.gravity  # ‖f‖ there
+                self._warn_scale(start, float(t[e - 1]), level)
                 return
             if e == len(t):  # open at the chunk's end: the next chunk may continue it
                 self._off = start
 
-    def _warn_scale(self, start: tuple[int, float, float], t1: float, level: float) -> None:
+    def _warn_scale(self, start: tuple[int, float], t1: float, level: float) -> None:
         self.report["acc_scale"] = {"first": start[0], "t0": start[1], "magnitude": level}
         unit = (" (≈ 1: in g? convert to m/s² by × 9.81)" if abs(level - 1.0) < 0.1 else
                 " (≈ 1000: in mg? × 0.00981)" if abs(level - 1000.0) < 100.0 else "")
