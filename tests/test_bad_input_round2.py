@@ -164,3 +164,35 @@ def test_a_result_folder_named_like_a_file_is_refused(sim_walk, tmp_path):
 def test_running_a_path_instead_of_a_recording_says_how_to_load_it():
     with pytest.raises(TypeError, match=r"load it first, Pipeline\.run\(footzoo\.load\('walk\.csv'\)\)"):
         footzoo.Pipeline.from_yaml("yun2012").run("walk.csv")
+
+
+# --------------------------------------------------------------------------- studies
+
+
+@pytest.mark.parametrize("simulate_spec, message", [
+    ({"path": "straigt"}, r"recordings\[0\]\.simulate: unknown path 'straigt'"),
+    ({"path": "straight", "n_strides": -4}, r"n_strides must be a whole number of strides >= 1, got -4"),
+    ({"path": "straight", "n_stride": 4}, r"unknown option 'n_stride' \(did you mean 'n_strides'\?\)"),
+    ({"path": "straight", "rate": 0}, r"rate must be a number in \(0, 20000\] Hz, got 0"),
+])
+def test_a_study_refuses_a_bad_simulate_entry_before_running(simulate_spec, message):
+    from footzoo.studies import Study
+
+    with pytest.raises(footzoo.ConfigError, match=message):
+        Study.from_dict({"base": "yun2012", "recordings": [{"simulate": simulate_spec}]})
+
+
+def test_two_recordings_with_one_name_are_refused_and_labels_tell_them_apart(walk_csv, tmp_path):
+    import shutil
+
+    from footzoo.studies import Study
+
+    for d in ("a", "b"):
+        (tmp_path / d).mkdir()
+        shutil.copy(walk_csv, tmp_path / d / "walk.csv")
+    same = [{"path": str(tmp_path / d / "walk.csv")} for d in ("a", "b")]
+    with pytest.raises(footzoo.ConfigError, match=r"both called 'walk'.*give each entry its own label"):
+        Study.from_dict({"base": "yun2012", "recordings": same})
+    labelled = [{**r, "label": d} for r, d in zip(same, ("a", "b"), strict=True)]
+    study = Study.from_dict({"base": "yun2012", "recordings": labelled})
+    assert [r.label for r in study.recordings] == ["a", "b"]

@@ -10,7 +10,9 @@ range of every distance sample.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -31,6 +33,54 @@ SPEEDS = {
 }
 
 PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed", "run", "stairs")
+
+
+#: The simulator's numeric arguments: the range each must lie in (as text) and its test.
+LIMITS: dict[str, tuple[str, Callable[[float], bool]]] = {
+    "stride_length": ("(0, 5] m", lambda v: 0 < v <= 5), "cycle": ("(0, 10] s", lambda v: 0 < v <= 10),
+    "stance_fraction": ("(0, 1)", lambda v: 0 < v < 1), "rate": ("(0, 20000] Hz", lambda v: 0 < v <= 20000),
+    "stand_start": ("[0, 3600] s", lambda v: 0 <= v <= 3600), "stand_end": ("[0, 3600] s", lambda v: 0 <= v <= 3600),
+    "clearance": ("[0, 2] m", lambda v: 0 <= v <= 2),
+}
+
+
+def check_arguments(**kw: Any) -> None:
+    """Refuse simulator arguments that cannot make a walk, with a ConfigError naming the argument (before any work).
+
+    Checks ``path``, ``foot``, ``n_strides`` (a whole number ≥ 1) and the numbers of :data:`LIMITS`;
+    a study checks its ``simulate:`` entries with it before running anything.
+    """
+    from ..core.errors import ConfigError
+
+    if "path" in kw and kw["path"] not in PATHS:
+        raise ConfigError(f"simulate: unknown path {kw['path']!r}; known: {list(PATHS)}")
+    if "foot" in kw and kw["foot"] not in ("right", "left"):
+        raise ConfigError(f"simulate: foot must be 'right' or 'left', got {kw['foot']!r}")
+    n = kw.get("n_strides", 1)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ConfigError(f"simulate: n_strides must be a whole number of strides >= 1, got {n!r}")
+    for name, (bounds, ok) in LIMITS.items():
+        v = kw.get(name, None)
+        if name in kw and (isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v)
+                           or not ok(float(v))):
+            raise ConfigError(f"simulate: {name} must be a number in {bounds}, got {v!r}")
+
+
+#: The path-shape options ``simulate`` takes besides its named arguments (see its ``**path_options``).
+PATH_OPTIONS = ("length", "width", "radius", "heading", "rise", "going", "landing_strides", "laps")
+
+
+def check_spec(spec: dict[str, Any]) -> None:
+    """A ``simulate(**spec)`` mapping (a study's ``simulate:`` entry): unknown names and bad values refused."""
+    import inspect
+
+    from ..core.errors import ConfigError, did_you_mean
+
+    known = [p for p in inspect.signature(simulate).parameters if p != "path_options"] + list(PATH_OPTIONS)
+    for key in spec:
+        if key not in known:
+            raise ConfigError(f"simulate: unknown option {key!r}{did_you_mean(str(key), known)}; options: {known}")
+    check_arguments(**spec)
 
 
 def _footsteps(path: str, n_strides: int, stride_length: float, **kw) -> tuple[list[Footstep], bool]:
@@ -133,8 +183,9 @@ def simulate(
         (stairs), ``laps`` (closed paths walked that many times: ``track`` with
         ``laps=10`` is a 4.4 km, one-hour walk at 1.2 m/s).
     """
-    if foot not in ("right", "left"):
-        raise ValueError(f"foot must be 'right' or 'left', got {foot!r}")
+    check_arguments(path=path, n_strides=n_strides, stride_length=stride_length, cycle=cycle,
+                    stance_fraction=stance_fraction, clearance=clearance, rate=rate, stand_start=stand_start,
+                    stand_end=stand_end, foot=foot)
     rec_name = f"sim_{path}"
     if path == "run":
         path, speeds = "mixed_speed", [("run", n_strides)]

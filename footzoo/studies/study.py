@@ -21,6 +21,7 @@ from ..core.errors import ConfigError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import METRICS, metric_name
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
+from ..sim.scenarios import check_spec
 
 #: Largest grid (bases × factor levels × recordings) a study runs unless its ``max_cells`` says more.
 MAX_CELLS = 10_000
@@ -30,7 +31,8 @@ STUDY_KEYS = {
     "description": "free text",
     "base": "a config path, an inline config, or a list of them",
     "factors": "mapping of dotted paths to lists of values (all combinations are run)",
-    "recordings": "list of {path: glob, format: ..., group: ...} or {simulate: {...}, seeds: [...], group: ...}",
+    "recordings": "list of {path: glob, format: ..., group: ..., label: ...} or {simulate: {...}, seeds: [...], "
+                  "group: ..., label: ...}",
     "metrics": "list of metric names to keep (default: all)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
     "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
@@ -315,6 +317,13 @@ class Study:
             recordings += _expand_recording(r, root, i)
         if not recordings:
             raise ConfigError("the study has no recordings (check the globs)")
+        seen: dict[str, RecordingSpec] = {}
+        for rec in recordings:
+            other = seen.setdefault(rec.label, rec)
+            if other is not rec:  # two recordings under one name would share their rows and cache entries
+                where = " and ".join(str(x.path) if x.path else f"simulate seed {x.seed}" for x in (other, rec))
+                raise ConfigError(f"two recordings of the study are both called {rec.label!r} ({where}); give each "
+                                  "entry its own label: (e.g. {path: subject2/walk.csv, label: subject2_walk})")
         metrics = d.get("metrics")
         if metrics is not None:
             if isinstance(metrics, str):
@@ -486,12 +495,22 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         if not matches:
             raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
         matches = _without_sidecars(matches)
-        opts = {k: v for k, v in r.items() if k not in ("path", "format", "group")}
-        return [RecordingSpec(Path(m).stem, path=m, format=r.get("format"), options=opts, group=group)
-                for m in matches]
+        label = r.get("label")
+        if label is not None and not isinstance(label, (str, int)):
+            raise ConfigError(f"recordings[{i}].label must be a name (text), got {label!r}")
+        opts = {k: v for k, v in r.items() if k not in ("path", "format", "group", "label")}
+
+        def name(m: str) -> str:  # one file: the label itself; a glob: the label as a prefix of each stem
+            return Path(m).stem if label is None else str(label) if len(matches) == 1 else f"{label}_{Path(m).stem}"
+
+        return [RecordingSpec(name(m), path=m, format=r.get("format"), options=opts, group=group) for m in matches]
     if not isinstance(r["simulate"], dict):
         raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
     sim = dict(r["simulate"])
+    try:
+        check_spec(sim)
+    except ConfigError as err:
+        raise ConfigError(f"recordings[{i}].{err}") from None
     seeds = r.get("seeds", [0])
     if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) for s in seeds):
         raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers, got {seeds!r}")
