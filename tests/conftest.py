@@ -32,6 +32,17 @@ if "FOOTZOO_SHIPPED_KERNELS" not in os.environ and (_shipped := installed_kernel
 DATA = Path(os.environ.get("FOOTZOO_DATA") or Path(__file__).resolve().parents[1].parent / "shared" / "data")
 
 
+def load_benchmark(name: str):
+    """The script ``benchmarks/<name>.py`` imported as a module (the benchmarks are scripts, not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(f"{name}_benchmark", Path(__file__).resolve().parents[1] /
+                                                  "benchmarks" / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
 def data_file(*parts: str) -> Path:
     """Path of a file under ../shared/data, skipping the test when it is absent."""
     p = DATA.joinpath(*parts)

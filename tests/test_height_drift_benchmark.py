@@ -1,6 +1,5 @@
 """benchmarks/height_drift.py: its stance shortening and its configs (the full run needs PyShoe's trials)."""
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -8,15 +7,14 @@ import pytest
 
 from footzoo.runtime.pipeline import Pipeline
 
+from .conftest import load_benchmark
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
 def hd():
-    spec = importlib.util.spec_from_file_location("height_drift_benchmark", ROOT / "benchmarks" / "height_drift.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_benchmark("height_drift")
 
 
 def test_shorten_stances_drops_seconds_at_each_inner_edge(hd):
