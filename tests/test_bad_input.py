@@ -414,7 +414,35 @@ CASES = [
          RecordingError, "dist at t"),
     Case("stream-mag-shape", lambda d, w: _push(w, (w.t[0], w.acc[0], w.gyr[0], [1.0, 2.0])), RecordingError,
          "mag at t"),
+    # a column named twice: pandas would rename the second and the first would be read silently
+    Case("canonical-duplicate-column", lambda d, w: (lambda: load(_text(
+        d, "r.csv", "".join(line + ",0\n" for line in _imu_text(w).splitlines()).replace(",0", ",acc_x", 1)))),
+         FormatError, "['acc_x'] more than once"),
+    Case("canonical-semicolons", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w).replace(",", ";")))),
+         FormatError, "separated by semicolons"),
+    Case("canonical-tabs", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w).replace(",", "\t")))),
+         FormatError, "separated by tabs"),
+    # the row's time is printed as a number, not as a numpy repr
+    Case("canonical-nan-cell-time", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w, nan_row=3)))),
+         RecordingError, "first at row 3 (t = 0.030000 s)"),
 ]
+
+
+def _imu_text(w: Recording, nan_row: int | None = None) -> str:
+    """The IMU columns of ``w`` as canonical CSV text (``nan`` in acc_x of ``nan_row``)."""
+    rows = ["t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z"]
+    for k in range(len(w.t)):
+        acc = ["nan" if k == nan_row else repr(float(w.acc[k, 0])), *map(repr, map(float, w.acc[k, 1:]))]
+        rows.append(",".join([repr(float(w.t[k])), *acc, *map(repr, map(float, w.gyr[k]))]))
+    return "\n".join(rows) + "\n"
+
+
+def test_quoted_header_is_read(tmp_path, walk):
+    """A header with quoted names ("t","acc_x",...) is valid CSV: it is read as the canonical format."""
+    lines = _imu_text(walk).split("\n")
+    lines[0] = ",".join(f'"{c}"' for c in lines[0].split(","))
+    rec = load(_text(tmp_path, "q.csv", "\n".join(lines)))
+    np.testing.assert_array_equal(rec.acc, load(_text(tmp_path, "p.csv", _imu_text(walk))).acc)
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])

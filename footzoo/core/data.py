@@ -282,7 +282,7 @@ class Recording:
                     )
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
-                    f"first at row {row} (t = {t[row]!r}); drop or repair those rows, "
+                    f"first at row {row} (t = {float(t[row]):.6f} s); drop or repair those rows, "
                     "or pass nan_policy='interpolate'"
                 )
             return values
