@@ -522,6 +522,13 @@ def test_clean_recordings_raise_no_sensor_warning(walk):
 
 # --------------------------------------------------------------------------- command line
 CLI_CASES = [
+    # an empty config, study or destination is not the current folder
+    *[(f"empty-{argv[0]}", (lambda a: lambda d, w: list(a))(argv), EXIT_USAGE, "an empty name")
+      for argv in (["run", ""], ["validate", ""], ["ablate", ""], ["tune", ""], ["compile", ""])],
+    ("configs-to-empty", lambda d, w: ["configs", "--copy", "recommended", "--to", ""], EXIT_USAGE,
+     "argument --to: an empty path"),
+    ("validate-a-recording", lambda d, w: ["validate", str(_text(d, "big.csv", "t,acc_x\n" + "0.0,1.0\n" * 150_000))],
+     EXIT_USAGE, "a recording goes to --data"),
     ("data-directory", lambda d, w: ["run", "yun2012", "--data", str(d)], EXIT_DATA,
      "is a directory"),
     ("calibrate-dev-zero", lambda d, w: ["calibrate", "--data", "/dev/zero", "--out", str(d / "fv.yaml")], EXIT_DATA,
