@@ -260,6 +260,13 @@ CASES = [
     Case("unit-not-text", lambda d, w: (lambda: Recording.from_dataframe(w.to_dataframe(), acc_unit=["g"])),
          RecordingError, "acc_unit=['g'] is not supported"),
     # ---------------------------------------------------------------- YAML
+    # the name and type fields hold text: anything else is an error, not a crash or a path
+    *[Case(f"config-name-{i}", lambda d, w, v=v: _config(d, _with(YUN, name=v)), ConfigError,
+           "name must be a non-empty text") for i, v in enumerate(["[a]", "5", "''", "../../etc", "'a:b'"])],
+    Case("config-description-list", lambda d, w: _config(d, _with(YUN, description="[a, b]")), ConfigError,
+         "description must be text"),
+    *[Case(f"config-type-{i}", lambda d, w, v=v: _config(d, _with(YUN, detector=v)), ConfigError,
+           "must be a plug-in's name (text)") for i, v in enumerate(["{type: [a]}", "{type: {a: 1}}", "{type: 3}"])],
     Case("config-invalid-yaml", lambda d, w: _config(d, "orientation: {type: [\n"), ConfigError, "not valid YAML"),
     Case("config-latin1", lambda d, w: _config(d, ("name: caf\xe9\n" + YUN).encode("latin-1")), ConfigError,
          "not UTF-8 text (byte 0xe9"),
