@@ -37,6 +37,7 @@ from footzoo.studies.study import Study
 ROOT = Path(__file__).resolve().parents[1]
 YUN = (ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml").read_text()
 NGUYEN = ROOT / "footzoo" / "config" / "builtin" / "nguyen2016.yaml"
+YUN_PATH = ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
 
@@ -494,6 +495,18 @@ def test_yaml_12_scalars():
 
 
 # --------------------------------------------------------------------------- sensor sanity
+def test_stream_unit_switched_after_the_start_is_warned(walk):
+    """An accelerometer switched to g after a start in m/s² is named live (the start check passed)."""
+    s = Stream(Pipeline.from_yaml(YUN_PATH), rate=walk.rate)
+    switch = int(np.searchsorted(walk.t, walk.t[0] + 2.0))
+    with pytest.warns(SensorWarning, match="look like g, not m/s"):
+        for k in range(min(len(walk.t), switch + int(3 * walk.rate))):
+            s.push(walk.t[k], walk.acc[k] / (9.81 if k >= switch else 1.0), walk.gyr[k])
+            if "acc_unit" in s.sensor:
+                break
+    assert s.sensor["acc_unit"]["unit"] == "g"
+
+
 def test_gyro_glitch_is_flagged_with_its_sample(walk):
     gyr = walk.gyr.copy()
     k = int(np.searchsorted(walk.t, 2.5))

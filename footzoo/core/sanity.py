@@ -62,6 +62,12 @@ GLITCH_JUMP = 15.0
 ACC_GLITCH_JUMP = 400.0
 #: Longest burst of samples reported as a glitch (a longer excursion is motion, or saturation).
 GLITCH_MAX_LEN = 3
+#: Live: seconds over which the accelerometer's median magnitude is checked for a unit switched to g or mg;
+#: a foot's median specific force over strides is near g = 9.81 m/s², never near 1 (free fall for seconds).
+UNIT_WINDOW = 2.0
+#: Median magnitudes that look like g and like mg (an accelerometer in m/s² has ~9.8).
+UNIT_G = (0.5, 2.5)
+UNIT_MG = (500.0, 2000.0)
 _AXES = "xyz"
 _SQRT3 = math.sqrt(3.0)
 
@@ -284,10 +290,40 @@ class SignalScan:
                     self.report.setdefault(key, []).extend(ks)
                 self._done = max(max(ks) for ks in fresh.values())
                 new.update(fresh)
+        new.update(self._units(t, acc, k0))
         keep = GLITCH_MAX_LEN + 1
         self._k0 += max(len(joined_t) - keep, 0)
         self._t, self._x = joined_t[-keep:], joined[-keep:]
         return new
+
+    def _units(self, t: np.ndarray, acc: np.ndarray, k0: int) -> dict[str, Any]:
+        """An accelerometer that switches to g (or mg) after the start: the median |acc| of the last
+        :data:`UNIT_WINDOW` s near 1 (or 1000) instead of g = 9.81 m/s² (checked once the start was in m/s²)."""
+        if "acc_unit" in self.report or not len(t):
+            return {}
+        mag = np.linalg.norm(acc, axis=1)
+        if not hasattr(self, "_unit_t"):
+            self._unit_t, self._unit_mag, self._unit_k = np.zeros(0), np.zeros(0), k0
+        self._unit_t = np.concatenate([self._unit_t, t])
+        self._unit_mag = np.concatenate([self._unit_mag, mag])
+        if self._unit_t[-1] - self._unit_t[0] < UNIT_WINDOW:
+            return {}
+        med = float(np.median(self._unit_mag))
+        unit = "g" if UNIT_G[0] < med < UNIT_G[1] else "mg" if UNIT_MG[0] < med < UNIT_MG[1] else None
+        start_t, start_k = float(self._unit_t[0]), self._unit_k
+        keep = int(np.searchsorted(self._unit_t, self._unit_t[-1] - UNIT_WINDOW / 2))
+        self._unit_k += keep
+        self._unit_t, self._unit_mag = self._unit_t[keep:], self._unit_mag[keep:]
+        if unit is None:
+            return {}
+        found = {"unit": unit, "median": med, "first": int(start_k), "t": start_t}
+        self.report["acc_unit"] = found
+        warnings.warn(
+            f"{self.name}: from sample {start_k} (t = {start_t:.3f} s) the accelerometer's median magnitude is "
+            f"{med:.3g} over {UNIT_WINDOW:.0f} s, not g = 9.81 m/s²: its values look like {unit}, not m/s² (the unit "
+            "changed after the start?). The estimate from there is wrong: convert the samples to m/s² before "
+            "pushing them", SensorWarning, stacklevel=4)
+        return {"acc_unit": found}
 
     def _saturation(self, t: np.ndarray, x: np.ndarray, k0: int, step: np.ndarray) -> dict[str, Any]:
         """Runs at each axis's rails so far (vectorised over the chunk and the axes; one sample: scalar)."""
