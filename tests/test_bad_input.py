@@ -422,6 +422,14 @@ CASES = [
          RecordingError, "dist at t"),
     Case("stream-mag-shape", lambda d, w: _push(w, (w.t[0], w.acc[0], w.gyr[0], [1.0, 2.0])), RecordingError,
          "mag at t"),
+    Case("stream-acc-complex", lambda d, w: _push(w, (w.t[0], w.acc[0] + 1j, w.gyr[0])), RecordingError,
+         "must be 3 real numbers"),
+    Case("stream-gyr-bool", lambda d, w: _push(w, (w.t[0], w.acc[0], [True, False, True])), RecordingError,
+         "must be 3 real numbers"),
+    Case("stream-pipeline-name", lambda d, w: (lambda: Stream("nguyen2016", rate=100.0)), ConfigError,
+         "Stream needs a footzoo Pipeline, got str"),
+    Case("stream-pipeline-none", lambda d, w: (lambda: Stream(None, rate=100.0)), ConfigError,
+         "Stream needs a footzoo Pipeline"),
     # a column named twice: pandas would rename the second and the first would be read silently
     Case("canonical-duplicate-column", lambda d, w: (lambda: load(_text(
         d, "r.csv", "".join(line + ",0\n" for line in _imu_text(w).splitlines()).replace(",0", ",acc_x", 1)))),
