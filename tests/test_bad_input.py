@@ -723,3 +723,28 @@ def test_declared_parameters_were_found():
     builtins = [cls for kind in KINDS for n, cls in available(kind).items() if not n.startswith("test_")]
     assert all(not cls.undeclared() for cls in builtins)  # every built-in parameter is declared
     assert len(DECLARED) >= 60 and len(EDGES) >= 80 and len(SETTINGS) == 16
+
+
+# --------------------------------------------------------------------------- damaged result archives
+@pytest.fixture(scope="module")
+def saved(walk, tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("archive") / "res"
+    Pipeline.from_yaml(YUN_PATH).run(walk).save(folder)
+    return folder
+
+
+@pytest.mark.parametrize("stem", ["result.json", "arrays.npz", "samples.", "steps."])
+@pytest.mark.parametrize("damage", ["truncated", "garbage"])
+def test_damaged_result_archive_is_a_format_error(saved, tmp_path, stem, damage):
+    """A truncated or overwritten file of a saved result is a FormatError naming the folder, not a parser's error."""
+    import shutil
+
+    from footzoo import Result
+
+    folder = tmp_path / "res"
+    shutil.copytree(saved, folder)
+    victim = next(p for p in folder.iterdir() if p.name.startswith(stem))
+    raw = victim.read_bytes()
+    victim.write_bytes(raw[: len(raw) // 2] if damage == "truncated" else b"\xff\x00garbage")
+    with pytest.raises(FormatError, match="the archive is damaged"):
+        Result.load(folder)
