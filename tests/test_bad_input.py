@@ -748,3 +748,12 @@ def test_damaged_result_archive_is_a_format_error(saved, tmp_path, stem, damage)
     victim.write_bytes(raw[: len(raw) // 2] if damage == "truncated" else b"\xff\x00garbage")
     with pytest.raises(FormatError, match="the archive is damaged"):
         Result.load(folder)
+
+
+def test_detector_without_its_optional_statistic_runs(tmp_path, walk):
+    """``statistic_`` is an optional output of a detector: one that sets only ``stance_`` runs (it crashed)."""
+    run = _faulty_plugin(tmp_path, walk, "test_case_no_statistic",
+                         "self.stance_ = np.linalg.norm(gyr, axis=1) < 0.6\n        return self")
+    result = run()
+    assert np.isnan(result.diagnostics["detector_statistic"]).all()
+    assert result.diagnostics["detector_stance"].any()
