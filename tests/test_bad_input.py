@@ -430,6 +430,11 @@ CASES = [
          "Stream needs a footzoo Pipeline, got str"),
     Case("stream-pipeline-none", lambda d, w: (lambda: Stream(None, rate=100.0)), ConfigError,
          "Stream needs a footzoo Pipeline"),
+    # a pasted number of strides would simulate for hours: bounded, and whole
+    Case("simulate-strides-huge", lambda d, w: (lambda: simulate(n_strides=10**8)), ConfigError,
+         "n_strides must be a whole number in [0, 100000]"),
+    Case("simulate-strides-float", lambda d, w: (lambda: simulate(n_strides=2.5)), ConfigError,
+         "n_strides must be a whole number"),
     # a column named twice: pandas would rename the second and the first would be read silently
     Case("canonical-duplicate-column", lambda d, w: (lambda: load(_text(
         d, "r.csv", "".join(line + ",0\n" for line in _imu_text(w).splitlines()).replace(",0", ",acc_x", 1)))),

@@ -17,6 +17,7 @@ import pandas as pd
 
 from ..core.conventions import GRAVITY, quat_conj, quat_rotate
 from ..core.data import Recording, Truth
+from ..core.errors import ConfigError
 from . import paths
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu
@@ -31,6 +32,10 @@ SPEEDS = {
 }
 
 PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed", "run", "stairs")
+
+
+#: Most strides one simulation makes (about a day of walking): more is a typo that would run for hours.
+MAX_STRIDES = 100_000
 
 
 def _footsteps(path: str, n_strides: int, stride_length: float, **kw) -> tuple[list[Footstep], bool]:
@@ -135,6 +140,9 @@ def simulate(
     """
     if foot not in ("right", "left"):
         raise ValueError(f"foot must be 'right' or 'left', got {foot!r}")
+    if isinstance(n_strides, bool) or not isinstance(n_strides, (int, np.integer)) or not 0 <= n_strides <= MAX_STRIDES:
+        raise ConfigError(f"n_strides must be a whole number in [0, {MAX_STRIDES}] (about a day of walking), got "
+                          f"{n_strides!r}; simulate a longer walk in parts")
     rec_name = f"sim_{path}"
     if path == "run":
         path, speeds = "mixed_speed", [("run", n_strides)]
