@@ -37,6 +37,7 @@ from footzoo.studies.study import Study
 ROOT = Path(__file__).resolve().parents[1]
 YUN = (ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml").read_text()
 NGUYEN = ROOT / "footzoo" / "config" / "builtin" / "nguyen2016.yaml"
+YUN_PATH = ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
 
@@ -260,6 +261,13 @@ CASES = [
     Case("unit-not-text", lambda d, w: (lambda: Recording.from_dataframe(w.to_dataframe(), acc_unit=["g"])),
          RecordingError, "acc_unit=['g'] is not supported"),
     # ---------------------------------------------------------------- YAML
+    # the name and type fields hold text: anything else is an error, not a crash or a path
+    *[Case(f"config-name-{i}", lambda d, w, v=v: _config(d, _with(YUN, name=v)), ConfigError,
+           "name must be a non-empty text") for i, v in enumerate(["[a]", "5", "''", "../../etc", "'a:b'"])],
+    Case("config-description-list", lambda d, w: _config(d, _with(YUN, description="[a, b]")), ConfigError,
+         "description must be text"),
+    *[Case(f"config-type-{i}", lambda d, w, v=v: _config(d, _with(YUN, detector=v)), ConfigError,
+           "must be a plug-in's name (text)") for i, v in enumerate(["{type: [a]}", "{type: {a: 1}}", "{type: 3}"])],
     Case("config-invalid-yaml", lambda d, w: _config(d, "orientation: {type: [\n"), ConfigError, "not valid YAML"),
     Case("config-latin1", lambda d, w: _config(d, ("name: caf\xe9\n" + YUN).encode("latin-1")), ConfigError,
          "not UTF-8 text (byte 0xe9"),
@@ -414,7 +422,48 @@ CASES = [
          RecordingError, "dist at t"),
     Case("stream-mag-shape", lambda d, w: _push(w, (w.t[0], w.acc[0], w.gyr[0], [1.0, 2.0])), RecordingError,
          "mag at t"),
+    Case("stream-acc-complex", lambda d, w: _push(w, (w.t[0], w.acc[0] + 1j, w.gyr[0])), RecordingError,
+         "must be 3 real numbers"),
+    Case("stream-gyr-bool", lambda d, w: _push(w, (w.t[0], w.acc[0], [True, False, True])), RecordingError,
+         "must be 3 real numbers"),
+    Case("stream-pipeline-name", lambda d, w: (lambda: Stream("nguyen2016", rate=100.0)), ConfigError,
+         "Stream needs a footzoo Pipeline, got str"),
+    Case("stream-pipeline-none", lambda d, w: (lambda: Stream(None, rate=100.0)), ConfigError,
+         "Stream needs a footzoo Pipeline"),
+    # a pasted number of strides would simulate for hours: bounded, and whole
+    Case("simulate-strides-huge", lambda d, w: (lambda: simulate(n_strides=10**8)), ConfigError,
+         "n_strides must be a whole number in [0, 100000]"),
+    Case("simulate-strides-float", lambda d, w: (lambda: simulate(n_strides=2.5)), ConfigError,
+         "n_strides must be a whole number"),
+    # a column named twice: pandas would rename the second and the first would be read silently
+    Case("canonical-duplicate-column", lambda d, w: (lambda: load(_text(
+        d, "r.csv", "".join(line + ",0\n" for line in _imu_text(w).splitlines()).replace(",0", ",acc_x", 1)))),
+         FormatError, "['acc_x'] more than once"),
+    Case("canonical-semicolons", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w).replace(",", ";")))),
+         FormatError, "separated by semicolons"),
+    Case("canonical-tabs", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w).replace(",", "\t")))),
+         FormatError, "separated by tabs"),
+    # the row's time is printed as a number, not as a numpy repr
+    Case("canonical-nan-cell-time", lambda d, w: (lambda: load(_text(d, "r.csv", _imu_text(w, nan_row=3)))),
+         RecordingError, "first at row 3 (t = 0.030000 s)"),
 ]
+
+
+def _imu_text(w: Recording, nan_row: int | None = None) -> str:
+    """The IMU columns of ``w`` as canonical CSV text (``nan`` in acc_x of ``nan_row``)."""
+    rows = ["t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z"]
+    for k in range(len(w.t)):
+        acc = ["nan" if k == nan_row else repr(float(w.acc[k, 0])), *map(repr, map(float, w.acc[k, 1:]))]
+        rows.append(",".join([repr(float(w.t[k])), *acc, *map(repr, map(float, w.gyr[k]))]))
+    return "\n".join(rows) + "\n"
+
+
+def test_quoted_header_is_read(tmp_path, walk):
+    """A header with quoted names ("t","acc_x",...) is valid CSV: it is read as the canonical format."""
+    lines = _imu_text(walk).split("\n")
+    lines[0] = ",".join(f'"{c}"' for c in lines[0].split(","))
+    rec = load(_text(tmp_path, "q.csv", "\n".join(lines)))
+    np.testing.assert_array_equal(rec.acc, load(_text(tmp_path, "p.csv", _imu_text(walk))).acc)
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
@@ -459,6 +508,17 @@ def test_yaml_12_scalars():
 
 
 # --------------------------------------------------------------------------- sensor sanity
+def test_stream_unit_switched_after_the_start_is_warned(walk):
+    """An accelerometer switched to g after a start in m/s² is named live (the start check passed)."""
+    s = Stream(Pipeline.from_yaml(YUN_PATH), rate=walk.rate)
+    switch = int(np.searchsorted(walk.t, walk.t[0] + 2.0))
+    with pytest.warns(SensorWarning, match=r"≈ 1: in g\?"):
+        for k in range(len(walk.t)):
+            s.push(walk.t[k], walk.acc[k] / (9.81 if k >= switch else 1.0), walk.gyr[k])
+        s.close()
+    assert s.sensor["acc_scale"]["first"] >= switch
+
+
 def test_gyro_glitch_is_flagged_with_its_sample(walk):
     gyr = walk.gyr.copy()
     k = int(np.searchsorted(walk.t, 2.5))
@@ -494,6 +554,13 @@ def test_clean_recordings_raise_no_sensor_warning(walk):
 
 # --------------------------------------------------------------------------- command line
 CLI_CASES = [
+    # an empty config, study or destination is not the current folder
+    *[(f"empty-{argv[0]}", (lambda a: lambda d, w: list(a))(argv), EXIT_USAGE, "an empty name")
+      for argv in (["run", ""], ["validate", ""], ["ablate", ""], ["tune", ""], ["compile", ""])],
+    ("configs-to-empty", lambda d, w: ["configs", "--copy", "recommended", "--to", ""], EXIT_USAGE,
+     "argument --to: an empty path"),
+    ("validate-a-recording", lambda d, w: ["validate", str(_text(d, "big.csv", "t,acc_x\n" + "0.0,1.0\n" * 150_000))],
+     EXIT_USAGE, "a recording goes to --data"),
     ("data-directory", lambda d, w: ["run", "yun2012", "--data", str(d)], EXIT_DATA,
      "is a directory"),
     ("calibrate-dev-zero", lambda d, w: ["calibrate", "--data", "/dev/zero", "--out", str(d / "fv.yaml")], EXIT_DATA,
@@ -660,3 +727,37 @@ def test_declared_parameters_were_found():
     builtins = [cls for kind in KINDS for n, cls in available(kind).items() if not n.startswith("test_")]
     assert all(not cls.undeclared() for cls in builtins)  # every built-in parameter is declared
     assert len(DECLARED) >= 60 and len(EDGES) >= 80 and len(SETTINGS) == 16
+
+
+# --------------------------------------------------------------------------- damaged result archives
+@pytest.fixture(scope="module")
+def saved(walk, tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("archive") / "res"
+    Pipeline.from_yaml(YUN_PATH).run(walk).save(folder)
+    return folder
+
+
+@pytest.mark.parametrize("stem", ["result.json", "arrays.npz", "samples.", "steps."])
+@pytest.mark.parametrize("damage", ["truncated", "garbage"])
+def test_damaged_result_archive_is_a_format_error(saved, tmp_path, stem, damage):
+    """A truncated or overwritten file of a saved result is a FormatError naming the folder, not a parser's error."""
+    import shutil
+
+    from footzoo import Result
+
+    folder = tmp_path / "res"
+    shutil.copytree(saved, folder)
+    victim = next(p for p in folder.iterdir() if p.name.startswith(stem))
+    raw = victim.read_bytes()
+    victim.write_bytes(raw[: len(raw) // 2] if damage == "truncated" else b"\xff\x00garbage")
+    with pytest.raises(FormatError, match="the archive is damaged"):
+        Result.load(folder)
+
+
+def test_detector_without_its_optional_statistic_runs(tmp_path, walk):
+    """``statistic_`` is an optional output of a detector: one that sets only ``stance_`` runs (it crashed)."""
+    run = _faulty_plugin(tmp_path, walk, "test_case_no_statistic",
+                         "self.stance_ = np.linalg.norm(gyr, axis=1) < 0.6\n        return self")
+    result = run()
+    assert np.isnan(result.diagnostics["detector_statistic"]).all()
+    assert result.diagnostics["detector_stance"].any()

@@ -45,7 +45,7 @@ def test_a_non_finite_value_names_its_time_in_seconds(walk_csv, tmp_path):
     bad = tmp_path / "nan.csv"
     bad.write_text("\n".join(lines) + "\n")
     with pytest.raises(RecordingError, match=r"column 'acc_z' has 1 non-finite value\(s\), first at row 9 "
-                                             r"\(t = 0\.18 s\)") as info:
+                                             r"\(t = 0\.180000 s\)") as info:
         footzoo.load(bad)
     assert "np.float64" not in str(info.value)
 
@@ -53,7 +53,7 @@ def test_a_non_finite_value_names_its_time_in_seconds(walk_csv, tmp_path):
 def test_a_semicolon_separated_file_says_so(walk_csv, tmp_path):
     semi = tmp_path / "semi.csv"
     semi.write_text(walk_csv.read_text().replace(",", ";"))
-    with pytest.raises(FormatError, match=r"separated by ';'"):
+    with pytest.raises(FormatError, match=r"separated by semicolons, not commas"):
         footzoo.load(semi)
 
 
@@ -72,7 +72,7 @@ def test_a_truncated_matlab_file_is_called_damaged(tmp_path):
         footzoo.load(other)
 
 
-NOT_A_NAME = r"'type' must be the name \(text\) of one of the {} plug-ins, got {}"
+NOT_A_NAME = r"the {} type must be a plug-in's name \(text\), got {}"
 
 
 @pytest.mark.parametrize("part, value, message", [
@@ -171,7 +171,7 @@ def test_running_a_path_instead_of_a_recording_says_how_to_load_it():
 
 @pytest.mark.parametrize("simulate_spec, message", [
     ({"path": "straigt"}, r"recordings\[0\]\.simulate: unknown path 'straigt'"),
-    ({"path": "straight", "n_strides": -4}, r"n_strides must be a whole number of strides >= 1, got -4"),
+    ({"path": "straight", "n_strides": -4}, r"n_strides must be a whole number in \[0, 100000\].*got -4"),
     ({"path": "straight", "n_stride": 4}, r"unknown option 'n_stride' \(did you mean 'n_strides'\?\)"),
     ({"path": "straight", "rate": 0}, r"rate must be a number in \(0, 20000\] Hz, got 0"),
 ])

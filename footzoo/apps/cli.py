@@ -63,6 +63,20 @@ def _output(text: str) -> str:
         raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
     return text
 
+
+def _input_yaml(text: str) -> str:
+    """An argparse ``type`` for a config or study argument: a shipped name or a path, never empty ('' is not '.')."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty name; give a shipped config's name (footzoo configs lists them) "
+                                         "or the path of a YAML file")
+    return text
+
+def _destination(text: str) -> str:
+    """An argparse ``type`` for ``--to``: a non-empty path (an empty one would silently mean here)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder or file name (or leave --to out: here)")
+    return text
+
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
@@ -519,7 +533,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
-    run.add_argument("config", help="pipeline YAML, e.g. yun2012")
+    run.add_argument("config", type=_input_yaml, help="pipeline YAML, e.g. yun2012")
     run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
     run.add_argument("--format", help="reader name: canonical, xio, pyshoe, gaitmap, sensorconnect, openshoe, "
                      "generic or an installed one (footzoo formats lists them; default: detect)")
@@ -539,8 +553,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     comp = sub.add_parser("compile", help="compile the kernels of pipeline configs now, so that their first "
                           "run loads them from numba's cache (e.g. before a study on a new machine)")
-    comp.add_argument("configs", nargs="+", help="pipeline YAML files or study files (every config of the "
-                      "grid), e.g. footzoo/config/builtin/*.yaml")
+    comp.add_argument("configs", nargs="+", type=_input_yaml,
+                      help="pipeline YAML files or study files (every config of the grid), "
+                           "e.g. footzoo/config/builtin/*.yaml")
     comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
                       "(what setup.py does for a wheel's footzoo/_compiled)")
     comp.set_defaults(func=cmd_compile)
@@ -588,7 +603,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     abl = sub.add_parser("ablate", aliases=["study"],
                          help="run an ablation study (configs x recordings) and write tables and plots")
-    abl.add_argument("study", help="study YAML, e.g. study_quick")
+    abl.add_argument("study", type=_input_yaml, help="study YAML, e.g. study_quick")
     abl.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores (default: the "
                      "study's jobs, else 1)")
     abl.add_argument("--max-cells", type=_number(1, 1e15, integer=True), metavar="N",
@@ -607,7 +622,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     tun = sub.add_parser("tune", help="choose a setting by leave-one-group-out cross-validation (a study file "
                          "with a tune: block) and write it as a config")
-    tun.add_argument("study", help="tune YAML: a study file with a tune: block (objective, search, group_by)")
+    tun.add_argument("study", type=_input_yaml,
+                     help="tune YAML: a study file with a tune: block (objective, search, group_by)")
     tun.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores")
     tun.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     tun.add_argument("--out", type=_output, help="output folder (default: tune_<file>): cache/, tune_folds.csv, "
@@ -631,12 +647,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
     cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")
-    cfg.add_argument("--to", default=".", metavar="DEST", help="folder or file name of the copy (default: here)")
+    cfg.add_argument("--to", default=".", metavar="DEST", type=_destination,
+                     help="folder or file name of the copy (default: here)")
     cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
     cfg.set_defaults(func=cmd_configs)
 
     val = sub.add_parser("validate", help="check a pipeline config without running it")
-    val.add_argument("config", help="pipeline YAML")
+    val.add_argument("config", type=_input_yaml, help="pipeline YAML")
     val.set_defaults(func=cmd_validate)
     return parser
 

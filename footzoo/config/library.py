@@ -54,6 +54,9 @@ def resolve(spec: str | Path) -> Path:
     ConfigError
         When ``spec`` is neither an existing file nor a shipped config's name.
     """
+    if not str(spec).strip():
+        raise ConfigError("the config is an empty name; give a shipped config's name (footzoo configs lists them) "
+                          "or the path of a YAML file")
     p = Path(spec)
     if p.exists() or not is_name(spec):
         if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml", ".yml"):

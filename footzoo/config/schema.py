@@ -110,6 +110,13 @@ def top_level_errors(d: dict[str, Any]) -> list[str]:
     for key in d:
         if key not in TOP_LEVEL_KEYS:
             errors.append(f"unknown config key {key!r}{did_you_mean(key, valid)}; valid keys: {valid}")
+    name = d.get("name")
+    if "name" in d and (not isinstance(name, str) or not name.strip() or any(c in name for c in '/\\:\0')):
+        errors.append(f"name must be a non-empty text without '/', '\\' or ':' (it names output files and "
+                      f"study rows), got {type(name).__name__} {name!r}")
+    for key in ("description",):
+        if d.get(key) is not None and not isinstance(d[key], str):
+            errors.append(f"{key} must be text, got {type(d[key]).__name__} {d[key]!r}; quote it")
     for key in REQUIRED:
         if key not in d:
             errors.append(f"config is missing {key!r} ({TOP_LEVEL_KEYS[key]})")

@@ -37,6 +37,7 @@ import math
 import os
 import shutil
 import warnings
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -532,11 +533,25 @@ def _load_result_files(folder: Path, files: dict[str, Any]) -> Any:
                   diagnostics=unpacker.unpack(body["diagnostics"]), reference=reference)
 
 
+#: What reading a damaged archive file raises (json, numpy's npz, pandas, pyarrow: ArrowInvalid is a ValueError).
+_DAMAGED = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
+
+
 def load_result(path: str | os.PathLike) -> Any:
-    """The :class:`~footzoo.core.data.Result` saved in the folder ``path`` (see the module doc)."""
+    """The :class:`~footzoo.core.data.Result` saved in the folder ``path`` (see the module doc).
+
+    A file of the archive that is truncated, overwritten or otherwise damaged is a FormatError
+    naming the folder and the cause (never a raw parser error).
+    """
     folder = Path(path)
     data = _read_manifest(folder, FORMAT)
-    return _load_result_files(folder, data["files"])
+    try:
+        return _load_result_files(folder, data["files"])
+    except FormatError:
+        raise
+    except _DAMAGED as err:
+        raise FormatError(f"{str(folder)!r}: the archive is damaged, a file cannot be read ({type(err).__name__}: "
+                          f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
 
 
 def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:

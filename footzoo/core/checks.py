@@ -84,6 +84,14 @@ def check_vector(name: str, value: Any, size: int = 3, nonzero: bool = False, un
 
 
 def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: str) -> np.ndarray:
+    raw = value if isinstance(value, np.ndarray) else None
+    if raw is None and isinstance(value, (list, tuple)):
+        raw = np.asarray(value, dtype=object)
+    if raw is not None and (np.iscomplexobj(raw) or raw.dtype == bool
+                            or (raw.dtype == object and any(isinstance(v, (bool, complex, np.bool_, np.complexfloating))
+                                                            for v in raw.ravel().tolist()))):
+        raise RecordingError(f"{name} at t = {t!r} must be 3 real numbers ({unit}), got {value!r} "
+                             "(booleans or complex numbers are not samples)")
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):

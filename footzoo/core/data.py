@@ -284,12 +284,12 @@ class Recording:
                 filled = int(np.argmax(empty)) if empty.any() else len(empty)
                 if filled < len(empty) - 1 and empty[filled:].all():  # the row stops short of its columns
                     raise RecordingError(
-                        f"row {row} (t = {float(t[row]):.6g} s) has values in only its first {filled} of "
+                        f"row {row} (t = {float(t[row]):.6f} s) has values in only its first {filled} of "
                         f"{len(empty)} columns: the file is cut short there, or the row is damaged; remove or "
                         "repair that row (a file still being written? copy it once it is complete)")
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
-                    f"first at row {row} (t = {float(t[row]):.6g} s); drop or repair those rows, "
+                    f"first at row {row} (t = {float(t[row]):.6f} s); drop or repair those rows, "
                     "or pass nan_policy='interpolate'"
                 )
             return values

@@ -215,6 +215,10 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
             loader.dispose()
 
 
+#: Extensions of recordings, named when one is given where a YAML file is expected.
+RECORDING_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq", ".mat", ".gz", ".zip")
+
+
 def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str = "YAML file") -> Any:
     """Read and parse a YAML file: at most :data:`MAX_BYTES`, UTF-8, strict and bounded (see the module doc).
 
@@ -227,6 +231,8 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
     what : str
         What the file is, for messages ("config file", "study file", …).
     """
+    if isinstance(path, str) and not path.strip():
+        raise error(f"{what} is an empty path ('' would read the current folder); give the path of a YAML file")
     p = Path(path)
     try:
         if not p.exists():
@@ -242,7 +248,9 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
     except OSError as err:
         raise error(f"{what} {str(p)!r} cannot be read: {err.strerror or err}") from None
     if len(raw) > MAX_BYTES:
-        raise error(f"{p}: larger than {MAX_BYTES} bytes; a {what} this large is not accepted")
+        hint = (f" ({p.suffix} is a recording's extension: a recording goes to --data, the {what} is YAML)"
+                if p.suffix.lower() in RECORDING_SUFFIXES else "")
+        raise error(f"{p}: larger than {MAX_BYTES} bytes; a {what} this large is not accepted{hint}")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:

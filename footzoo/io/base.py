@@ -20,13 +20,14 @@ too, in footzoo's ``setup.cfg``); :func:`footzoo.io.load` finds them there (see
 from __future__ import annotations
 
 import io
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
 from ..core.data import Recording
-from ..core.errors import FootzooWarning
+from ..core.errors import FootzooWarning, FormatError
 
 #: Longest line read when looking at a file's header (characters).
 HEADER_MAX_CHARS = 64 * 1024
@@ -185,3 +186,16 @@ def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
         f"(a logger stopped or a copy interrupted mid-write); dropped that row: {last[:80]!r}. If the file is "
         "complete, end it with a line break"), stacklevel=3)
     return io.BytesIO(data[:cut + 1])
+
+
+def check_unique_columns(df: Any, path: str | Path) -> None:
+    """A FormatError when the file's header names a column twice (pandas renames the second ``x`` to ``x.1``).
+
+    Reading on would take one of the two silently; the user must say which one holds the data.
+    """
+    cols = [str(c) for c in df.columns]
+    names = set(cols)
+    dup = sorted({m.group(1) for c in cols if (m := re.fullmatch(r"(.+)\.(\d+)", c)) and m.group(1) in names})
+    if dup:
+        raise FormatError(f"{path}: the header names column(s) {dup} more than once; footzoo cannot tell which "
+                          "one holds the data: rename or delete the duplicates")

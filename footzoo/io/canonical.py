@@ -20,7 +20,7 @@ from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.data import Recording
 from ..core.errors import FormatError, OutputError
-from .base import RECORDING_OPTIONS, Option, Reader, first_line, input_files, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, input_files, text_source
 from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
@@ -34,7 +34,7 @@ PARQUET_SUFFIXES = (".parquet", ".pq")
 
 def matches(header: str) -> bool:
     """True for a canonical CSV header."""
-    cols = [c.strip() for c in header.split(",")]
+    cols = [c.strip().strip('"').strip("'").strip() for c in header.split(",")]
     return "t" in cols and "acc_x" in cols and "gyr_x" in cols
 
 
@@ -49,6 +49,7 @@ def read(path: Path, **options: Any) -> Recording:
         raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
+    check_unique_columns(df, path)
     facts = read_facts(path)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "canonical"}
     meta.update(facts.meta)

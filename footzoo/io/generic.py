@@ -40,7 +40,7 @@ from ..core.data import Recording, Truth
 from ..core.errors import FormatError, did_you_mean
 from ..core.yamlsafe import load_file
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, text_source
 
 #: Suffix of a data file's description: ``<file>.footzoo.yaml``.
 SIDECAR_SUFFIX = ".footzoo.yaml"
@@ -186,6 +186,7 @@ def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recor
                          engine="python" if spec.delimiter == r"\s+" and spec.comment else "c")
     except (ValueError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as described in {side.name}: {err}") from None
+    check_unique_columns(df, path)
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
     names = list(df.columns)
 

@@ -181,9 +181,11 @@ class Readers(Mapping[str, Any]):
         if p.suffix.lower() in (".csv", ".txt", ".tsv", "") and not head:
             raise FormatError(f"{p}: the file has no header line (it is empty or blank); check the file")
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
-        if head and ";" in head and "," not in head:
-            seen += " (its values are separated by ';': footzoo's CSV readers read ',', so convert the file or " \
-                    "describe it in a sidecar)"
+        sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"))
+                    if head and ch in head and "," not in head), "")
+        if sep:
+            seen += (f"; its values are separated by {sep}, not commas: save it as comma-separated CSV, or "
+                     f"describe it (delimiter, decimal) in a sidecar {p.name}.footzoo.yaml")
         if p.suffix.lower() == ".mat":
             seen += f" ({_mat_contents(p)})"
         raise FormatError(f"{p}: cannot tell the format: no reader recognises this file{seen}. Formats: "

@@ -22,7 +22,7 @@ import pandas as pd
 
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Reader, first_line, text_source
+from .base import RECORDING_OPTIONS, Reader, check_unique_columns, first_line, text_source
 
 SIGNALS = {
     "scaledAccelX": "acc_x", "scaledAccelY": "acc_y", "scaledAccelZ": "acc_z",
@@ -39,6 +39,7 @@ def matches(header: str) -> bool:
 def read(path: Path, **options: Any) -> Recording:
     """Read a SensorConnect CSV and convert to FRD/SI."""
     df = pd.read_csv(text_source(path))
+    check_unique_columns(df, path)
     rename = {"Time": "t"}
     for col in df.columns:
         key = col.split(":")[-1]

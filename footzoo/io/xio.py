@@ -28,7 +28,7 @@ import pandas as pd
 from ..core.checks import check_bool
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Option, Reader, first_line, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, text_source
 from .metadata import read_facts, sha256
 
 COLUMNS = {
@@ -77,6 +77,7 @@ def read(
         the metadata sidecar says, else false.
     """
     df = pd.read_csv(text_source(path))
+    check_unique_columns(df, path)
     missing = [c for c in COLUMNS if c not in df.columns]
     if missing:
         raise FormatError(f"{path}: not an x-io Gait-Tracking CSV, missing {missing}")

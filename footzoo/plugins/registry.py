@@ -114,8 +114,8 @@ def get(kind: str, name: str, where: str = "") -> type[Plugin]:
     """The plug-in class registered as ``name`` under ``kind``."""
     plugins = available(kind)
     if not isinstance(name, str):
-        raise ConfigError(f"{where or kind}: 'type' must be the name (text) of one of the {kind} plug-ins, got "
-                          f"{type(name).__name__} {name!r:.80}; valid types: {sorted(plugins)}")
+        raise ConfigError(f"{where or kind}: the {kind} type must be a plug-in's name (text), got "
+                          f"{type(name).__name__} {name!r}; valid types: {sorted(plugins)}")
     if name not in plugins:
         names = sorted(plugins)
         raise ConfigError(

@@ -295,7 +295,10 @@ class Pipeline:
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():
             sensor["consistency"] = axes.report
-        diagnostics = {"detector_statistic": detector.statistic_, "detector_stance": detector.stance_,
+        statistic = getattr(detector, "statistic_", None)  # optional output: NaN when a detector has none
+        if statistic is None:
+            statistic = np.full(rec.n, np.nan)
+        diagnostics = {"detector_statistic": statistic, "detector_stance": detector.stance_,
                        "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
         if self.calibration:
             diagnostics["calibration"] = calibration

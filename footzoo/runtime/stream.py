@@ -27,6 +27,7 @@ same fit (:meth:`footzoo.Pipeline.with_fits` and :attr:`Stream.fits`).
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from typing import Any
 
@@ -101,6 +102,10 @@ class Stream:
     def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
                  max_wait: float = 10.0, fits: Any = None, warmup: float = STREAM_WARMUP, guess: bool = True,
                  max_pending: float = 30.0, keep: bool = False):
+        if not callable(getattr(pipeline, "live_problems", None)):
+            hint = (f" (Stream(Pipeline.from_yaml({pipeline!r}), ...) builds it from a config)"
+                    if isinstance(pipeline, (str, os.PathLike)) else "")
+            raise ConfigError(f"Stream needs a footzoo Pipeline, got {type(pipeline).__name__} {pipeline!r}{hint}")
         reasons = pipeline.live_problems(fits=_fit_reports(fits))
         if rate is not None and not (isinstance(rate, (int, float)) and not isinstance(rate, bool)
                                      and math.isfinite(rate) and rate > 0):

@@ -19,6 +19,7 @@ import pandas as pd
 
 from ..core.conventions import GRAVITY, quat_conj, quat_rotate
 from ..core.data import Recording, Truth
+from ..core.errors import ConfigError
 from . import paths
 from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu
@@ -35,6 +36,10 @@ SPEEDS = {
 PATHS = ("straight", "rectangle", "track", "figure_eight", "mixed_speed", "run", "stairs")
 
 
+#: Most strides one simulation makes (about a day of walking): more is a typo that would run for hours.
+MAX_STRIDES = 100_000
+
+
 #: The simulator's numeric arguments: the range each must lie in (as text) and its test.
 LIMITS: dict[str, tuple[str, Callable[[float], bool]]] = {
     "stride_length": ("(0, 5] m", lambda v: 0 < v <= 5), "cycle": ("(0, 10] s", lambda v: 0 < v <= 10),
@@ -47,18 +52,17 @@ LIMITS: dict[str, tuple[str, Callable[[float], bool]]] = {
 def check_arguments(**kw: Any) -> None:
     """Refuse simulator arguments that cannot make a walk, with a ConfigError naming the argument (before any work).
 
-    Checks ``path``, ``foot``, ``n_strides`` (a whole number ≥ 1) and the numbers of :data:`LIMITS`;
-    a study checks its ``simulate:`` entries with it before running anything.
+    Checks ``path``, ``foot``, ``n_strides`` (a whole number up to :data:`MAX_STRIDES`) and the numbers of
+    :data:`LIMITS`; a study checks its ``simulate:`` entries with it before running anything.
     """
-    from ..core.errors import ConfigError
-
     if "path" in kw and kw["path"] not in PATHS:
         raise ConfigError(f"simulate: unknown path {kw['path']!r}; known: {list(PATHS)}")
     if "foot" in kw and kw["foot"] not in ("right", "left"):
         raise ConfigError(f"simulate: foot must be 'right' or 'left', got {kw['foot']!r}")
     n = kw.get("n_strides", 1)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ConfigError(f"simulate: n_strides must be a whole number of strides >= 1, got {n!r}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 0 <= n <= MAX_STRIDES:
+        raise ConfigError(f"simulate: n_strides must be a whole number in [0, {MAX_STRIDES}] (about a day of "
+                          f"walking), got {n!r}; simulate a longer walk in parts")
     for name, (bounds, ok) in LIMITS.items():
         v = kw.get(name, None)
         if name in kw and (isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v)
@@ -74,7 +78,7 @@ def check_spec(spec: dict[str, Any]) -> None:
     """A ``simulate(**spec)`` mapping (a study's ``simulate:`` entry): unknown names and bad values refused."""
     import inspect
 
-    from ..core.errors import ConfigError, did_you_mean
+    from ..core.errors import did_you_mean
 
     known = [p for p in inspect.signature(simulate).parameters if p != "path_options"] + list(PATH_OPTIONS)
     for key in spec:

@@ -93,7 +93,10 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     if getattr(det, "needs_truth", False):
         return []
     det.detect(rec.t, rec.acc, rec.gyr)
-    stat, truth = np.asarray(det.statistic_, float), rec.truth.stance
+    stat, truth = np.asarray(getattr(det, "statistic_", None) if getattr(det, "statistic_", None) is not None
+                             else np.full(rec.n, np.nan), float), rec.truth.stance
+    if not np.isfinite(stat).any():  # the detector has no statistic (an optional output): no ROC curve
+        return []
     out = []
     for th in np.quantile(stat, np.linspace(0.0, 1.0, points)):
         pred = stat <= th
