@@ -196,3 +196,16 @@ def test_two_recordings_with_one_name_are_refused_and_labels_tell_them_apart(wal
     labelled = [{**r, "label": d} for r, d in zip(same, ("a", "b"), strict=True)]
     study = Study.from_dict({"base": "yun2012", "recordings": labelled})
     assert [r.label for r in study.recordings] == ["a", "b"]
+
+
+@pytest.mark.parametrize("factors, message", [
+    ({"detector.threshold.x": [1, 2]}, r"'detector\.threshold' is a value .* one level too deep"),
+    ({"detector.threshold": [0.5, 0.5]}, r"lists the level 0\.5 more than once"),
+])
+def test_a_factor_that_cannot_be_set_or_repeats_a_level_is_refused(factors, message, tmp_path):
+    from footzoo.studies import Study, run_study
+
+    with pytest.raises(footzoo.ConfigError, match=message):
+        study = Study.from_dict({"base": "yun2012", "factors": factors,
+                                 "recordings": [{"simulate": {"path": "straight", "n_strides": 4}}]})
+        run_study(study, out=tmp_path / "out", quiet=True)

@@ -310,6 +310,10 @@ class Study:
             if not v:
                 raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
                                   "or remove it")
+            keys = [json.dumps(level, sort_keys=True, default=str) for level in v]
+            twice = next((level for level, key in zip(v, keys, strict=True) if keys.count(key) > 1), None)
+            if twice is not None:  # it would run every cell of that level twice under one name
+                raise ConfigError(f"factor {k!r} lists the level {twice!r} more than once; list each level once")
         recordings = []
         if not isinstance(d["recordings"] or [], list):
             raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
@@ -536,7 +540,14 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
     """
     parts = path.split(".")
     node: Any = d
-    for part in parts[:-1]:
+    for depth, part in enumerate(parts[:-1]):
+        if not isinstance(node, (dict, list)):
+            where = ".".join(parts[:depth])
+            raise ConfigError(f"factor {path!r}: {where!r} is a value ({type(node).__name__} {node!r:.40}), not a "
+                              f"section with parameters; the factor goes one level too deep (did you mean {where!r}?)")
+        if isinstance(node, list) and not part.lstrip("-").isdigit():
+            raise ConfigError(f"factor {path!r}: {'.'.join(parts[:depth])!r} is a list; index it by number "
+                              f"(e.g. {'.'.join([*parts[:depth], '0'])})")
         key: Any = int(part) if isinstance(node, list) else part
         if isinstance(node, list):
             if key >= len(node):
@@ -545,6 +556,10 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
             node[key] = {}
         node = node[key]
     last = parts[-1]
+    if not isinstance(node, (dict, list)):
+        where = ".".join(parts[:-1])
+        raise ConfigError(f"factor {path!r}: {where!r} is a value ({type(node).__name__} {node!r:.40}), not a "
+                          f"section with parameters; the factor goes one level too deep (did you mean {where!r}?)")
     if isinstance(node, list):
         node[int(last)] = value
     elif last == "type" and isinstance(node, dict) and node.get("type") != value:
