@@ -191,3 +191,22 @@ def test_cli_exits_4_and_a_study_fails_only_the_careless_cells(tmp_path, capsys)
     failed = table["error"].notna()
     assert failed.any() and (~failed).any()
     assert table.loc[failed, "error"].str.contains("test_careless_far_write").all()
+
+
+def test_the_fault_capture_survives_a_replaced_hook_and_restores_it(walk):
+    """Something else (a test runner, an application) may swap sys.unraisablehook between runs: a write
+    outside the arrays is still caught, and the caller's hook is back afterwards."""
+    import sys
+
+    def theirs(unraisable):
+        raise AssertionError("a compiled plug-in's fault reached the caller's hook")
+
+    before = sys.unraisablehook
+    sys.unraisablehook = theirs
+    try:
+        for _ in range(2):
+            with pytest.raises(PluginError, match="test_careless_far_memory"):
+                Pipeline.from_dict(_config("far_memory")).run(walk)
+            assert sys.unraisablehook is theirs
+    finally:
+        sys.unraisablehook = before

@@ -170,7 +170,8 @@ def bind(loop: Any, functions: tuple) -> Any:
 
 
 _capture = threading.local()
-_installed: list[Callable[..., Any]] = []
+_hook_lock = threading.Lock()
+_hook_state: dict[str, Any] = {"depth": 0, "previous": sys.unraisablehook}
 
 
 def _hook(unraisable: Any) -> None:
@@ -179,7 +180,7 @@ def _hook(unraisable: Any) -> None:
     if caught is not None and "CPUContext" in repr(unraisable.object):
         caught.append(unraisable.exc_value)
         return
-    _installed[0](unraisable)
+    _hook_state["previous"](unraisable)
 
 
 @contextlib.contextmanager
@@ -187,14 +188,21 @@ def capture_faults() -> Iterator[list[BaseException]]:
     """Collect the exceptions raised (and ignored) in compiled functions called through their address.
 
     Yields the list they are appended to, in this thread; other threads and other unraisable
-    exceptions are not affected.
+    exceptions are not affected. The hook is installed while any thread captures (again if something
+    else replaced it meanwhile, as test runners do) and the previous one is restored after the last.
     """
-    if not _installed:
-        _installed.append(sys.unraisablehook)
-        sys.unraisablehook = _hook
+    with _hook_lock:
+        if sys.unraisablehook is not _hook:
+            _hook_state["previous"] = sys.unraisablehook
+            sys.unraisablehook = _hook
+        _hook_state["depth"] += 1
     outer = getattr(_capture, "caught", None)
     _capture.caught = []
     try:
         yield _capture.caught
     finally:
         _capture.caught = outer
+        with _hook_lock:
+            _hook_state["depth"] -= 1
+            if _hook_state["depth"] == 0 and sys.unraisablehook is _hook:
+                sys.unraisablehook = _hook_state["previous"]
