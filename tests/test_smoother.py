@@ -56,8 +56,7 @@ def _linear_system(measured_every: int = 40):
     every other ``measured_every`` samples, as in stance), and filterpy's standard RTS smoother on it."""
     from filterpy.kalman import KalmanFilter
 
-    from footzoo.filters.smoother import smoother_gain
-    from footzoo.filters.stepwise import record_arrays
+    from footzoo.filters.smoother import record_arrays
 
     rng = np.random.default_rng(0)
     dt, n_steps = 0.01, 300
@@ -87,8 +86,6 @@ def _linear_system(measured_every: int = 40):
     # closed-loop error-state form: nominal estimate, error estimate fed back and reset
     nominal = np.zeros((n_steps, 6))
     P = p0.copy()
-    gains, dxs = np.zeros((n_steps, 6, 6)), np.zeros((n_steps, 6))
-    work = (np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty(6, dtype=np.int64))
     # the step-wise smoother's record, filled as the compiled loop fills it: P⁺, Φ's blocks (here only
     # Δ[pos, vel] = I dt), the scalar update rows one at a time (h, k, ν / s)
     record = record_arrays(n_steps, 6, 3)
@@ -96,9 +93,7 @@ def _linear_system(measured_every: int = 40):
     cov[0] = P
     for k in range(1, n_steps):
         nominal[k] = F @ nominal[k - 1]
-        M = F @ P
-        P = M @ F.T + Q
-        smoother_gain(M, P, gains[k - 1], *work)
+        P = F @ P @ F.T + Q
         phi[k, 0] = dt
         first[k] = first[k - 1] + count[k - 1]
         if measured[k]:
@@ -116,11 +111,10 @@ def _linear_system(measured_every: int = 40):
             count[k] = 3
             np.testing.assert_allclose(seq, dx, atol=1e-12)
             nominal[k] -= dx
-            dxs[k] = dx
             P = (np.eye(6) - K @ H) @ P @ (np.eye(6) - K @ H).T + K @ R @ K.T
         cov[k] = P
     np.testing.assert_allclose(nominal, np.array(means), atol=1e-12)
-    return nominal, gains, dxs, record, np.array(measured), expected[:, :, 0]
+    return nominal, record, np.array(measured), expected[:, :, 0]
 
 
 #: INS core offsets of the linear system: no attitude, no biases, position at 0, velocity at 3.
@@ -132,23 +126,15 @@ def _trajectories(nominal):
     return np.zeros((n, 4)), nominal[:, 3:].copy(), nominal[:, :3].copy(), np.zeros((n, 3)), np.zeros((n, 3))
 
 
-def test_the_error_state_backward_pass_equals_filterpys_rts_smoother_on_a_linear_system():
-    """footzoo's closed-loop RTS backward pass equals filterpy's standard RTS smoother on the same system."""
-    from footzoo.filters.smoother import rts_backward
+def test_the_backward_recursion_over_the_whole_run_and_over_each_segment_is_filterpys_rts_smoother():
+    """Without a gain or an inverse, footzoo's closed-loop backward recursion over the whole run (the
+    ``rts`` smoother) equals filterpy's standard RTS smoother; over the segments between measured
+    instants (``stepwise``) it is filterpy's RTS smoother run on each segment alone, from the filtered
+    estimate at its end."""
+    from footzoo.filters.smoother import smooth_segments
+    from footzoo.filters.stepwise import segment_ends
 
-    nominal, gains, dxs, _, _, expected = _linear_system()
-    quat, vel, pos, gb, ab = _trajectories(nominal)
-    rts_backward(gains, dxs, LINEAR_IDX, True, quat, vel, pos, gb, ab)
-    np.testing.assert_allclose(np.hstack([pos, vel]), expected, atol=1e-9)
-
-
-def test_the_stepwise_recursion_over_one_segment_is_filterpys_rts_smoother():
-    """Without a gain or an inverse, the step-wise backward recursion over one segment (the whole run)
-    equals filterpy's RTS smoother; over the segments between measured instants it is filterpy's RTS
-    smoother run on each segment alone, from the filtered estimate at its end."""
-    from footzoo.filters.stepwise import segment_ends, smooth_segments
-
-    nominal, _, _, record, measured, expected = _linear_system()
+    nominal, record, measured, expected = _linear_system()
     quat, vel, pos, gb, ab = _trajectories(nominal)
     smooth_segments(record, np.array([len(nominal) - 1]), 0, 0, LINEAR_IDX, True, quat, vel, pos, gb, ab)
     np.testing.assert_allclose(np.hstack([pos, vel]), expected, atol=1e-9)

@@ -22,10 +22,11 @@ from ..core.checks import Settings
 from ..core.errors import ConfigError, FootzooWarning, PluginError
 from ..core.params import Real
 from ..kernels import jit as _jit
-from ..kernels.functions import bind, capture_faults, compiled_with_signature, fixed_address, trusted
+from ..kernels.functions import bind, capture_faults, fixed_address, trusted
 from .eskf import ErrorStateFilter, Layout
 from .measurement import BA, BG, CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock, is_no_op
-from .stepwise import RECORD_KEYS, ROWS_KEY, record_tuple, segment_ends
+from .smoother import RECORD_KEYS, ROWS_KEY, record_tuple
+from .stepwise import segment_ends
 
 ENGINES = ("auto", "fast", "reference")
 # the compiled loop takes the models' functions as first-class function values, which numba marks
@@ -211,15 +212,12 @@ class KalmanEngine:
         nav0 = np.zeros(16)
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
-        record = self._whole_recording_record(state, stance, t) if smoother == "stepwise" else False
+        in_loop = smoother == "stepwise" and self.engine != "reference"  # the loop smooths each stride as it closes
+        record = self._whole_recording_record(state, stance, t) if in_loop else smoother != "none"
         out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
-                           smoother == "rts", record=record)
+                           record=record)
         out["diagnostics"] = self.diagnostics(state)
-        if smoother == "stepwise" and record is True:  # the reference engine: every segment after the loop
-            for key in ("quat", "vel", "pos"):
-                out[f"{key}_forward"] = out[key].copy()
-            self.smooth_stepwise(out, stance, t, closed=True)
-        elif smoother == "stepwise":  # the loop smoothed every segment but the last, into record[6]
+        if in_loop:  # every segment but the last is smoothed, into record[6]
             from .stepwise import smooth_copy
 
             lo = int(record[5][1])
@@ -231,24 +229,19 @@ class KalmanEngine:
                     out[key] = smoothed
                 elif self.layout.has(key):  # else the forward value (the state's, constant)
                     out[key] = smoothed
-        if smoother == "rts":
-            from .smoother import rts_backward
-
+        elif smoother != "none":  # the record of every sample: the whole recording, or each stride, after the loop
             for key in ("quat", "vel", "pos"):
                 out[f"{key}_forward"] = out[key].copy()
-            core = np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64)
-            rts_backward(out["gains"], out["dxs"], core, not self.carries_attitude, out["quat"], out["vel"],
-                         out["pos"], out["gyro_bias"], out["acc_bias"])
-        for key in ("gains", "dxs", "record", ROWS_KEY, *RECORD_KEYS):
+            ends = segment_ends(stance, t, True) if smoother == "stepwise" else np.array([len(t) - 1])
+            self.smooth(out, ends)
+        for key in ("record", ROWS_KEY, *RECORD_KEYS):
             out.pop(key, None)
         return out
 
     def _whole_recording_record(self, state: Any, stance: np.ndarray, t: np.ndarray) -> tuple:
         """The step-wise smoother's record for a whole recording, smoothed in the loop: the longest segment's rows."""
-        from .stepwise import record_arrays
+        from .smoother import record_arrays
 
-        if self.engine == "reference":  # a row per sample, smoothed after the loop
-            return True
         ends = segment_ends(stance, t, True)
         longest = int(np.max(np.diff(ends, prepend=-1))) if ends.size else max(len(stance), 1)
         return record_arrays(longest, self.layout.n, state.core[4], in_loop=len(stance))
@@ -267,14 +260,24 @@ class KalmanEngine:
         the rows up to the last end are final. A live stream's stage calls it (the batch run smooths
         in the loop, by the same rule and kernel).
         """
-        from .stepwise import smooth_segments
-
         ends = segment_ends(stance, t, closed)
         if not ends.size:
             return 0
-        smooth_segments(record_tuple(rows), ends, 0, 0, self.core_offsets(), not self.carries_attitude,
-                        rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"], rows["acc_bias"])
+        self.smooth(rows, ends)
         return int(ends[-1]) + 1
+
+    def smooth(self, rows: dict[str, np.ndarray], ends: np.ndarray) -> None:
+        """Smooth ``rows`` (as in :meth:`smooth_stepwise`) in place, span by span up to each of ``ends`` (increasing).
+
+        One end at the last row is the RTS smoother over the whole recording
+        (:mod:`footzoo.filters.smoother`); the ends of :func:`footzoo.filters.stepwise.segment_ends`
+        are the step-wise smoother.
+        """
+        from .smoother import smooth_segments
+
+        smooth_segments(record_tuple(rows), np.asarray(ends, np.int64), 0, 0, self.core_offsets(),
+                        not self.carries_attitude, rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"],
+                        rows["acc_bias"])
 
     def start(self, nav0: np.ndarray) -> Any:
         """The filter's state before sample 0 (resumable with :meth:`advance`)."""
@@ -285,23 +288,22 @@ class KalmanEngine:
         return self.pack(nav0)
 
     def advance(self, state: Any, t, acc, gyr, stance, quat_ext, data: list[np.ndarray | None], k0: int,
-                covariance: bool = True, smoother: bool = False, record: bool | tuple = False) -> dict[str, np.ndarray]:
+                covariance: bool = True, record: bool | tuple = False) -> dict[str, np.ndarray]:
         """Run samples 1… of a chunk from ``state`` (updated); row 0 of the outputs is the incoming state.
 
-        ``smoother``: also the RTS gains (``gains``, ``dxs``); ``record``: also the step-wise
-        smoother's record of every row (``record_cov``, ``record_phi``, ``record_first``,
-        ``record_count``, ``record_rows``: :func:`footzoo.filters.stepwise.record_arrays`), or
-        the loop writes into the record given (one made ``in_loop``).
+        ``record``: also a smoother's record of every row (``record_cov``, ``record_phi``,
+        ``record_first``, ``record_count``, ``record_rows``: :func:`footzoo.filters.smoother.record_arrays`),
+        or the loop writes into the record given (one the step-wise smoother made ``in_loop``).
         """
         n = len(t)
         if self.engine == "reference":
             from .kalman_reference import ModelFault, run_reference
-            from .stepwise import record_arrays
+            from .smoother import record_arrays
 
             arrays = record_arrays(n, self.layout.n, sum(m.max_rows for m in state["models"])) if record else None
             try:
                 out = run_reference(t, acc, gyr, stance, quat_ext, self.layout, state["kf"], state["models"],
-                                    self.idx, state["nav"], self.gravity, data, k0, smoother, arrays)
+                                    self.idx, state["nav"], self.gravity, data, k0, arrays)
             except ModelFault as err:
                 raise self.fault(err.j, err.rows, err.k, [err.error] if err.error else []) from err.error
             if record:
@@ -311,10 +313,9 @@ class KalmanEngine:
         nx = self.layout.n
         out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
-               "P_diag": np.empty((n if covariance else 0, nx)), "nis": np.zeros((n if covariance else 0, 2)),
-               "gains": np.zeros((n if smoother else 0, nx, nx)), "dxs": np.zeros((n if smoother else 0, nx))}
+               "P_diag": np.empty((n if covariance else 0, nx)), "nis": np.zeros((n if covariance else 0, 2))}
         if record is True:
-            from .stepwise import record_arrays
+            from .smoother import record_arrays
 
             cov, phi, rows, first, count, *_ = record_arrays(n, nx, state.core[4])
             out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
@@ -396,7 +397,7 @@ class KalmanEngine:
         or a write outside its arrays, which a plug-in's bounds-checked code turns into an exception)
         is raised here as that correction's :class:`~footzoo.core.errors.PluginError`.
         """
-        from .kalman_fast import eskf_loop, scratch, smoother_arrays
+        from .kalman_fast import eskf_loop, scratch
 
         ext = np.ascontiguousarray(quat_ext, dtype=float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks, rows = packed.arrays
@@ -409,14 +410,12 @@ class KalmanEngine:
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
         work = packed.work
-        record = out.get("record")  # step-wise smoother
+        record = out.get("record")  # a smoother's
         with capture_faults() as caught:
-            if packed.bound is not None and not out["gains"].shape[0]:
+            if packed.bound is not None:
                 packed.bound(signals, packed.core, state, arrays, outputs, k0, work, record)
             else:
-                smoother = (smoother_arrays(out["gains"], out["dxs"], _gain_function()) if out["gains"].shape[0]
-                            else None)
-                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, smoother, record)
+                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, record)
         fault = work[-1]
         if fault[0] >= 0 or caught:
             raise self.fault(int(fault[0]), int(fault[1]), int(fault[2]), caught)
@@ -441,19 +440,3 @@ class KalmanEngine:
         else:
             problem = f"returned a row count {-rows} below the first free row it was given (sample {k})"
         return PluginError(f"{who}: its measure function {problem}; {fix}", plugin=who, method="measure")
-
-def _gain_function() -> Any:
-    """The smoother's gain function for the compiled loop, compiled once with a fixed signature.
-
-    Passed as a first-class function, so the loop does not compile it; a run without the smoother
-    compiles neither it nor the loop's smoothing code.
-    """
-    from . import smoother
-
-    if not _GAIN:
-        _GAIN.append(compiled_with_signature(smoother.smoother_gain, lambda t: t.none(
-            *(t.float64[:, ::1],) * 6, t.int64[::1])))
-    return _GAIN[0]
-
-
-_GAIN: list[Any] = []

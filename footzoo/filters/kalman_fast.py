@@ -57,13 +57,9 @@ The arguments of :func:`eskf_loop`:
     The loop's buffers, from :func:`scratch` (any content); its last, ``fault`` (3,) int, is
     ``(model, rows returned − m, sample)`` after a model broke its row count, ``(−1, 0, 0)``
     otherwise.
-``smoother``
-    For an RTS smoother (:mod:`footzoo.filters.smoother`), from :func:`smoother_arrays`: its
-    gains ``A_k`` (N, n, n) and fed-back errors (N, n) are written. ``None`` (no smoother):
-    numba compiles the loop without the smoother's code.
 ``record``
-    For the step-wise smoother (:mod:`footzoo.filters.stepwise`), from
-    :func:`footzoo.filters.stepwise.record_arrays` with a row per sample: each sample's
+    For a smoother (:mod:`footzoo.filters.stepwise`: step-wise, or RTS over the whole recording), from
+    :func:`footzoo.filters.smoother.record_arrays` with a row per sample: each sample's
     ``P⁺``, Φ's blocks and update rows are written (made ``in_loop``: each segment is smoothed
     in place as soon as it has closed, the last one left to the caller). ``None``: compiled
     without that code.
@@ -72,20 +68,19 @@ The arguments of :func:`eskf_loop`:
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
 from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .measurement import ACC_BIAS, ATT, BA, BG, GYRO_BIAS, POS, VEL, P, Q, V
-from .smoother import feed_back_attitude
-from .stepwise import close_segment, record_covariance, record_row, record_transition
+from .smoother import feed_back_attitude, record_covariance, record_row, record_transition
+from .stepwise import close_segment
 from .strapdown import quat_product, rotvec_quat
 
 
 @njit
-def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
+def eskf_loop(signals, core, state, models, out, k0, work, record):
     """Run samples 1… of ``signals`` from ``state`` (updated in place); outputs into ``out``.
 
     The arguments are described in the module docstring. When a model's ``measure`` returns a row
@@ -110,8 +105,6 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
     data = unowned(data)
     views = (unowned(m_idx), unowned(par), unowned(par_off), unowned(mem_off), unowned(data_off), unowned(hooks),
              unowned(rows))
-    if smoother is not None:
-        gains, dxs, smoother_gain, M, sub, Ls, inv, keep = smoother
     fault[0], fault[1], fault[2] = -1, 0, 0
     for a in range(m_max):
         z[a] = 0.0
@@ -120,7 +113,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
             H[a, b] = 0.0
     n_dyn = moving_rows(idx, n, dyn, still)
     store(0, nav, a_n, Pk, idx, out, keep_p, True, 0.0, 0)
-    if record is not None:  # step-wise smoother: P⁺ of the incoming state
+    if record is not None:  # smoother: P⁺ of the incoming state
         record_covariance(record, 0, Pk)
     for k in range(1, t.shape[0]):
         if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
@@ -133,19 +126,11 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
         sdt[0, 0], sdt[0, 1], sdt[0, 2] = 0.0, dt * f_n[2], -dt * f_n[1]
         sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * f_n[2], 0.0, dt * f_n[0]
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
-        if record is not None:  # step-wise smoother: Φ's blocks
+        if record is not None:  # smoother: Φ's blocks
             record_transition(record, k, dt, sdt, cdt)
         propagate_rows(Pk, idx, dt, sdt, cdt)
-        if smoother is not None:  # M = Φ P⁺_{k−1}
-            for i in range(n):
-                for j in range(n):
-                    M[i, j] = Pk[i, j]
         propagate_columns(Pk, idx, dt, sdt, cdt, dyn, still, n_dyn)
         add_process_noise(Pk, idx, qn, impact, a_n, dt)
-        if smoother is not None:  # P = P⁻_k
-            smoother_gain(M, Pk, gains[k - 1], sub, Ls, inv, keep)
-            for i in range(n):
-                dxs[k, i] = 0.0
         st = stance[k]
         m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
         nis = 0.0
@@ -155,7 +140,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
             for a in range(m):
                 cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
                 nis += innov * scaled
-                if record is not None:  # step-wise smoother: the row, its gain, ν / s
+                if record is not None:  # smoother: the row, its gain, ν / s
                     record_row(record, k, H[a], kv, scaled)
                 for e in range(cnt):
                     H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
@@ -163,12 +148,9 @@ def eskf_loop(signals, core, state, models, out, k0, work, smoother, record):
                 for j in range(i + 1, n):
                     Pk[j, i] = Pk[i, j]
             feed_back(nav, dx, idx, use_ext, functions[1], views, mems)
-            if smoother is not None:
-                for i in range(n):
-                    dxs[k, i] = dx[i]
         after(functions[2], views, k0 + k, nav, st, mems)
         store(k, nav, a_n, Pk, idx, out, keep_p, False, nis, m)
-        if record is not None:  # step-wise smoother: P⁺_k
+        if record is not None:  # smoother: P⁺_k
             record_covariance(record, k, Pk)
 
 
@@ -447,14 +429,3 @@ def scratch(n: int, m_max: int) -> tuple:
             np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros((3, 3)),
             np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3), np.zeros(3), np.full(3, -1, i8))
 
-
-def smoother_arrays(gains: np.ndarray, dxs: np.ndarray, gain: Any) -> tuple:
-    """The ``smoother`` argument of :func:`eskf_loop`: its outputs, gain function and work arrays.
-
-    ``gains`` (N, n, n) and ``dxs`` (N, n) receive the smoother's gains and the fed-back errors;
-    ``gain`` is :func:`footzoo.filters.smoother.smoother_gain`, compiled on its own; then ``M``
-    and the gain function's work arrays, (n, n) ×4 and (n,) int.
-    """
-    n = dxs.shape[1]
-    return (gains, dxs, gain, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-            np.zeros(n, np.int64))

@@ -12,7 +12,6 @@ import numpy as np
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
 from .measurement import BA, BG, MeasurementModel, P, Q, V
-from .smoother import smoother_gain
 
 
 class ModelFault(Exception):
@@ -34,7 +33,7 @@ def _call(j: int, k: int, fn, *args):
 def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray, quat_ext: np.ndarray | None,
                   layout: Layout, kf: ErrorStateFilter, models: list[MeasurementModel], idx: list[np.ndarray],
                   nav0: np.ndarray, gravity: float, data: list[np.ndarray] | None = None, k0: int = 0,
-                  smooth: bool = False, record: tuple | None = None) -> dict[str, np.ndarray]:
+                  record: tuple | None = None) -> dict[str, np.ndarray]:
     """Strapdown mechanisation with error-state Kalman corrections (Nguyen & La 2016, eqs. 37–52).
 
     Attitude: with an ``att`` block, ``q_k = q_{k-1} ⊗ exp((ω_k − b̂_g) dt)`` (the exact form
@@ -63,10 +62,8 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
         Each model's per-sample inputs for these samples (default: the models' ``data``).
     k0 : int
         Index of sample 0 in the whole recording (a stream's running count).
-    smooth : bool
-        Also return ``gains`` (N, n, n) and ``dxs`` (N, n) for :mod:`footzoo.filters.smoother`.
     record : tuple, optional
-        The step-wise smoother's record (:func:`footzoo.filters.stepwise.record_arrays`, a row per
+        A smoother's record (:func:`footzoo.filters.smoother.record_arrays`, a row per
         sample), filled as the compiled loop fills it (:func:`record_update` gives filterpy's stacked
         update as the compiled loop's scalar rows).
 
@@ -83,9 +80,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
     nav = nav0
     data = data if data is not None else [m.data for m in models]
     m_max = sum(m.max_rows for m in models)
-    out = _outputs(n, layout.n, smooth)
-    work = (np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)), np.empty((layout.n, layout.n)),
-            np.empty(layout.n, dtype=np.int64))
+    out = _outputs(n, layout.n)
     _store(out, 0, nav, np.zeros(3), kf.P)
     if record is not None:
         record[0][0] = kf.P
@@ -93,10 +88,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
         dt = t[k] - t[k - 1]
         w, f, c, f_n, a_n = _propagate(nav, acc[k], gyr[k], quat_ext[k] if not ins else None, g_n, dt)
         F = transition(layout, c, f_n, dt)
-        p_post = kf.P.copy()
         kf.predict(F, dt, float(a_n @ a_n))
-        if smooth:
-            smoother_gain(F @ p_post, kf.P, out["gains"][k - 1], *work)
         if record is not None:
             record_transition(record, k, F, layout, c, dt)
         st = bool(stance[k])
@@ -109,8 +101,6 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
             _feed_back(nav, dx, layout, ins)
             for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
                 _call(j, k0 + k, model.feedback, dx, ix, model.par, model.mem)
-            if smooth:
-                out["dxs"][k] = dx
         for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
             _call(j, k0 + k, model.after, k0 + k, nav, st, ix, model.par, model.mem)
         _store(out, k, nav, a_n, kf.P)
@@ -119,14 +109,12 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
     return out
 
 
-def _outputs(n: int, nx: int, smooth: bool) -> dict[str, np.ndarray]:
+def _outputs(n: int, nx: int) -> dict[str, np.ndarray]:
     """The outputs of :func:`run_reference` for ``n`` samples of an ``nx``-state filter, zeroed."""
     out = {k: np.zeros((n, 3)) for k in ("vel", "pos", "acc_nav", "gyro_bias", "acc_bias")}
     out["quat"] = np.zeros((n, 4))
     out["P_diag"] = np.zeros((n, nx))
     out["nis"] = np.zeros((n, 2))
-    out["gains"] = np.zeros((n if smooth else 0, nx, nx))
-    out["dxs"] = np.zeros((n if smooth else 0, nx))
     return out
 
 
@@ -187,7 +175,7 @@ def _feed_back(nav: np.ndarray, dx: np.ndarray, layout: Layout, ins: bool) -> No
 
 
 def record_transition(record: tuple, k: int, F: np.ndarray, layout: Layout, c: np.ndarray, dt: float) -> None:
-    """Φ_k's blocks into the step-wise smoother's record (as :func:`footzoo.filters.stepwise.record_transition`)."""
+    """Φ_k's blocks into a smoother's record (as :func:`footzoo.filters.smoother.record_transition`)."""
     phi, first, count = record[1], record[3], record[4]
     phi[k, 0] = dt
     if layout.has("att"):

@@ -1,18 +1,44 @@
-"""Rauch–Tung–Striebel smoothing of the error-state filter (offline, after the forward pass).
+"""Rauch–Tung–Striebel smoothing of the closed-loop error-state filter, without a gain or an inverse.
 
-Forward pass unchanged. At every sample it keeps the smoother gain
-``A_k = P_k⁺ Φ_{k+1}ᵀ (P_{k+1}⁻)⁻¹`` and the error ``δx̂_{k+1}`` its update fed back. Because the
-closed-loop filter resets its error state to zero after every feedback, the backward pass of the
-RTS smoother (Rauch, Tung & Striebel 1965) reduces to
+The forward pass is unchanged; it keeps a record of what the backward pass needs
+(:func:`record_arrays`). Because the closed-loop filter feeds its error estimate back and resets
+it to zero after every update, the backward pass of the RTS smoother (Rauch, Tung & Striebel
+1965) for a span that ends at sample ``s`` reduces to
 
-    e_{N−1} = 0,    e_k = A_k (e_{k+1} + δx̂_{k+1}),
+    e_s = 0,    e_{k−1} = A_{k−1} (e_k + δx̂_k),    A_{k−1} = P⁺_{k−1} Φ_kᵀ (P⁻_k)⁻¹,
 
-``e_k`` being the smoothed error of the forward estimate at sample k (``e_{k+1} + δx̂_{k+1}`` is
-the smoothed error of the prediction at k+1, whose forward mean is zero). It is applied as the
-feedback is (``p ← p − e_p``, ``v ← v − e_v``, ``q ← exp(−e_φ) ⊗ q``, ``b ← b + e_b``). This is
-the error-state form of the smoother that gaitmap's ``RtsKalman`` and OpenShoe's smoothed ZUPT
-filters run. States with zero variance (e.g. the position before the first step) are left out of
-the inverse; a relative jitter of 1e-12 keeps the Cholesky factorisation of ``P⁻`` defined.
+``e_k`` being the smoothed error of the forward estimate at sample k and ``δx̂_k`` the error its
+update fed back. ``e_k`` is applied as the feedback is (``p ← p − e_p``, ``v ← v − e_v``,
+``q ← exp(−e_φ) ⊗ q``, ``b ← b + e_b``: :func:`correct_sample`). This is the error-state form of
+the smoother that gaitmap's ``RtsKalman`` and OpenShoe's smoothed ZUPT filters run.
+
+The recursion is evaluated without forming the gain — no inverse or factorisation of ``P⁻`` —
+by carrying ``λ_k = (P⁻_k)⁻¹ (e_k + δx̂_k)`` backwards (the Bryson–Frazier form of the same
+recursion; Bierman 1973)::
+
+    λ ← 0                                      (at k = s: e_s = 0, before the update of s)
+    λ ← λ + h_aᵀ (ν_a / s_a − k_aᵀ λ)          for the update rows a of sample k, last first
+    μ = Φ_kᵀ λ                                 (= (P⁺_{k−1})⁻¹ e_{k−1})
+    e_{k−1} = P⁺_{k−1} μ,   λ ← μ
+
+with each scalar update row's ``h_a`` (1, n), gain ``k_a = P h_aᵀ / s_a``, innovation ``ν_a``
+and its variance ``s_a`` (the compiled loop updates with one row at a time; the reference engine
+records filterpy's stacked update as the same scalar rows). Because ``P⁺ = (I − K H) P⁻`` and
+``K = P⁻ Hᵀ S⁻¹``, ``(P⁻_k)⁻¹ (P⁺_k μ + K_k y_k) = (I − K_k H_k)ᵀ μ + H_kᵀ S_k⁻¹ y_k``: the
+recursion is exactly the RTS one, and states without variance (the position before the first
+step) need no special case. Per sample it costs a few products of n-vectors, where forming the
+gain took a Cholesky factorisation of ``P⁻`` and n triangular solves (8× the forward pass).
+
+Two smoothers run it: ``smoother: rts``, over the whole recording as one span ending at its last
+sample (:func:`smooth_segments` with that one end; offline, the record of every sample kept),
+and ``smoother: stepwise`` (:mod:`footzoo.filters.stepwise`), over each stride as it closes.
+
+What is kept per sample (:func:`record_arrays`)
+    ``P⁺_k`` (n × n), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``; Nguyen & La eq. 33, as
+    :func:`footzoo.filters.eskf.transition`), and the update rows (``h``, ``k``, ``ν/s``: 2n+1
+    each, only the rows there are), written by the compiled loop
+    (:func:`footzoo.filters.kalman_fast.eskf_loop`'s ``record``) or the reference loop: about
+    1 kB per sample at 9 states.
 """
 
 from __future__ import annotations
@@ -24,61 +50,148 @@ import numpy as np
 from ..kernels.jit import njit
 from .strapdown import quat_product, rotvec_quat
 
-JITTER = 1e-12
+#: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
+PHI_WIDTH = 19
 
 
-@njit
-def cholesky(S, m, L):
-    """Lower Cholesky factor of the symmetric positive definite ``S[:m, :m]``, into ``L[:m, :m]``."""
-    for i in range(m):
-        for j in range(i + 1):
-            acc_ = S[i, j]
-            for k in range(j):
-                acc_ -= L[i, k] * L[j, k]
-            if i == j:
-                L[i, i] = math.sqrt(acc_)
-            else:
-                L[i, j] = acc_ / L[j, j]
+def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
+    """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
 
+    ``(cov (N, n, n): P⁺, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
+    h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
+    its number of rows, segment (2,) int: smoothed by the loop itself, first sample of the open
+    segment, smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for
+    ``m_max`` rows per sample; only the rows written are touched.
 
-@njit
-def smoother_gain(M, P_pred, A, sub, L, x, keep):
-    """``A = Mᵀ (P⁻)⁻¹`` with ``M = Φ P⁺`` (so ``Mᵀ = P⁺ Φᵀ``), over the states with variance.
-
-    Row i of A solves ``P⁻ aᵢ = M[:, i]`` (P⁻ symmetric) with the Cholesky factor of P⁻: one
-    factorisation and two triangular solves per row, no explicit inverse. ``sub``, ``L``,
-    ``x`` (n, n) and ``keep`` (n,) int are work arrays.
+    ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
+    as soon as it has closed (:func:`footzoo.filters.stepwise.close_segment`), while its record is in the cache, into
+    ``smoothed`` (the loop's outputs stay the forward pass's), and the record holds the open
+    segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
+    segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths.
     """
-    n = P_pred.shape[0]
-    top = 0.0
+    m = int(in_loop)
+    smoothed = (np.zeros((m, 4)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)))
+    return (np.empty((n_samples, n, n)), np.zeros((n_samples, PHI_WIDTH)),
+            np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
+            np.zeros(n_samples, np.int64), np.array([int(m > 0), 0], np.int64), smoothed)
+
+
+#: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
+RECORD_KEYS = ("record_cov", "record_phi", "record_first", "record_count")
+ROWS_KEY = "record_rows"
+
+
+def record_tuple(out: dict[str, np.ndarray]) -> tuple:
+    """The record (of a live chunk) in the order of :func:`record_arrays` from a dict of its arrays."""
+    cov, phi, first, count = (out[k] for k in RECORD_KEYS)
+    none = np.zeros((0, 3))
+    return cov, phi, out[ROWS_KEY], first, count, np.zeros(2, np.int64), (np.zeros((0, 4)), none, none, none, none)
+
+
+@njit(inline=True)
+def record_transition(record, k, dt, sdt, cdt):
+    """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
+    phi, first, count = record[1], record[3], record[4]
+    r = k - record[5][1]
+    phi[r, 0] = dt
+    for i in range(3):
+        for j in range(3):
+            phi[r, 1 + 3 * i + j] = sdt[i, j]
+            phi[r, 10 + 3 * i + j] = cdt[i, j]
+    first[r] = first[r - 1] + count[r - 1] if r > 0 else 0
+    count[r] = 0
+
+
+@njit(inline=True)
+def record_row(record, k, h, gain, scaled_innovation):
+    """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
+    rows, first, count = record[2], record[3], record[4]
+    s = k - record[5][1]
+    r = first[s] + count[s]
+    n = h.shape[0]
     for i in range(n):
-        top = max(top, P_pred[i, i])
-    m = 0
-    for i in range(n):
-        if P_pred[i, i] > 0.0:
-            keep[m] = i
-            m += 1
-    for a in range(m):
-        for b in range(m):
-            sub[a, b] = P_pred[keep[a], keep[b]]
-        sub[a, a] += JITTER * top
-    cholesky(sub, m, L)
+        rows[r, i] = h[i]
+        rows[r, n + i] = gain[i]
+    rows[r, 2 * n] = scaled_innovation
+    count[s] += 1
+
+
+@njit(inline=True)
+def record_covariance(record, k, P):
+    """Keep ``P⁺_k``."""
+    cov = record[0]
+    r = k - record[5][1]
+    n = P.shape[0]
     for i in range(n):
         for j in range(n):
-            A[i, j] = 0.0
-        y = x[i]
-        for a in range(m):  # forward: L y = M[keep, i]
-            acc_ = M[keep[a], i]
-            for k in range(a):
-                acc_ -= L[a, k] * y[k]
-            y[a] = acc_ / L[a, a]
-        for a in range(m - 1, -1, -1):  # backward: Lᵀ aᵢ = y
-            acc_ = y[a]
-            for k in range(a + 1, m):
-                acc_ -= L[k, a] * y[k]
-            y[a] = acc_ / L[a, a]
-        for b in range(m):
-            A[i, keep[b]] = y[b]
+            cov[r, i, j] = P[i, j]
+
+
+@njit(inline=True)
+def transition_transposed(phi, k, idx, lam, out):
+    """``out = Φ_kᵀ λ`` for Φ = I + Δ with the blocks of Nguyen & La eq. 33 (kept by :func:`record_transition`).
+
+    Δ[pos, vel] = I dt, Δ[vel, att] = −[f^n×] dt, Δ[vel, acc_bias] = C dt, Δ[att, gyro_bias] = C dt.
+    """
+    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
+    for i in range(lam.shape[0]):
+        out[i] = lam[i]
+    dt = phi[k, 0]
+    for j in range(3):
+        out[vel_i + j] += dt * lam[pos_i + j]
+    if att >= 0:
+        for j in range(3):
+            out[att + j] += phi[k, 1 + j] * lam[vel_i] + phi[k, 4 + j] * lam[vel_i + 1] + phi[k, 7 + j] * lam[vel_i + 2]
+    if ab_i >= 0:
+        for j in range(3):
+            out[ab_i + j] += (phi[k, 10 + j] * lam[vel_i] + phi[k, 13 + j] * lam[vel_i + 1]
+                              + phi[k, 16 + j] * lam[vel_i + 2])
+    if att >= 0 and gb_i >= 0:
+        for j in range(3):
+            out[gb_i + j] += phi[k, 10 + j] * lam[att] + phi[k, 13 + j] * lam[att + 1] + phi[k, 16 + j] * lam[att + 2]
+
+
+@njit
+def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
+    """Smooth samples ``lo … hi − 1`` in place, the span ending at ``hi`` (``e_hi = 0``; module docstring).
+
+    ``record`` (:func:`record_arrays`) holds samples ``lo … hi``, sample k in its row ``k − off``;
+    ``lam``, ``mu``, ``e`` (n,) are work arrays.
+    """
+    cov, phi, rows, first, count = record[0], record[1], record[2], record[3], record[4]
+    n = lam.shape[0]
+    for i in range(n):
+        lam[i] = 0.0
+    for j_ in range(hi - off, lo - off, -1):
+        k = j_ + off
+        for r in range(first[j_] + count[j_] - 1, first[j_] - 1, -1):  # the update of sample k, last row first
+            kl = 0.0
+            for i in range(n):
+                kl += rows[r, n + i] * lam[i]
+            c = rows[r, 2 * n] - kl
+            for i in range(n):
+                lam[i] += rows[r, i] * c
+        transition_transposed(phi, j_, idx, lam, mu)
+        for i in range(n):
+            e[i] = 0.0
+        for j in range(n):  # e = P⁺_{k−1} μ, as Σ_j μ_j P⁺[j, :] (P⁺ symmetric: rows, no sums to chain)
+            mj = mu[j]
+            for i in range(n):
+                e[i] += cov[j_ - 1, j, i] * mj
+        correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
+        for i in range(n):
+            lam[i] = mu[i]
+
+
+@njit
+def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+    """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn (record rows ``k − off``)."""
+    n = record[0].shape[1]
+    lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
+    for s in ends:
+        smooth_segment(record, lo, s, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
+        lo = s + 1
+
 
 
 @njit(inline=True)
@@ -103,20 +216,3 @@ def correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
             acc_bias[k, i] += e[ab_i + i]
     if att >= 0 and not use_ext:
         feed_back_attitude(quat[k], e[att], e[att + 1], e[att + 2])
-
-
-@njit
-def rts_backward(A, dxs, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
-    """Backward pass: correct the forward trajectories in place (see the module docstring)."""
-    N, n = dxs.shape
-    e = np.zeros(n)
-    s = np.empty(n)
-    for k in range(N - 2, -1, -1):
-        for i in range(n):
-            s[i] = e[i] + dxs[k + 1, i]
-        for i in range(n):
-            acc_ = 0.0
-            for j in range(n):
-                acc_ += A[k, i, j] * s[j]
-            e[i] = acc_
-        correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)

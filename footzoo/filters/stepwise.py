@@ -23,37 +23,17 @@ Where a segment ends
     equal the batch run's.
 
 The backward pass of a segment ``(s₀, s]``
-    The closed-loop RTS recursion of :mod:`footzoo.filters.smoother`,
-    ``e_s = 0``, ``e_{k−1} = A_{k−1} (e_k + δx̂_k)`` with ``A_{k−1} = P⁺_{k−1} Φ_kᵀ (P⁻_k)⁻¹``,
-    run for k = s … s₀+2 (sample s₀ is the previous segment's end, ``e_{s₀} = 0``). It is
-    evaluated without forming the gain — no inverse or factorisation of ``P⁻`` (the RTS gain's
-    Cholesky factorisation and n triangular solves per sample are what make the
-    whole-recording smoother cost 8× the forward pass) — by carrying
-    ``λ_k = (P⁻_k)⁻¹ (e_k + δx̂_k)`` backwards (the Bryson–Frazier form of the same recursion;
-    Bierman 1973)::
+    The closed-loop RTS recursion of :mod:`footzoo.filters.smoother` (its Bryson–Frazier form,
+    without a gain or an inverse), ``e_s = 0``, ``e_{k−1} = A_{k−1} (e_k + δx̂_k)``, run for
+    k = s … s₀+2 (sample s₀ is the previous segment's end, ``e_{s₀} = 0``): the same kernel as the
+    whole-recording smoother, over a stride instead of the whole recording.
 
-        λ ← 0                                      (at k = s: e_s = 0, before the update of s)
-        λ ← λ + h_aᵀ (ν_a / s_a − k_aᵀ λ)          for the update rows a of sample k, last first
-        μ = Φ_kᵀ λ                                 (= (P⁺_{k−1})⁻¹ e_{k−1})
-        e_{k−1} = P⁺_{k−1} μ,   λ ← μ
-
-    with each scalar update row's ``h_a`` (1, n), gain ``k_a = P h_aᵀ / s_a``, innovation
-    ``ν_a`` and its variance ``s_a`` (the compiled loop updates with one row at a time; the
-    reference engine records filterpy's stacked update as the same scalar rows). Because ``P⁺ = (I − K H) P⁻`` and
-    ``K = P⁻ Hᵀ S⁻¹``, ``(P⁻_k)⁻¹ (P⁺_k μ + K_k y_k) = (I − K_k H_k)ᵀ μ + H_kᵀ S_k⁻¹ y_k``: the
-    recursion is exactly the RTS one, and states without variance (the position before the
-    first step) need no special case. ``e_{k−1}`` is applied as the feedback is
-    (:func:`footzoo.filters.smoother.correct_sample`, shared with the RTS pass).
-
-What is kept (per sample of the open segment, :func:`record_arrays`)
-    ``P⁺_k`` (n × n), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``;
-    Nguyen & La eq. 33, as :func:`footzoo.filters.eskf.transition`), and the update rows
-    (``h``, ``k``, ``ν/s``: 2n+1 each, only the rows there are) — written by the
-    compiled loop (:func:`footzoo.filters.kalman_fast.eskf_loop`'s ``record``), dropped once
-    their segment has been smoothed: about 1 kB per sample at 9 states, one stride. Live, the
-    Kalman stage holds them; on a whole recording the loop itself smooths each segment as soon
-    as it has closed (:func:`close_segment`), while the record is in the cache, so the pass
-    costs less than the forward filter.
+What is kept
+    The record of :func:`footzoo.filters.smoother.record_arrays` (``P⁺_k``, Φ_k's blocks and the
+    update rows), per sample of the open segment only, dropped once the segment has been smoothed:
+    about 1 kB per sample at 9 states, one stride. Live, the Kalman stage holds them; on a whole
+    recording the loop itself smooths each segment as soon as it has closed
+    (:func:`close_segment`), while the record is in the cache.
 """
 
 from __future__ import annotations
@@ -61,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import njit
-from .smoother import correct_sample
+from .smoother import smooth_segment
 
 #: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
 WAITS_FOR = "the end of the next stance"
@@ -69,149 +49,6 @@ WAITS_FOR = "the end of the next stance"
 #: Longest segment (s) before a stance sample closes it although the stance goes on (standing still);
 #: a walking stride with its stance lasts about 1–1.5 s.
 MAX_SEGMENT = 3.0
-
-#: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
-PHI_WIDTH = 19
-
-
-def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
-    """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
-
-    ``(cov (N, n, n): P⁺, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
-    h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
-    its number of rows, segment (2,) int: smoothed by the loop itself, first sample of the open
-    segment, smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for
-    ``m_max`` rows per sample; only the rows written are touched.
-
-    ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
-    as soon as it has closed (:func:`close_segment`), while its record is in the cache, into
-    ``smoothed`` (the loop's outputs stay the forward pass's), and the record holds the open
-    segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
-    segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths.
-    """
-    m = int(in_loop)
-    smoothed = (np.zeros((m, 4)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)))
-    return (np.empty((n_samples, n, n)), np.zeros((n_samples, PHI_WIDTH)),
-            np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
-            np.zeros(n_samples, np.int64), np.array([int(m > 0), 0], np.int64), smoothed)
-
-
-#: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
-RECORD_KEYS = ("record_cov", "record_phi", "record_first", "record_count")
-ROWS_KEY = "record_rows"
-
-
-def record_tuple(out: dict[str, np.ndarray]) -> tuple:
-    """The record (of a live chunk) in the order of :func:`record_arrays` from a dict of its arrays."""
-    cov, phi, first, count = (out[k] for k in RECORD_KEYS)
-    none = np.zeros((0, 3))
-    return cov, phi, out[ROWS_KEY], first, count, np.zeros(2, np.int64), (np.zeros((0, 4)), none, none, none, none)
-
-
-@njit(inline=True)
-def record_transition(record, k, dt, sdt, cdt):
-    """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
-    phi, first, count = record[1], record[3], record[4]
-    r = k - record[5][1]
-    phi[r, 0] = dt
-    for i in range(3):
-        for j in range(3):
-            phi[r, 1 + 3 * i + j] = sdt[i, j]
-            phi[r, 10 + 3 * i + j] = cdt[i, j]
-    first[r] = first[r - 1] + count[r - 1] if r > 0 else 0
-    count[r] = 0
-
-
-@njit(inline=True)
-def record_row(record, k, h, gain, scaled_innovation):
-    """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
-    rows, first, count = record[2], record[3], record[4]
-    s = k - record[5][1]
-    r = first[s] + count[s]
-    n = h.shape[0]
-    for i in range(n):
-        rows[r, i] = h[i]
-        rows[r, n + i] = gain[i]
-    rows[r, 2 * n] = scaled_innovation
-    count[s] += 1
-
-
-@njit(inline=True)
-def record_covariance(record, k, P):
-    """Keep ``P⁺_k``."""
-    cov = record[0]
-    r = k - record[5][1]
-    n = P.shape[0]
-    for i in range(n):
-        for j in range(n):
-            cov[r, i, j] = P[i, j]
-
-
-@njit(inline=True)
-def transition_transposed(phi, k, idx, lam, out):
-    """``out = Φ_kᵀ λ`` for Φ = I + Δ with the blocks of Nguyen & La eq. 33 (kept by :func:`record_transition`).
-
-    Δ[pos, vel] = I dt, Δ[vel, att] = −[f^n×] dt, Δ[vel, acc_bias] = C dt, Δ[att, gyro_bias] = C dt.
-    """
-    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
-    for i in range(lam.shape[0]):
-        out[i] = lam[i]
-    dt = phi[k, 0]
-    for j in range(3):
-        out[vel_i + j] += dt * lam[pos_i + j]
-    if att >= 0:
-        for j in range(3):
-            out[att + j] += phi[k, 1 + j] * lam[vel_i] + phi[k, 4 + j] * lam[vel_i + 1] + phi[k, 7 + j] * lam[vel_i + 2]
-    if ab_i >= 0:
-        for j in range(3):
-            out[ab_i + j] += (phi[k, 10 + j] * lam[vel_i] + phi[k, 13 + j] * lam[vel_i + 1]
-                              + phi[k, 16 + j] * lam[vel_i + 2])
-    if att >= 0 and gb_i >= 0:
-        for j in range(3):
-            out[gb_i + j] += phi[k, 10 + j] * lam[att] + phi[k, 13 + j] * lam[att + 1] + phi[k, 16 + j] * lam[att + 2]
-
-
-@njit
-def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
-    """Smooth samples ``lo … hi − 1`` in place, the segment ending at ``hi`` (``e_hi = 0``; module docstring).
-
-    ``record`` (:func:`record_arrays`) holds samples ``lo … hi``, sample k in its row ``k − off``;
-    ``lam``, ``mu``, ``e`` (n,) are work arrays.
-    """
-    cov, phi, rows, first, count = record[0], record[1], record[2], record[3], record[4]
-    n = lam.shape[0]
-    for i in range(n):
-        lam[i] = 0.0
-    for j_ in range(hi - off, lo - off, -1):
-        k = j_ + off
-        for r in range(first[j_] + count[j_] - 1, first[j_] - 1, -1):  # the update of sample k, last row first
-            kl = 0.0
-            for i in range(n):
-                kl += rows[r, n + i] * lam[i]
-            c = rows[r, 2 * n] - kl
-            for i in range(n):
-                lam[i] += rows[r, i] * c
-        transition_transposed(phi, j_, idx, lam, mu)
-        for i in range(n):
-            e[i] = 0.0
-        for j in range(n):  # e = P⁺_{k−1} μ, as Σ_j μ_j P⁺[j, :] (P⁺ symmetric: rows, no sums to chain)
-            mj = mu[j]
-            for i in range(n):
-                e[i] += cov[j_ - 1, j, i] * mj
-        correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
-        for i in range(n):
-            lam[i] = mu[i]
-
-
-@njit
-def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
-    """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn (record rows ``k − off``)."""
-    n = record[0].shape[1]
-    lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
-    for s in ends:
-        smooth_segment(record, lo, s, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
-        lo = s + 1
-
 
 @njit(inline=True)
 def ends_segment(stance, t, k, lo):

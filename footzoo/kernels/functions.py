@@ -108,19 +108,6 @@ def fixed_address(fn: Any) -> Any:
     return cached
 
 
-def compiled_with_signature(fn: Callable[..., Any], argument_types: Callable[[Any], tuple]) -> Any:
-    """``fn`` (a kernel) compiled for one signature, as a :func:`fixed_address` value.
-
-    ``argument_types(types)`` gives the signature from ``numba.types`` (so callers need not import
-    numba). Without numba, the kernel itself.
-    """
-    fn = _jit.compiled(fn)
-    numba = _jit.load_numba()
-    if numba is None:
-        return fn
-    return fixed_address(_jit.njit_signature(getattr(fn, "py_func", fn), argument_types(numba.types), nogil=True))
-
-
 @functools.cache
 def _fixed_address_type() -> type:
     """The class of :func:`fixed_address`'s values (defined at first use: it derives from a numba class)."""
@@ -154,16 +141,15 @@ _BOUND: dict[tuple, Any] = {}
 def bind(loop: Any, functions: tuple) -> Any:
     """``bound(signals, core, state, arrays, out, k0, work, record)``: ``loop`` with ``functions`` as constants.
 
-    ``loop`` is called as ``loop(signals, core, state, (functions, arrays), out, k0, work, None,
-    record)`` (the error-state loop's argument order, without a whole-recording smoother). Compiled
-    once per process and set of functions.
+    ``loop`` is called as ``loop(signals, core, state, (functions, arrays), out, k0, work, record)``
+    (the error-state loop's argument order). Compiled once per process and set of functions.
     """
     key = (id(loop),) + tuple(id(f) for group in functions for f in group)
     if key not in _BOUND:
         inner = _jit.compiled(loop)
 
         def bound(signals, core, state, arrays, out, k0, work, record):
-            inner(signals, core, state, (functions, arrays), out, k0, work, None, record)
+            inner(signals, core, state, (functions, arrays), out, k0, work, record)
 
         _BOUND[key] = _jit.load_numba().njit(nogil=True)(bound)
     return _BOUND[key]

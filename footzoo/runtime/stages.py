@@ -22,7 +22,8 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
-from ..filters.stepwise import RECORD_KEYS, ROWS_KEY, segment_ends
+from ..filters.smoother import RECORD_KEYS, ROWS_KEY
+from ..filters.stepwise import segment_ends
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
