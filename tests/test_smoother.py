@@ -56,7 +56,7 @@ def _linear_system(measured_every: int = 40):
     every other ``measured_every`` samples, as in stance), and filterpy's standard RTS smoother on it."""
     from filterpy.kalman import KalmanFilter
 
-    from footzoo.filters.smoother import record_arrays
+    from footzoo.filters.smoother import packed, record_arrays
 
     rng = np.random.default_rng(0)
     dt, n_steps = 0.01, 300
@@ -90,7 +90,7 @@ def _linear_system(measured_every: int = 40):
     # Δ[pos, vel] = I dt), the scalar update rows one at a time (h, k, ν / s)
     record = record_arrays(n_steps, 6, 3)
     cov, phi, rows, first, count = record[:5]
-    cov[0] = P
+    cov[0] = packed(P)
     for k in range(1, n_steps):
         nominal[k] = F @ nominal[k - 1]
         P = F @ P @ F.T + Q
@@ -112,7 +112,7 @@ def _linear_system(measured_every: int = 40):
             np.testing.assert_allclose(seq, dx, atol=1e-12)
             nominal[k] -= dx
             P = (np.eye(6) - K @ H) @ P @ (np.eye(6) - K @ H).T + K @ R @ K.T
-        cov[k] = P
+        cov[k] = packed(P)
     np.testing.assert_allclose(nominal, np.array(means), atol=1e-12)
     return nominal, record, np.array(measured), expected[:, :, 0]
 
@@ -146,9 +146,27 @@ def test_the_backward_recursion_over_the_whole_run_and_over_each_segment_is_filt
     smoothed = np.hstack([pos, vel])
     lo = 0
     for hi in ends:  # the RTS smoother of filterpy on the filtered means and covariances of one segment
-        alone = _filterpy_rts_on(nominal[lo:hi + 1], record[0][lo:hi + 1])
+        alone = _filterpy_rts_on(nominal[lo:hi + 1], _unpacked(record[0][lo:hi + 1], 6))
         np.testing.assert_allclose(smoothed[lo:hi + 1], alone, atol=1e-9)
         lo = hi + 1
+
+
+def _unpacked(cov, n):
+    """The record's upper triangles (N, n(n+1)/2) as full symmetric matrices (N, n, n)."""
+    full = np.zeros((len(cov), n, n))
+    i, j = np.triu_indices(n)
+    full[:, i, j] = cov
+    full[:, j, i] = cov
+    return full
+
+
+def test_the_record_keeps_the_upper_triangle_row_by_row():
+    from footzoo.filters.smoother import packed
+
+    P = np.arange(9.0).reshape(3, 3)
+    P = P + P.T  # [[0, 4, 8], [4, 8, 12], [8, 12, 16]]
+    np.testing.assert_array_equal(packed(P), [0, 4, 8, 8, 12, 16])
+    np.testing.assert_array_equal(_unpacked(packed(P)[None], 3)[0], P)
 
 
 def _filterpy_rts_on(means, covs):

@@ -12,6 +12,7 @@ import numpy as np
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
 from .measurement import BA, BG, MeasurementModel, P, Q, V
+from .smoother import packed
 
 
 class ModelFault(Exception):
@@ -83,7 +84,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
     out = _outputs(n, layout.n)
     _store(out, 0, nav, np.zeros(3), kf.P)
     if record is not None:
-        record[0][0] = kf.P
+        record[0][0] = packed(kf.P)
     for k in range(1, n):
         dt = t[k] - t[k - 1]
         w, f, c, f_n, a_n = _propagate(nav, acc[k], gyr[k], quat_ext[k] if not ins else None, g_n, dt)
@@ -105,7 +106,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
             _call(j, k0 + k, model.after, k0 + k, nav, st, ix, model.par, model.mem)
         _store(out, k, nav, a_n, kf.P)
         if record is not None:
-            record[0][k] = kf.P
+            record[0][k] = packed(kf.P)
     return out
 
 

@@ -57,21 +57,22 @@ PHI_WIDTH = 19
 def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
     """Empty record of the forward pass for ``n_samples`` samples of an ``n``-state filter (``m_max`` rows at most).
 
-    ``(cov (N, n, n): P⁺, phi (N, 19): Φ's blocks, rows (R, 2n+1): the update rows
-    h, k, ν/s one after the other, first (N,) int: each sample's first row in ``rows``, count (N,) int:
-    its number of rows, segment (2,) int: smoothed by the loop itself, first sample of the open
-    segment, smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for
-    ``m_max`` rows per sample; only the rows written are touched.
+    ``(cov (N, n(n+1)/2): P⁺'s upper triangle, row by row (:func:`packed`), phi (N, 19): Φ's
+    blocks, rows (R, 2n+1): the update rows h, k, ν/s one after the other, first (N,) int: each
+    sample's first row in ``rows``, count (N,) int: its number of rows, segment (2,) int: smoothed
+    by the loop itself, first sample of the open segment, smoothed (quat (M, 4), vel, pos,
+    gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for ``m_max`` rows per sample; only the rows
+    written are touched.
 
     ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
-    as soon as it has closed (:func:`footzoo.filters.stepwise.close_segment`), while its record is in the cache, into
-    ``smoothed`` (the loop's outputs stay the forward pass's), and the record holds the open
-    segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
+    as soon as it has closed (:func:`footzoo.filters.stepwise.close_segment`), while its record is
+    in the cache, into ``smoothed`` (the loop's outputs stay the forward pass's), and the record
+    holds the open segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
     segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths.
     """
     m = int(in_loop)
     smoothed = (np.zeros((m, 4)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)))
-    return (np.empty((n_samples, n, n)), np.zeros((n_samples, PHI_WIDTH)),
+    return (np.empty((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
             np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
             np.zeros(n_samples, np.int64), np.array([int(m > 0), 0], np.int64), smoothed)
 
@@ -79,6 +80,11 @@ def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple
 #: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
 RECORD_KEYS = ("record_cov", "record_phi", "record_first", "record_count")
 ROWS_KEY = "record_rows"
+
+
+def packed(P: np.ndarray) -> np.ndarray:
+    """The upper triangle of the symmetric ``P`` (n, n), row by row: the record's form of ``P⁺`` (n(n+1)/2,)."""
+    return P[np.triu_indices(P.shape[0])]
 
 
 def record_tuple(out: dict[str, np.ndarray]) -> tuple:
@@ -118,13 +124,15 @@ def record_row(record, k, h, gain, scaled_innovation):
 
 @njit(inline=True)
 def record_covariance(record, k, P):
-    """Keep ``P⁺_k``."""
+    """Keep ``P⁺_k``: its upper triangle, row by row (P is symmetric; half the memory)."""
     cov = record[0]
     r = k - record[5][1]
     n = P.shape[0]
+    a = 0
     for i in range(n):
-        for j in range(n):
-            cov[r, i, j] = P[i, j]
+        for j in range(i, n):
+            cov[r, a] = P[i, j]
+            a += 1
 
 
 @njit(inline=True)
@@ -174,10 +182,16 @@ def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias,
         transition_transposed(phi, j_, idx, lam, mu)
         for i in range(n):
             e[i] = 0.0
-        for j in range(n):  # e = P⁺_{k−1} μ, as Σ_j μ_j P⁺[j, :] (P⁺ symmetric: rows, no sums to chain)
-            mj = mu[j]
-            for i in range(n):
-                e[i] += cov[j_ - 1, j, i] * mj
+        a = 0
+        for i in range(n):  # e = P⁺_{k−1} μ from P⁺'s upper triangle (P⁺ symmetric)
+            mi = mu[i]
+            e[i] += cov[j_ - 1, a] * mi
+            a += 1
+            for j in range(i + 1, n):
+                p = cov[j_ - 1, a]
+                e[i] += p * mu[j]
+                e[j] += p * mi
+                a += 1
         correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         for i in range(n):
             lam[i] = mu[i]
@@ -186,7 +200,7 @@ def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias,
 @njit
 def smooth_segments(record, ends, lo, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Smooth every segment from sample ``lo`` up to each of ``ends`` (increasing) in turn (record rows ``k − off``)."""
-    n = record[0].shape[1]
+    n = (record[2].shape[1] - 1) // 2
     lam, mu, e = np.zeros(n), np.zeros(n), np.zeros(n)
     for s in ends:
         smooth_segment(record, lo, s, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)

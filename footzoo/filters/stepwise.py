@@ -99,7 +99,7 @@ def smooth_copy(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, ac
             sp[k, i] = pos[k, i]
             sg[k, i] = gyro_bias[k, i]
             sa[k, i] = acc_bias[k, i]
-    n = record[0].shape[1]
+    n = (record[2].shape[1] - 1) // 2
     smooth_segment(record, lo, hi, off, idx, use_ext, sq, sv, sp, sg, sa, np.empty(n), np.empty(n), np.empty(n))
 
 

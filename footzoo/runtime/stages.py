@@ -310,7 +310,7 @@ class KalmanStage:
         rows = self.open.view()
         if not segment_ends(rows["stance"], rows["t"], closed).size:  # most packets end no stance: nothing to do
             return {}
-        no_rows = np.zeros((0, 1 + 2 * rows["record_cov"].shape[1]))
+        no_rows = np.zeros((0, 1 + 2 * self.engine.layout.n))
         held = {**rows, "record_first": rows["record_first"] - self.rows_before,
                 ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else no_rows}
         n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), rows["t"], closed)
