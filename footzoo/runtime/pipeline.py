@@ -79,7 +79,8 @@ class Pipeline:
         Process noise and initial uncertainty of the INS core of the Kalman filter.
     smoother : {"none", "rts", "stepwise"}
         ``rts``: after the Kalman filter's forward pass, a Rauch–Tung–Striebel backward pass
-        over the whole recording (:mod:`footzoo.filters.smoother`; offline only). ``stepwise``:
+        over the whole recording (:mod:`footzoo.filters.smoother`, without a gain or an
+        inverse: about the forward pass's cost; offline only). ``stepwise``:
         the same backward pass over each stride, from the last sample of a stance back to the
         previous one (Colomar, Nilsson & Händel 2012; :mod:`footzoo.filters.stepwise`): it runs
         live, each stride final once the stance after it has ended. The forward trajectory
