@@ -234,3 +234,11 @@ def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_ar
                 assert ("half" if factor == 2.0 else "twice") in cause, (rec.name, factor, cause)
                 named += 1
     assert named >= 60  # 72 restamped files: 64 named (the unusual-motion trials and a few runs are not)
+
+
+def test_a_reference_that_is_only_the_true_ranges_round_trips(tmp_path):
+    rec = simulate(n_strides=3, rate=50.0, distance_sensors=True)
+    bare = Recording(t=rec.t, acc=rec.acc, gyr=rec.gyr, dist=rec.dist, meta={"name": "ranges"},
+                     truth=Truth(dist=rec.truth.dist))
+    back = footzoo.load(write(bare, tmp_path / "ranges.csv"))
+    np.testing.assert_array_equal(back.truth.dist, rec.truth.dist)
