@@ -369,7 +369,7 @@ def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
         stance = flags.astype(bool)
     dist_cols = sorted(c for c in df.columns if c.startswith("true_dist_"))
     dist = df[dist_cols].to_numpy(dtype=float) if dist_cols else None
-    if pos is None and vel is None and quat is None and stance is None:
+    if pos is None and vel is None and quat is None and stance is None and dist is None:
         return None
     return Truth(pos=pos, vel=vel, quat=quat, stance=stance, dist=dist)
 

@@ -19,12 +19,13 @@ Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.co
   :class:`~footzoo.core.errors.SensorWarning` naming the axis, the value, the sample
   and time ranges; the estimate is computed but its velocity and position
   underestimate the motion in those samples.
-* **Glitches** — a burst of 1 to :data:`GLITCH_MAX_LEN` samples whose angular rate differs
-  from both the sample before and the sample after it by more than :data:`GLITCH_JUMP`
-  (15 rad/s) plus the change between those two (:func:`find_bursts`); the same for the
-  specific force with :data:`ACC_GLITCH_JUMP` (400 m/s²). On the real recordings the largest
+* **Glitches** — a burst of 1 to :data:`GLITCH_MAX_LEN` (20) samples whose angular rate jumps
+  into it and out of it and stands more than :data:`GLITCH_JUMP` (15 rad/s) above the signal
+  around it (up to 3 samples: above both neighbours plus the change between them; longer: off the
+  chord between them, :func:`find_bursts`); the same for the specific force with
+  :data:`ACC_GLITCH_JUMP` (400 m/s²). On the real recordings the largest
   such single-sample peak is 5.7 rad/s (gaitmap example, 204.8 Hz; PyShoe ≤ 1.7 rad/s, x-io
-  1.0 rad/s) and no burst is found in any; one 40 rad/s spike in a walk turns the attitude by
+  1.0 rad/s) and no burst of any length up to 20 is found in any; one 40 rad/s spike in a walk turns the attitude by
   0.2–0.4 rad and misplaces the end by metres. Reported with a
   :class:`~footzoo.core.errors.SensorWarning` listing the samples.
 
@@ -61,7 +62,9 @@ GLITCH_JUMP = 15.0
 #: folder — PyShoe walking, running and stairs, x-io, gaitmap, Köroğlu — is 256 m/s², gaitmap's heel strikes).
 ACC_GLITCH_JUMP = 400.0
 #: Longest burst of samples reported as a glitch (a longer excursion is motion, or saturation).
-GLITCH_MAX_LEN = 3
+GLITCH_MAX_LEN = 20
+#: Longest burst measured against its two neighbours (:func:`find_bursts`); a longer one against the chord between them.
+SHORT_GLITCH_LEN = 3
 _AXES = "xyz"
 _SQRT3 = math.sqrt(3.0)
 
@@ -122,10 +125,16 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
 def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np.ndarray:
     """Samples of bursts of 1 to ``max_len`` samples that stand out from the samples around them by more than ``jump``.
 
-    A burst ``x[k:k+L]`` is a glitch when every one of its samples differs from both the sample
-    before (``x[k-1]``) and the sample after (``x[k+L]``) by more than ``jump`` plus the change
-    between those two (a real peak rises and falls over its samples; a glitch jumps and returns).
-    For ``L = 1`` this is the single-sample spike test.
+    A burst ``x[k:k+L]`` starts with a jump into it and ends with one out of it (``x`` changes by
+    more than ``jump`` from ``x[k-1]`` to ``x[k]`` and from ``x[k+L-1]`` to ``x[k+L]``). Up to
+    :data:`SHORT_GLITCH_LEN` samples, it is a glitch when every one of its samples differs from both
+    the sample before (``x[k-1]``) and the sample after (``x[k+L]``) by more than ``jump`` plus the
+    change between those two (a real peak rises and falls over its samples; a glitch jumps and
+    returns); for ``L = 1`` this is the single-sample spike test. A longer burst (4 to ``max_len``
+    samples) is a glitch when every one of its samples lies more than ``jump`` off the straight
+    line from ``x[k-1]`` to ``x[k+L]``: the signal under it keeps moving (a swing's angular rate
+    changes by several rad/s in 0.1 s), the glitch stands on it. A clipped axis (flat at its
+    sensor's full scale, reached without a jump) is not a burst: :func:`find_saturation` reports it.
 
     Parameters
     ----------
@@ -156,11 +165,17 @@ def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np
             continue
         before, after = x[k - 1], x[k + length]
         height = np.full(len(k), np.inf)
-        for j in range(length):
-            mid = x[k + j]
-            height = np.minimum(height, np.minimum(np.linalg.norm(mid - before, axis=1),
-                                                   np.linalg.norm(mid - after, axis=1)))
-        k = k[height - np.linalg.norm(after - before, axis=1) > jump]
+        if length <= SHORT_GLITCH_LEN:  # above both neighbours, beyond the change between them
+            for j in range(length):
+                mid = x[k + j]
+                height = np.minimum(height, np.minimum(np.linalg.norm(mid - before, axis=1),
+                                                       np.linalg.norm(mid - after, axis=1)))
+            height -= np.linalg.norm(after - before, axis=1)
+        else:  # a longer burst rides on a signal that moves meanwhile: off the chord from before to after
+            for j in range(length):
+                chord = before + (after - before) * ((j + 1) / (length + 1))
+                height = np.minimum(height, np.linalg.norm(x[k + j] - chord, axis=1))
+        k = k[height > jump]
         found.extend((k[:, None] + np.arange(length)).ravel().tolist())
     return np.unique(np.asarray(found, dtype=int))
 

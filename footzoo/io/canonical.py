@@ -4,13 +4,16 @@ SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``).
 A file written by ``footzoo simulate`` also carries its ground truth in
 ``true_*`` columns, a metadata sidecar ``<file>.meta.yaml`` (metadata and the
 ``closed_loop`` marker, :mod:`footzoo.io.metadata`) and the true steps in
-``<file>.steps.csv`` (every true stride: its row count becomes ``truth.stride_count``).
+``<file>.steps.csv`` (every true stride: its row count becomes ``truth.stride_count``, unless the sidecar's ``truth:``
+gives a hand count). A reference that has only a stride table, a closed-loop marker or a
+stride count (gaitmap's strides, x-io's closed loop, Köroğlu's count) round-trips too.
 :func:`write` writes the three files as one unit (atomically, never over an input), and
 removes the steps sidecar of an earlier file of the same name when the new one has none.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -18,8 +21,8 @@ import pandas as pd
 
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
-from ..core.data import Recording
-from ..core.errors import FormatError, OutputError
+from ..core.data import Recording, Truth
+from ..core.errors import FootzooWarning, FormatError, OutputError
 from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, input_files, text_source
 from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
 
@@ -55,6 +58,8 @@ def read(path: Path, **options: Any) -> Recording:
     meta.update(facts.meta)
     meta["input_files"] = [str(path), *map(str, facts.files)]
     rec = Recording.from_dataframe(df, meta=meta, **options)
+    if rec.truth is None and (facts.steps is not None or facts.closed_loop or facts.truth):
+        rec.truth = Truth()  # a reference without per-sample columns: a stride table, a closed loop, a count
     if rec.truth is not None:
         rec.truth.closed_loop = bool(facts.closed_loop)
         if facts.steps is not None:
@@ -63,8 +68,12 @@ def read(path: Path, **options: Any) -> Recording:
             except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
                 raise FormatError(f"{facts.steps}: cannot read the true steps: {err}; fix or delete the file") from None
             rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
+        if "stride_count" in facts.truth:  # the reference's own count (a hand count, or null: none)
+            count = facts.truth["stride_count"]
+            rec.truth.stride_count = None if count is None else int(count)
         if meta.get("source") == "footzoo.sim":
             rec.truth.source = "simulator"
+        rec.truth.source = str(facts.truth.get("source", rec.truth.source))
     return rec
 
 
@@ -151,5 +160,34 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
             group.remove(steps_path(p))
         meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
         closed = bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))
-        group.path(meta_path(p)).write_text(facts_text(meta, closed, sha256(tmp), steps_sha), encoding="utf-8")
+        group.path(meta_path(p)).write_text(facts_text(meta, closed, sha256(tmp), steps_sha, _truth_facts(rec)),
+                                            encoding="utf-8")
+    _warn_unwritten(rec, p)
     return p
+
+
+def _truth_facts(rec: Recording) -> dict[str, Any]:
+    """The reference's scalar facts for the metadata sidecar: its source and a stride count the steps do not give."""
+    tr = rec.truth
+    if tr is None:
+        return {}
+    out: dict[str, Any] = {}
+    if tr.source:
+        out["source"] = str(tr.source)
+    if tr.stride_count is None:
+        if tr.steps is not None:
+            out["stride_count"] = None  # the steps' rows are not a count here
+    elif tr.steps is None or int(tr.stride_count) != len(tr.steps):
+        out["stride_count"] = int(tr.stride_count)
+    return out
+
+
+def _warn_unwritten(rec: Recording, path: Path) -> None:
+    """Warn about the parts of a reference the canonical files cannot hold (never dropped silently)."""
+    tr = rec.truth
+    lost = [name for name in ("footprints", "stride_positions") if tr is not None and getattr(tr, name) is not None]
+    if lost:
+        warnings.warn(FootzooWarning(
+            f"{path.name}: the reference's {' and '.join(lost)} (truth.{', truth.'.join(lost)}) are not written: the "
+            "canonical files hold per-sample truth, the steps table, the stride count and the closed-loop marker only. "
+            "Keep the original recording for them (footzoo.load reads them from it)"), stacklevel=3)

@@ -7,6 +7,9 @@ Any recording file may have one, next to it::
       subject: S07
       foot: left
     closed_loop: true     # the walk ends where it started: loop-closure metrics apply
+    truth:                # facts of the reference that have no per-sample column (optional)
+      source: motion capture (gaitmap)
+      stride_count: 12    # strides counted by hand (null: none; absent: the rows of the steps file)
 
 ``footzoo simulate`` and :func:`footzoo.io.canonical.write` write it for every recording, with
 ``data_sha256`` (the SHA-256 of the data file it describes) and, when there is a true-steps
@@ -14,7 +17,9 @@ sidecar ``<file>.steps.csv``, ``steps_sha256``. A sidecar whose ``data_sha256`` 
 the data file is **stale** (left over from an earlier file of the same name): it is ignored,
 together with the steps file, with a warning. A steps file is read only when the metadata
 sidecar vouches for it (its ``steps_sha256`` matches) or when the sidecar carries no hashes at
-all (a hand-written sidecar, or one written before footzoo 0.3).
+all (a hand-written sidecar, or one written before footzoo 0.3). A reference with no per-sample
+column (only a stride table, a closed-loop marker or a hand count) is still a reference: the
+reader builds its :class:`~footzoo.core.data.Truth` from the sidecars alone.
 """
 
 from __future__ import annotations
@@ -29,7 +34,9 @@ from ..core.errors import FootzooWarning, FormatError
 from ..core.yamlsafe import dump_text, load_file
 
 #: Keys of a metadata sidecar.
-KEYS = ("meta", "closed_loop", "data_sha256", "steps_sha256")
+KEYS = ("meta", "closed_loop", "truth", "data_sha256", "steps_sha256")
+#: Keys of a sidecar's ``truth`` mapping: the reference's scalar facts.
+TRUTH_KEYS = ("source", "stride_count")
 
 
 def meta_path(path: Path) -> Path:
@@ -65,10 +72,14 @@ class Facts:
         The true-steps sidecar to read, when there is a valid one.
     files : list of Path
         The sidecar files that were used (inputs of the run).
+    truth : dict
+        The reference's scalar facts (:data:`TRUTH_KEYS`: ``source`` text, ``stride_count`` a
+        whole number, or None for "no count"), empty when the sidecar has none.
     """
 
     meta: dict[str, Any] = field(default_factory=dict)
     closed_loop: bool | None = None
+    truth: dict[str, Any] = field(default_factory=dict)
     steps: Path | None = None
     files: list[Path] = field(default_factory=list)
 
@@ -96,6 +107,7 @@ def read_facts(path: Path) -> Facts:
     closed_loop = raw.get("closed_loop")
     if closed_loop is not None and not isinstance(closed_loop, bool):
         raise FormatError(f"{side}: closed_loop must be true or false, got {closed_loop!r}; {fix}")
+    truth = _truth_facts(raw.get("truth"), side, fix)
     for key in ("data_sha256", "steps_sha256"):
         if raw.get(key) is not None and not isinstance(raw[key], str):
             raise FormatError(f"{side}: {key} must be a hex digest (text), got {raw[key]!r:.80}; {fix}")
@@ -105,7 +117,7 @@ def read_facts(path: Path) -> Facts:
             + (f" together with {steps.name}" if steps.exists() else "")
             + "; delete it, or write the recording again with footzoo.io.canonical.write"), stacklevel=3)
         return Facts()
-    facts = Facts(meta=dict(meta), closed_loop=closed_loop, files=[side])
+    facts = Facts(meta=dict(meta), closed_loop=closed_loop, truth=truth, files=[side])
     if steps.exists():
         vouched = raw.get("steps_sha256")
         hashed = raw.get("data_sha256") is not None
@@ -120,9 +132,43 @@ def read_facts(path: Path) -> Facts:
     return facts
 
 
-def facts_text(meta: dict[str, Any], closed_loop: bool, data_sha256: str, steps_sha256: str | None) -> str:
-    """YAML text of a metadata sidecar (metadata values that are text stay text)."""
+def _truth_facts(raw: Any, side: Path, fix: str) -> dict[str, Any]:
+    """The sidecar's ``truth`` mapping, checked (empty when absent)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise FormatError(f"{side}: 'truth' must be a mapping ({', '.join(TRUTH_KEYS)}), got {raw!r:.80}; {fix}")
+    unknown = [k for k in raw if k not in TRUTH_KEYS]
+    if unknown:
+        raise FormatError(f"{side}: unknown truth key(s) {unknown}; 'truth' holds {list(TRUTH_KEYS)}; {fix}")
+    if raw.get("source") is not None and not isinstance(raw["source"], str):
+        raise FormatError(f"{side}: truth.source must be text, got {raw['source']!r:.80}; {fix}")
+    count = raw.get("stride_count")
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
+        raise FormatError(f"{side}: truth.stride_count must be a whole number of strides (0 or more) or null, got "
+                          f"{count!r:.80}; {fix}")
+    # stride_count: null says "no count" (the steps file's rows are then not taken for one)
+    return {k: v for k, v in raw.items() if v is not None or k == "stride_count"}
+
+
+def facts_text(meta: dict[str, Any], closed_loop: bool, data_sha256: str, steps_sha256: str | None,
+               truth: dict[str, Any] | None = None) -> str:
+    """YAML text of a metadata sidecar (metadata values that are text stay text).
+
+    Parameters
+    ----------
+    meta : dict
+        Scalar metadata.
+    closed_loop : bool
+        The closed-loop marker.
+    data_sha256, steps_sha256 : str
+        Hashes of the data file and of the steps file (None: no steps file).
+    truth : dict, optional
+        The reference's scalar facts (:data:`TRUTH_KEYS`); written when not empty.
+    """
     side: dict[str, Any] = {"meta": meta, "closed_loop": bool(closed_loop), "data_sha256": data_sha256}
+    if truth:
+        side["truth"] = dict(truth)
     if steps_sha256 is not None:
         side["steps_sha256"] = steps_sha256
     return dump_text(side)
