@@ -216,14 +216,14 @@ def _real_recordings() -> list[Recording]:
 
 @pytest.mark.slow
 def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_are():
-    from footzoo.runtime.timescale import TimeScaleScan
+    from footzoo.filters.consistency import ConsistencyScan
 
     named = 0
     recs = _real_recordings()
     for rec in recs:
         for factor in (1.0, 2.0, 0.5):
             r = _restamped(rec, factor) if factor != 1.0 else rec
-            scan = TimeScaleScan(r.rate, name=rec.name)
+            scan = ConsistencyScan(r.rate, name=rec.name)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", SensorWarning)
                 scan.push(np.arange(r.n), r.t, r.acc, r.gyr)

@@ -30,6 +30,7 @@ from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
 from ..evaluation.metrics import nis_summary
+from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
 from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
@@ -50,7 +51,6 @@ from ..plugins.incremental import WHOLE_RECORDING, Latency, total
 from ..plugins.registry import build
 from .alignment import initial_attitude
 from .guards import StanceGuard, check_speed
-from .timescale import TimeScaleScan
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
 STREAM_WARMUP = 30.0
@@ -291,7 +291,7 @@ class Pipeline:
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
-        axes = TimeScaleScan(ctx.rate, self.gravity, rec.name)
+        axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
         axes.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr)
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():

@@ -38,6 +38,7 @@ from ..core.context import RunContext
 from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..core.sanity import EstimateScan, SignalScan
+from ..filters.consistency import ConsistencyScan
 from ..plugins.base import Samples
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
@@ -50,7 +51,6 @@ from .stages import (
     OrientationStage,
     Queue,
 )
-from .timescale import TimeScaleScan
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
 SCAN_BLOCK = 128
@@ -139,7 +139,7 @@ class Stream:
         self._kept: list[Chunk] = []
         self._signals = SignalScan("stream")  # glitches, as a batch run's Recording scans them
         self._estimates: EstimateScan | None = None  # no stance, drift while still (from the start)
-        self._axes: TimeScaleScan | None = None  # gyroscope-accelerometer consistency (rate, axis map)
+        self._axes: ConsistencyScan | None = None  # gyroscope-accelerometer consistency (rate, axis map)
         self._scan_raw = Blocks(self._signals.push)
         self._scan_final: Blocks | None = None
         self.log: list[dict[str, Any]] | None = None
@@ -397,7 +397,7 @@ class Stream:
                           FootzooWarning, stacklevel=4)
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
         self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
-        self._axes = TimeScaleScan(rate, pipe.gravity, "stream")
+        self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
 
         def scan_final(k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
                        pos: np.ndarray) -> None:
