@@ -513,7 +513,8 @@ def main(argv: list[str] | None = None) -> int:
         pd.DataFrame(columns=["best_error_m", "best_detector", "n_strides_manual_koroglu"])
     summary = args.summary or (args.results / "accuracy_quick.md" if args.quick else DEFAULT_SUMMARY)
     flagship = [p for p in parts if p != "configs"]
-    lines = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER) \
+    lines = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER,
+                                     args.jobs) \
         if flagship else []
     if "configs" in parts:
         table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
