@@ -82,9 +82,14 @@ def test_shipping_writes_the_kernels_into_the_folder_and_not_into_numbas_cache(s
     assert _cached_files(shipped / "cache") == []
 
 
+@pytest.fixture(scope="module")
+def cold(tmp_path_factory):
+    """:data:`RUN` in a new process, empty cache, nothing shipped: what it compiles and where it ends."""
+    return json.loads(_run(RUN, cache=tmp_path_factory.mktemp("cold") / "cache").stdout)
+
+
 @pytest.mark.slow
-def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, tmp_path):
-    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
+def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, cold, tmp_path):
     warm = json.loads(_run(RUN, cache=tmp_path / "b", shipped=shipped / "shipped").stdout)
     assert len(cold["compiled"]) >= 5  # without the folder: compiled
     assert warm["compiled"] == []
@@ -106,7 +111,7 @@ def test_a_recording_read_from_a_file_without_magnetometer_needs_no_compilation_
 
 
 @pytest.mark.slow
-def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_path):
+def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, cold, tmp_path):
     changed = tmp_path / "shipped"
     subprocess.run(["cp", "-r", str(shipped / "shipped"), str(changed)], check=True)
     for index in _cached_files(changed):  # as if the module's source had changed since: another content hash
@@ -116,7 +121,6 @@ def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, tmp_
         with open(index, "wb") as f:
             pickle.dump(version, f)
             f.write(pickle.dumps(("0" * 64, overloads)))
-    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
     stale = json.loads(_run(RUN, cache=tmp_path / "b", shipped=changed).stdout)
     assert sorted(stale["compiled"]) == sorted(cold["compiled"])
     assert stale["pos"] == cold["pos"]
@@ -156,7 +160,7 @@ def test_compile_names_a_file_that_is_not_a_config(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_path):
+def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, cold, tmp_path):
     damaged = tmp_path / "shipped"
     subprocess.run(["cp", "-r", str(shipped / "shipped"), str(damaged)], check=True)
     for data in damaged.rglob("*.nbc"):
@@ -164,7 +168,6 @@ def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, tmp_
     proc = _run(RUN.replace('warnings.simplefilter("ignore")', 'warnings.simplefilter("default")'),
                 cache=tmp_path / "b", shipped=damaged)
     result = json.loads(proc.stdout)
-    cold = json.loads(_run(RUN, cache=tmp_path / "a").stdout)
     assert sorted(result["compiled"]) == sorted(cold["compiled"])
     assert result["pos"] == cold["pos"]
     assert "could not be loaded" in proc.stderr
