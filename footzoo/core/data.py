@@ -330,6 +330,17 @@ class Recording:
         return pd.DataFrame(cols)
 
 
+def writable_array(value: Any, dtype: Any = float) -> np.ndarray:
+    """``value`` as a C-contiguous, writable array of ``dtype`` (copied only if it must be).
+
+    numba types a read-only array apart from a writable one: kernels handed read-only inputs (pandas'
+    copy-on-write views, a study's frozen recordings) would compile a second time instead of loading
+    the code already compiled (or shipped) for writable ones.
+    """
+    array = np.ascontiguousarray(value, dtype=dtype)
+    return array if array.flags.writeable else array.copy()
+
+
 def _floats(name: str, value: Any) -> np.ndarray:
     """``value`` as a contiguous, writable float array, or a RecordingError naming the input.
 
@@ -344,8 +355,7 @@ def _floats(name: str, value: Any) -> np.ndarray:
         raise RecordingError(f"{name} holds complex numbers; footzoo needs real samples (a float array): pass "
                              f"{name}.real if the imaginary parts are zero, else check how the array was made")
     try:
-        array = np.ascontiguousarray(value, dtype=float)
-        return array if array.flags.writeable else array.copy()
+        return writable_array(value)
     except (TypeError, ValueError) as err:
         raise RecordingError(
             f"{name} must be numbers (an array of floats), got {type(value).__name__}: {err}"

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import Settings
+from ..core.data import writable_array
 from ..core.errors import ConfigError, FootzooWarning, PluginError
 from ..core.params import Real
 from ..kernels import jit as _jit
@@ -399,11 +400,11 @@ class KalmanEngine:
         """
         from .kalman_fast import eskf_loop, scratch
 
-        ext = loop_array(quat_ext, float) if quat_ext is not None else np.zeros((1, 4))
+        ext = writable_array(quat_ext, float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks, rows = packed.arrays
         arrays = (m_idx, par, par_off, mem_off, data, data_off, hooks, rows)
-        signals = (loop_array(t, float), loop_array(acc, float), loop_array(gyr, float),
-                   loop_array(stance, np.bool_), ext)
+        signals = (writable_array(t, float), writable_array(acc, float), writable_array(gyr, float),
+                   writable_array(stance, np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["nis"])
         state = (packed.nav, packed.P, packed.mems)
@@ -440,14 +441,3 @@ class KalmanEngine:
         else:
             problem = f"returned a row count {-rows} below the first free row it was given (sample {k})"
         return PluginError(f"{who}: its measure function {problem}; {fix}", plugin=who, method="measure")
-
-
-def loop_array(a: np.ndarray, dtype: Any) -> np.ndarray:
-    """``a`` as the compiled loop takes a signal: C-contiguous, of ``dtype``, writable (copied only if it must be).
-
-    The loop only reads its signals, but numba types a read-only array apart from a writable one:
-    read-only signals (a study's shared recordings, a calibration's read-only view) would compile
-    and cache a second loop, 15–19 s per process, instead of loading the one the wheel ships.
-    """
-    out = np.ascontiguousarray(a, dtype=dtype)
-    return out if out.flags.writeable else out.copy()
