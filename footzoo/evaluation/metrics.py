@@ -502,6 +502,16 @@ METRICS: dict[str, str] = {
     "stance_offset_error_mean_s": "mean stance-offset (toe-off) error against the reference stance (s)",
 }
 
+#: The metrics a study draws a box plot of when its file names neither ``figures:`` nor ``metrics:``:
+#: one error per question a study asks (position, loop closure, stride count, stride length, gait
+#: events, foot progression angle, footprints, stance detection). The table and the summaries keep
+#: every metric; a box plot of each of the 48 per factor would bury these few.
+FIGURE_METRICS: tuple[str, ...] = (
+    "armse_3d_m", "pyshoe_error_m", "loop_closure_xy_pct", "stride_count_error", "stride_length_rms_error_m",
+    "ic_error_median_abs_s", "to_error_median_abs_s", "fpa_rms_error_deg", "footprint_error_rms_m", "stance_f1",
+    "gait_phase_error_rate",
+)
+
 #: Old metric names -> their names now (accepted with a DeprecationWarning).
 METRIC_ALIASES: dict[str, str] = {"steps": "strides"}
 

@@ -55,7 +55,8 @@ def _fmt(v: Any, digits: int) -> str:
 
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: Any = None) -> None:
+                  step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: Any = None,
+                  figures: list[str] | None = None) -> None:
     """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
@@ -65,12 +66,13 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     processes (see :func:`figure_tasks`) while this process writes the tables; with ``scheduler``
     (a Dask scheduler's address, or a connected ``Client``) the cluster's workers draw them in memory
     (:func:`render_figure`) and this process writes the files, since the workers may not see ``out``.
+    ``figures`` names the metrics drawn as a box plot per factor (default: every metric of the table).
     """
     step = step or (lambda n: None)
     out.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
-        _write_outputs(table, runs, factors, staging, step, jobs, scheduler)
+        _write_outputs(table, runs, factors, staging, step, jobs, scheduler, figures)
         for f in sorted(staging.iterdir()):
             if f.is_file():
                 os.replace(f, out / f.name)
@@ -78,12 +80,14 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
         shutil.rmtree(staging, ignore_errors=True)
 
 
-def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> list[tuple]:
+def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
+                 figures: list[str] | None = None) -> list[tuple]:
     """:func:`plot_study` as independent one-figure tasks for :func:`draw_figure`, in its order.
 
     Each task carries only what its figure reads (the runs of one recording, the rows of one
     metric, the threshold sweeps), so the tasks are cheap to send to worker processes and can
-    be shared out evenly; their figures together are the whole call's, labels included.
+    be shared out evenly; their figures together are the whole call's, labels included. A box plot
+    is drawn per factor for each metric of the table that ``figures`` names (default: every one).
     """
     tasks: list[tuple] = []
     labels = run_labels(runs, factors)
@@ -92,7 +96,7 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
         tasks.append(("trajectories", mine, {r["key"]: labels[r["key"]] for r in mine}, rec))
     ok = table[table["metric"].notna()]
     for f in factors:
-        for metric in sorted(ok["metric"].unique()):
+        for metric in sorted(m for m in ok["metric"].unique() if figures is None or m in figures):
             tasks.append(("metric", ok[ok["metric"] == metric], f, metric))
     detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
     sweeps = [{k: r[k] for k in ("key", "recording", "roc", "entry") if k in r} for r in runs]
@@ -158,7 +162,8 @@ def render_figure(task: tuple) -> tuple[str, bytes] | None:
 
 
 def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
-                   step: Callable[[int], Any], jobs: int = 1, scheduler: Any = None) -> None:
+                   step: Callable[[int], Any], jobs: int = 1, scheduler: Any = None,
+                   figures: list[str] | None = None) -> None:
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
     if scheduler is not None:
@@ -169,7 +174,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
         with connected as client:  # the workers draw while this process writes the tables
             # the workers may not see the cache: each task is sent with its runs' trajectories, a few at a time
-            tasks = iter(_largest_first(figure_tasks(table, runs, factors)))
+            tasks = iter(_largest_first(figure_tasks(table, runs, factors, figures)))
             window = max(2, 2 * len(client.scheduler_info().get("workers", {})))
             pending = as_completed([client.submit(render_figure, loaded(t), pure=False)
                                     for t in itertools.islice(tasks, window)])
@@ -183,17 +188,17 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
                     pending.add(client.submit(render_figure, loaded(nxt), pure=False))
         step(1)
         return
-    figures = None
+    drawn = None
     if jobs != 1:  # started first: the workers draw while this process writes the tables
         from joblib import Parallel, delayed
 
-        figures = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
-            delayed(draw_figure)(task, out) for task in _largest_first(figure_tasks(table, runs, factors)))
+        drawn = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
+            delayed(draw_figure)(task, out) for task in _largest_first(figure_tasks(table, runs, factors, figures)))
     _write_tables(table, runs, factors, out, step)
-    if figures is None:
-        plot_study(table, runs, factors, out)
+    if drawn is None:
+        plot_study(table, runs, factors, out, figures)
     else:
-        for _ in figures:
+        for _ in drawn:
             pass
     step(1)
 
@@ -406,14 +411,17 @@ def metric_label(metric: str) -> str:
 # --------------------------------------------------------------------------- plots
 
 
-def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path) -> list[Path]:
-    """Trajectories per recording, each metric per factor level, ROC of the detectors' threshold sweeps.
+def plot_study(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
+               figures: list[str] | None = None) -> list[Path]:
+    """Trajectories per recording, metrics per factor level, ROC of the detectors' threshold sweeps.
 
-    Returns the files written. The figures are the tasks of :func:`figure_tasks`, drawn in order.
+    Returns the files written. The figures are the tasks of :func:`figure_tasks`, drawn in order;
+    ``figures`` names the metrics drawn (default: every metric of ``table``).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    return [p for p in (draw_figure(task, out) for task in figure_tasks(table, runs, factors)) if p is not None]
+    tasks = figure_tasks(table, runs, factors, figures)
+    return [p for p in (draw_figure(task, out) for task in tasks) if p is not None]
 
 
 def _grid(plt, n: int, size: float = 2.6, max_cols: int = 8):

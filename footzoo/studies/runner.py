@@ -582,14 +582,16 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         if recomputed:
             _log_damaged(Path(out), recomputed)
         bar.phase("report")
-        digest = _outputs_digest(table, runs, list(study.factors))
+        figures = study.figure_metrics(sorted(table.loc[table["metric"].notna(), "metric"].unique()))
+        digest = _outputs_digest(table, runs, list(study.factors), figures)
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
         else:
             # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
                           jobs=jobs if scheduler is None else 1,
-                          scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler)
+                          scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler,
+                          figures=figures)
             _write_manifest(Path(out), digest)
     return table
 
@@ -597,10 +599,12 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
 MANIFEST = "outputs.json"
 
 
-def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str]) -> str:
-    """What the report depends on: the table, the runs (keys and labels), the factors and footzoo's source."""
+def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
+                    figures: list[str]) -> str:
+    """What the report depends on: the table, the runs (keys and labels), the factors, the metrics drawn
+    and footzoo's source."""
     h = hashlib.sha256(json.dumps([[r["key"], r["base"], r["recording"]] for r in runs]).encode())
-    h.update(json.dumps([factors, code_fingerprint()]).encode())
+    h.update(json.dumps([factors, figures, code_fingerprint()]).encode())
     h.update(pd.util.hash_pandas_object(table.astype(str), index=True).to_numpy().tobytes())
     return h.hexdigest()
 

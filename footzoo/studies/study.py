@@ -19,7 +19,7 @@ from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
-from ..evaluation.metrics import METRICS, metric_name
+from ..evaluation.metrics import FIGURE_METRICS, METRICS, metric_name
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
 from ..sim.scenarios import check_spec
 
@@ -34,6 +34,8 @@ STUDY_KEYS = {
     "recordings": "list of {path: glob, format: ..., group: ..., label: ...} or {simulate: {...}, seeds: [...], "
                   "group: ..., label: ...}",
     "metrics": "list of metric names to keep (default: all)",
+    "figures": "metrics drawn as a box plot per factor: a list of names, all or none (default: those listed under "
+               "metrics, else the headline errors of footzoo.evaluation.metrics.FIGURE_METRICS)",
     "sweep": "threshold sweep of the detectors: {points: 25}",
     "plugins": "external plug-ins to load in every worker: module names or .py paths (relative to the study file)",
     "jobs": "local worker processes (1 = serial, -1 = every core); the command line's --jobs overrides it",
@@ -235,6 +237,26 @@ class Cell:
         return hashlib.sha256(payload.encode()).hexdigest()[:24]
 
 
+def _metric_names(value: Any, key: str, also: str = "") -> list[str] | None:
+    """The metric names a study lists under ``key`` (a name or a list; aliases renamed), or None if absent."""
+    if value is None:
+        return None
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not all(isinstance(m, str) for m in value):
+        raise ConfigError(f"{key} must be a list of metric names{', ' + also if also else ''}, got {value!r}; "
+                          f"valid: {list(METRICS)}")
+    named = []
+    for m in value:
+        try:
+            named.append(metric_name(m))
+        except KeyError:
+            where = "" if key == "metrics" else f" in {key}"
+            raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}{where}; "
+                              f"valid metrics: {list(METRICS)}") from None
+    return list(dict.fromkeys(named))
+
+
 @dataclass
 class Study:
     """A parsed study file."""
@@ -248,6 +270,18 @@ class Study:
     plugins: list[str] = field(default_factory=list)
     jobs: int | None = None
     max_cells: int = MAX_CELLS
+    figures: list[str] | str | None = None
+
+    def figure_metrics(self, table_metrics: list[str]) -> list[str]:
+        """The metrics of ``table_metrics`` (those a study's table holds) to draw a box plot per factor of.
+
+        ``figures:`` when the study names them (``all``: every one, ``none``: none), else every metric
+        the study keeps under ``metrics:``, else those of :data:`~footzoo.evaluation.metrics.FIGURE_METRICS`.
+        """
+        if self.figures == "all" or (self.figures is None and self.metrics is not None):
+            return list(table_metrics)
+        wanted = [] if self.figures == "none" else (FIGURE_METRICS if self.figures is None else self.figures)
+        return [m for m in table_metrics if m in wanted]
 
     @classmethod
     def from_yaml(cls, path: str | Path, max_cells: int | None = None) -> Study:
@@ -328,20 +362,14 @@ class Study:
                 where = " and ".join(str(x.path) if x.path else f"simulate seed {x.seed}" for x in (other, rec))
                 raise ConfigError(f"two recordings of the study are both called {rec.label!r} ({where}); give each "
                                   "entry its own label: (e.g. {path: subject2/walk.csv, label: subject2_walk})")
-        metrics = d.get("metrics")
-        if metrics is not None:
-            if isinstance(metrics, str):
-                metrics = [metrics]
-            if not isinstance(metrics, list) or not all(isinstance(m, str) for m in metrics):
-                raise ConfigError(f"metrics must be a list of metric names, got {metrics!r}; valid: {list(METRICS)}")
-            named = []
-            for m in metrics:
-                try:
-                    named.append(metric_name(m))
-                except KeyError:
-                    raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}; "
-                                      f"valid metrics: {list(METRICS)}") from None
-            metrics = list(dict.fromkeys(named))
+        metrics = _metric_names(d.get("metrics"), "metrics")
+        figures = d.get("figures")
+        if figures not in ("all", "none"):
+            figures = _metric_names(figures, "figures", also="or the word all or none")
+        if isinstance(figures, list) and metrics is not None and set(figures) - set(metrics):
+            missing = [m for m in figures if m not in metrics]
+            raise ConfigError(f"figures names {missing} but metrics does not keep them: add them to metrics, "
+                              "or leave them out of figures")
         sweep = d.get("sweep") or {}
         if not isinstance(sweep, dict) or set(sweep) - {"points"}:
             raise ConfigError(f"sweep must be a mapping like {{points: 25}}, got {sweep!r}")
@@ -355,7 +383,7 @@ class Study:
         if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
             raise ConfigError(f"max_cells must be a whole number >= 1, got {max_cells!r}")
         study = cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins, jobs,
-                    max_cells)
+                    max_cells, figures)
         study.check_size()
         return study
 

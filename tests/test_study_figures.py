@@ -1,0 +1,72 @@
+"""Which metrics a study draws: the headline errors by default, the study's own choice with ``figures:``."""
+
+import pytest
+
+from footzoo import ConfigError
+from footzoo.evaluation.metrics import FIGURE_METRICS, METRICS
+from footzoo.studies import Study, run_study
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+STUDY = {
+    "name": "figures",
+    "base": {"orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
+             "corrections": [{"type": "zvu_dedrift"}]},
+    "factors": {"orientation.static_gain": [0.5, 1.05]},
+    "recordings": [{"simulate": {"path": "straight", "n_strides": 4, "rate": 50}, "seeds": [0]}],
+}
+
+
+def _drawn(out) -> set[str]:
+    """The metrics of the box plots in ``out`` (``metric_<metric>_by_<factor>.png``)."""
+    return {p.name.removeprefix("metric_").split("_by_")[0] for p in out.glob("metric_*_by_*.png")}
+
+
+def test_the_headline_metrics_are_registered():
+    assert set(FIGURE_METRICS) <= set(METRICS)
+
+
+def test_by_default_the_headline_errors_are_drawn_and_the_table_keeps_every_metric(tmp_path):
+    table = run_study(Study.from_dict(STUDY), out=tmp_path)
+    kept = set(table["metric"].dropna())
+    assert _drawn(tmp_path) == kept & set(FIGURE_METRICS)
+    assert {"armse_3d_m", "stride_length_rms_error_m", "stance_f1"} <= _drawn(tmp_path)
+    assert {"duration_s", "median_stride_time_s", "stride_count_ref"} <= kept - _drawn(tmp_path)
+    assert list(tmp_path.glob("trajectories_*.png"))  # the trajectories are drawn whatever the choice
+
+
+@pytest.mark.parametrize("figures,metrics,expected", [
+    ("all", None, "every"),
+    ("none", None, set()),
+    (["stance_f1", "duration_s"], None, {"stance_f1", "duration_s"}),
+    (None, ["duration_s", "armse_3d_m"], {"duration_s", "armse_3d_m"}),  # the metrics the study keeps
+    (["armse_3d_m"], ["duration_s", "armse_3d_m"], {"armse_3d_m"}),
+])
+def test_figures_names_what_is_drawn(tmp_path, figures, metrics, expected):
+    spec = {**STUDY, **({"figures": figures} if figures is not None else {}),
+            **({"metrics": metrics} if metrics is not None else {})}
+    table = run_study(Study.from_dict(spec), out=tmp_path)
+    assert _drawn(tmp_path) == (set(table["metric"].dropna()) if expected == "every" else expected)
+
+
+def test_changing_figures_rewrites_the_outputs(tmp_path):
+    run_study(Study.from_dict(STUDY), out=tmp_path)
+    assert "duration_s" not in _drawn(tmp_path)
+    table = run_study(Study.from_dict({**STUDY, "figures": "all"}), out=tmp_path)
+    assert table.attrs["cached"] == 2 and table.attrs["computed"] == 0  # the runs are read back, not redone
+    assert "duration_s" in _drawn(tmp_path)
+
+
+@pytest.mark.parametrize("figures,message", [
+    (["armse_3d"], r"unknown metric 'armse_3d' \(did you mean 'armse_3d_m'\?\) in figures; valid metrics"),
+    (3, r"figures must be a list of metric names, or the word all or none, got 3"),
+    ("every", r"unknown metric 'every'.* in figures"),
+])
+def test_a_bad_figures_entry_names_the_problem(figures, message):
+    with pytest.raises(ConfigError, match=message):
+        Study.from_dict({**STUDY, "figures": figures})
+
+
+def test_figures_of_a_metric_the_study_drops_are_refused():
+    with pytest.raises(ConfigError, match=r"figures names \['stance_f1'\] but metrics does not keep them"):
+        Study.from_dict({**STUDY, "metrics": ["armse_3d_m"], "figures": ["stance_f1", "armse_3d_m"]})
