@@ -214,3 +214,17 @@ def test_a_read_only_recording_runs_the_same_compiled_loop():
     assert len(kalman_fast.eskf_loop.signatures) == n
     np.testing.assert_array_equal(again.pos, writable.pos)
     assert not frozen.acc.flags.writeable  # the recording itself stays frozen
+
+
+
+@pytest.mark.slow
+def test_kernels_shipped_in_parts_are_all_read(tmp_path):
+    """A wheel's build compiles groups of configs side by side, each into its own part of the folder."""
+    other = str(ROOT / "footzoo" / "config" / "builtin" / "nguyen2016.yaml")
+    for k, config in enumerate((CONFIG, other)):
+        _run(["compile", "--ship", str(tmp_path / "shipped" / f"part-{k}"), config], cache=tmp_path / "c")
+    both = RUN.replace("result = footzoo.Pipeline.from_yaml", f"footzoo.Pipeline.from_yaml({other!r}).run(rec)\n"
+                                                            "    result = footzoo.Pipeline.from_yaml")
+    warm = json.loads(_run(both, cache=tmp_path / "b", shipped=tmp_path / "shipped").stdout)
+    assert warm["compiled"] == []  # each config's kernels found in whichever part compiled them
+    assert _cached_files(tmp_path / "c") == [] and _cached_files(tmp_path / "b") == []

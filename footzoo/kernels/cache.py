@@ -7,6 +7,11 @@ kernel the shipped configs use, compiled while the wheel is built (``setup.py`` 
 ``footzoo compile --ship``) into the package's ``_compiled`` folder. A kernel that is in
 neither numba's cache nor that folder is compiled and cached as usual.
 
+The folder holds one set of machine code, or several in its subfolders ``part-0``, ``part-1``...
+(``footzoo compile --ship DIR --jobs N`` compiles in N processes, each into its own part: a numba
+index file names its data files by number, so two processes must not share one); a kernel's code is
+looked up in the folder, then in each part in turn.
+
 numba uses shipped code only where it is valid: the same numba and Python versions, the same
 CPU model and features (numba's own key), and footzoo source files whose content has not
 changed since (a SHA-256 of the file, where numba's cache compares the file's time stamp,
@@ -64,16 +69,18 @@ class KernelCache(FunctionCache):
     def __init__(self, py_func: Callable[..., Any], source: Path):
         super().__init__(py_func)
         self._source = source
-        self._shipped_files: tuple[Path, IndexDataCacheFile] | None = None
+        self._shipped_files: tuple[Path, list[IndexDataCacheFile]] | None = None
 
     @property
-    def _shipped(self) -> IndexDataCacheFile:
-        """The shipped index and data files of this kernel, in the folder :data:`SHIPPED` names now."""
-        folder = SHIPPED / self._source.parent.relative_to(PACKAGE)
-        if self._shipped_files is None or self._shipped_files[0] != folder:
-            self._shipped_files = folder, IndexDataCacheFile(
-                cache_path=str(folder), filename_base=self._impl.filename_base,
-                source_stamp=_content_stamp(self._source))
+    def _shipped(self) -> list[IndexDataCacheFile]:
+        """The shipped index and data files of this kernel, in the folder :data:`SHIPPED` names now and then
+        in each of its parts (while shipping: the folder being written only)."""
+        if self._shipped_files is None or self._shipped_files[0] != SHIPPED:
+            inside = self._source.parent.relative_to(PACKAGE)
+            roots = [SHIPPED] if _state["shipping"] else [SHIPPED, *sorted(SHIPPED.glob("part-*"))]
+            self._shipped_files = SHIPPED, [
+                IndexDataCacheFile(cache_path=str(root / inside), filename_base=self._impl.filename_base,
+                                   source_stamp=_content_stamp(self._source)) for root in roots]
         return self._shipped_files[1]
 
     def _load_overload(self, sig: Any, target_context: Any) -> Any:
@@ -82,7 +89,8 @@ class KernelCache(FunctionCache):
         data = None if _state["shipping"] else super()._load_overload(sig, target_context)
         if data is None:
             try:
-                shipped = self._shipped.load(self._index_key(sig, target_context.codegen()))
+                key = self._index_key(sig, target_context.codegen())
+                shipped = next((code for part in self._shipped if (code := part.load(key)) is not None), None)
                 if shipped is not None:
                     data = self._impl.rebuild(target_context, shipped)
             except Exception as err:  # a damaged or foreign file: compile instead, and say so once
@@ -98,7 +106,7 @@ class KernelCache(FunctionCache):
         if not self._enabled or not self._impl.check_cachable(data):
             return
         os.makedirs(SHIPPED / self._source.parent.relative_to(PACKAGE), exist_ok=True)
-        self._shipped.save(self._index_key(sig, data.codegen), self._impl.reduce(data))
+        self._shipped[0].save(self._index_key(sig, data.codegen), self._impl.reduce(data))
 
 
 def attach(dispatcher: Any) -> Any:
