@@ -28,6 +28,30 @@ def installed_kernels() -> Path | None:
 if "FOOTZOO_SHIPPED_KERNELS" not in os.environ and (_shipped := installed_kernels()) is not None:
     os.environ["FOOTZOO_SHIPPED_KERNELS"] = str(_shipped)  # the tests' subprocesses inherit it
 
+def made_once(tmp_path_factory: pytest.TempPathFactory, name: str, make) -> Path:
+    """A folder ``make(folder)`` fills once per test session, shared by every xdist worker (read it, never write).
+
+    The module-scoped fixtures that compile kernels in new processes (10 s each) would otherwise be made
+    once by each worker that runs one of their tests. The first worker makes the folder under a lock in
+    the session's shared temporary folder; the others wait for it and reuse it.
+    """
+    import fcntl
+    import shutil
+
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the folder all workers' temporary folders are in
+    folder, done = root / f"made-once-{name}", root / f"made-once-{name}.done"
+    with open(root / f"made-once-{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            make(folder)
+            done.touch()
+    return folder
+
+
 #: The shared recordings: ../shared/data next to the checkout, or the folder named by FOOTZOO_DATA.
 DATA = Path(os.environ.get("FOOTZOO_DATA") or Path(__file__).resolve().parents[1].parent / "shared" / "data")
 

@@ -7,6 +7,7 @@ numba compiles there (numba's compile events).
 import json
 import os
 import pickle
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,8 @@ import pytest
 
 from footzoo.apps.cli import main as cli_main
 from footzoo.kernels import jit as _jit
+
+from .conftest import made_once
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = str(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml")
@@ -66,11 +69,13 @@ def _cached_files(folder: Path) -> list[Path]:
 
 @pytest.fixture(scope="module")
 def shipped(tmp_path_factory):
-    """A folder of shipped kernels for yun2012, written by ``footzoo compile --ship``."""
-    tmp = tmp_path_factory.mktemp("kernels")
-    proc = _run(["compile", "--ship", str(tmp / "shipped"), CONFIG], cache=tmp / "cache")
-    assert "yun2012.yaml" in proc.stdout
-    return tmp
+    """A folder of shipped kernels for yun2012, written by ``footzoo compile --ship`` (once for all workers)."""
+
+    def make(tmp: Path) -> None:
+        proc = _run(["compile", "--ship", str(tmp / "shipped"), CONFIG], cache=tmp / "cache")
+        assert "yun2012.yaml" in proc.stdout
+
+    return made_once(tmp_path_factory, "shipped-yun2012", make)
 
 
 @pytest.mark.slow
@@ -84,8 +89,13 @@ def test_shipping_writes_the_kernels_into_the_folder_and_not_into_numbas_cache(s
 
 @pytest.fixture(scope="module")
 def cold(tmp_path_factory):
-    """:data:`RUN` in a new process, empty cache, nothing shipped: what it compiles and where it ends."""
-    return json.loads(_run(RUN, cache=tmp_path_factory.mktemp("cold") / "cache").stdout)
+    """:data:`RUN` in a new process, empty cache, nothing shipped: what it compiles and where it ends
+    (once for all workers)."""
+
+    def make(tmp: Path) -> None:
+        (tmp / "run.json").write_text(_run(RUN, cache=tmp / "cache").stdout)
+
+    return json.loads((made_once(tmp_path_factory, "cold-yun2012", make) / "run.json").read_text())
 
 
 @pytest.mark.slow
@@ -217,14 +227,16 @@ def test_a_read_only_recording_runs_the_same_compiled_loop():
 
 
 
+
 @pytest.mark.slow
-def test_kernels_shipped_in_parts_are_all_read(tmp_path):
-    """A wheel's build compiles groups of configs side by side, each into its own part of the folder."""
-    other = str(ROOT / "footzoo" / "config" / "builtin" / "nguyen2016.yaml")
-    for k, config in enumerate((CONFIG, other)):
-        _run(["compile", "--ship", str(tmp_path / "shipped" / f"part-{k}"), config], cache=tmp_path / "c")
-    both = RUN.replace("result = footzoo.Pipeline.from_yaml", f"footzoo.Pipeline.from_yaml({other!r}).run(rec)\n"
-                                                            "    result = footzoo.Pipeline.from_yaml")
-    warm = json.loads(_run(both, cache=tmp_path / "b", shipped=tmp_path / "shipped").stdout)
-    assert warm["compiled"] == []  # each config's kernels found in whichever part compiled them
-    assert _cached_files(tmp_path / "c") == [] and _cached_files(tmp_path / "b") == []
+def test_kernels_shipped_in_parts_are_all_read(shipped, tmp_path):
+    """A wheel's build compiles groups of configs side by side, each into its own part of the folder
+    (``part-0``, ``part-1``...): a new process looks a kernel up in every part."""
+    folders = sorted(p for p in (shipped / "shipped").iterdir() if p.is_dir())
+    assert len(folders) >= 2
+    for k, part in enumerate((folders[:1], folders[1:])):  # one subpackage's kernels in part-0, the rest in part-1
+        for folder in part:
+            shutil.copytree(folder, tmp_path / "parts" / f"part-{k}" / folder.name)
+    warm = json.loads(_run(RUN, cache=tmp_path / "b", shipped=tmp_path / "parts").stdout)
+    assert warm["compiled"] == []  # each kernel found in whichever part holds it
+    assert _cached_files(tmp_path / "b") == []
