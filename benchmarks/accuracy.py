@@ -8,7 +8,7 @@ Usage: python benchmarks/accuracy.py [--jobs 2] [--quick] [--results benchmarks/
 ``--parts`` chooses what runs (default all): ``configs`` is the table of every shipped config below;
 the others score the flagship on every axis (benchmarks/accuracy_parts.py: 3-D and height on PyShoe
 per motion class, rate independence, gait events, filter consistency, 24 mountings). Without
-``configs`` only the flagship section of the existing summary is rewritten.
+``configs`` only the chosen parts' blocks of the existing summary's flagship section are rewritten.
 
 Every config in ``footzoo/config/builtin/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
 ablation runner (one study per dataset: parallel with ``--jobs``, cached in
@@ -57,7 +57,7 @@ from footzoo.studies.report import to_markdown  # noqa: E402
 DEFAULT_DATA = ROOT.parent / "shared" / "data"
 DEFAULT_RESULTS = ROOT / "benchmarks" / "results"
 DEFAULT_SUMMARY = ROOT / "benchmarks" / "accuracy.md"
-#: Where the flagship section starts in the summary (a rerun of some parts replaces what follows).
+#: Where the flagship section starts in the summary (a rerun of some parts replaces their blocks in it).
 FLAGSHIP_MARK = "<!-- flagship parts: everything below is rewritten by --parts -->"
 
 #: PyShoe trials by recording day (the dataset does not label them; see ../shared/data/README.md).
@@ -513,17 +513,18 @@ def main(argv: list[str] | None = None) -> int:
         pd.DataFrame(columns=["best_error_m", "best_detector", "n_strides_manual_koroglu"])
     summary = args.summary or (args.results / "accuracy_quick.md" if args.quick else DEFAULT_SUMMARY)
     flagship = [p for p in parts if p != "configs"]
-    lines = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER,
-                                     args.jobs) \
-        if flagship else []
+    blocks = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER,
+                                      args.jobs) if flagship else {}
     if "configs" in parts:
         table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
         write_summary(table, ref, summary, args.recommended, time.time() - t0, args.quick)
         print(f"tables in {args.results}, summary {summary}")
-    if lines:
+    if blocks:
         old = summary.read_text() if summary.exists() else ""
-        head = old.split(FLAGSHIP_MARK)[0].rstrip("\n")
-        summary.write_text(f"{head}\n\n{FLAGSHIP_MARK}\n\n" + "\n".join(lines))
+        head, _, section = old.partition(FLAGSHIP_MARK)
+        merged = {**accuracy_parts.read_parts(section), **blocks}  # the parts not rerun keep their blocks
+        section = "\n".join(accuracy_parts.flagship_section(merged))
+        summary.write_text(f"{head.rstrip()}\n\n{FLAGSHIP_MARK}\n\n{section}")
         print(f"flagship parts {flagship} in {summary}")
     return 0
 

@@ -79,10 +79,14 @@ def test_koroglu_footprint_errors_against_the_measured_footprints(accuracy):
 @pytest.mark.slow
 def test_flagship_parts_rewrite_only_their_section(accuracy, tmp_path):
     summary = tmp_path / "summary.md"
-    summary.write_text("# kept\n\nthe configs' table\n")
+    summary.write_text(f"# kept\n\nthe configs' table\n\n{accuracy.FLAGSHIP_MARK}\n\n<!-- part: rates -->\n"
+                       "### Rates, from an earlier run\n\n<!-- part: mounting -->\n### an old mounting block\n")
     assert accuracy.main(["--parts", "mounting", "--data", str(tmp_path / "absent"), "--summary", str(summary)]) == 0
     text = summary.read_text()
     assert text.startswith("# kept\n\nthe configs' table") and accuracy.FLAGSHIP_MARK in text
+    assert "### Rates, from an earlier run" in text and "an old mounting block" not in text  # only its own block
+    assert text.index("<!-- part: rates -->") < text.index("<!-- part: mounting -->")
+    assert "--parts rates,mounting`" in text
     assert "### 24 sensor mountings (simulator)" in text
     assert "| 24 mountings: largest event difference | ≤ 10 ms |" in text
     # a second run replaces the section, it does not append another
@@ -90,3 +94,15 @@ def test_flagship_parts_rewrite_only_their_section(accuracy, tmp_path):
     assert summary.read_text().count(accuracy.FLAGSHIP_MARK) == 1
     with pytest.raises(SystemExit, match="unknown part"):
         accuracy.main(["--parts", "nonsense", "--summary", str(summary)])
+
+
+def test_the_rate_spread_is_paired_over_the_seeds():
+    """Hand-derived: each seed's error 10 % higher at the second rate is a 10 % spread with no uncertainty, however
+    much the seeds differ; the unpaired bootstrap of the earlier design put it anywhere from 0 to 100 %."""
+    import numpy as np
+
+    parts = load_benchmark("accuracy_parts")
+    seeds = np.random.default_rng(0).uniform(0.04, 0.3, 24)  # one seed's error varies by a factor 7
+    s = parts.rate_spread([seeds, 1.1 * seeds, seeds * 1.05])
+    assert s["spread"] == pytest.approx(0.1) and s["spread_lo"] == pytest.approx(0.1)
+    assert s["spread_hi"] == pytest.approx(0.1) and s["p"] < 1e-6

@@ -67,7 +67,7 @@ def simulate_pendulum(
     acc, gyr = sample_imu({"q": q, "v": vel, "a": acc_n, "w": w}, t, gravity, sampling)
     mag = quat_rotate(quat_conj(q), magnetic_field_ned(location))
     if noise is not None:
-        acc, gyr, mag = noise.apply(acc, gyr, mag)
+        acc, gyr, mag = noise.apply(acc, gyr, mag, t)
     truth = Truth(pos=pos - pos[0], vel=vel, quat=q, stance=np.zeros(t.size, bool))
     meta = {"name": "sim_pendulum", "source": "footzoo.sim", "format": "simulated", "period": period,
             "length_m": length}

@@ -223,7 +223,7 @@ def simulate(
         mag = quat_rotate(quat_conj(state["q"]), field)
     if noise is not None:
         noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
-        acc, gyr, mag = noise.apply(acc, gyr, mag)
+        acc, gyr, mag = noise.apply(acc, gyr, mag, t)
     dist = true_dist = None
     if distance_sensors:
         ds = distance_sensors if isinstance(distance_sensors, DistanceSensors) else DistanceSensors()
@@ -271,7 +271,7 @@ def simulate_calibration(
     mag = quat_rotate(quat_conj(state["q"]), magnetic_field_ned(location)) if magnetometer else None
     if noise is not None:
         noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
-        acc, gyr, mag = noise.apply(acc, gyr, mag)
+        acc, gyr, mag = noise.apply(acc, gyr, mag, t)
     truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=state["still"])
     meta = {"name": "sim_calibration", "source": "footzoo.sim", "format": "simulated", "foot": foot,
             "calibration_still": list(timeline.phases["still"]), "calibration_flex": list(timeline.phases["flex"])}

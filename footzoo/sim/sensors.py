@@ -96,6 +96,12 @@ class NoiseModel:
         Which biases are on: any of ``"acc"``, ``"gyr"``, ``"mag"``.
     seed : int
         Random seed (every run is reproducible).
+    paired_rate : float, optional
+        Draw the white noise at this rate (Hz, at least the recording's) and give each sample the mean
+        of that noise over its interval ``(t[k-1], t[k]]``, scaled to the σ above. One seed then gives
+        the same noise path at every sampling rate, so walks at several rates differ only by the rate
+        (a paired comparison, as a real sensor sampled at two rates at once). Default: independent
+        draws per sample. Each sensor has its own random stream (``[seed, 0..2]``).
     """
 
     acc_bias: float = 0.001 * 5 * GRAVITY
@@ -107,30 +113,65 @@ class NoiseModel:
     scale: float = 1.0
     biases: tuple[str, ...] = ("acc", "gyr", "mag")
     seed: int = 0
+    paired_rate: float | None = None
 
     def __post_init__(self) -> None:
         unknown = set(self.biases) - {"acc", "gyr", "mag"}
         if unknown:
             raise ValueError(f"unknown bias name(s) {sorted(unknown)}; use 'acc', 'gyr', 'mag'")
+        if self.paired_rate is not None and not (np.isfinite(self.paired_rate) and self.paired_rate > 0):
+            raise ValueError(f"paired_rate must be a rate in Hz > 0, got {self.paired_rate!r}")
 
-    def apply(self, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None):
-        """Noisy copies of the signals (eq. 18)."""
+    def apply(self, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None, t: np.ndarray | None = None):
+        """Noisy copies of the signals (eq. 18); ``t`` (s), the sample times, is needed with ``paired_rate``."""
+        if self.paired_rate is not None and t is None:
+            raise ValueError("NoiseModel.apply needs the sample times t with paired_rate")
         rng = np.random.default_rng(self.seed)
         out = []
-        for name, x, mu, sigma in (("acc", acc, self.acc_bias, self.acc_sigma),
-                                   ("gyr", gyr, self.gyr_bias, self.gyr_sigma),
-                                   ("mag", mag, self.mag_bias, self.mag_sigma)):
+        for k, (name, x, mu, sigma) in enumerate((("acc", acc, self.acc_bias, self.acc_sigma),
+                                                  ("gyr", gyr, self.gyr_bias, self.gyr_sigma),
+                                                  ("mag", mag, self.mag_bias, self.mag_sigma))):
             if x is None:
                 out.append(None)
                 continue
-            noise = rng.standard_normal(x.shape) * sigma * self.scale
-            out.append(x + noise + (mu if name in self.biases else 0.0))
+            unit = rng.standard_normal(x.shape) if self.paired_rate is None else \
+                interval_means(np.random.default_rng([self.seed, k]), t, self.paired_rate)
+            out.append(x + unit * sigma * self.scale + (mu if name in self.biases else 0.0))
         return tuple(out)
 
     @classmethod
     def none(cls) -> NoiseModel:
         """No noise and no bias."""
         return cls(scale=0.0, biases=())
+
+
+#: Length of the paired noise path before the first sample (s): the same for every rate, so paths align.
+PATH_LEAD = 1.0
+
+
+def interval_means(rng: np.random.Generator, t: np.ndarray, rate: float) -> np.ndarray:
+    """(N, 3) noise of unit σ per sample: the mean over each interval ``(t[k-1], t[k]]`` of one white-noise
+    path drawn at ``rate`` (Hz) from :data:`PATH_LEAD` before ``t[0]``, scaled by sqrt(interval × rate).
+
+    The path's running sum is a random walk on the grid of ``rate``; a sample's mean is its increment over
+    the interval (linear between grid points), so intervals on the grid get exactly the mean of the draws
+    they cover, and the same path serves every sampling rate whose intervals fall on it (the first
+    sample's interval is taken as long as the second's). Intervals off the grid get slightly less
+    variance (linear interpolation of the walk): at most half a grid step's worth.
+    """
+    t = np.asarray(t, float)
+    first = t[1] - t[0] if t.size > 1 else 1.0 / rate
+    if first * rate < 1.0 - 1e-9:
+        raise ValueError(f"paired_rate {rate:g} Hz must be at least the recording's rate ({1.0 / first:g} Hz)")
+    if first > PATH_LEAD:
+        raise ValueError(f"paired noise needs samples at least {1.0 / PATH_LEAD:g} Hz apart, got {1.0 / first:g} Hz")
+    edges = (np.r_[t[0] - first, t] - (t[0] - PATH_LEAD)) * rate  # interval edges on the grid of the path
+    n = int(np.ceil(edges[-1] - 1e-9)) + 1
+    walk = np.vstack([np.zeros((1, 3)), np.cumsum(rng.standard_normal((n, 3)), axis=0)])
+    grid = np.arange(n + 1, dtype=float)
+    at = np.column_stack([np.interp(edges, grid, walk[:, j]) for j in range(3)])
+    width = np.diff(edges)
+    return np.diff(at, axis=0) / np.sqrt(width)[:, None]
 
 
 def magnetic_field_ned(location: str | tuple[float, float] = "monterey") -> np.ndarray:
