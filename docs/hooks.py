@@ -45,6 +45,9 @@ def use_checkout() -> None:
     mod = sys.modules.get("footzoo")
     if mod is not None and not str(getattr(mod, "__file__", "")).startswith(str(ROOT)):
         raise RuntimeError(f"footzoo was imported from {mod.__file__} before the docs hook could use {ROOT}")
+    from footzoo.kernels.installed import use_installed_kernels
+
+    use_installed_kernels()  # the gallery loads an installed wheel's machine code where the source is the same
 
 log = logging.getLogger("mkdocs.hooks.footzoo")
 

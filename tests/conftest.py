@@ -2,31 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.metadata
 import os
 from pathlib import Path
 
 import pytest
 
+from footzoo.kernels.installed import use_installed_kernels
 
-def installed_kernels() -> Path | None:
-    """The machine code an installed footzoo wheel ships (``footzoo/_compiled``), if footzoo is installed so.
+# the installed wheel's machine code, for the checkout's footzoo the tests import (and their subprocesses)
+use_installed_kernels()
 
-    The tests import the checkout's footzoo, whose kernels numba would compile afresh (about a minute of
-    CPU on a new machine). A kernel's shipped code is used only where its source file has the same
-    content (footzoo.kernels.cache checks a SHA-256 of the file), so after ``pip install .`` of this
-    checkout the tests load what the wheel compiled, and compile whatever differs. Pointing
-    ``FOOTZOO_SHIPPED_KERNELS`` at a folder (an empty one: nothing shipped) overrides this.
-    """
-    for dist in importlib.metadata.distributions(name="footzoo"):  # the checkout's own egg-info may come first
-        folder = Path(dist.locate_file("footzoo/_compiled"))
-        if folder.is_dir():
-            return folder
-    return None
-
-
-if "FOOTZOO_SHIPPED_KERNELS" not in os.environ and (_shipped := installed_kernels()) is not None:
-    os.environ["FOOTZOO_SHIPPED_KERNELS"] = str(_shipped)  # the tests' subprocesses inherit it
 
 def made_once(tmp_path_factory: pytest.TempPathFactory, name: str, make) -> Path:
     """A folder ``make(folder)`` fills once per test session, shared by every xdist worker (read it, never write).

@@ -37,9 +37,16 @@ def test_a_reference_that_is_only_a_stride_table_round_trips(walk, tmp_path):
     rec = _bare(walk, Truth(steps=steps, source="hand-labelled strides"))
     back = footzoo.load(write(rec, tmp_path / "strides.csv"))
     assert back.truth is not None and back.truth.pos is None
-    pd.testing.assert_frame_equal(back.truth.steps, steps, check_dtype=False)
+    pd.testing.assert_frame_equal(back.truth.steps, steps)  # dtypes too
     assert back.truth.source == "hand-labelled strides"
     assert back.truth.stride_count is None  # none was given: the table's rows are not taken for a hand count
+
+
+def test_whole_number_floats_of_a_stride_table_reload_as_floats(walk, tmp_path):
+    steps = pd.DataFrame({"start_s": [1.0, 2.0, 3.0], "stride_length_m": [1.0, 1.0, np.nan], "n": [1, 2, 3],
+                          "tiny": [5e-324, 0.1, 1e22]})
+    back = footzoo.load(write(_bare(walk, Truth(steps=steps)), tmp_path / "whole.csv"))
+    pd.testing.assert_frame_equal(back.truth.steps, steps)  # float64 stays float64, int64 stays int64, bit for bit
 
 
 @pytest.mark.parametrize("truth, check", [
@@ -78,7 +85,7 @@ def test_the_real_gaitmap_stride_table_survives_a_round_trip(tmp_path):
         rec = footzoo.load(data_file("gaitmap_example", "imu_sample.csv"), foot="left")
         back = footzoo.load(write(rec, tmp_path / "left.csv"))
     assert rec.truth.steps is not None and rec.truth.pos is None
-    pd.testing.assert_frame_equal(back.truth.steps, rec.truth.steps, check_dtype=False)
+    pd.testing.assert_frame_equal(back.truth.steps, rec.truth.steps)  # dtypes too
     assert (back.truth.source, back.truth.stride_count) == (rec.truth.source, rec.truth.stride_count)
 
 

@@ -28,6 +28,14 @@ from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"
+
+
+def float_text(x: float) -> str:
+    """A float as the shortest text that reloads to the same double, always with a ``.`` or an exponent
+    (``2.0``, not ``2``), so a column of whole-number floats reloads as floats, not integers."""
+    return repr(float(x))
+
+
 #: ``pd.read_csv`` options that parse those digits back exactly (pandas 3 does by default).
 EXACT_CSV: dict[str, Any] = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 #: File suffixes of the canonical format.
@@ -154,7 +162,7 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
         steps = rec.truth.steps if rec.truth is not None else None
         if steps is not None:
             tmp_steps = group.path(steps_path(p))
-            steps.to_csv(tmp_steps, index=False, float_format=FLOAT_FORMAT)
+            steps.to_csv(tmp_steps, index=False, float_format=float_text)  # the table's dtypes reload as written
             steps_sha = sha256(tmp_steps)
         else:
             group.remove(steps_path(p))
