@@ -50,3 +50,14 @@ def test_bad_paired_rates_are_refused_with_the_reason():
         simulate(n_strides=2, rate=100.0, noise=NoiseModel(paired_rate=50.0))
     with pytest.raises(ValueError, match="needs the sample times"):
         NoiseModel(paired_rate=1000.0).apply(np.zeros((5, 3)), np.zeros((5, 3)), None)
+
+
+def test_the_path_drawn_block_by_block_is_the_path_drawn_at_once(monkeypatch):
+    """Memory stays one block of draws; the random stream and the sums continue across the blocks exactly."""
+    from footzoo.sim import sensors
+
+    t = np.arange(3_000) / 300.0  # off the 1 kHz grid: interpolated edges fall in every block
+    whole = interval_means(np.random.default_rng(9), t, 1000.0)
+    monkeypatch.setattr(sensors, "PATH_BLOCK", 7)
+    np.testing.assert_allclose(interval_means(np.random.default_rng(9), t, 1000.0), whole, rtol=1e-9, atol=1e-9)
+    assert np.std(whole) == pytest.approx(1.0, rel=0.1)  # off the grid: a little less than 1 (interpolation)
