@@ -8,9 +8,9 @@ kernel the shipped configs use, compiled while the wheel is built (``setup.py`` 
 neither numba's cache nor that folder is compiled and cached as usual.
 
 The folder holds one set of machine code, or several in its subfolders ``part-0``, ``part-1``...
-(``footzoo compile --ship DIR --jobs N`` compiles in N processes, each into its own part: a numba
-index file names its data files by number, so two processes must not share one); a kernel's code is
-looked up in the folder, then in each part in turn.
+(``setup.py`` runs one ``footzoo compile --ship`` process per group of configs side by side, each
+into its own part: a numba index file names its data files by number, so two processes must not
+share one); a kernel's code is looked up in the folder, then in each part in turn.
 
 numba uses shipped code only where it is valid: the same numba and Python versions, the same
 CPU model and features (numba's own key), and footzoo source files whose content has not
