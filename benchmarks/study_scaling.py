@@ -281,8 +281,7 @@ def figure_cpu(s: Study, out: Path, table) -> list[float]:
             runs.append({**rec, "recording": row["recording"], "base": row["base"]})
     costs = []
     with tempfile.TemporaryDirectory() as tmp:
-        figures = s.figure_metrics(sorted(table.loc[table["metric"].notna(), "metric"].unique()))
-        for task in report.figure_tasks(table, runs, list(s.factors), figures):
+        for task in report.figure_tasks(table, runs, list(s.factors), s.figure_metrics()):
             c0 = time.process_time()
             report.draw_figure(task, Path(tmp))
             costs.append(time.process_time() - c0)

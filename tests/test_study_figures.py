@@ -49,12 +49,15 @@ def test_figures_names_what_is_drawn(tmp_path, figures, metrics, expected):
     assert _drawn(tmp_path) == (set(table["metric"].dropna()) if expected == "every" else expected)
 
 
-def test_changing_figures_rewrites_the_outputs(tmp_path):
+def test_changing_figures_rewrites_the_outputs_and_removes_the_figures_no_longer_drawn(tmp_path):
     run_study(Study.from_dict(STUDY), out=tmp_path)
-    assert "duration_s" not in _drawn(tmp_path)
+    assert "duration_s" not in _drawn(tmp_path) and "stance_f1" in _drawn(tmp_path)
+    (tmp_path / "my_notes.txt").write_text("the user's own file")
     table = run_study(Study.from_dict({**STUDY, "figures": ["duration_s", "armse_3d_m"]}), out=tmp_path)
     assert table.attrs["cached"] == 2 and table.attrs["computed"] == 0  # the runs are read back, not redone
-    assert {"duration_s", "armse_3d_m"} <= _drawn(tmp_path)
+    assert _drawn(tmp_path) == {"duration_s", "armse_3d_m"}  # the earlier report's other figures are gone
+    assert (tmp_path / "my_notes.txt").read_text() == "the user's own file"  # what footzoo did not write stays
+    assert list(tmp_path.glob("trajectories_*.png")) and (tmp_path / "results.csv").exists()
 
 
 @pytest.mark.parametrize("figures,message", [

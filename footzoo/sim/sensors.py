@@ -166,7 +166,8 @@ def interval_means(rng: np.random.Generator, t: np.ndarray, rate: float) -> np.n
     if first * rate < 1.0 - 1e-9:
         raise ValueError(f"paired_rate {rate:g} Hz must be at least the recording's rate ({1.0 / first:g} Hz)")
     if first > PATH_LEAD:
-        raise ValueError(f"paired noise needs samples at least {1.0 / PATH_LEAD:g} Hz apart, got {1.0 / first:g} Hz")
+        raise ValueError(f"paired noise needs a sampling rate of at least {1.0 / PATH_LEAD:g} Hz, "
+                         f"got {1.0 / first:g} Hz")
     edges = (np.r_[t[0] - first, t] - (t[0] - PATH_LEAD)) * rate  # interval edges on the grid of the path
     if np.any(np.diff(edges) <= 0):
         raise ValueError("paired noise needs increasing sample times")

@@ -56,8 +56,9 @@ def _fmt(v: Any, digits: int) -> str:
 
 def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
                   step: Callable[[int], Any] | None = None, jobs: int = 1, scheduler: Any = None,
-                  figures: list[str] | None = None) -> None:
-    """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``.
+                  figures: list[str] | None = None) -> list[str]:
+    """Write the tidy table, the trajectories and sweeps (apart from it), summaries and plots into ``out``;
+    return the names of the files written.
 
     ``step(1)`` is called after each of the four parts (tables, trajectories, summaries, plots).
     Everything is written into a staging folder first and then moved into ``out`` file by file
@@ -73,9 +74,10 @@ def write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
         _write_outputs(table, runs, factors, staging, step, jobs, scheduler, figures)
-        for f in sorted(staging.iterdir()):
-            if f.is_file():
-                os.replace(f, out / f.name)
+        written = [f.name for f in sorted(staging.iterdir()) if f.is_file()]
+        for name in written:
+            os.replace(staging / name, out / name)
+        return written
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 

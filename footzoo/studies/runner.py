@@ -582,17 +582,17 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         if recomputed:
             _log_damaged(Path(out), recomputed)
         bar.phase("report")
-        figures = study.figure_metrics(sorted(table.loc[table["metric"].notna(), "metric"].unique()))
+        figures = study.figure_metrics()
         digest = _outputs_digest(table, runs, list(study.factors), figures)
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
         else:
             # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
-            write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
-                          jobs=jobs if scheduler is None else 1,
-                          scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler,
-                          figures=figures)
-            _write_manifest(Path(out), digest)
+            written = write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
+                                    jobs=jobs if scheduler is None else 1,
+                                    scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler,
+                                    figures=figures)
+            _write_manifest(Path(out), digest, written)
     return table
 
 
@@ -600,7 +600,7 @@ MANIFEST = "outputs.json"
 
 
 def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
-                    figures: list[str]) -> str:
+                    figures: list[str] | None) -> str:
     """What the report depends on: the table, the runs (keys and labels), the factors, the metrics drawn
     and footzoo's source."""
     h = hashlib.sha256(json.dumps([[r["key"], r["base"], r["recording"]] for r in runs]).encode())
@@ -619,9 +619,17 @@ def _outputs_current(out: Path, digest: str) -> bool:
         return False
 
 
-def _write_manifest(out: Path, digest: str) -> None:
-    skip = {MANIFEST, "cache_report.log"}
-    files = {f.name: _file_sha256(f) for f in sorted(out.iterdir()) if f.is_file() and f.name not in skip}
+def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
+    """Record the report's files (``written``) with their content; remove the files the previous report
+    wrote and this one did not (a figure of a metric no longer drawn), so none is taken for current."""
+    try:
+        before = set(json.loads((out / MANIFEST).read_text())["files"])
+    except (OSError, ValueError, KeyError, TypeError):
+        before = set()
+    for name in sorted(before - set(written)):
+        if Path(name).name == name:  # a file of this folder, as every report writes
+            (out / name).unlink(missing_ok=True)
+    files = {name: _file_sha256(out / name) for name in sorted(written)}
     tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
     tmp.write_text(json.dumps({"digest": digest, "files": files}, indent=1))
     tmp.replace(out / MANIFEST)

@@ -272,16 +272,15 @@ class Study:
     max_cells: int = MAX_CELLS
     figures: list[str] | str | None = None
 
-    def figure_metrics(self, table_metrics: list[str]) -> list[str]:
-        """The metrics of ``table_metrics`` (those a study's table holds) to draw a box plot per factor of.
+    def figure_metrics(self) -> list[str] | None:
+        """The metrics to draw a box plot per factor of (those the table holds), None for every one.
 
         ``figures:`` when the study names them (``all``: every one, ``none``: none), else every metric
         the study keeps under ``metrics:``, else those of :data:`~footzoo.evaluation.metrics.FIGURE_METRICS`.
         """
         if self.figures == "all" or (self.figures is None and self.metrics is not None):
-            return list(table_metrics)
-        wanted = [] if self.figures == "none" else (FIGURE_METRICS if self.figures is None else self.figures)
-        return [m for m in table_metrics if m in wanted]
+            return None
+        return [] if self.figures == "none" else list(FIGURE_METRICS if self.figures is None else self.figures)
 
     @classmethod
     def from_yaml(cls, path: str | Path, max_cells: int | None = None) -> Study:
