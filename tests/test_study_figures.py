@@ -73,3 +73,15 @@ def test_a_bad_figures_entry_names_the_problem(figures, message):
 def test_figures_of_a_metric_the_study_drops_are_refused():
     with pytest.raises(ConfigError, match=r"figures names \['stance_f1'\] but metrics does not keep them"):
         Study.from_dict({**STUDY, "metrics": ["armse_3d_m"], "figures": ["stance_f1", "armse_3d_m"]})
+
+
+def test_a_manifest_of_an_older_footzoo_removes_nothing(tmp_path):
+    """Older manifests listed every file of the folder, the user's own included: none of them is removed."""
+    import json
+
+    (tmp_path / "my_notes.txt").write_text("the user's own file")
+    (tmp_path / "outputs.json").write_text(json.dumps({"digest": "old", "files": {"my_notes.txt": "0" * 64}}))
+    run_study(Study.from_dict(STUDY), out=tmp_path)
+    assert (tmp_path / "my_notes.txt").read_text() == "the user's own file"
+    assert "my_notes.txt" not in json.loads((tmp_path / "outputs.json").read_text())["files"]
+

@@ -623,15 +623,17 @@ def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
     """Record the report's files (``written``) with their content; remove the files the previous report
     wrote and this one did not (a figure of a metric no longer drawn), so none is taken for current."""
     try:
-        before = set(json.loads((out / MANIFEST).read_text())["files"])
-    except (OSError, ValueError, KeyError, TypeError):
+        old = json.loads((out / MANIFEST).read_text())
+        # only a manifest of report files: older ones listed every file of the folder, the user's too
+        before = set(old["files"]) if old.get("lists") == "report files" else set()
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         before = set()
     for name in sorted(before - set(written)):
         if Path(name).name == name:  # a file of this folder, as every report writes
             (out / name).unlink(missing_ok=True)
     files = {name: _file_sha256(out / name) for name in sorted(written)}
     tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps({"digest": digest, "files": files}, indent=1))
+    tmp.write_text(json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
     tmp.replace(out / MANIFEST)
 
 
