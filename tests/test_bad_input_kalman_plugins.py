@@ -26,8 +26,10 @@ pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
 
 @measurement_function
-def three_rows(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def three_rows(ctx, rows):
     """Writes the three velocity rows of a zero-velocity update, with a model that declares one."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     if not stance:
         return m
     for i in range(3):
@@ -39,8 +41,10 @@ def three_rows(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
 
 
 @measurement_function
-def far_write(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def far_write(ctx, rows):
     """Writes a column of H far outside the error state."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     if stance:
         H[m, 1000] = 1.0
         z[m] = 0.0
@@ -50,26 +54,32 @@ def far_write(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
 
 
 @measurement_function
-def claims_rows(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def claims_rows(ctx, rows):
     """Writes nothing but says it wrote five rows (one declared)."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     return m + 5 if stance else m
 
 
 @measurement_function
-def gives_back(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def gives_back(ctx, rows):
     """Returns a row before the first free one."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     return m - 1 if stance else m
 
 
 @measurement_function
-def no_rows(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def no_rows(ctx, rows):
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     return m
 
 
 @feedback_function
-def far_memory(dx, idx, par, mem):
+def far_memory(ctx, dx):
     """Writes past the end of its two-value memory."""
-    mem[50] = dx[0]
+    ctx.mem[50] = dx[0]
 
 
 FUNCTIONS = {"three_rows": (three_rows, None), "far_write": (far_write, None), "claims_rows": (claims_rows, None),

@@ -47,7 +47,9 @@ def external(tmp_path_factory):
             name = "test_my_zupt"
 
 
-        def slow_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+        def slow_measure(ctx, rows):
+            k, t, nav, w, f, stance, idx, par, mem, data = ctx
+            z, H, R, m = rows
             if stance and statistics.fmean([1.0, 1.0]) == 1.0:  # the statistics module: numba cannot compile it
                 for i, value in enumerate(nav[7:10]):
                     H[m, idx[VEL] + i] = 1.0

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from footzoo import Pipeline
-from footzoo.filters.measurement import measurement_function
+from footzoo.filters.measurement import Context, Rows, measurement_function
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
@@ -129,9 +129,11 @@ def test_kernels_are_compiled_at_first_call_and_callers_see_the_compiled_callees
 
 
 @measurement_function
-def _dense_rows_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def _dense_rows_measure(ctx, rows):
     """Test model: in stance, three rows each a mix of the velocity (true value 0) and small attitude
     and position terms (several nonzero entries per row)."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     if not stance:
         return m
     for r in range(3):
@@ -195,8 +197,10 @@ def test_alignment_runs_fqa_of_one_sample_as_python_with_the_compiled_kernels_nu
         assert np.array_equal(fqa(a[None])[0], np.array(py(*a, 0.0, 0.0, 0.0, False)))
 
 
-def _allocating_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def _allocating_measure(ctx, rows):
     """Test model: allocates a temporary array (so it needs numba's reference counting)."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
     v = np.zeros(3)
     for i in range(3):
         v[i] = nav[7 + i]
@@ -222,5 +226,11 @@ def test_measurement_functions_compile_without_reference_counting_and_allocating
     nav = np.zeros(16)
     nav[7:10] = [1.0, 2.0, 3.0]
     idx = np.array([0, -1, 3, 6, -1], dtype=np.int64)
-    m = fn(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0), z, H, R, 0)
+    conv = fn.compiled()  # the calling convention the loop calls, with the function compiled into it
+    assert conv.targetoptions.get("_nrt") is not False
+    m = conv(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0), z, H, R, 0)
     assert m == 3 and z.tolist() == [1.0, 2.0, 3.0] and H[:, 6:9].tolist() == np.eye(3).tolist()
+    # called itself, it is the function as written, in Python: the same rows
+    z2, H2, R2 = np.zeros(3), np.zeros((3, 9)), np.zeros(3)
+    ctx = Context(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0))
+    assert fn(ctx, Rows(z2, H2, R2, 0)) == 3 and np.array_equal(z2, z) and np.array_equal(H2, H)

@@ -25,9 +25,11 @@ from footzoo.plugins.base import KalmanCorrection, Samples
 
 
 @measurement_function
-def impact_weighted_zv_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def impact_weighted_zv_measure(ctx, rows):
     """In stance: ``δv = v̂`` with ``R = σ_v² + (τ (|f| − g))²``; ``par`` = (σ_v m/s, τ s, g m/s²)."""
-    if not stance:
+    nav, f, idx, par = ctx.nav, ctx.f, ctx.idx, ctx.par
+    z, H, R, m = rows
+    if not ctx.stance:
         return m
     excess = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) - par[2]
     r = par[0] * par[0] + par[1] * par[1] * excess * excess

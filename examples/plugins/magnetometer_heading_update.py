@@ -22,47 +22,56 @@ import math
 import numpy as np
 
 import footzoo
-from footzoo.filters.measurement import ATT, MeasurementModel, measurement_function
+from footzoo.filters.measurement import ATT, MeasurementModel, Q, measurement_function
 from footzoo.plugins.base import KalmanCorrection, Samples
+
+#: Positions in ``par``: σ_ψ (rad), the field magnitude's tolerance (a fraction), the dip's tolerance (rad).
+HEADING_STD, NORM_TOLERANCE, DIP_TOLERANCE = 0, 1, 2
+#: In ``data``: in the still start, the reading is valid, the field m_x, m_y, m_z (body frame, any unit).
+IN_START, VALID, FIELD = 0, 1, 2
+#: In ``mem``: the sums Σm_N, Σm_E, Σm_D, Σ|m| and their count over the still start, the reference is ready,
+#: its heading ψ_0 (rad), magnitude |m|_0 and dip (rad).
+SUM_N, SUM_E, SUM_D, SUM_NORM, COUNT, READY, HEADING_0, NORM_0, DIP_0 = range(9)
 
 
 @measurement_function
-def magu_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
-    """``par`` = (σ_ψ rad, magnitude tolerance (fraction), dip tolerance rad); ``data`` = (in the
-    still start, reading valid, m_x, m_y, m_z); ``mem`` = (Σm_N, Σm_E, Σm_D, Σ|m|, count,
-    reference ready, ψ_0, |m|_0, dip_0)."""
-    if data[1] == 0.0:
+def magu_measure(ctx, rows):
+    """In stance: the heading of the field in NED against the still start's (``ctx`` and ``rows``: see
+    footzoo.filters.measurement; ``par``, ``data``, ``mem``: the positions above)."""
+    nav, par, mem, data = ctx.nav, ctx.par, ctx.mem, ctx.data
+    z, H, R, m = rows
+    if data[VALID] == 0.0:
         return m
-    qw, qx, qy, qz = nav[0], nav[1], nav[2], nav[3]
-    mx, my, mz = data[2], data[3], data[4]
+    qw, qx, qy, qz = nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3]
+    mx, my, mz = data[FIELD], data[FIELD + 1], data[FIELD + 2]
     m_n = (1 - 2 * (qy * qy + qz * qz)) * mx + 2 * (qx * qy - qw * qz) * my + 2 * (qx * qz + qw * qy) * mz
     m_e = 2 * (qx * qy + qw * qz) * mx + (1 - 2 * (qx * qx + qz * qz)) * my + 2 * (qy * qz - qw * qx) * mz
     m_d = 2 * (qx * qz - qw * qy) * mx + 2 * (qy * qz + qw * qx) * my + (1 - 2 * (qx * qx + qy * qy)) * mz
     norm = math.sqrt(mx * mx + my * my + mz * mz)
-    if data[0] != 0.0:  # still start: accumulate the reference
-        mem[0] += m_n
-        mem[1] += m_e
-        mem[2] += m_d
-        mem[3] += norm
-        mem[4] += 1.0
+    if data[IN_START] != 0.0:  # still start: accumulate the reference
+        mem[SUM_N] += m_n
+        mem[SUM_E] += m_e
+        mem[SUM_D] += m_d
+        mem[SUM_NORM] += norm
+        mem[COUNT] += 1.0
         return m
-    if mem[5] == 0.0:
-        if mem[4] == 0.0:
+    if mem[READY] == 0.0:
+        if mem[COUNT] == 0.0:
             return m
-        mem[6] = math.atan2(mem[1], mem[0])
-        mem[7] = mem[3] / mem[4]
-        mem[8] = math.atan2(mem[2], math.sqrt(mem[0] * mem[0] + mem[1] * mem[1]))
-        mem[5] = 1.0
-    if not stance:
+        mem[HEADING_0] = math.atan2(mem[SUM_E], mem[SUM_N])
+        mem[NORM_0] = mem[SUM_NORM] / mem[COUNT]
+        mem[DIP_0] = math.atan2(mem[SUM_D], math.sqrt(mem[SUM_N] * mem[SUM_N] + mem[SUM_E] * mem[SUM_E]))
+        mem[READY] = 1.0
+    if not ctx.stance:
         return m
     dip = math.atan2(m_d, math.sqrt(m_n * m_n + m_e * m_e))
-    if abs(norm - mem[7]) > par[1] * mem[7] or abs(dip - mem[8]) > par[2]:
+    if abs(norm - mem[NORM_0]) > par[NORM_TOLERANCE] * mem[NORM_0] or abs(dip - mem[DIP_0]) > par[DIP_TOLERANCE]:
         return m  # disturbed field: no update
-    d = math.atan2(m_e, m_n) - mem[6]
+    d = math.atan2(m_e, m_n) - mem[HEADING_0]
     d = -((-d + math.pi) % (2 * math.pi) - math.pi)
-    H[m, idx[ATT] + 2] = 1.0
+    H[m, ctx.idx[ATT] + 2] = 1.0
     z[m] = d
-    R[m] = par[0] * par[0]
+    R[m] = par[HEADING_STD] * par[HEADING_STD]
     return m + 1
 
 

@@ -26,13 +26,15 @@ GUARD_ROWS = 0
 
 
 @measurement_function
-def zero_velocity_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def zero_velocity_measure(ctx, rows):
     """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[ZERO_RATE]``, ``δω = ω̂ − 0`` (eq. 30).
 
     In any sample, a bias estimate beyond its bound ``par[GYRO_BOUND]`` (rad/s) or
     ``par[ACC_BOUND]`` (m/s²) is measured at the bound, with σ a tenth of the
     bound: ``δb = clip(b̂) − b̂`` (footzoo's bias guard; a bound of 0: none).
     """
+    nav, w, idx, par, mem = ctx.nav, ctx.w, ctx.idx, ctx.par, ctx.mem
+    z, H, R, m = rows
     for blk, off, bound in ((GYRO_BIAS, BG, par[GYRO_BOUND]), (ACC_BIAS, BA, par[ACC_BOUND])):
         if idx[blk] < 0 or bound <= 0.0:
             continue
@@ -44,7 +46,7 @@ def zero_velocity_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R,
                 R[m] = (0.1 * bound) * (0.1 * bound)
                 mem[GUARD_ROWS] += 1.0
                 m += 1
-    if not stance:
+    if not ctx.stance:
         return m
     vel = idx[VEL]
     for i in range(3):

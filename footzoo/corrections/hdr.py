@@ -71,34 +71,37 @@ WAS_STANCE, LAST_YAW, ENDS_SEEN, YAW_1, YAW_2 = 0, 1, 2, 3, 4
 
 
 @measurement_function
-def heading_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def heading_measure(ctx, rows):
     """In stance: δψ of the current yaw against the two previous stances' final yaws (eqs. 23–24, 28).
 
     ``par`` and ``mem``: see :data:`THRESHOLD` and :data:`WAS_STANCE`.
     """
-    if not stance or mem[ENDS_SEEN] < 2:
+    par, mem = ctx.par, ctx.mem
+    z, H, R, m = rows
+    if not ctx.stance or mem[ENDS_SEEN] < 2:
         return m
     a, b = mem[YAW_1], mem[YAW_2]
     mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
-    d = yaw_of(nav) - mean
+    d = yaw_of(ctx.nav) - mean
     d = -((-d + math.pi) % (2 * math.pi) - math.pi)  # wrap to (-π, π], as conventions.wrap_angle
     if abs(d) > par[THRESHOLD]:
         return m
-    H[m, idx[ATT] + 2] = 1.0
+    H[m, ctx.idx[ATT] + 2] = 1.0
     z[m] = d
     R[m] = par[YAW_STD] * par[YAW_STD]
     return m + 1
 
 
 @after_function
-def heading_after(k, nav, stance, idx, par, mem):
+def heading_after(ctx):
     """Record the final heading of each stance (γ^{T_i}), after the update."""
-    if mem[WAS_STANCE] != 0.0 and not stance and k > 1:
+    mem, stance = ctx.mem, ctx.stance
+    if mem[WAS_STANCE] != 0.0 and not stance and ctx.k > 1:
         mem[YAW_2] = mem[YAW_1]
         mem[YAW_1] = mem[LAST_YAW]
         mem[ENDS_SEEN] += 1.0
     mem[WAS_STANCE] = 1.0 if stance else 0.0
-    mem[LAST_YAW] = yaw_of(nav)
+    mem[LAST_YAW] = yaw_of(ctx.nav)
 
 
 @register

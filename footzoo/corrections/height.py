@@ -77,12 +77,14 @@ IN_START, READINGS = 0, 1
 
 
 @measurement_function
-def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def distance_measure(ctx, rows):
     """Rows of eqs. 14–15 for each valid range reading, with eqs. 18 and 20 when calibrating.
 
     ``par``, ``mem`` and ``data``: see :data:`RANGE_STD`, :data:`FLOOR` and :data:`IN_START`;
     ``idx`` after the core: the offsets of r̄_j then n̄_j.
     """
+    nav, idx, par, mem, data = ctx.nav, ctx.idx, ctx.par, ctx.mem, ctx.data
+    z, H, R, m = rows
     ks = int(par[N_SENSORS])
     n_init = int(par[N_INIT])
     calibrate = par[CALIBRATE] != 0.0
@@ -110,7 +112,7 @@ def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
     # first two rows of C(q), for the attitude columns
     a00, a01, a02 = 1 - 2 * (y_ * y_ + z_ * z_), 2 * (x_ * y_ - w_ * z_), 2 * (x_ * z_ + w_ * y_)
     a10, a11, a12 = 2 * (x_ * y_ + w_ * z_), 1 - 2 * (x_ * x_ + z_ * z_), 2 * (y_ * z_ - w_ * x_)
-    rows = 0
+    written = 0
     for j in range(ks):
         if data[READINGS + ks + j] == 0.0:
             continue
@@ -136,8 +138,8 @@ def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
         scale = c0 * mem[nn] + c1 * mem[nn + 1] + c2 * mem[nn + 2]
         R[m] = (scale * par[RANGE_STD]) ** 2
         m += 1
-        rows += 1
-    if rows > 0 and calibrate:
+        written += 1
+    if written > 0 and calibrate:
         for j in range(ks):  # eqs. 16-18: n̂ᵀ n̄ = 0
             cn = idx[OWN + ks + j]
             nn = MOUNTING + 3 * ks + 3 * j
@@ -158,8 +160,9 @@ def distance_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
 
 
 @feedback_function
-def distance_feedback(dx, idx, par, mem):
+def distance_feedback(ctx, dx):
     """Add the calibration errors to the mounting estimates (eq. 1)."""
+    idx, par, mem = ctx.idx, ctx.par, ctx.mem
     if par[CALIBRATE] == 0.0:
         return
     ks = int(par[N_SENSORS])
@@ -358,13 +361,14 @@ HEIGHT_STD = 0
 
 
 @measurement_function
-def flat_floor_measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+def flat_floor_measure(ctx, rows):
     """In stance: the height error ``p̂_z − 0`` (the pipeline starts at the origin); ``par`` = (σ m,)."""
-    if not stance:
+    z, H, R, m = rows
+    if not ctx.stance:
         return m
-    H[m, idx[POS] + 2] = 1.0
-    z[m] = nav[P + 2]
-    R[m] = par[HEIGHT_STD] * par[HEIGHT_STD]
+    H[m, ctx.idx[POS] + 2] = 1.0
+    z[m] = ctx.nav[P + 2]
+    R[m] = ctx.par[HEIGHT_STD] * ctx.par[HEIGHT_STD]
     return m + 1
 
 

@@ -147,8 +147,8 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
             for i in range(n):
                 for j in range(i + 1, n):
                     Pk[j, i] = Pk[i, j]
-            feed_back(nav, dx, idx, use_ext, functions[1], views, mems)
-        after(functions[2], views, k0 + k, nav, st, mems)
+            feed_back(nav, dx, idx, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
+        after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
         store(k, nav, a_n, Pk, idx, out, keep_p, False, nis, m)
         if record is not None:  # smoother: P⁺_k
             record_covariance(record, k, Pk)
@@ -363,10 +363,11 @@ def update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc):
 
 
 @njit(inline=True)
-def feed_back(nav, dx, idx, use_ext, feedbacks, views, mems):
+def feed_back(nav, dx, idx, use_ext, feedbacks, views, mems, k, t_k, w, f, st, data_k):
     """The estimated error into the nominal state, eqs. 49–52, then into each model's memory.
 
-    q ← exp(−δφ) ⊗ q, p ← p − δp, v ← v − δv, b ← b + δb.
+    q ← exp(−δφ) ⊗ q, p ← p − δp, v ← v − δv, b ← b + δb. The models' ``feedback`` get sample ``k``
+    (its corrected state; ``w`` and ``f`` as their ``measure`` got them).
     """
     m_idx, par, par_off, mem_off, data_off, hooks, rows = views
     att, gb_i, pos_i, vel_i, ab_i = idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS]
@@ -381,16 +382,18 @@ def feed_back(nav, dx, idx, use_ext, feedbacks, views, mems):
             nav[BA + i] += dx[ab_i + i]
     for j in range(len(feedbacks)):
         if hooks[j, 0]:
-            feedbacks[j](dx, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
+            feedbacks[j](k, t_k, nav, w, f, st, m_idx[j], par[par_off[j]:par_off[j + 1]],
+                         mems[mem_off[j]:mem_off[j + 1]], data_k[data_off[j]:data_off[j + 1]], dx)
 
 
 @njit(inline=True)
-def after(afters, views, k, nav, st, mems):
+def after(afters, views, k, t_k, nav, w, f, st, mems, data_k):
     """Each model's ``after`` function, once per sample after the update (bookkeeping on the corrected state)."""
     m_idx, par, par_off, mem_off, data_off, hooks, rows = views
     for j in range(len(afters)):
         if hooks[j, 1]:
-            afters[j](k, nav, st, m_idx[j], par[par_off[j]:par_off[j + 1]], mems[mem_off[j]:mem_off[j + 1]])
+            afters[j](k, t_k, nav, w, f, st, m_idx[j], par[par_off[j]:par_off[j + 1]],
+                      mems[mem_off[j]:mem_off[j + 1]], data_k[data_off[j]:data_off[j + 1]])
 
 
 @njit(inline=True)

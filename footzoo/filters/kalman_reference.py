@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
-from .measurement import BA, BG, MeasurementModel, P, Q, V
+from .measurement import BA, BG, MeasurementModel, P, Q, V, calling
 from .smoother import packed
 
 
@@ -81,6 +81,9 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
     nav = nav0
     data = data if data is not None else [m.data for m in models]
     m_max = sum(m.max_rows for m in models)
+    # each model's functions as the engine calls them (compiled where they compile, else in Python)
+    measures = [calling(m.measure, "measure") for m in models]
+    feedbacks, afters = [calling(m.feedback, "feedback") for m in models], [calling(m.after, "after") for m in models]
     out = _outputs(n, layout.n)
     _store(out, 0, nav, np.zeros(3), kf.P)
     if record is not None:
@@ -93,7 +96,7 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
         if record is not None:
             record_transition(record, k, F, layout, c, dt)
         st = bool(stance[k])
-        z, H, R = _measure(models, idx, data, k, k0, float(t[k]), nav, w, f, st, m_max, layout.n)
+        z, H, R = _measure(models, measures, idx, data, k, k0, float(t[k]), nav, w, f, st, m_max, layout.n)
         if len(z):
             if record is not None:
                 record_update(record, k, kf.P, z, H, R)
@@ -101,9 +104,11 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
             out["nis"][k] = kf.nis, len(z)
             _feed_back(nav, dx, layout, ins)
             for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
-                _call(j, k0 + k, model.feedback, dx, ix, model.par, model.mem)
+                _call(j, k0 + k, feedbacks[j], k0 + k, float(t[k]), nav, w, f, st, ix,
+                      model.par, model.mem, _row(data[j], k), dx)
         for j, (model, ix) in enumerate(zip(models, idx, strict=True)):
-            _call(j, k0 + k, model.after, k0 + k, nav, st, ix, model.par, model.mem)
+            _call(j, k0 + k, afters[j], k0 + k, float(t[k]), nav, w, f, st, ix, model.par,
+                  model.mem, _row(data[j], k))
         _store(out, k, nav, a_n, kf.P)
         if record is not None:
             record[0][k] = packed(kf.P)
@@ -141,25 +146,30 @@ def _propagate(nav: np.ndarray, acc_k: np.ndarray, gyr_k: np.ndarray, quat_ext_k
     return w, f, c, f_n, a_n
 
 
-def _measure(models: list[MeasurementModel], idx: list[np.ndarray], data: list[np.ndarray | None], k: int, k0: int,
-             t_k: float, nav: np.ndarray, w: np.ndarray, f: np.ndarray, st: bool, m_max: int,
+def _measure(models: list[MeasurementModel], measures: list, idx: list[np.ndarray], data: list[np.ndarray | None],
+             k: int, k0: int, t_k: float, nav: np.ndarray, w: np.ndarray, f: np.ndarray, st: bool, m_max: int,
              n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The models' rows of sample ``k``, stacked: ``z`` (m,), ``H`` (m, n), ``R`` (m,).
 
+    ``measures``: the models' ``measure`` as the engine calls it (:func:`~footzoo.filters.measurement.calling`).
     Each model gets the buffers cut at the rows it declared, as in the compiled loop; a row count
     outside them is a :class:`ModelFault`.
     """
     z, H, R = np.zeros(m_max), np.zeros((m_max, n)), np.zeros(m_max)
     m = 0
     for j, (model, ix, d) in enumerate(zip(models, idx, data, strict=True)):
-        row = d[k] if d is not None and d.shape[1] else np.zeros(0)
         top = m + model.max_rows
-        m_new = int(_call(j, k0 + k, model.measure, k0 + k, t_k, nav, w, f, st, ix, model.par, model.mem, row,
-                          z[:top], H[:top], R[:top], m))
+        m_new = int(_call(j, k0 + k, measures[j], k0 + k, t_k, nav, w, f, st, ix, model.par,
+                          model.mem, _row(d, k), z[:top], H[:top], R[:top], m))
         if m_new < m or m_new > top:
             raise ModelFault(j, m_new - m, k0 + k)
         m = m_new
     return z[:m], H[:m], R[:m]
+
+
+def _row(d: np.ndarray | None, k: int) -> np.ndarray:
+    """Sample ``k``'s row of a model's per-sample inputs (empty without any)."""
+    return d[k] if d is not None and d.shape[1] else np.zeros(0)
 
 
 def _feed_back(nav: np.ndarray, dx: np.ndarray, layout: Layout, ins: bool) -> None:

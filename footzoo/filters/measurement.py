@@ -9,70 +9,83 @@ functions; the engine knows no correction by name.
 The three functions (compile them with :func:`measurement_function`,
 :func:`feedback_function` and :func:`after_function`)::
 
-    measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m) -> m_new
-    feedback(dx, idx, par, mem) -> None
-    after(k, nav, stance, idx, par, mem) -> None
+    measure(ctx, rows) -> m_new      # this sample's measurement rows
+    feedback(ctx, dx) -> None        # after an update: the correction's own error states
+    after(ctx) -> None               # once per sample, after the update
 
-Arguments:
+``ctx`` is a :class:`Context`, the sample as the correction sees it:
 
-``k`` (int)
+``ctx.k`` (int)
     Index of the sample in the whole recording (or stream).
-``t`` (float, s)
+``ctx.t`` (float, s)
     Its time.
-``nav`` ((16,) float)
+``ctx.nav`` ((16,) float)
     The nominal state: ``nav[Q:Q+4]`` attitude quaternion (body → NED, scalar
     first), ``nav[P:P+3]`` position (m, NED), ``nav[V:V+3]`` velocity (m/s),
     ``nav[BG:BG+3]`` gyro bias and ``nav[BA:BA+3]`` accelerometer bias
-    estimates (rad/s, m/s²). Read only.
-``w``, ``f`` ((3,) float)
+    estimates (rad/s, m/s²). Read only. ``measure`` sees the prediction,
+    ``feedback`` and ``after`` the corrected state.
+``ctx.w``, ``ctx.f`` ((3,) float)
     Bias-corrected angular rate (rad/s) and specific force (m/s²), body frame.
-``stance`` (bool)
+``ctx.stance`` (bool)
     The detector's gait phase at this sample.
-``idx`` ((5 + b,) int)
+``ctx.idx`` ((5 + b,) int)
     Offsets of the error-state blocks: ``idx[ATT]``, ``idx[GYRO_BIAS]``,
     ``idx[POS]``, ``idx[VEL]``, ``idx[ACC_BIAS]`` (−1 where the block is
     absent), then the offsets of the correction's own blocks in the order of
     its :meth:`state_blocks`.
-``par`` ((p,) float)
+``ctx.par`` ((p,) float)
     The correction's constants (read only).
-``mem`` ((s,) float)
+``ctx.mem`` ((s,) float)
     The correction's memory, carried from sample to sample (read/write).
-``data`` ((d,) float)
+``ctx.data`` ((d,) float)
     This sample's row of the correction's per-sample inputs.
-``z``, ``H``, ``R``
-    Buffers for this sample's stacked measurement: write rows ``m, m+1, …``
-    of the residual ``z`` (measured − predicted, with the engine's sign: the
-    error state is estimate − truth), the **nonzero** entries of the
-    measurement matrix ``H`` (the engine keeps every other entry zero) and
-    the measurement noise variance ``R`` (diagonal: rows are independent; a
-    correlated measurement can be whitened first). They end after row
-    ``m + max_rows − 1``: write at most the model's ``max_rows`` rows. A
-    plug-in's functions are compiled with bounds checks, so a write past
-    the end (or outside ``par``, ``mem``, ``data``) is refused, and so is a
-    returned row count outside ``[m, m + max_rows]``: both are the
-    plug-in's :class:`~footzoo.core.errors.PluginError`.
-``m`` (int)
-    First free row; return the next free row (``m`` when there is nothing
-    to measure).
-``dx`` ((n,) float)
-    The error estimated by the update, fed back by the engine to the core
-    states; ``feedback`` applies the correction's own blocks to its memory.
 
-``after`` runs once per sample after the update and feedback (bookkeeping
-that needs the corrected state, e.g. the heading at the end of a stance).
+``rows`` is a :class:`Rows`, the buffers of this sample's stacked measurement:
+
+``rows.z``, ``rows.H``, ``rows.R``
+    Write rows ``m, m+1, …`` of the residual ``z`` (measured − predicted, with
+    the engine's sign: the error state is estimate − truth), the **nonzero**
+    entries of the measurement matrix ``H`` (the engine keeps every other entry
+    zero) and the measurement noise variance ``R`` (diagonal: rows are
+    independent; a correlated measurement can be whitened first). They end
+    after row ``m + max_rows − 1``: write at most the model's ``max_rows``
+    rows. A plug-in's functions are compiled with bounds checks, so a write
+    past the end (or outside ``par``, ``mem``, ``data``) is refused, and so is
+    a returned row count outside ``[m, m + max_rows]``: both are the plug-in's
+    :class:`~footzoo.core.errors.PluginError`.
+``rows.m`` (int)
+    The first free row; ``measure`` returns the next free row (``rows.m`` when
+    there is nothing to measure).
+
+``dx`` ((n,) float) is the error estimated by the update, fed back by the
+engine to the core states; ``feedback`` applies the correction's own blocks to
+its memory. ``after`` does bookkeeping that needs the corrected state (e.g. the
+heading at the end of a stance).
+
+The compiled loop calls the functions through a calling convention of plain
+positional arguments, the fields of ``ctx`` and then those of ``rows`` (or
+``dx``), into which numba compiles each function (:mod:`footzoo.kernels.functions`);
+:func:`convention` gives it in Python. Functions written for footzoo 0.x took
+those positional arguments themselves (``measure(k, t, nav, w, f, stance, idx,
+par, mem, data, z, H, R, m)``, ``feedback(dx, idx, par, mem)``, ``after(k,
+nav, stance, idx, par, mem)``): they still run, with a ``FutureWarning``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import inspect
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..kernels import jit as _jit
+from ..core.errors import PluginError
 from ..kernels.functions import NotCompilable, compile_model_function
 from ..kernels.jit import njit
 
@@ -84,49 +97,148 @@ ATT, GYRO_BIAS, POS, VEL, ACC_BIAS, OWN = 0, 1, 2, 3, 4, 5
 CORE_BLOCKS = ("att", "gyro_bias", "pos", "vel", "acc_bias")
 
 
+class Context(NamedTuple):
+    """One sample as a correction's functions see it (the fields are described in the module docstring)."""
+
+    k: int
+    t: float
+    nav: np.ndarray
+    w: np.ndarray
+    f: np.ndarray
+    stance: bool
+    idx: np.ndarray
+    par: np.ndarray
+    mem: np.ndarray
+    data: np.ndarray
+
+
+class Rows(NamedTuple):
+    """The buffers a ``measure`` function writes its rows into, from row ``m`` on (see the module docstring)."""
+
+    z: np.ndarray
+    H: np.ndarray
+    R: np.ndarray
+    m: int
+
+
+#: Parameters of each function: with the context (this contract), and positional (footzoo 0.x).
+PARAMETERS = {"measure": (("ctx", "rows"), 14), "feedback": (("ctx", "dx"), 4), "after": (("ctx",), 6)}
+
+
+def convention(fn: Callable[..., Any], role: str, positional: bool = False) -> Callable[..., Any]:
+    """The engine's calling convention for ``fn``: a function of the positional arguments that calls ``fn``.
+
+    The arguments are the fields of :class:`Context`, then those of :class:`Rows` (``measure``) or
+    ``dx`` (``feedback``). ``positional``: ``fn`` takes footzoo 0.x's positional arguments instead.
+    Plain Python; :mod:`footzoo.kernels.functions` compiles ``fn`` into it.
+    """
+    if role == "measure":
+        if positional:
+            return fn
+
+        def measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+            return fn(Context(k, t, nav, w, f, stance, idx, par, mem, data), Rows(z, H, R, m))
+
+        return measure
+    if role == "feedback":
+        if positional:
+            def feedback(k, t, nav, w, f, stance, idx, par, mem, data, dx):  # noqa: ARG001
+                fn(dx, idx, par, mem)
+        else:
+            def feedback(k, t, nav, w, f, stance, idx, par, mem, data, dx):
+                fn(Context(k, t, nav, w, f, stance, idx, par, mem, data), dx)
+        return feedback
+    if positional:
+        def after(k, t, nav, w, f, stance, idx, par, mem, data):  # noqa: ARG001
+            fn(k, nav, stance, idx, par, mem)
+    else:
+        def after(k, t, nav, w, f, stance, idx, par, mem, data):
+            fn(Context(k, t, nav, w, f, stance, idx, par, mem, data))
+    return after
+
+
+def is_positional(fn: Callable[..., Any], role: str) -> bool:
+    """Whether ``fn`` takes footzoo 0.x's positional arguments (warned about); raises
+    :class:`~footzoo.core.errors.PluginError` when it takes neither those nor this contract's."""
+    py = getattr(fn, "py_func", fn)
+    names, old = PARAMETERS[role]
+    try:
+        params = [p for p in inspect.signature(py).parameters.values()
+                  if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    except (TypeError, ValueError):  # no signature to read: take it as this contract's
+        return False
+    if len(params) == len(names):
+        return False
+    where = f"{getattr(py, '__module__', '?')}.{getattr(py, '__qualname__', py)}"
+    if len(params) == old:
+        warnings.warn(f"{role} function {where} takes footzoo 0.x's {old} positional arguments; write it as "
+                      f"{role}({', '.join(names)}) (footzoo.filters.measurement explains the fields): the old form "
+                      "will be refused in a future release", FutureWarning, stacklevel=4)
+        return True
+    raise PluginError(f"{role} function {where} takes {len(params)} argument(s); a {role} function takes "
+                      f"({', '.join(names)}): see footzoo.filters.measurement for what they hold")
+
+
 def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
-    """``fn`` compiled with the engine's signature for ``role`` (:mod:`footzoo.kernels.functions`)."""
+    """``fn`` compiled to the engine's calling convention for ``role`` (:mod:`footzoo.kernels.functions`)."""
     if isinstance(fn, ModelFunction):
         return fn.compiled()
-    return compile_model_function(fn, role)
+    if getattr(fn, "footzoo_convention", None) == role:  # already compiled to it
+        return fn
+    return _compiled_convention(fn, role, is_positional(fn, role))
+
+
+def _compiled_convention(fn: Callable[..., Any], role: str, positional: bool) -> Callable[..., Any]:
+    """``fn`` compiled into :func:`convention` (a positional 0.x ``measure`` takes it as it is)."""
+    wrap = None if positional and role == "measure" else (lambda g: convention(g, role, positional))
+    compiled = compile_model_function(fn, role, wrap)
+    with contextlib.suppress(AttributeError, TypeError):  # a plain function without numba: marked as well
+        compiled.footzoo_convention = role
+    return compiled
 
 
 class ModelFunction:
-    """A measurement model's function, compiled with the engine's signature at its first use.
+    """A measurement model's function, compiled to the engine's calling convention at its first use.
 
-    Calling it, or asking for numba's attributes (``signatures``, ``targetoptions``, ...),
-    compiles it (or loads it from numba's cache); :meth:`compiled` gives numba's dispatcher.
-    Nothing is imported or compiled before: importing a correction's module stays cheap.
+    Calling it runs the function as written (``measure(ctx, rows)``...), in Python. Asking for
+    :meth:`compiled`, or for numba's attributes (``signatures``, ``targetoptions``, ...), compiles
+    it into the calling convention (or loads it from numba's cache); :func:`calling` gives what the
+    engines call. Nothing is imported or compiled before: importing a correction's module stays cheap.
     """
 
     def __init__(self, fn: Callable[..., Any], role: str):
         functools.update_wrapper(self, fn)
         self.py_func = fn
         self.role = role
+        self.positional = is_positional(fn, role)
         self._dispatcher: Any = None
         self._error: str | None = None
 
     def compiled(self) -> Any:
-        """numba's dispatcher (compiled once); raises :class:`NotCompilable` with the reason (tried once)."""
+        """numba's dispatcher of the calling convention (compiled once); raises :class:`NotCompilable` with the
+        reason (tried once)."""
         if self._dispatcher is None:
             if self._error is not None:
                 raise NotCompilable(self._error)
             try:
-                self._dispatcher = _compile(self.py_func, self.role)
+                self._dispatcher = _compiled_convention(self.py_func, self.role, self.positional)
             except NotCompilable as err:
                 self._error = str(err)
                 raise
         return self._dispatcher
 
-    def __call__(self, *args: Any) -> Any:
+    def conventional(self) -> Callable[..., Any]:
+        """The calling convention: compiled, or in Python where it does not compile (the reference engine's)."""
         try:
-            fn = self.compiled()
-        except NotCompilable:  # the reference engine runs it as Python
-            fn = self.py_func
-        return fn(*args)
+            return self.compiled()
+        except NotCompilable:
+            return convention(self.py_func, self.role, self.positional)
+
+    def __call__(self, *args: Any) -> Any:
+        return self.py_func(*args)
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__") or name in ("py_func", "role", "_dispatcher", "_error"):
+        if name.startswith("__") or name in ("py_func", "role", "positional", "_dispatcher", "_error"):
             raise AttributeError(name)
         return getattr(self.compiled(), name)
 
@@ -134,17 +246,31 @@ class ModelFunction:
         return f"<footzoo {self.role} function {self.py_func.__module__}.{self.py_func.__qualname__}>"
 
 
+def calling(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
+    """``fn`` as the engines call it: a function of the calling convention's positional arguments.
+
+    A function marked with :func:`measurement_function` (or its siblings) compiled, where it compiles;
+    an unmarked one in Python.
+    """
+    if isinstance(fn, ModelFunction):
+        return fn.conventional()
+    if getattr(fn, "footzoo_convention", None) == role:
+        return fn
+    return convention(fn, role, is_positional(fn, role))
+
+
 def _lazy(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
-    if not _jit.HAVE_NUMBA or isinstance(fn, ModelFunction):
+    if isinstance(fn, ModelFunction):
         return fn
     return ModelFunction(fn, role)
 
 
 def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
-    """Mark a ``measure`` function for compilation with the engine's signature (plain Python without numba).
+    """Mark a ``measure(ctx, rows)`` function for compilation to the engine's calling convention.
 
-    Use as a decorator in a correction's module. The function is compiled at its first use
-    (a call, or the engine's compiled loop), not when the module is imported. A function that
+    Use as a decorator in a correction's module (without numba the engines run it in Python). The
+    function is compiled at its first use by the engine's compiled loop (or :meth:`ModelFunction.compiled`),
+    not when the module is imported; calling it runs it as written, in Python. A function that
     creates no array is compiled without numba's reference counting (cheaper calls from the
     compiled loop). A function that does not compile raises :class:`NotCompilable` with numba's
     reason at its first use; the engine then runs the reference loop under ``engine="auto"``
@@ -154,20 +280,20 @@ def measurement_function(fn: Callable[..., int]) -> Callable[..., int]:
 
 
 def feedback_function(fn: Callable[..., None]) -> Callable[..., None]:
-    """Mark a ``feedback`` function for compilation with the engine's signature."""
+    """Mark a ``feedback(ctx, dx)`` function for compilation to the engine's calling convention."""
     return _lazy(fn, "feedback")
 
 
 def after_function(fn: Callable[..., None]) -> Callable[..., None]:
-    """Mark an ``after`` function for compilation with the engine's signature."""
+    """Mark an ``after(ctx)`` function for compilation to the engine's calling convention."""
     return _lazy(fn, "after")
 
 
-def _no_feedback(dx, idx, par, mem):  # noqa: ARG001 - the signature is the contract
+def _no_feedback(ctx, dx):  # noqa: ARG001 - the signature is the contract
     return None
 
 
-def _no_after(k, nav, stance, idx, par, mem):  # noqa: ARG001
+def _no_after(ctx):  # noqa: ARG001
     return None
 
 

@@ -64,12 +64,27 @@ def _content_stamp(path: Path) -> str:
 
 
 class KernelCache(FunctionCache):
-    """numba's cache of one footzoo kernel, falling back on the machine code shipped with footzoo."""
+    """numba's cache of one footzoo kernel, falling back on the machine code shipped with footzoo.
 
-    def __init__(self, py_func: Callable[..., Any], source: Path):
+    ``identity``: for a kernel that wraps a function given at run time (a closure over it, as the
+    measurement functions' calling convention is: :mod:`footzoo.kernels.functions`), a text naming that
+    function and the content of its source. numba keys a closure's code by its captured values
+    pickled, which for a compiled function differ in every process (it would never be found again);
+    the identity stands in for them.
+    """
+
+    def __init__(self, py_func: Callable[..., Any], source: Path, identity: str | None = None):
         super().__init__(py_func)
         self._source = source
+        self._identity = identity
         self._shipped_files: tuple[Path, list[IndexDataCacheFile]] | None = None
+
+    def _index_key(self, sig: Any, codegen: Any) -> Any:
+        key = super()._index_key(sig, codegen)
+        if self._identity is None:
+            return key
+        signature, magic, (code, _captured) = key
+        return signature, magic, (code, hashlib.sha256(self._identity.encode()).hexdigest())
 
     @property
     def _shipped(self) -> list[IndexDataCacheFile]:
@@ -109,25 +124,25 @@ class KernelCache(FunctionCache):
         self._shipped[0].save(self._index_key(sig, data.codegen), self._impl.reduce(data))
 
 
-def attach(dispatcher: Any) -> Any:
+def attach(dispatcher: Any, identity: str | None = None) -> Any:
     """Give a dispatcher of a footzoo kernel the :class:`KernelCache`; others keep numba's cache unchanged.
 
     Call before the dispatcher compiles (a dispatcher made with an explicit signature compiles at once:
-    make it without one and call :func:`compile_with`).
+    make it without one and call :func:`compile_with`). ``identity``: see :class:`KernelCache`.
     """
     try:
         source = Path(inspect.getfile(dispatcher.py_func)).resolve()
     except (TypeError, OSError):
         return dispatcher
     if source.suffix == ".py" and PACKAGE in source.parents:
-        dispatcher._cache = KernelCache(dispatcher.py_func, source)
+        dispatcher._cache = KernelCache(dispatcher.py_func, source, identity)
     return dispatcher
 
 
-def compile_with(dispatcher: Any, signature: Any) -> Any:
+def compile_with(dispatcher: Any, signature: Any, identity: str | None = None) -> Any:
     """Compile ``dispatcher`` (made with ``cache=True``, no signature) for ``signature`` only, as numba's
-    ``njit(signature)`` does, reading and writing the kernel cache."""
-    attach(dispatcher)
+    ``njit(signature)`` does, reading and writing the kernel cache (``identity``: see :class:`KernelCache`)."""
+    attach(dispatcher, identity)
     dispatcher.compile(signature)
     dispatcher.disable_compile()
     return dispatcher

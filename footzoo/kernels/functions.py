@@ -1,13 +1,19 @@
-"""Compiled functions handed to compiled loops: signatures, addresses, binding, faults.
+"""Compiled functions handed to compiled loops: calling convention, addresses, binding, faults.
 
 The error-state loop calls each Kalman correction's measurement functions as
 first-class function values (numba calls them through their machine-code
 address). Everything numba-specific about that lives here:
 
-- :data:`MODEL_SIGNATURES` and :func:`compile_model_function`: a model function
-  compiled with the engine's signature (without reference counting when it
-  allocates nothing). A function that is not footzoo's own is compiled with
-  bounds checking, so it cannot write outside the arrays it is given;
+- :func:`model_signature` and :func:`compile_model_function`: a model function
+  compiled to the engine's calling convention (without reference counting when
+  it allocates nothing). A correction writes ``measure(ctx, rows)``,
+  ``feedback(ctx, dx)`` and ``after(ctx)`` over named tuples
+  (:mod:`footzoo.filters.measurement`); the loop calls them through a small
+  wrapper with plain positional arguments, into which numba compiles the
+  correction's function: a call through an address with the named tuples
+  themselves costs twice as much (they are copied into it field by field). A
+  function that is not footzoo's own is compiled with bounds checking, so it
+  cannot write outside the arrays it is given;
 - :func:`fixed_address`: a compiled function as a value whose address is looked up
   once (not at every call of the loop);
 - :func:`bind`: a loop with its functions bound in as constants (a live stream
@@ -22,6 +28,9 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import hashlib
+import inspect
+import pickle
 import sys
 import threading
 from collections.abc import Callable, Iterator
@@ -36,17 +45,20 @@ class NotCompilable(Exception):
 
 @functools.cache
 def model_signature(role: str) -> Any:
-    """numba's signature of a measurement model's ``measure``, ``feedback`` or ``after`` function.
+    """numba's signature of the calling convention of a measurement model's ``measure``, ``feedback`` or ``after``.
 
-    The argument list is :mod:`footzoo.filters.measurement`'s contract (imports numba).
+    The sample's fields (those of :class:`footzoo.filters.measurement.Context`) as positional
+    arguments, then, for ``measure``, the rows (:class:`~footzoo.filters.measurement.Rows`), returning
+    the next free row, and for ``feedback`` the error ``dx``.
     """
     from numba import types as t
 
-    f1, i1, f = t.float64[::1], t.int64[::1], t.float64[:]
+    f1, i1 = t.float64[::1], t.int64[::1]
+    sample = (t.int64, t.float64, f1, f1, f1, t.boolean, i1, f1, f1, f1)
     return {
-        "measure": t.int64(t.int64, t.float64, f1, f1, f1, t.boolean, i1, f, f, f, f1, t.float64[:, ::1], f1, t.int64),
-        "feedback": t.none(f1, i1, f, f),
-        "after": t.none(t.int64, f1, t.boolean, i1, f, f),
+        "measure": t.int64(*sample, f1, t.float64[:, ::1], f1, t.int64),
+        "feedback": t.none(*sample, f1),
+        "after": t.none(*sample),
     }[role]
 
 
@@ -56,38 +68,82 @@ def trusted(fn: Callable[..., Any]) -> bool:
     return module == "footzoo" or module.startswith("footzoo.")
 
 
-def compile_model_function(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
-    """``fn`` compiled with :func:`model_signature` ``(role)``; raises :class:`NotCompilable` with numba's reason.
+def identity(fn: Callable[..., Any]) -> str | None:
+    """A text that names ``fn`` and the content of its source (its file, its code, its captured values), or
+    ``None`` when it has no source file or captures a value that cannot be written down the same way twice."""
+    try:
+        source = inspect.getfile(fn)
+        with open(source, "rb") as fh:
+            content = hashlib.sha256(fh.read()).hexdigest()
+        captured = tuple(c.cell_contents for c in fn.__closure__ or ())
+        values = hashlib.sha256(pickle.dumps(captured)).hexdigest() if captured else ""
+    except Exception:  # no file (an interactive session), or a captured object pickle cannot write
+        return None
+    if any(type(c).__name__ in ("CPUDispatcher", "ModelFunction") for c in captured):
+        return None
+    code = hashlib.sha256(fn.__code__.co_code).hexdigest()
+    return f"{fn.__module__}.{fn.__qualname__}|{source}|{content}|{code}|{values}"
 
-    A function that is not footzoo's own (:func:`trusted`) is compiled with numba's bounds
-    checking: a write outside an array it was given raises (see :func:`capture_faults`) instead of
-    corrupting memory. Without numba, ``fn`` itself.
+
+def compile_model_function(fn: Callable[..., Any], role: str,
+                           convention: Callable[[Callable[..., Any]], Callable[..., Any]] | None = None) -> Any:
+    """``fn`` compiled to the calling convention :func:`model_signature` ``(role)``; raises :class:`NotCompilable`.
+
+    ``convention(g)``: the wrapper that calls ``g`` with the convention's positional arguments (``None``:
+    ``fn`` takes them itself); ``fn`` is compiled into it. A function that is not footzoo's own
+    (:func:`trusted`) is compiled with numba's bounds checking: a write outside an array it was given
+    raises (see :func:`capture_faults`) instead of corrupting memory. Without numba, ``convention(fn)``
+    (or ``fn``) itself.
     """
     numba = _jit.load_numba()
     if numba is None:
-        return fn
+        return convention(fn) if convention is not None else fn
     sig = model_signature(role)
     if isinstance(fn, numba.core.registry.CPUDispatcher):
-        if fn.signatures and all(tuple(s) == tuple(sig.args) for s in fn.signatures) and trusted(fn):
+        if (convention is None and fn.signatures and all(tuple(s) == tuple(sig.args) for s in fn.signatures)
+                and trusted(fn)):
             return fn
         fn = fn.py_func
     checked = {} if trusted(fn) else {"boundscheck": True}
+    key = identity(fn)
+
+    def build(**options: Any) -> Any:
+        if convention is None:
+            return _jit.njit_signature(fn, sig, nogil=True, **options, **checked)
+        # numba copies fn's typed body into the wrapper: one function, as fast as fn called directly
+        inner = numba.njit(inline="always", **checked)(fn)
+        outer = _named_after(convention(inner), fn, role)
+        if key is None:
+            return numba.njit(sig, nogil=True, cache=False, **options, **checked)(outer)
+        return _jit.njit_signature(outer, sig, identity=f"{role}|{key}", nogil=True, **options, **checked)
+
     try:
         # first without reference counting: the same machine code for a function that allocates no
         # array (numba refuses to compile one that does, here or in a function it calls), minus the
         # counting of every array argument at each call
-        return _jit.njit_signature(fn, sig, nogil=True, _nrt=False, **checked)
+        return build(_nrt=False)
     except Exception:  # it allocates (or numba lacks the option): with reference counting
         pass
     try:
-        return _jit.njit_signature(fn, sig, nogil=True, **checked)
+        return build()
     except Exception:  # e.g. an on-disk cache written when the module had another name: compile afresh
         pass
     try:
-        return numba.njit(sig, cache=False, nogil=True, **checked)(fn)
+        if convention is None:
+            return numba.njit(sig, cache=False, nogil=True, **checked)(fn)
+        inner = numba.njit(inline="always", **checked)(fn)
+        return numba.njit(sig, cache=False, nogil=True, **checked)(_named_after(convention(inner), fn, role))
     except Exception as err:  # numba raises many types; the message is what matters
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise NotCompilable(f"{role} function {getattr(fn, '__qualname__', fn)!r}: {first}") from None
+
+
+def _named_after(wrapper: Callable[..., Any], fn: Callable[..., Any], role: str) -> Callable[..., Any]:
+    """``wrapper`` under ``fn``'s module and name (so :func:`trusted` and numba's cache files go by ``fn``)."""
+    wrapper.__module__ = fn.__module__
+    wrapper.__qualname__ = wrapper.__name__ = f"{fn.__qualname__.replace('<locals>.', '')}__{role}"
+    wrapper.footzoo_wraps = fn  # type: ignore[attr-defined]  # (not __wrapped__: numba would read its bytecode)
+    return wrapper
 
 
 _ADDRESSES: dict[int, Any] = {}

@@ -72,14 +72,15 @@ def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
     return _kernel_cache.attach(_numba.njit(**options)(fn))
 
 
-def njit_signature(fn: Callable[..., Any], signature: Any, **options: Any) -> Any:
+def njit_signature(fn: Callable[..., Any], signature: Any, identity: str | None = None, **options: Any) -> Any:
     """``numba.njit(signature, cache=True, **options)(fn)``, with footzoo's kernel cache (:mod:`footzoo.kernels.cache`).
 
     Compiles now, for that signature only; numba's errors propagate. Needs numba (:func:`load_numba`).
+    ``identity``: of the function a closure ``fn`` wraps (:class:`~footzoo.kernels.cache.KernelCache`).
     """
     from . import cache as _kernel_cache
 
-    return _kernel_cache.compile_with(load_numba().njit(cache=True, **options)(fn), signature)
+    return _kernel_cache.compile_with(load_numba().njit(cache=True, **options)(fn), signature, identity)
 
 
 def _materialise() -> None:
