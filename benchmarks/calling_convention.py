@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/calling_convention.py [--calls 2e6] [--repeat 3]
 
-A compiled loop calls one zero-velocity ``measure`` function (three rows in every other sample) through
+A compiled loop calls footzoo's zero-velocity ``measure`` (three rows in every other sample) through
 numba first-class function values, as the error-state loop does, three ways:
 
 * ``positional``: the function takes the fourteen fields as positional arguments;
@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit
 from numba import types as nt
 
+from footzoo.corrections.ekf_zupt import zero_velocity_measure
 from footzoo.filters.measurement import VEL, Context, Rows, V, convention
 from footzoo.kernels.functions import fixed_address, model_signature
 
@@ -31,6 +32,7 @@ warnings.filterwarnings("ignore", message=".*First-class function type feature i
 
 
 def positional(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """footzoo's zero-velocity rows (the ``measure`` of ``ekf_zupt`` without its bias guard), positional."""
     if not stance:
         return m
     for i in range(3):
@@ -41,23 +43,11 @@ def positional(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
     return m
 
 
-def with_context(ctx, rows):
-    z, H, R, m = rows
-    if not ctx.stance:
-        return m
-    for i in range(3):
-        H[m, ctx.idx[VEL] + i] = 1.0
-        z[m] = ctx.nav[V + i]
-        R[m] = ctx.par[0] * ctx.par[0]
-        m += 1
-    return m
-
-
 @njit
 def loop_positional(fns, n, nav, w, f, idx, par, mem, data, z, H, R):
     total = 0
     for k in range(n):
-        m = fns[0](k, 0.01 * k, nav, w, f, k % 2 == 0, idx, par[0:1], mem[0:1], data[k, 0:1], z, H, R, 0)
+        m = fns[0](k, 0.01 * k, nav, w, f, k % 2 == 0, idx, par, mem[0:1], data[k, 0:1], z, H, R, 0)
         total += m
         for a in range(m):
             H[a, idx[VEL] + a] = 0.0
@@ -68,7 +58,7 @@ def loop_positional(fns, n, nav, w, f, idx, par, mem, data, z, H, R):
 def loop_named(fns, n, nav, w, f, idx, par, mem, data, z, H, R):
     total = 0
     for k in range(n):
-        m = fns[0](Context(k, 0.01 * k, nav, w, f, k % 2 == 0, idx, par[0:1], mem[0:1], data[k, 0:1]),
+        m = fns[0](Context(k, 0.01 * k, nav, w, f, k % 2 == 0, idx, par, mem[0:1], data[k, 0:1]),
                    Rows(z, H, R, 0))
         total += m
         for a in range(m):
@@ -87,9 +77,12 @@ def main() -> None:
     fields = [nt.int64, nt.float64, f1, f1, f1, nt.boolean, nt.int64[::1], f1, f1, f1]
     named_sig = nt.int64(nt.NamedTuple(fields, Context), nt.NamedTuple([f1, nt.float64[:, ::1], f1, nt.int64], Rows))
     fn_positional = fixed_address(njit(sig, _nrt=False)(positional))
+    with_context = zero_velocity_measure.py_func  # footzoo's own, (ctx, rows)
     fn_named = fixed_address(njit(named_sig, _nrt=False)(with_context))
     fn_convention = fixed_address(njit(sig, _nrt=False)(convention(njit(inline="always")(with_context), "measure")))
-    arrays = (np.zeros(16), np.zeros(3), np.zeros(3), np.array([0, -1, 3, 6, -1], np.int64), np.ones(1), np.zeros(1),
+    # par: ekf_zupt's (σ_v, no zero rate, σ_ω, no bias bounds); idx: a 9-state filter
+    arrays = (np.zeros(16), np.zeros(3), np.zeros(3), np.array([0, -1, 3, 6, -1], np.int64),
+              np.array([1.0, 0.0, 0.05, 0.0, 0.0]), np.zeros(1),
               np.zeros((n, 1)), np.zeros(3), np.zeros((3, 9)), np.zeros(3))
     runs = {"positional": (loop_positional, fn_positional), "named tuples": (loop_named, fn_named),
             "convention": (loop_positional, fn_convention)}
