@@ -8,7 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from footzoo.analysis.gait_events import sagittal_rate, travel_directions
 from footzoo.analysis.mounting import mounting_report, nearest_axis_map, warn_mounting
+from footzoo.core.conventions import quat_from_euler, quat_rotate
 from footzoo.core.errors import SensorWarning
 from footzoo.evaluation.metrics import event_stance_mask, gait_phase_errors, match_strides, reference_steps
 from footzoo.runtime.pipeline import Pipeline
@@ -24,6 +26,37 @@ def _run(rec):
         warnings.simplefilter("always")
         res = Pipeline.from_yaml(CONFIG).run(rec)
     return res, [w for w in caught if issubclass(w.category, SensorWarning)]
+
+
+def test_sagittal_rate_of_a_level_foot_is_the_rate_about_the_axis_right_of_travel():
+    # hand-derived: the foot turns at 2 rad/s about north and 1 rad/s about east (NED). Walking north
+    # the axis right of travel is east (ω_ml = 1), walking east it is south (ω_ml = −2). A level sensor
+    # aligned with north (C = I) reads (2, 1, 0); one turned a quarter about down (x east, y south)
+    # reads (1, −2, 0) for the same motion, and gives the same ω_ml.
+    n = 40
+    stances = np.array([[0, 5], [15, 25], [35, 40]])  # middles 2, 19, 37
+    pos = np.zeros((n, 3))
+    pos[10:, 0] = 1.0  # stride 0 (samples before 19) goes 1 m north
+    pos[30:, 1] = 1.0  # stride 1 (from 19 on) goes 1 m east
+    w = sagittal_rate(np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)), np.tile([2.0, 1.0, 0.0], (n, 1)), pos, stances)
+    assert np.array_equal(w[:19], np.ones(19)) and np.array_equal(w[19:], np.full(n - 19, -2.0))
+    q = np.tile(quat_from_euler(0.0, 0.0, np.pi / 2), (n, 1))
+    body = np.tile([1.0, -2.0, 0.0], (n, 1))
+    assert np.allclose(quat_rotate(q[0], body[0]), [2.0, 1.0, 0.0])
+    assert np.allclose(sagittal_rate(q, body, pos, stances), w, rtol=0, atol=1e-12)
+
+
+def test_compiled_sagittal_rate_equals_the_array_formula():
+    rng = np.random.default_rng(4)
+    n = 500
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    gyr, pos = rng.normal(size=(n, 3)), np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    stances = np.array([[0, 30], [90, 130], [200, 220], [220, 260], [400, 500]])  # two touching stances
+    d, _ = travel_directions(pos, stances)
+    w_n = quat_rotate(q, gyr)
+    assert np.allclose(sagittal_rate(q, gyr, pos, stances), -w_n[:, 0] * d[:, 1] + w_n[:, 1] * d[:, 0],
+                       rtol=0, atol=1e-12)
 
 
 @pytest.fixture(scope="module")

@@ -57,7 +57,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.conventions import quat_rotate
 from ..kernels.jit import njit
 
 
@@ -141,13 +140,12 @@ def _mid_times(ts: np.ndarray, idx: np.ndarray, needed: np.ndarray) -> np.ndarra
     return ts[idx] - 0.5 * d
 
 
-def travel_directions(pos: np.ndarray, stances: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each sample's stride direction of travel: horizontal unit vector (N, 2) (north, east), and the stride index.
+def stride_directions(pos: np.ndarray, stances: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each stride's horizontal unit direction of travel (K, 2) (north, east), and the stances' middles (K + 1,).
 
     Stride ``i`` runs from the middle of stance ``i`` to the middle of stance ``i + 1``; its
-    direction is that of the horizontal displacement between the two middles. Samples before
-    the first middle belong to the first stride, those after the last middle to the last one.
-    A stride that does not move (shorter than 1 mm) takes the direction (1, 0).
+    direction is that of the horizontal displacement between the two middles. A stride that
+    does not move (shorter than 1 mm) takes the direction (1, 0).
     """
     pos = np.asarray(pos, dtype=float)
     a, b = stances[:, 0], stances[:, 1]
@@ -156,16 +154,47 @@ def travel_directions(pos: np.ndarray, stances: np.ndarray) -> tuple[np.ndarray,
     norm = np.hypot(d[:, 0], d[:, 1])
     still = norm < 1e-3
     d = np.where(still[:, None], [1.0, 0.0], d / np.where(still, 1.0, norm)[:, None])
+    return d, mid
+
+
+def travel_directions(pos: np.ndarray, stances: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample's stride direction of travel: horizontal unit vector (N, 2) (north, east), and the stride index.
+
+    The directions are those of :func:`stride_directions`. Samples before the first middle
+    belong to the first stride, those after the last middle to the last one.
+    """
+    d, mid = stride_directions(pos, stances)
     stride = np.clip(np.searchsorted(mid, np.arange(len(pos)), side="right") - 1, 0, len(d) - 1)
     return d[stride], stride
+
+
+@njit
+def _sagittal_kernel(quat: np.ndarray, gyr: np.ndarray, mid: np.ndarray, d: np.ndarray, out: np.ndarray) -> None:
+    """``out[k] = (C(q_k) ω_k) · (−d_e, d_n, 0)`` with ``d`` the direction of sample ``k``'s stride.
+
+    Sample ``k`` belongs to the last stride ``i`` with ``mid[i] ≤ k`` (the first one before
+    ``mid[0]``, the last one after the last middle), as in :func:`travel_directions`; ``C(q)``
+    is :func:`footzoo.core.conventions.quat_to_matrix`, written out.
+    """
+    last = d.shape[0] - 1
+    i = 0
+    for k in range(quat.shape[0]):
+        while i < last and mid[i + 1] <= k:
+            i += 1
+        w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
+        gx, gy, gz = gyr[k, 0], gyr[k, 1], gyr[k, 2]
+        north = (1 - 2 * (y * y + z * z)) * gx + 2 * (x * y - w * z) * gy + 2 * (x * z + w * y) * gz
+        east = 2 * (x * y + w * z) * gx + (1 - 2 * (x * x + z * z)) * gy + 2 * (y * z - w * x) * gz
+        out[k] = -north * d[i, 1] + east * d[i, 0]
 
 
 def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray) -> np.ndarray:
     """The foot's sagittal angular rate ``ω_ml`` (N,) (rad/s, positive lifts the toe), whatever the mounting.
 
     ``ω_ml = (C_b^n ω_b) · (e_down × d)``: the angular rate rotated into NED with the attitude
-    ``quat`` (scalar-first, body to NED) and projected on the horizontal axis to the right of the
-    stride's direction of travel ``d`` (:func:`travel_directions`). Needs two stances or more.
+    ``quat`` (scalar-first, body to NED) and projected on the horizontal axis to the right of
+    the stride's direction of travel ``d`` (:func:`travel_directions`); ``e_down × (d_n, d_e, 0)
+    = (−d_e, d_n, 0)``. Needs two stances or more. One compiled pass over the samples.
 
     Parameters
     ----------
@@ -178,10 +207,12 @@ def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: n
     stances : (K + 1, 2) int ndarray
         ``(start, stop)`` sample indices (stop exclusive) of the stances, in order, K ≥ 1.
     """
-    w_n = quat_rotate(np.asarray(quat, dtype=float), np.asarray(gyr, dtype=float))
-    d, _ = travel_directions(pos, stances)
-    # right of travel: e_down × (d_n, d_e, 0) = (−d_e, d_n, 0)
-    return -w_n[:, 0] * d[:, 1] + w_n[:, 1] * d[:, 0]
+    d, mid = stride_directions(pos, stances)
+    quat = np.ascontiguousarray(quat, dtype=float)
+    out = np.empty(len(quat))
+    _sagittal_kernel(quat, np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(mid, dtype=np.int64),
+                     np.ascontiguousarray(d), out)
+    return out
 
 
 def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> GaitEvents:

@@ -41,7 +41,7 @@ import numpy as np
 from ..core.conventions import quat_to_matrix
 from ..core.errors import FormatError, SensorWarning
 from ..io.axes import describe_axes, parse_axes
-from .gait_events import sagittal_rate, travel_directions
+from .gait_events import sagittal_rate, stride_directions
 
 #: Fewest strides for a mounting estimate.
 MIN_STRIDES = 3
@@ -108,15 +108,16 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     a0, b0 = stances[:, 0], stances[:, 1]
     mid = (a0 + b0 - 1) // 2
     pos = np.asarray(pos, dtype=float)
-    d, _ = travel_directions(pos, stances)
+    d, middles = stride_directions(pos, stances)
     # the stance before each long stride, with that stride's direction (turns on the spot and shuffles left out)
     long = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T) >= MIN_STRIDE_LENGTH
     out["strides_used"] = int(long.sum())
     if long.sum() < MIN_STRIDES:
         return out
     mid = mid[:-1][long]
-    fwd = np.column_stack([d[mid], np.zeros(len(mid))])
-    right = np.column_stack([-d[mid, 1], d[mid, 0], np.zeros(len(mid))])
+    d = d[np.clip(np.searchsorted(middles, mid, side="right") - 1, 0, len(d) - 1)]  # the stride of each mid-stance
+    fwd = np.column_stack([d, np.zeros(len(mid))])
+    right = np.column_stack([-d[:, 1], d[:, 0], np.zeros(len(mid))])
     down = np.broadcast_to([0.0, 0.0, 1.0], fwd.shape)
     foot = np.stack([fwd, right, down], axis=1)  # rows: foot axes in NED
     a = nearest_rotation(np.median(foot @ quat_to_matrix(np.asarray(quat, dtype=float)[mid]), axis=0))
