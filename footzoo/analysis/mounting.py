@@ -122,9 +122,9 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     foot = np.stack([fwd, right, down], axis=1)  # rows: foot axes in NED
     a = nearest_rotation(np.median(foot @ quat_to_matrix(np.asarray(quat, dtype=float)[mid]), axis=0))
     w = sagittal_rate(quat, gyr, pos, stances)
-    swing = np.zeros(len(w), bool)
-    for lo, hi in zip(b0[:-1], a0[1:], strict=True):
-        swing[lo:hi] = True
+    # the swings [b0_i, a0_{i+1}): +1 where one starts, −1 where it ends, summed along the samples
+    n = len(w)
+    swing = np.cumsum(np.bincount(b0[:-1], minlength=n + 1) - np.bincount(a0[1:], minlength=n + 1))[:n] > 0
     gy = np.asarray(gyr, dtype=float)[swing, 1]
     corr = float(np.corrcoef(gy, w[swing])[0, 1]) if swing.sum() > 2 and np.std(gy) > 0 else float("nan")
     p = nearest_axis_map(a)

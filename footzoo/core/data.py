@@ -20,6 +20,7 @@ import pandas as pd
 from .checks import check_positive
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
 from .errors import FootzooWarning, RecordingError
+from .norms import row_norms
 from .sanity import check_impossible, scan
 
 ACC_COLS = ["acc_x", "acc_y", "acc_z"]
@@ -557,8 +558,8 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
 
     Run on every recording and, live, on a stream's first samples (:class:`footzoo.Stream`).
     """
-    acc_norm = np.linalg.norm(acc, axis=1)
-    gyr_norm = np.linalg.norm(gyr, axis=1)
+    acc_norm = row_norms(acc)
+    gyr_norm = row_norms(gyr)
     # the stillest tenth of the samples tells the unit of the accelerometer
     still = gyr_norm <= np.quantile(gyr_norm, 0.1)
     rest = float(np.median(acc_norm[still]))

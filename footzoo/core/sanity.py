@@ -48,6 +48,7 @@ import numpy as np
 from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
 from .errors import RecordingError, SensorWarning
+from .norms import row_norms, row_norms_squared
 
 #: Fewest consecutive samples at an axis's exact extreme reported as saturation.
 SATURATION_MIN_RUN = 3
@@ -154,7 +155,7 @@ def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np
     if n < 3:
         return np.zeros(0, dtype=int)
     step = np.diff(x, axis=0)
-    big = np.einsum("ij,ij->i", step, step) > jump**2  # big[i]: x jumps between samples i and i+1
+    big = row_norms_squared(step) > jump**2  # big[i]: x jumps between samples i and i+1
     found = []
     for length in range(1, max_len + 1):
         if n < length + 2:
@@ -421,8 +422,8 @@ class EstimateScan:
                 i = int(np.argmax(moving))
                 self._first = (float(t[i]), pos[i].copy())
         self._last = (float(t[-1]), pos[-1].copy())
-        quiet = np.einsum("ij,ij->i", gyr, gyr) < STILL_GYR**2
-        off_g = np.sqrt(np.einsum("ij,ij->i", acc, acc)) - self.gravity
+        quiet = row_norms_squared(gyr) < STILL_GYR**2
+        off_g = row_norms(acc) - self.gravity
         self._scale(k, t, quiet, off_g)
         still = quiet & (np.abs(off_g) < STILL_ACC)
         if not still[0] and self._run is not None:  # the open run ended at the chunk's start
@@ -436,7 +437,7 @@ class EstimateScan:
             run = self._run if (s == 0 and self._run is not None) else {
                 "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0}
             moved = pos[s:e] - run["pos0"]
-            run["drift"] = max(run["drift"], float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max())))
+            run["drift"] = max(run["drift"], float(row_norms(moved).max()))
             run["last"], run["t1"] = int(k[e - 1]), float(t[e - 1])
             if e == len(t):
                 self._run = run

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from ..core.context import RunContext
+from ..core.norms import row_norms
 from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
@@ -150,7 +151,7 @@ class AngularRateFSM(Detector):
             The run's context (rate); default: from ``t``.
         """
         self.begin(run_context(ctx, t))
-        out = self._compute(np.linalg.norm(gyr, axis=1))
+        out = self._compute(row_norms(gyr))
         self.statistic_, self.stance_, self.stance_online_ = out["statistic"], out["stance"], out["online"]
         return self
 
@@ -169,7 +170,7 @@ class AngularRateFSM(Detector):
 
     def step(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
         """The stance of the samples whose machine state is now decided."""
-        return self._live.step(statistic=np.linalg.norm(np.asarray(gyr, dtype=float).reshape(-1, 3), axis=1))
+        return self._live.step(statistic=row_norms(np.asarray(gyr, dtype=float).reshape(-1, 3)))
 
     def provisional(self) -> Chunk:
         """The machine's current reading of the undecided samples."""

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
+from ..core.norms import row_norms_squared
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
 from ..plugins.base import Detector, Real, run_context
@@ -358,7 +359,7 @@ class DGP(Detector):
         s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
         moving = None
         if self.max_stance_rate > 0.0:
-            moving = np.einsum("ij,ij->i", gyr, gyr) > self.max_stance_rate**2
+            moving = row_norms_squared(gyr) > self.max_stance_rate**2
         s_d, max_cd, th, stance = dgp_kernel(s_c, self._state, self._min_swing, self._max_swing, moving)
         return s_c, d_g, s_d, max_cd, th, stance
 

@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.context import RunContext
+from ..core.norms import row_norms
 from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
-from .windows import row_norms, window_max
+from .windows import window_max
 
 
 @register

@@ -13,16 +13,6 @@ from ..kernels.jit import njit
 
 
 @njit
-def row_norms(x: np.ndarray) -> np.ndarray:
-    """Euclidean norm of each row of an (N, 3) array."""
-    n = x.shape[0]
-    out = np.empty(n)
-    for k in range(n):
-        out[k] = math.sqrt(x[k, 0] * x[k, 0] + x[k, 1] * x[k, 1] + x[k, 2] * x[k, 2])
-    return out
-
-
-@njit
 def window_max(x: np.ndarray, half: int) -> np.ndarray:
     """Maximum of ``x`` over ``[k − half, k + half]``, clipped at the ends."""
     n = x.shape[0]

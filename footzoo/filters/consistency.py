@@ -50,6 +50,7 @@ import numpy as np
 
 from ..core.conventions import GRAVITY
 from ..core.errors import SensorWarning
+from ..core.norms import row_norms, row_norms_squared
 from ..kernels.jit import njit
 from .strapdown import quat_product, rotate, rotvec_quat
 
@@ -148,8 +149,7 @@ class ConsistencyScan:
         """The next samples (absolute indices ``k``, time (s), FRD specific force (m/s²), rate (rad/s))."""
         if not len(t) or self.report or len(self.residuals) >= MAX_SWINGS:
             return
-        static = (np.einsum("ij,ij->i", gyr, gyr) < STATIC_GYR**2) & (
-            np.abs(np.linalg.norm(acc, axis=1) - self.gravity) < STATIC_ACC)
+        static = (row_norms_squared(gyr) < STATIC_GYR**2) & (np.abs(row_norms(acc) - self.gravity) < STATIC_ACC)
         new = {"k": np.asarray(k), "t": t, "acc": acc, "gyr": gyr, "static": static}
         self._buf = new if self._buf is None else {n: np.concatenate([self._buf[n], v]) for n, v in new.items()}
         self._scan()

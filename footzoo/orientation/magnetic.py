@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ..core.conventions import GRAVITY
+from ..core.norms import row_norms
 from ..core.params import Boolean, Real
 from ..kernels.jit import njit
 
@@ -32,8 +33,8 @@ def field_norm_and_dip(acc: np.ndarray, mag: np.ndarray) -> tuple[np.ndarray, np
     """
     m = np.asarray(mag, dtype=float)
     f = np.asarray(acc, dtype=float)
-    mn = np.linalg.norm(m, axis=1)
-    fn = np.linalg.norm(f, axis=1)
+    mn = row_norms(m)
+    fn = row_norms(f)
     s = -np.einsum("ij,ij->i", m, f) / np.maximum(mn * fn, 1e-300)
     return mn, np.arcsin(np.clip(s, -1.0, 1.0))
 

@@ -56,7 +56,7 @@ class RecursiveFilter(Orientation):
                  stance: np.ndarray, q0: np.ndarray, ctx: RunContext | None = None) -> RecursiveFilter:
         """Run the filter over a recording (see the class docstring for the inputs' units)."""
         self.begin(run_context(ctx, t), q0)
-        out = concat([self.step(t, acc, gyr, mag, stance), self.finish()])
+        out = concat([self.step(t, acc, gyr, mag, stance), self.finish()], copy=False)
         self.mag_valid_ = None
         for key, value in out.items():
             setattr(self, f"{key}_", value)

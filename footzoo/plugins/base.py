@@ -249,7 +249,7 @@ def _takes_context(method: Callable[..., Any]) -> bool:
 def run_whole(block: Plugin, ctx: RunContext, *arrays: Any) -> Chunk:
     """A block's outputs over whole arrays through its incremental protocol: begin, one step, finish."""
     block.begin(ctx)
-    return concat([block.step(*arrays), block.finish()])
+    return concat([block.step(*arrays), block.finish()], copy=False)
 def _declaration(cls: type[Plugin]) -> dict[str, Declared]:
     defaults = {k: (REQUIRED if v is inspect.Parameter.empty else v) for k, v in cls.defaults().items()}
     return declared(cls, defaults)
@@ -366,7 +366,7 @@ class Orientation(Plugin):
                  stance: np.ndarray, q0: np.ndarray, ctx: RunContext | None = None) -> Orientation:
         """Set ``quat_``; returns ``self``. Default: the incremental protocol over the whole arrays."""
         self.begin(run_context(ctx, t), q0)
-        out = concat([self.step(t, acc, gyr, mag, stance), self.finish()])
+        out = concat([self.step(t, acc, gyr, mag, stance), self.finish()], copy=False)
         for key, value in out.items():
             setattr(self, f"{key}_", value)
         return self
@@ -461,7 +461,7 @@ class AccelerationCorrection(Correction):
                            ctx: RunContext | None = None) -> np.ndarray:
         """The corrected motion acceleration (m/s², NED). Default: the incremental protocol over the whole arrays."""
         self.begin(ctx if ctx is not None else RunContext(rate=1.0))
-        return concat([self.step_acceleration(quat, acc_nav, stance), self.finish()])["acc_nav"]
+        return concat([self.step_acceleration(quat, acc_nav, stance), self.finish()], copy=False)["acc_nav"]
 
     def step_acceleration(self, quat: np.ndarray, acc_nav: np.ndarray, stance: np.ndarray) -> Chunk:
         """Push the next samples; ``{"acc_nav": (m, 3)}`` of those now final (``apply_acceleration`` live)."""

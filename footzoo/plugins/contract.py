@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import FootzooError, PluginError
+from ..core.norms import row_norms_squared
 
 #: Methods whose faults are the plug-in's: each one a plug-in class defines is wrapped by :func:`guard`.
 GUARDED = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze", "annotate", "check",
@@ -238,7 +239,7 @@ def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, 
         raise broken(plugin, method, f"set {label} with {len(bad)} non-finite sample(s) (NaN or inf), first at sample "
                                      f"{int(bad[0])}")
     if spec.what == "quat":
-        err = np.abs(np.einsum("ij,ij->i", arr, arr) - 1.0)  # |q|² - 1 ≈ 2 (|q| - 1)
+        err = np.abs(row_norms_squared(arr) - 1.0)  # |q|² - 1 ≈ 2 (|q| - 1)
         if err.max() > 2 * QUAT_NORM_TOL:
             k = int(np.argmax(err))
             raise broken(plugin, method, f"set {label} with non-unit quaternions (|q| = {np.linalg.norm(arr[k]):.9g} "

@@ -100,11 +100,17 @@ def total(latencies: Iterable[Latency]) -> Latency:
     return out
 
 
-def concat(parts: Iterable[Chunk]) -> Chunk:
-    """Chunks of consecutive samples, joined key by key (empty parts skipped)."""
+def concat(parts: Iterable[Chunk], copy: bool = True) -> Chunk:
+    """Chunks of consecutive samples, joined key by key (empty parts skipped).
+
+    ``copy=False``: a single non-empty part is returned with its own arrays, not copies (a batch
+    run's ``step`` followed by an empty ``finish``, whose output nothing else holds).
+    """
     parts = [p for p in parts if p]
     if not parts:
         return {}
+    if len(parts) == 1 and not copy:
+        return dict(parts[0])
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 

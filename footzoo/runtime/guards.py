@@ -46,6 +46,7 @@ import numpy as np
 from ..core.checks import Settings
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
+from ..core.norms import row_norms
 from ..core.params import Real
 from ..evaluation.metrics import intervals
 from ..kernels.jit import njit
@@ -165,7 +166,7 @@ class StanceGuard(Settings):
         long = swings[(swings[:, 1] - swings[:, 0]) > self.max_swing * rate]
         if not len(long):
             return out, report
-        w = np.sqrt(np.einsum("ij,ij->i", gyr, gyr))
+        w = row_norms(gyr)
         k = self._half_window(rate)
         score = np.convolve(np.pad(w, k, mode="edge"), np.full(2 * k + 1, 1.0 / (2 * k + 1)), mode="valid")
         sep = max(int(math.floor(self.min_step * rate + 0.5)), 1)
@@ -238,7 +239,7 @@ def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str
         ``max_speed`` (the estimate's, m/s), ``over_max_speed`` (samples above the bound),
         ``first_over_t`` (s, or None).
     """
-    speed = np.sqrt(np.einsum("ij,ij->i", vel, vel))
+    speed = row_norms(vel)
     top = float(np.max(speed)) if speed.size and np.all(np.isfinite(speed)) else float("inf")
     over = np.flatnonzero(~(speed <= max_speed)) if max_speed > 0 else np.zeros(0, dtype=int)
     report = {"max_speed": top, "over_max_speed": int(over.size),

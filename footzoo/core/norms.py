@@ -1,0 +1,60 @@
+"""Norms of the rows of a sample array (N, k), in one compiled pass with no (N, k) temporary.
+
+The checks that run on every recording (the sanity and consistency scans, the guards, the
+plug-in contract) take the norm of each sample's angular rate, specific force or velocity;
+``np.linalg.norm(x, axis=1)`` allocates the squares and traverses them twice. These give
+numpy's numbers (the squares summed in column order, ``np.add.reduce(x * x, axis=1)``, as
+``np.linalg.norm`` does; ``np.einsum`` rounds differently in the last bit). A C-contiguous
+float array (writable or read-only, as a recording's are) goes through the compiled kernel;
+a strided or other array through numpy, rather than compiling a kernel variant for it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kernels.jit import njit
+
+
+@njit
+def _squared_kernel(x: np.ndarray, out: np.ndarray) -> None:
+    for i in range(x.shape[0]):
+        s = 0.0
+        for j in range(x.shape[1]):
+            s += x[i, j] * x[i, j]
+        out[i] = s
+
+
+@njit
+def _norm_kernel(x: np.ndarray, out: np.ndarray) -> None:
+    for i in range(x.shape[0]):
+        s = 0.0
+        for j in range(x.shape[1]):
+            s += x[i, j] * x[i, j]
+        out[i] = math.sqrt(s)
+
+
+def _compilable(x: np.ndarray) -> bool:
+    return x.ndim == 2 and x.dtype == np.float64 and x.flags.c_contiguous
+
+
+def row_norms_squared(x: np.ndarray) -> np.ndarray:
+    """``|x_i|²`` of every row of ``x`` (N, k), as ``np.add.reduce(x * x, axis=1)``; (N,), in x's unit squared."""
+    x = np.asarray(x, dtype=float)
+    if not _compilable(x):
+        return np.add.reduce(x * x, axis=1)
+    out = np.empty(x.shape[0])
+    _squared_kernel(x, out)
+    return out
+
+
+def row_norms(x: np.ndarray) -> np.ndarray:
+    """``|x_i|`` of every row of ``x`` (N, k), as ``np.linalg.norm(x, axis=1)``; (N,), in x's unit."""
+    x = np.asarray(x, dtype=float)
+    if not _compilable(x):
+        return np.linalg.norm(x, axis=1)
+    out = np.empty(x.shape[0])
+    _norm_kernel(x, out)
+    return out
