@@ -208,6 +208,26 @@ def test_the_distance_of_a_walk_stamped_at_half_its_rate_is_what_the_warning_say
     assert travelled > 3.0 * np.linalg.norm(true.truth.pos[-1, :2] - true.truth.pos[0, :2])
 
 
+def test_a_batch_run_scans_in_blocks_until_decided_with_the_finding_of_one_push():
+    from footzoo.filters.consistency import ConsistencyScan
+
+    class Counted(ConsistencyScan):
+        def push(self, k, t, acc, gyr):
+            self.last_pushed = int(k[-1])
+            super().push(k, t, acc, gyr)
+
+    walk = simulate(n_strides=80, rate=100.0, noise=NoiseModel(seed=3))
+    for r in (walk, _restamped(walk, 2.0)):
+        one, blocks = ConsistencyScan(r.rate, name="one"), Counted(r.rate, name="blocks")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SensorWarning)
+            one.push(np.arange(r.n), r.t, r.acc, r.gyr)
+            blocks.push_recording(r.t, r.acc, r.gyr, block=500)
+            assert blocks.finish() == one.finish()
+        assert blocks.swings == one.swings[:len(blocks.swings)]  # one push measures every swing it holds
+        assert blocks.done and blocks.last_pushed < r.n - 1  # decided before the walk's end: the rest is not read
+
+
 def _real_recordings() -> list[Recording]:
     import glob
 

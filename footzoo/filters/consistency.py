@@ -73,6 +73,8 @@ MIN_SWINGS = 8
 #: Swings after which a consistent recording is not scanned further (a rate or an axis map does not change
 #: within a recording): the scan's cost is bounded, whatever the recording's length.
 MAX_SWINGS = 64
+#: Samples per push when a batch run feeds a whole recording (:meth:`ConsistencyScan.push_recording`).
+BATCH_BLOCK = 4096
 #: Quasi-static sample: |ω| below this (rad/s) and |‖f‖ − g| below :data:`STATIC_ACC` (m/s²).
 STATIC_GYR = 0.6
 STATIC_ACC = 1.5
@@ -145,9 +147,14 @@ class ConsistencyScan:
         self._buf: dict[str, np.ndarray] | None = None
         self._anchored = False  # the buffer starts with a confirmed quasi-static run
 
+    @property
+    def done(self) -> bool:
+        """Whether the scan has a finding or has seen :data:`MAX_SWINGS` swings: more samples change nothing."""
+        return bool(self.report) or len(self.residuals) >= MAX_SWINGS
+
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
         """The next samples (absolute indices ``k``, time (s), FRD specific force (m/s²), rate (rad/s))."""
-        if not len(t) or self.report or len(self.residuals) >= MAX_SWINGS:
+        if not len(t) or self.done:
             return
         static = (row_norms_squared(gyr) < STATIC_GYR**2) & (np.abs(row_norms(acc) - self.gravity) < STATIC_ACC)
         new = {"k": np.asarray(k), "t": t, "acc": acc, "gyr": gyr, "static": static}
@@ -262,6 +269,18 @@ class ConsistencyScan:
             "Details in diagnostics['sensor']['consistency']",
             SensorWarning, stacklevel=6,
         )
+
+    def push_recording(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, block: int = BATCH_BLOCK) -> None:
+        """A whole recording, pushed ``block`` samples at a time until the scan is :attr:`done`.
+
+        The same finding as one push of everything (the scan is the live one, fed chunk by chunk), at
+        the cost of the samples that decide it rather than of the recording's length.
+        """
+        for lo in range(0, len(t), block):
+            if self.done:
+                return
+            hi = min(lo + block, len(t))
+            self.push(np.arange(lo, hi), t[lo:hi], acc[lo:hi], gyr[lo:hi])
 
     def finish(self) -> dict[str, Any]:
         """End of the data: decide on every swing seen, from :data:`MIN_RATE_SWINGS` on; the finding (empty: none)."""

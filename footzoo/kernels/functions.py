@@ -115,7 +115,10 @@ def compile_model_function(fn: Callable[..., Any], role: str,
         outer = _named_after(convention(inner), fn, role)
         if key is None:
             return numba.njit(sig, nogil=True, cache=False, **options, **checked)(outer)
-        return _jit.njit_signature(outer, sig, identity=f"{role}|{key}", nogil=True, **options, **checked)
+        # numba's cache index does not tell the two builds apart: the one with reference counting is kept
+        # under its own name, so a warm cache never hands it to the build without (nor the other way round)
+        counted = "" if options.get("_nrt") is False else "|nrt"
+        return _jit.njit_signature(outer, sig, identity=f"{role}|{key}{counted}", nogil=True, **options, **checked)
 
     try:
         # first without reference counting: the same machine code for a function that allocates no

@@ -84,12 +84,12 @@ class RecursiveFilter(Orientation):
         if self._uses_mag(mag):
             chunk["mag"] = np.asarray(mag, float).reshape(-1, 3)
         if self._rejects() and "mag" in chunk and self._reference is None:
-            self._held = concat([self._held, chunk])
-            h = self._held
+            h = concat([self._held, chunk], copy=False)  # the caller's arrays while they are not held
             self._reference = reference_field(h["t"], h["acc"], h["mag"], h["stance"], complete=False)
-            if self._reference is None:
+            if self._reference is None:  # held until the next samples: copies of our own
+                self._held = {k: np.array(v) for k, v in h.items()} if not self._held else h
                 return {}
-            chunk, self._held = self._held, {}
+            chunk, self._held = h, {}
         return self._run(chunk)
 
     def finish(self) -> Chunk:

@@ -292,7 +292,7 @@ class Pipeline:
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
         axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
-        axes.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr)
+        axes.push_recording(rec.t, rec.acc, rec.gyr)
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():
             sensor["consistency"] = axes.report
