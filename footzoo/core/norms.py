@@ -19,21 +19,13 @@ from ..kernels.jit import njit
 
 
 @njit
-def _squared_kernel(x: np.ndarray, out: np.ndarray) -> None:
+def _norms_kernel(x: np.ndarray, root: bool, out: np.ndarray) -> None:
+    """``out[i] = Σ_j x[i, j]²`` in column order, or its square root with ``root``."""
     for i in range(x.shape[0]):
         s = 0.0
         for j in range(x.shape[1]):
             s += x[i, j] * x[i, j]
-        out[i] = s
-
-
-@njit
-def _norm_kernel(x: np.ndarray, out: np.ndarray) -> None:
-    for i in range(x.shape[0]):
-        s = 0.0
-        for j in range(x.shape[1]):
-            s += x[i, j] * x[i, j]
-        out[i] = math.sqrt(s)
+        out[i] = math.sqrt(s) if root else s
 
 
 def _compilable(x: np.ndarray) -> bool:
@@ -46,7 +38,7 @@ def row_norms_squared(x: np.ndarray) -> np.ndarray:
     if not _compilable(x):
         return np.add.reduce(x * x, axis=1)
     out = np.empty(x.shape[0])
-    _squared_kernel(x, out)
+    _norms_kernel(x, False, out)
     return out
 
 
@@ -56,5 +48,5 @@ def row_norms(x: np.ndarray) -> np.ndarray:
     if not _compilable(x):
         return np.linalg.norm(x, axis=1)
     out = np.empty(x.shape[0])
-    _norm_kernel(x, out)
+    _norms_kernel(x, True, out)
     return out
