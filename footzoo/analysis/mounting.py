@@ -77,7 +77,8 @@ def axis_map_text(p: np.ndarray) -> str:
     return "[" + ", ".join(names) + "]"
 
 
-def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray) -> dict[str, Any]:
+def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray,
+                    sagittal: np.ndarray | None = None) -> dict[str, Any]:
     """The sensor's mounting on the foot measured from the strides (see the module docstring).
 
     Parameters
@@ -90,6 +91,8 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
         Position in NED (m).
     stances : (K + 1, 2) int ndarray
         The real stances ``(start, stop)`` (:func:`footzoo.analysis.strides.real_stances`).
+    sagittal : (N,) ndarray, optional
+        ``sagittal_rate(quat, gyr, pos, stances)`` (rad/s) when the caller has it already.
 
     Returns
     -------
@@ -121,7 +124,7 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     down = np.broadcast_to([0.0, 0.0, 1.0], fwd.shape)
     foot = np.stack([fwd, right, down], axis=1)  # rows: foot axes in NED
     a = nearest_rotation(np.median(foot @ quat_to_matrix(np.asarray(quat, dtype=float)[mid]), axis=0))
-    w = sagittal_rate(quat, gyr, pos, stances)
+    w = sagittal_rate(quat, gyr, pos, stances) if sagittal is None else sagittal
     # the swings [b0_i, a0_{i+1}): +1 where one starts, −1 where it ends, summed along the samples
     n = len(w)
     swing = np.cumsum(np.bincount(b0[:-1], minlength=n + 1) - np.bincount(a0[1:], minlength=n + 1))[:n] > 0

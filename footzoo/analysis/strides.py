@@ -42,7 +42,8 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
 
 def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.ndarray | None = None,
                   min_stride_length: float = 0.1, max_stance_time: float = 2.0,
-                  quat: np.ndarray | None = None) -> pd.DataFrame:
+                  quat: np.ndarray | None = None, stances: np.ndarray | None = None,
+                  sagittal: np.ndarray | None = None) -> pd.DataFrame:
     """One row per stride: the stance from its initial contact, its toe-off, the swing to the next contact.
 
     Strides start at the first real step: the standing before the first toe-off
@@ -72,6 +73,10 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     quat : (N, 4) ndarray, optional
         Attitude (scalar-first, body to NED) that turns ``gyr`` into the navigation
         frame (:func:`footzoo.analysis.gait_events.sagittal_rate`).
+    stances : (K + 1, 2) int ndarray, optional
+        ``real_stances(stance, pos, min_stride_length)`` when the caller has it already.
+    sagittal : (N,) ndarray, optional
+        ``sagittal_rate(quat, gyr, pos, stances)`` (rad/s) when the caller has it already.
 
     Returns
     -------
@@ -91,14 +96,14 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     """
     t = np.asarray(t, dtype=float)
     pos = np.asarray(pos, dtype=float)
-    st = real_stances(stance, pos, min_stride_length)
+    st = real_stances(stance, pos, min_stride_length) if stances is None else stances
     if len(st) < 2:
         return pd.DataFrame({c: pd.Series(dtype=bool if c == "events_from_rate" else float) for c in STEP_COLUMNS})
     n = len(t)
     a, b = st[:, 0], st[:, 1]
     mid = (a + b - 1) // 2
     if gyr is not None:
-        rate = gyr if quat is None else sagittal_rate(quat, gyr, pos, st)
+        rate = gyr if quat is None else sagittal if sagittal is not None else sagittal_rate(quat, gyr, pos, st)
         ev = detect_gait_events(t, rate, st)
         to, ic, from_rate = ev.to, ev.ic, ev.from_rate
     else:

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .._version import __version__
+from ..analysis.gait_events import sagittal_rate
 from ..analysis.mounting import mounting_report, warn_mounting
 from ..analysis.strides import real_stances, segment_steps
 from ..config.library import resolve
@@ -287,7 +288,9 @@ class Pipeline:
         q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
         quat = self.orient(rec, stance, q0, ctx)
         nav = self.navigate(rec, stance, q0, quat, engine, covariance, ctx)
-        steps = self.analyse(rec, stance, nav["quat"], nav["pos"])
+        stances = real_stances(stance, nav["pos"])  # the steps and the mounting report share them and the rate
+        sagittal = sagittal_rate(nav["quat"], rec.gyr, nav["pos"], stances) if len(stances) >= 2 else None
+        steps = self.analyse(rec, stance, nav["quat"], nav["pos"], stances, sagittal)
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
@@ -303,7 +306,7 @@ class Pipeline:
                        "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
         if self.calibration:
             diagnostics["calibration"] = calibration
-        diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], real_stances(stance, nav["pos"]))
+        diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], stances, sagittal)
         warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"))
         config = self.to_dict()
         config["engine"] = nav["engine"]
@@ -411,9 +414,14 @@ class Pipeline:
         return KalmanEngine(self.orientation.carried_by_filter, blocks, models, self.navigation, self.gravity, engine,
                             names=[f"correction {c.name!r}" for c in kalman])
 
-    def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray) -> pd.DataFrame:
-        """Stage 4: the steps table, with the analysis plug-ins' columns."""
-        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat)
+    def analyse(self, rec: Recording, stance: np.ndarray, quat: np.ndarray, pos: np.ndarray,
+                stances: np.ndarray | None = None, sagittal: np.ndarray | None = None) -> pd.DataFrame:
+        """Stage 4: the steps table, with the analysis plug-ins' columns.
+
+        ``stances`` and ``sagittal``: the real stances and the sagittal rate when the caller has them
+        (:func:`footzoo.analysis.strides.segment_steps`).
+        """
+        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat, stances=stances, sagittal=sagittal)
         for a in self.analysis:
             steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
         return steps
