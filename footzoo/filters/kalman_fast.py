@@ -92,6 +92,9 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
     t, acc, gyr, stance, quat_ext = signals
     idx, qn, gravity, use_ext, m_max, impact = core
     idx, qn = unowned(idx), unowned(qn)
+    # the core blocks' offsets as integers, read once: the steps index P with them, and a store into P
+    # cannot change an integer (as it could an array's entry), so the compiler keeps them in registers
+    offs = (idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS])
     functions, arrays = models
     nav_owned, P_owned, mems_owned = state
     n = P_owned.shape[0]
@@ -111,8 +114,8 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
         rdiag[a] = 0.0
         for b in range(n):
             H[a, b] = 0.0
-    n_dyn = moving_rows(idx, n, dyn, still)
-    store(0, nav, a_n, Pk, idx, out, keep_p, True, 0.0, 0)
+    n_dyn = moving_rows(offs, n, dyn, still)
+    store(0, nav, a_n, Pk, offs, out, keep_p, True, 0.0, 0)
     if record is not None:  # smoother: P⁺ of the incoming state
         record_covariance(record, 0, Pk)
     for k in range(1, t.shape[0]):
@@ -128,9 +131,9 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
         if record is not None:  # smoother: Φ's blocks
             record_transition(record, k, dt, sdt, cdt)
-        propagate_rows(Pk, idx, dt, sdt, cdt)
-        propagate_columns(Pk, idx, dt, sdt, cdt, dyn, still, n_dyn)
-        add_process_noise(Pk, idx, qn, impact, a_n, dt)
+        propagate_rows(Pk, offs, dt, sdt, cdt)
+        propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
+        add_process_noise(Pk, offs, qn, impact, a_n, dt)
         st = stance[k]
         m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
         nis = 0.0
@@ -147,21 +150,21 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
             for i in range(n):
                 for j in range(i + 1, n):
                     Pk[j, i] = Pk[i, j]
-            feed_back(nav, dx, idx, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
+            feed_back(nav, dx, offs, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
         after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
-        store(k, nav, a_n, Pk, idx, out, keep_p, False, nis, m)
+        store(k, nav, a_n, Pk, offs, out, keep_p, False, nis, m)
         if record is not None:  # smoother: P⁺_k
             record_covariance(record, k, Pk)
 
 
 @njit(inline=True)
-def moving_rows(idx, n, dyn, still):
+def moving_rows(offs, n, dyn, still):
     """The rows of Φ − I that are not zero into ``dyn``, the others into ``still``; returns their count.
 
     pos; vel with att or acc_bias; att with gyro_bias — in the order the in-place products need;
     the other rows and columns of P keep their values.
     """
-    att, gb_i, pos_i, vel_i, ab_i = idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS]
+    att, gb_i, pos_i, vel_i, ab_i = offs
     vel_moves = att >= 0 or ab_i >= 0
     att_moves = att >= 0 and gb_i >= 0
     n_dyn = 3 + (3 if vel_moves else 0) + (3 if att_moves else 0)
@@ -226,14 +229,14 @@ def propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_
 
 
 @njit(inline=True)
-def propagate_rows(Pk, idx, dt, sdt, cdt):
+def propagate_rows(Pk, offs, dt, sdt, cdt):
     """``P ← Φ P`` in place (the first half of eq. 44), on the rows of Φ − I that are not zero.
 
     The blocks of Δ = Φ − I (Nguyen & La eq. 33): Δ[att, gyro_bias] = C dt, Δ[pos, vel] = I dt,
     Δ[vel, att] = −[f^n×] dt, Δ[vel, acc_bias] = C dt; rows in the order pos (reads vel), vel
     (reads att, acc_bias), att (reads gyro_bias).
     """
-    att, gb_i, pos_i, vel_i, ab_i = idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS]
+    att, gb_i, pos_i, vel_i, ab_i = offs
     n = Pk.shape[0]
     for i in range(3):
         for j in range(n):
@@ -249,14 +252,14 @@ def propagate_rows(Pk, idx, dt, sdt, cdt):
 
 
 @njit(inline=True)
-def propagate_columns(Pk, idx, dt, sdt, cdt, dyn, still, n_dyn):
+def propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn):
     """``(Φ P) Φᵀ`` in place, columns in the order of :func:`propagate_rows`, on the moving rows.
 
     Φ P Φᵀ is symmetric: of its moving block only the entries (dyn[e], dyn[e2]) with e ≤ e2 are
     computed (the columns of the block dyn[b:b+3] on the rows dyn[:b+3]), then mirrored, as are
     the other rows, which are those of Φ P.
     """
-    att, gb_i, pos_i, vel_i, ab_i = idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS]
+    att, gb_i, pos_i, vel_i, ab_i = offs
     n = Pk.shape[0]
     for e in range(3):
         i = dyn[e]
@@ -282,7 +285,7 @@ def propagate_columns(Pk, idx, dt, sdt, cdt, dyn, still, n_dyn):
 
 
 @njit(inline=True)
-def add_process_noise(Pk, idx, qn, impact, a_n, dt):
+def add_process_noise(Pk, offs, qn, impact, a_n, dt):
     """``P ← P + Q dt`` (the second half of eq. 44), plus the impact noise on the velocity.
 
     The impact noise: accelerometer errors that grow with the motion acceleration (heel strikes).
@@ -291,8 +294,9 @@ def add_process_noise(Pk, idx, qn, impact, a_n, dt):
         Pk[i, i] += qn[i] * dt
     if impact > 0.0:
         qa = impact * (a_n[0] * a_n[0] + a_n[1] * a_n[1] + a_n[2] * a_n[2]) * dt
+        vel = offs[VEL]
         for i in range(3):
-            Pk[idx[VEL] + i, idx[VEL] + i] += qa
+            Pk[vel + i, vel + i] += qa
 
 
 @njit(inline=True)
@@ -363,14 +367,14 @@ def update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc):
 
 
 @njit(inline=True)
-def feed_back(nav, dx, idx, use_ext, feedbacks, views, mems, k, t_k, w, f, st, data_k):
+def feed_back(nav, dx, offs, use_ext, feedbacks, views, mems, k, t_k, w, f, st, data_k):
     """The estimated error into the nominal state, eqs. 49–52, then into each model's memory.
 
     q ← exp(−δφ) ⊗ q, p ← p − δp, v ← v − δv, b ← b + δb. The models' ``feedback`` get sample ``k``
     (its corrected state; ``w`` and ``f`` as their ``measure`` got them).
     """
     m_idx, par, par_off, mem_off, data_off, hooks, rows = views
-    att, gb_i, pos_i, vel_i, ab_i = idx[ATT], idx[GYRO_BIAS], idx[POS], idx[VEL], idx[ACC_BIAS]
+    att, gb_i, pos_i, vel_i, ab_i = offs
     if att >= 0 and not use_ext:
         feed_back_attitude(nav, dx[att], dx[att + 1], dx[att + 2])
     for i in range(3):
@@ -397,7 +401,7 @@ def after(afters, views, k, t_k, nav, w, f, st, mems, data_k):
 
 
 @njit(inline=True)
-def store(k, nav, a_n, Pk, idx, out, keep_p, first, nis_k, rows_k):
+def store(k, nav, a_n, Pk, offs, out, keep_p, first, nis_k, rows_k):
     """Sample ``k``'s estimates into the outputs (the motion acceleration of the incoming state: 0).
 
     With the covariance kept, also its diagonal and the update's NIS and rows.
@@ -408,9 +412,9 @@ def store(k, nav, a_n, Pk, idx, out, keep_p, first, nis_k, rows_k):
     for i in range(3):
         pos[k, i] = nav[P + i]
         vel[k, i] = nav[V + i]
-        if idx[GYRO_BIAS] >= 0:  # without the block the estimate stays 0 (the caller's zeros)
+        if offs[GYRO_BIAS] >= 0:  # without the block the estimate stays 0 (the caller's zeros)
             gb_out[k, i] = nav[BG + i]
-        if idx[ACC_BIAS] >= 0:
+        if offs[ACC_BIAS] >= 0:
             ab_out[k, i] = nav[BA + i]
         acc_nav[k, i] = 0.0 if first else a_n[i]
     if keep_p:
