@@ -111,14 +111,13 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     a0, b0 = stances[:, 0], stances[:, 1]
     mid = (a0 + b0 - 1) // 2
     pos = np.asarray(pos, dtype=float)
-    d, middles = stride_directions(pos, stances)
+    d, _ = stride_directions(pos, stances)  # d[i]: stride i, from the middle of stance i
     # the stance before each long stride, with that stride's direction (turns on the spot and shuffles left out)
     long = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T) >= MIN_STRIDE_LENGTH
     out["strides_used"] = int(long.sum())
     if long.sum() < MIN_STRIDES:
         return out
-    mid = mid[:-1][long]
-    d = d[np.clip(np.searchsorted(middles, mid, side="right") - 1, 0, len(d) - 1)]  # the stride of each mid-stance
+    mid, d = mid[:-1][long], d[long]
     fwd = np.column_stack([d, np.zeros(len(mid))])
     right = np.column_stack([-d[:, 1], d[:, 0], np.zeros(len(mid))])
     down = np.broadcast_to([0.0, 0.0, 1.0], fwd.shape)
