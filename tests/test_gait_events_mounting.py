@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from footzoo.analysis.gait_events import sagittal_rate, travel_directions
-from footzoo.analysis.mounting import mounting_report, nearest_axis_map, warn_mounting
+from footzoo.analysis.mounting import mounting_report, nearest_axis_map, swing_correlation, warn_mounting
 from footzoo.core.conventions import quat_from_euler, quat_rotate
 from footzoo.core.errors import SensorWarning
 from footzoo.evaluation.metrics import event_stance_mask, gait_phase_errors, match_strides, reference_steps
@@ -198,3 +198,27 @@ def test_pyshoe_upside_down_trial_is_named():
     assert rep["suggested_axes"] == "[x, -y, -z]" and warned
     steps = res.steps
     assert len(steps) > 5 and steps["events_from_rate"].mean() > 0.9
+
+
+def test_the_swing_correlation_is_numpys_over_the_swing_samples():
+    """The pitch-rate correlation of the mounting report, computed over the swings in one compiled pass,
+    against ``np.corrcoef`` of the samples the swings select (and NaN where there is nothing to correlate)."""
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        n = int(rng.integers(20, 2000))
+        gyr = rng.normal(size=(n, 3))
+        w = 0.4 * gyr[:, 1] + rng.normal(size=n) * rng.random()
+        cuts = np.sort(rng.choice(n + 1, size=2 * int(rng.integers(1, 6)), replace=False))
+        lo, hi = cuts[0::2], cuts[1::2]
+        mask = np.zeros(n, bool)
+        for a, b in zip(lo, hi, strict=True):
+            mask[a:b] = True
+        got = swing_correlation(gyr, w, lo.astype(np.int64), hi.astype(np.int64))
+        if mask.sum() > 2:
+            assert abs(got - np.corrcoef(gyr[mask, 1], w[mask])[0, 1]) < 1e-13
+        else:
+            assert np.isnan(got)
+    gyr = np.zeros((10, 3))
+    assert np.isnan(swing_correlation(gyr, np.arange(10.0), np.array([0]), np.array([10])))  # constant gyr_y
+    gyr[:, 1] = np.arange(10.0)
+    assert abs(swing_correlation(gyr, -2.0 * np.arange(10.0), np.array([0, 6]), np.array([4, 10])) + 1.0) < 1e-15

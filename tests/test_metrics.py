@@ -5,6 +5,7 @@ import pytest
 
 from footzoo.evaluation.metrics import (
     armse,
+    intervals,
     loop_closure,
     path_length,
     pyshoe_error,
@@ -103,3 +104,17 @@ def test_a_merged_detection_counts_both_true_phases_wrong():
     det[2:13] = True
     r = step_detection(det, truth, t)
     assert r["correct"] == 0 and r["error_rate"] == 1.0
+
+
+def test_intervals_are_the_true_runs_of_a_mask():
+    np.testing.assert_array_equal(intervals(np.array([0, 1, 1, 0, 1, 0, 0, 1], bool)), [[1, 3], [4, 5], [7, 8]])
+    np.testing.assert_array_equal(intervals(np.ones(4, bool)), [[0, 4]])
+    assert intervals(np.zeros(5, bool)).shape == (0, 2) and intervals(np.zeros(0, bool)).shape == (0, 2)
+    rng = np.random.default_rng(2)
+    for p in (0.1, 0.5, 0.9):  # against the differences of the mask padded with False
+        m = rng.random(1001) < p
+        d = np.diff(np.concatenate([[0], m.astype(np.int8), [0]]))
+        expected = np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)])
+        got = intervals(m)
+        assert got.dtype == np.int64
+        np.testing.assert_array_equal(got, expected)

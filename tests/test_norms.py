@@ -30,3 +30,25 @@ def test_hand_made_rows():
     x = np.array([[3.0, 4.0, 0.0], [0.0, 0.0, -2.0], [1.0, 2.0, 2.0]])
     assert row_norms(x).tolist() == [5.0, 2.0, 3.0]
     assert row_norms_squared(x).tolist() == [25.0, 4.0, 9.0]
+
+
+@pytest.mark.parametrize("kind", list(_inputs()))
+def test_unit_error_is_the_largest_distance_of_a_squared_norm_from_one(kind):
+    from footzoo.core.norms import unit_error
+
+    x = _inputs()[kind]
+    x = np.asarray(x, dtype=float) / 50.0
+    err, k = unit_error(x)
+    if not len(x):
+        assert (err, k) == (0.0, -1)
+        return
+    expected = np.abs(np.add.reduce(x * x, axis=1) - 1.0)
+    assert err == expected.max() and k == int(np.argmax(expected))
+
+
+def test_unit_error_of_hand_made_quaternions():
+    from footzoo.core.norms import unit_error
+
+    q = np.array([[1.0, 0.0, 0.0, 0.0], [0.6, 0.8, 0.0, 0.0], [0.0, 0.0, 0.0, 1.001], [0.5, 0.5, 0.5, 0.5]])
+    err, k = unit_error(q)
+    assert k == 2 and abs(err - (1.001**2 - 1.0)) < 1e-15

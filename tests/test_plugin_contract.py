@@ -77,6 +77,27 @@ def test_nan_input_to_any_action_method_is_a_clear_error():
         det.detect(t, acc, np.zeros((100, 3)))
 
 
+def test_within_a_run_an_array_proven_finite_is_not_scanned_again_but_any_other_is():
+    """A pipeline run scans its recording's arrays for NaN once (inputs_checked_once); a new or changed
+    array handed to a block is still checked, and outside a run every call checks."""
+    from footzoo.plugins.base import inputs_checked_once
+
+    det = available("detector")["shoe"]()
+    t = np.arange(100) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (100, 1))
+    gyr = np.zeros((100, 3))
+    with inputs_checked_once():
+        det.detect(t, acc, gyr)
+        bad = acc.copy()
+        bad[40, 2] = np.nan
+        with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 40"):
+            det.detect(t, bad, gyr)  # another object: checked
+        acc[7, 0] = np.inf  # the same object, changed behind the run's back: not scanned again
+        det.detect(t, acc, gyr)
+    with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 7"):
+        det.detect(t, acc, gyr)  # outside: every call checks
+
+
 def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
     class NotAPlugin:
         name = "x"

@@ -33,6 +33,7 @@ flips y and z: the warning says so.
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
@@ -41,6 +42,7 @@ import numpy as np
 from ..core.conventions import quat_to_matrix
 from ..core.errors import FormatError, SensorWarning
 from ..io.axes import describe_axes, parse_axes
+from ..kernels.jit import njit
 from .gait_events import sagittal_rate, stride_directions
 
 #: Fewest strides for a mounting estimate.
@@ -75,6 +77,34 @@ def axis_map_text(p: np.ndarray) -> str:
         k = int(np.argmax(np.abs(row)))
         names.append(("-" if row[k] < 0 else "") + "xyz"[k])
     return "[" + ", ".join(names) + "]"
+
+
+@njit
+def swing_correlation(gyr: np.ndarray, w: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Pearson's correlation of ``gyr[:, 1]`` (rad/s) with ``w`` (rad/s) over the samples ``lo[i] … hi[i] − 1``.
+
+    The swings: disjoint, increasing. Two passes (the means, then the centred sums), as
+    ``np.corrcoef``; NaN with fewer than 3 samples or a constant ``gyr_y``.
+    """
+    m, sx, sy = 0, 0.0, 0.0
+    for i in range(lo.shape[0]):
+        for k in range(lo[i], hi[i]):
+            sx += gyr[k, 1]
+            sy += w[k]
+            m += 1
+    if m < 3:
+        return math.nan
+    mx, my = sx / m, sy / m
+    sxx, syy, sxy = 0.0, 0.0, 0.0
+    for i in range(lo.shape[0]):
+        for k in range(lo[i], hi[i]):
+            dx, dy = gyr[k, 1] - mx, w[k] - my
+            sxx += dx * dx
+            syy += dy * dy
+            sxy += dx * dy
+    if not (sxx > 0.0 and syy > 0.0):
+        return math.nan
+    return min(max(sxy / math.sqrt(sxx) / math.sqrt(syy), -1.0), 1.0)
 
 
 def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: np.ndarray,
@@ -124,11 +154,8 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     foot = np.stack([fwd, right, down], axis=1)  # rows: foot axes in NED
     a = nearest_rotation(np.median(foot @ quat_to_matrix(np.asarray(quat, dtype=float)[mid]), axis=0))
     w = sagittal_rate(quat, gyr, pos, stances) if sagittal is None else sagittal
-    # the swings [b0_i, a0_{i+1}): +1 where one starts, −1 where it ends, summed along the samples
-    n = len(w)
-    swing = np.cumsum(np.bincount(b0[:-1], minlength=n + 1) - np.bincount(a0[1:], minlength=n + 1))[:n] > 0
-    gy = np.asarray(gyr, dtype=float)[swing, 1]
-    corr = float(np.corrcoef(gy, w[swing])[0, 1]) if swing.sum() > 2 and np.std(gy) > 0 else float("nan")
+    swings = np.ascontiguousarray(b0[:-1], dtype=np.int64), np.ascontiguousarray(a0[1:], dtype=np.int64)
+    corr = swing_correlation(np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(w, dtype=float), *swings)
     p = nearest_axis_map(a)
     out.update(sensor_in_foot=np.round(a, 4).tolist(), x_forward=float(a[0, 0]), y_right=float(a[1, 1]),
                pitch_rate_correlation=corr, walks_backwards=bool(a[0, 0] < REVERSED_COS),

@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..kernels.jit import njit
+
 
 def path_length(pos: np.ndarray, horizontal: bool = True) -> float:
     """Length (m) of the travelled path: sum of distances between samples.
@@ -121,11 +123,25 @@ def trajectory_metrics(pos: np.ndarray, truth_pos: np.ndarray | None, closed_loo
 # --------------------------------------------------------------------------- stance detection
 
 
+@njit
+def _runs_kernel(mask: np.ndarray, out: np.ndarray) -> int:
+    """The True runs of ``mask`` as ``(start, stop)`` rows of ``out``; returns their count."""
+    k = 0
+    n = mask.shape[0]
+    for i in range(n):
+        if mask[i] and (i == 0 or not mask[i - 1]):
+            out[k, 0] = i
+        if mask[i] and (i == n - 1 or not mask[i + 1]):
+            out[k, 1] = i + 1
+            k += 1
+    return k
+
+
 def intervals(mask: np.ndarray) -> np.ndarray:
-    """``(start, stop)`` index pairs (stop exclusive) of the True runs of a boolean mask, (K, 2)."""
-    m = np.asarray(mask, dtype=bool).astype(np.int8)
-    d = np.diff(np.concatenate([[0], m, [0]]))
-    return np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)])
+    """``(start, stop)`` index pairs (stop exclusive) of the True runs of a boolean mask, (K, 2) int."""
+    m = np.ascontiguousarray(mask, dtype=bool).reshape(-1)
+    out = np.empty(((len(m) + 1) // 2, 2), dtype=np.int64)
+    return out[:_runs_kernel(m, out)].copy()
 
 
 def stance_scores(stance: np.ndarray, truth: np.ndarray) -> dict[str, float]:

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import FootzooError, PluginError
-from ..core.norms import row_norms_squared
+from ..core.norms import unit_error
 
 #: Methods whose faults are the plug-in's: each one a plug-in class defines is wrapped by :func:`guard`.
 GUARDED = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze", "annotate", "check",
@@ -239,9 +239,8 @@ def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, 
         raise broken(plugin, method, f"set {label} with {len(bad)} non-finite sample(s) (NaN or inf), first at sample "
                                      f"{int(bad[0])}")
     if spec.what == "quat":
-        err = np.abs(row_norms_squared(arr) - 1.0)  # |q|² - 1 ≈ 2 (|q| - 1)
-        if err.max() > 2 * QUAT_NORM_TOL:
-            k = int(np.argmax(err))
+        err, k = unit_error(arr)  # max ||q|² - 1| ≈ 2 (|q| - 1)
+        if err > 2 * QUAT_NORM_TOL:
             raise broken(plugin, method, f"set {label} with non-unit quaternions (|q| = {np.linalg.norm(arr[k]):.9g} "
                                          f"at sample {k}, tolerance {QUAT_NORM_TOL:g}): normalise each attitude "
                                          "(q / |q|)")

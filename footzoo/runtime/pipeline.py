@@ -46,6 +46,7 @@ from ..plugins.base import (
     Samples,
     VelocityCorrection,
     call,
+    inputs_checked_once,
 )
 from ..plugins.extensions import load_plugins
 from ..plugins.incremental import WHOLE_RECORDING, Latency, total
@@ -276,6 +277,10 @@ class Pipeline:
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+        with inputs_checked_once():  # the recording's arrays are scanned for NaN once, not by every block
+            return self._run(rec, engine, covariance)
+
+    def _run(self, rec: Recording, engine: str, covariance: bool) -> Result:
         if not isinstance(rec, Recording):
             hint = (f": load it first, Pipeline.run(footzoo.load({str(rec)!r}))" if isinstance(rec, (str, os.PathLike))
                     else ": build one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
