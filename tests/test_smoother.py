@@ -205,3 +205,54 @@ def test_both_engines_smooth_stride_by_stride_alike(walk, name):
     assert np.abs(fast.pos - ref.pos).max() <= 1e-9 * scale
     assert np.abs(fast.quat - ref.quat).max() <= 1e-9
     np.testing.assert_allclose(ref.diagnostics["pos_forward"], fast.diagnostics["pos_forward"], atol=1e-9 * scale)
+
+
+def _engine_inputs(p, rec):
+    """A fresh engine of pipeline ``p`` for ``rec`` and what its run takes (stance, initial and external attitude)."""
+    from footzoo.plugins.base import Samples
+    from footzoo.runtime.alignment import initial_attitude
+
+    stance = p.detect(rec).stance_
+    q0 = initial_attitude(rec.t, rec.acc, rec.gyr, None, **p.init)
+    quat = p.orient(rec, stance, q0)
+    samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + p.init["duration"])
+    return (lambda: p.kalman_engine([c.clone() for c in p.filter_corrections], samples, "fast")), stance, q0, quat
+
+
+@pytest.mark.parametrize("block", [1, 7, 1024, 10**6])
+@pytest.mark.parametrize("name", ["nguyen2016", "duong2015_zupt_height", "madgwick+zupt"])
+def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample_bit_for_bit(walk, name, block,
+                                                                                            monkeypatch):
+    """``smoother: rts`` keeps checkpoints and makes the record again block by block: the same smoothed
+    trajectory, bit for bit, as one record of every sample, whatever the block length (one block, blocks
+    of 2 samples, a last block shorter than the others), with biases and memory-keeping models (nguyen2016:
+    15 states and the heading reduction; the height update) and with an external attitude."""
+    from footzoo.filters import checkpointed
+
+    if name == "madgwick+zupt":
+        p = Pipeline.from_dict({"name": name, "orientation": {"type": "madgwick", "use_magnetometer": False},
+                                "detector": {"type": "windowed"}, "corrections": [{"type": "zupt"}]})
+    else:
+        p = Pipeline.from_yaml(name)
+    make, stance, q0, quat = _engine_inputs(p, walk)
+    t, acc, gyr, n = walk.t, walk.acc, walk.gyr, len(walk.t)
+    assert n > 2 * 1024 + 1 and n % 7 != 1  # several blocks of 1024, the last shorter
+    monkeypatch.setattr(checkpointed, "BLOCK", block)
+    eng = make()
+    got = eng.run(t, acc, gyr, stance, q0, quat, covariance=True, smoother="rts")
+
+    ref = make()  # the forward pass with the record of every sample, then the backward pass over it
+    nav0 = np.zeros(16)
+    nav0[:4] = quat[0] if quat is not None else q0
+    state = ref.start(nav0)
+    full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.models], 0, True, record=True)
+    forward = {k: full[k].copy() for k in ("quat", "vel", "pos", "acc_nav", "P_diag", "nis")}
+    ref.smooth(full, np.array([n - 1]))
+    for key in ("quat", "vel", "pos", "gyro_bias", "acc_bias"):
+        np.testing.assert_array_equal(got[key], full[key], err_msg=key)
+    for key in ("quat", "vel", "pos"):
+        np.testing.assert_array_equal(got[f"{key}_forward"], forward[key], err_msg=key)
+    for key in ("acc_nav", "P_diag", "nis"):  # the forward pass's, every block's first row included
+        np.testing.assert_array_equal(got[key], forward[key], err_msg=key)
+    assert got["diagnostics"].keys() == ref.diagnostics(state).keys()
+    assert np.abs(got["vel"] - got["vel_forward"]).max() > 1e-4  # it did smooth

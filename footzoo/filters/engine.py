@@ -214,9 +214,15 @@ class KalmanEngine:
         nav0[:4] = quat_ext[0] if quat_ext is not None else q0
         state = self.start(nav0)
         in_loop = smoother == "stepwise" and self.engine != "reference"  # the loop smooths each stride as it closes
-        record = self._whole_recording_record(state, stance, t) if in_loop else smoother != "none"
-        out = self.advance(state, t, acc, gyr, stance, quat_ext, [m.data for m in self.models], 0, covariance,
-                           record=record)
+        checkpointed = smoother == "rts" and self.engine != "reference"  # RTS in bounded memory
+        datas = [m.data for m in self.models]
+        if checkpointed:
+            out = self.outputs(len(t), covariance)
+            self.smooth_checkpointed(state, t, acc, gyr, stance, quat_ext, self.stack_data(datas, len(t)), out)
+            self._constant_biases(state, out)
+        else:
+            record = self._whole_recording_record(state, stance, t) if in_loop else smoother != "none"
+            out = self.advance(state, t, acc, gyr, stance, quat_ext, datas, 0, covariance, record=record)
         out["diagnostics"] = self.diagnostics(state)
         if in_loop:  # every segment but the last is smoothed, into record[6]
             from .stepwise import smooth_copy
@@ -230,7 +236,7 @@ class KalmanEngine:
                     out[key] = smoothed
                 elif self.layout.has(key):  # else the forward value (the state's, constant)
                     out[key] = smoothed
-        elif smoother != "none":  # the record of every sample: the whole recording, or each stride, after the loop
+        elif smoother != "none" and not checkpointed:  # the record of every sample (reference loop), after the loop
             for key in ("quat", "vel", "pos"):
                 out[f"{key}_forward"] = out[key].copy()
             ends = segment_ends(stance, t, True) if smoother == "stepwise" else np.array([len(t) - 1])
@@ -311,22 +317,30 @@ class KalmanEngine:
                 out.update(zip(RECORD_KEYS, (arrays[0], arrays[1], arrays[3], arrays[4]), strict=True))
                 out[ROWS_KEY] = arrays[2]
             return out
-        nx = self.layout.n
-        out = {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
-               "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
-               "P_diag": np.empty((n if covariance else 0, nx)), "nis": np.zeros((n if covariance else 0, 2))}
+        out = self.outputs(n, covariance)
         if record is True:
             from .smoother import record_arrays
 
-            cov, phi, rows, first, count, *_ = record_arrays(n, nx, state.core[4])
+            cov, phi, rows, first, count, *_ = record_arrays(n, self.layout.n, state.core[4])
             out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
             out[ROWS_KEY] = rows
         out["record"] = record_tuple(out) if record is True else record or None
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
-        for key, at in (("gyro_bias", BG), ("acc_bias", BA)):  # without its block the loop leaves a bias at 0
+        self._constant_biases(state, out)
+        return out
+
+    def outputs(self, n: int, covariance: bool) -> dict[str, np.ndarray]:
+        """Empty per-sample outputs of the compiled loop, ``n`` rows (``P_diag``, ``nis``: only with ``covariance``)."""
+        nx = self.layout.n
+        return {"quat": np.empty((n, 4)), "vel": np.empty((n, 3)), "pos": np.empty((n, 3)),
+                "acc_nav": np.empty((n, 3)), "gyro_bias": np.zeros((n, 3)), "acc_bias": np.zeros((n, 3)),
+                "P_diag": np.empty((n if covariance else 0, nx)), "nis": np.zeros((n if covariance else 0, 2))}
+
+    def _constant_biases(self, state: Packed, out: dict[str, np.ndarray]) -> None:
+        """A bias without its error-state block: the loop leaves its output at 0; it is the state's (constant) value."""
+        for key, at in (("gyro_bias", BG), ("acc_bias", BA)):
             if not self.layout.has(key) and np.any(state.nav[at:at + 3]):
                 out[key][:] = state.nav[at:at + 3]
-        return out
 
     def fork(self, state: Any) -> Any:
         """An independent copy of a state from :meth:`start` (a live stream's guess runs ahead on it)."""
@@ -398,7 +412,21 @@ class KalmanEngine:
         or a write outside its arrays, which a plug-in's bounds-checked code turns into an exception)
         is raised here as that correction's :class:`~footzoo.core.errors.PluginError`.
         """
-        from .kalman_fast import eskf_loop, scratch
+        from .kalman_fast import eskf_loop
+
+        signals, arrays, outputs = self._loop_arguments(packed, t, acc, gyr, stance, quat_ext, data, out)
+        state, work = (packed.nav, packed.P, packed.mems), packed.work
+        record = out.get("record")  # a smoother's
+        with capture_faults() as caught:
+            if packed.bound is not None:
+                packed.bound(signals, packed.core, state, arrays, outputs, k0, work, record)
+            else:
+                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, record)
+        self._raise_fault(work, caught)
+
+    def _loop_arguments(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out) -> tuple:
+        """The compiled loop's ``signals``, model ``arrays`` and ``out`` (kalman_fast's module docstring)."""
+        from .kalman_fast import scratch
 
         ext = writable_array(quat_ext, float) if quat_ext is not None else np.zeros((1, 4))
         m_idx, par, par_off, mem_off, data_off, hooks, rows = packed.arrays
@@ -407,19 +435,45 @@ class KalmanEngine:
                    writable_array(stance, np.bool_), ext)
         outputs = (out["quat"], out["vel"], out["pos"], out["acc_nav"], out["gyro_bias"], out["acc_bias"],
                    out["P_diag"], out["nis"])
-        state = (packed.nav, packed.P, packed.mems)
         if packed.work is None:
             packed.work = scratch(packed.P.shape[0], packed.core[4])
-        work = packed.work
-        record = out.get("record")  # a smoother's
-        with capture_faults() as caught:
-            if packed.bound is not None:
-                packed.bound(signals, packed.core, state, arrays, outputs, k0, work, record)
-            else:
-                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, record)
+        return signals, arrays, outputs
+
+    def _raise_fault(self, work: tuple, caught: list[BaseException]) -> None:
         fault = work[-1]
         if fault[0] >= 0 or caught:
             raise self.fault(int(fault[0]), int(fault[1]), int(fault[2]), caught)
+
+    def smooth_checkpointed(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out) -> None:
+        """RTS over the whole recording in bounded memory (:mod:`footzoo.filters.checkpointed`), compiled loop.
+
+        ``out``: empty outputs of :meth:`advance` (no record); filled with the forward pass, whose
+        ``quat``, ``vel`` and ``pos`` are kept as ``*_forward``, then smoothed in place.
+        ``packed`` ends in the forward filter's final state.
+        """
+        from .checkpointed import BLOCK, backward, checkpoint_arrays, forward
+        from .kalman_fast import scratch
+        from .smoother import record_arrays
+
+        signals, arrays, outputs = self._loop_arguments(packed, t, acc, gyr, stance, quat_ext, data, out)
+        models, work, nx = (packed.functions, arrays), packed.work, packed.P.shape[0]
+        checkpoints = checkpoint_arrays(len(t), nx, packed.mems.size, BLOCK)
+        with capture_faults() as caught:
+            forward(signals, packed.core, (packed.nav, packed.P, packed.mems), models, outputs, 0, work, checkpoints,
+                    BLOCK)
+        self._raise_fault(work, caught)
+        for key in ("quat", "vel", "pos"):
+            out[f"{key}_forward"] = out[key].copy()
+        rows = BLOCK + 1
+        block_out = (np.empty((rows, 4)), *(np.empty((rows, 3)) for _ in range(5)), np.empty((0, nx)),
+                     np.empty((0, 2)))
+        state = (packed.nav.copy(), packed.P.copy(), packed.mems.copy())  # the checkpoints go here
+        work = scratch(nx, packed.core[4])
+        with capture_faults() as caught:
+            backward(signals, packed.core, state, models, 0, work, checkpoints, BLOCK,
+                     record_arrays(rows, nx, packed.core[4]), block_out,
+                     (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"]))
+        self._raise_fault(work, caught)
 
     def fault(self, j: int, rows: int, k: int, caught: list[BaseException]) -> PluginError:
         """The :class:`PluginError` for a model that broke its contract in the loop (see :meth:`step`)."""

@@ -166,10 +166,21 @@ def smooth_segment(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias,
     ``record`` (:func:`record_arrays`) holds samples ``lo … hi``, sample k in its row ``k − off``;
     ``lam``, ``mu``, ``e`` (n,) are work arrays.
     """
+    for i in range(lam.shape[0]):
+        lam[i] = 0.0
+    smooth_span(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
+
+
+@njit
+def smooth_span(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e):
+    """:func:`smooth_segment`'s recursion over samples ``lo … hi − 1``, from the ``λ`` given (updated in place).
+
+    ``λ`` comes from the samples after ``hi`` (zero at the end of a segment): the record of a
+    long span can so be read in consecutive pieces, the last first, each ending where the next
+    begins (:mod:`footzoo.filters.checkpointed`); the update of sample ``hi`` is in this piece.
+    """
     cov, phi, rows, first, count = record[0], record[1], record[2], record[3], record[4]
     n = lam.shape[0]
-    for i in range(n):
-        lam[i] = 0.0
     for j_ in range(hi - off, lo - off, -1):
         k = j_ + off
         for r in range(first[j_] + count[j_] - 1, first[j_] - 1, -1):  # the update of sample k, last row first
