@@ -147,6 +147,14 @@ def test_the_reference_engine_refuses_the_same_plugins(how, walk):
         Pipeline.from_dict(_config(how)).run(walk, engine="reference")
 
 
+@pytest.mark.parametrize("smoother", ["rts", "stepwise"])
+@pytest.mark.parametrize("how", ["three_rows", "claims_rows", "far_memory"])
+def test_a_smoothed_run_refuses_the_same_plugins(how, smoother, walk):
+    """The smoothers' forward passes (RTS with its checkpoints, step-wise in the loop) check the same contract."""
+    with pytest.raises(PluginError, match=CAUSES[how]):
+        Pipeline.from_dict({**_config(how), "smoother": smoother}).run(walk)
+
+
 @pytest.mark.parametrize("how", ["three_rows", "claims_rows"])
 def test_live_a_careless_kalman_plugin_is_a_plugin_error(how, walk):
     stream = Stream(Pipeline.from_dict(_config(how)), rate=walk.rate)

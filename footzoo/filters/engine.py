@@ -205,7 +205,8 @@ class KalmanEngine:
             smoother: bool | str = False) -> dict[str, Any]:
         """Filter a whole recording; returns the trajectories and each model's diagnostics.
 
-        With ``smoother`` (``"rts"`` or True: :mod:`footzoo.filters.smoother`; ``"stepwise"``:
+        With ``smoother`` (``"rts"`` or True: :mod:`footzoo.filters.smoother`, in bounded memory with
+        the compiled loop, :mod:`footzoo.filters.checkpointed`; ``"stepwise"``:
         :mod:`footzoo.filters.stepwise`) the trajectories are the smoothed ones and the forward
         pass's are kept as ``quat_forward``, ``vel_forward``, ``pos_forward``.
         """
@@ -282,7 +283,7 @@ class KalmanEngine:
         """
         from .smoother import smooth_segments
 
-        smooth_segments(record_tuple(rows), np.asarray(ends, np.int64), 0, 0, self.core_offsets(),
+        smooth_segments(record_tuple(rows, self.layout.n), np.asarray(ends, np.int64), 0, 0, self.core_offsets(),
                         not self.carries_attitude, rows["quat"], rows["vel"], rows["pos"], rows["gyro_bias"],
                         rows["acc_bias"])
 
@@ -324,7 +325,7 @@ class KalmanEngine:
             cov, phi, rows, first, count, *_ = record_arrays(n, self.layout.n, state.core[4])
             out.update(zip(RECORD_KEYS, (cov, phi, first, count), strict=True))
             out[ROWS_KEY] = rows
-        out["record"] = record_tuple(out) if record is True else record or None
+        out["record"] = record_tuple(out, self.layout.n) if record is True else record or None
         self.step(state, t, acc, gyr, stance, quat_ext, self.stack_data(data, n), out, k0)
         self._constant_biases(state, out)
         return out
@@ -447,33 +448,29 @@ class KalmanEngine:
     def smooth_checkpointed(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out) -> None:
         """RTS over the whole recording in bounded memory (:mod:`footzoo.filters.checkpointed`), compiled loop.
 
-        ``out``: empty outputs of :meth:`advance` (no record); filled with the forward pass, whose
-        ``quat``, ``vel`` and ``pos`` are kept as ``*_forward``, then smoothed in place.
-        ``packed`` ends in the forward filter's final state.
+        ``out``: empty outputs of :meth:`outputs`; filled with the forward pass, whose ``quat``,
+        ``vel`` and ``pos`` are kept as ``*_forward``, then smoothed in place. ``packed`` ends in
+        the forward filter's final state.
         """
-        from .checkpointed import BLOCK, backward, checkpoint_arrays, forward
-        from .kalman_fast import scratch
+        from .checkpointed import BLOCK, backward, checkpoint_record
         from .smoother import record_arrays
 
-        signals, arrays, outputs = self._loop_arguments(packed, t, acc, gyr, stance, quat_ext, data, out)
-        models, work, nx = (packed.functions, arrays), packed.work, packed.P.shape[0]
-        checkpoints = checkpoint_arrays(len(t), nx, packed.mems.size, BLOCK)
-        with capture_faults() as caught:
-            forward(signals, packed.core, (packed.nav, packed.P, packed.mems), models, outputs, 0, work, checkpoints,
-                    BLOCK)
-        self._raise_fault(work, caught)
+        nx, m_max = packed.P.shape[0], packed.core[4]
+        checkpoints = checkpoint_record(len(t), nx, packed.mems.size, BLOCK)
+        self.step(packed, t, acc, gyr, stance, quat_ext, data, {**out, "record": checkpoints}, 0)
         for key in ("quat", "vel", "pos"):
             out[f"{key}_forward"] = out[key].copy()
-        rows = BLOCK + 1
-        block_out = (np.empty((rows, 4)), *(np.empty((rows, 3)) for _ in range(5)), np.empty((0, nx)),
-                     np.empty((0, 2)))
-        state = (packed.nav.copy(), packed.P.copy(), packed.mems.copy())  # the checkpoints go here
-        work = scratch(nx, packed.core[4])
-        with capture_faults() as caught:
-            backward(signals, packed.core, state, models, 0, work, checkpoints, BLOCK,
-                     record_arrays(rows, nx, packed.core[4]), block_out,
-                     (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"]))
-        self._raise_fault(work, caught)
+        scratch_out = self.outputs(BLOCK + 1, False)  # the block's outputs, run again: not read
+        record = record_arrays(BLOCK + 1, nx, m_max)
+        def run_block(a: int, b: int, nav: np.ndarray, P: np.ndarray, mems: np.ndarray) -> None:
+            state = dataclasses.replace(packed, nav=nav, P=P, mems=mems)
+            rows = {k: v[: b - a + 1] for k, v in scratch_out.items()}
+            self.step(state, t[a:b + 1], acc[a:b + 1], gyr[a:b + 1], stance[a:b + 1],
+                      None if quat_ext is None else quat_ext[a:b + 1], data[a:b + 1], {**rows, "record": record}, a)
+
+        backward(run_block, checkpoints[7], len(t), BLOCK, record,
+                 (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"]), self.core_offsets(),
+                 not self.carries_attitude)
 
     def fault(self, j: int, rows: int, k: int, caught: list[BaseException]) -> PluginError:
         """The :class:`PluginError` for a model that broke its contract in the loop (see :meth:`step`)."""

@@ -74,7 +74,14 @@ import numpy as np
 from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .measurement import ACC_BIAS, ATT, BA, BG, GYRO_BIAS, POS, VEL, P, Q, V
-from .smoother import feed_back_attitude, record_covariance, record_row, record_transition
+from .smoother import (
+    feed_back_attitude,
+    record_covariance,
+    record_row,
+    record_transition,
+    take_checkpoint,
+    unowned_record,
+)
 from .stepwise import close_segment
 from .strapdown import quat_product, rotvec_quat
 
@@ -109,6 +116,8 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
     views = (unowned(m_idx), unowned(par), unowned(par_off), unowned(mem_off), unowned(data_off), unowned(hooks),
              unowned(rows))
     fault[0], fault[1], fault[2] = -1, 0, 0
+    if record is not None:  # a smoother's record, its arrays as views that own no reference too
+        rec = unowned_record(record)
     for a in range(m_max):
         z[a] = 0.0
         rdiag[a] = 0.0
@@ -117,10 +126,11 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
     n_dyn = moving_rows(offs, n, dyn, still)
     store(0, nav, a_n, Pk, offs, out, keep_p, True, 0.0, 0)
     if record is not None:  # smoother: P⁺ of the incoming state
-        record_covariance(record, 0, Pk)
+        record_covariance(rec, 0, Pk)
     for k in range(1, t.shape[0]):
         if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
-            close_segment(record, k, stance, t, idx, use_ext, out[0], out[1], out[2], out[4], out[5])
+            close_segment(rec, k, stance, t, idx, use_ext, out[0], out[1], out[2], out[4], out[5])
+            take_checkpoint(rec, k, nav, Pk, mems)  # RTS in bounded memory: the state at a block's start
         dt = t[k] - t[k - 1]
         propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_n)
         for i in range(3):
@@ -130,7 +140,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
         sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * f_n[2], 0.0, dt * f_n[0]
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
         if record is not None:  # smoother: Φ's blocks
-            record_transition(record, k, dt, sdt, cdt)
+            record_transition(rec, k, dt, sdt, cdt)
         propagate_rows(Pk, offs, dt, sdt, cdt)
         propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
         add_process_noise(Pk, offs, qn, impact, a_n, dt)
@@ -144,7 +154,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
                 cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
                 nis += innov * scaled
                 if record is not None:  # smoother: the row, its gain, ν / s
-                    record_row(record, k, H[a], kv, scaled)
+                    record_row(rec, k, H[a], kv, scaled)
                 for e in range(cnt):
                     H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
             for i in range(n):
@@ -154,7 +164,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
         after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
         store(k, nav, a_n, Pk, offs, out, keep_p, False, nis, m)
         if record is not None:  # smoother: P⁺_k
-            record_covariance(record, k, Pk)
+            record_covariance(rec, k, Pk)
 
 
 @njit(inline=True)

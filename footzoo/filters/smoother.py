@@ -30,8 +30,10 @@ step) need no special case. Per sample it costs a few products of n-vectors, whe
 gain took a Cholesky factorisation of ``P⁻`` and n triangular solves (8× the forward pass).
 
 Two smoothers run it: ``smoother: rts``, over the whole recording as one span ending at its last
-sample (:func:`smooth_segments` with that one end; offline, the record of every sample kept),
-and ``smoother: stepwise`` (:mod:`footzoo.filters.stepwise`), over each stride as it closes.
+sample (offline: the compiled loop keeps checkpoints and makes the record again block by block,
+:mod:`footzoo.filters.checkpointed`, its pieces read by :func:`smooth_span`; the reference loop
+keeps the record of every sample, :func:`smooth_segments` with that one end), and ``smoother:
+stepwise`` (:mod:`footzoo.filters.stepwise`), over each stride as it closes.
 
 What is kept per sample (:func:`record_arrays`)
     ``P⁺_k`` (n × n), Φ_k's blocks (``dt``, ``−[f^n×] dt``, ``C dt``; Nguyen & La eq. 33, as
@@ -48,10 +50,18 @@ import math
 import numpy as np
 
 from ..kernels.jit import njit
+from ..kernels.views import unowned
 from .strapdown import quat_product, rotvec_quat
 
 #: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
 PHI_WIDTH = 19
+
+
+#: The modes of a record (its ``segment[0]``): a row per sample, smoothed by the caller (a live chunk,
+#: or a block run again by :mod:`footzoo.filters.checkpointed`); each stride smoothed by the loop as it
+#: closes (:mod:`footzoo.filters.stepwise`); no row at all, the filter's state every ``segment[2]``
+#: samples (the forward pass of :mod:`footzoo.filters.checkpointed`).
+ROWS, IN_LOOP, CHECKPOINTS = 0, 1, 2
 
 
 def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
@@ -59,22 +69,30 @@ def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple
 
     ``(cov (N, n(n+1)/2): P⁺'s upper triangle, row by row (:func:`packed`), phi (N, 19): Φ's
     blocks, rows (R, 2n+1): the update rows h, k, ν/s one after the other, first (N,) int: each
-    sample's first row in ``rows``, count (N,) int: its number of rows, segment (2,) int: smoothed
-    by the loop itself, first sample of the open segment, smoothed (quat (M, 4), vel, pos,
-    gyro_bias, acc_bias (M, 3)))``. ``rows`` has room for ``m_max`` rows per sample; only the rows
-    written are touched.
+    sample's first row in ``rows``, count (N,) int: its number of rows, segment (3,) int: the mode
+    (:data:`ROWS`, :data:`IN_LOOP`, :data:`CHECKPOINTS`), the first sample of the open segment, the
+    samples per checkpoint; smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)),
+    checkpoints (nav (J, 16), P (J, n, n), mems (J, s)))``. ``rows`` has room for ``m_max`` rows per
+    sample; only the rows written are touched.
 
     ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
     as soon as it has closed (:func:`footzoo.filters.stepwise.close_segment`), while its record is
     in the cache, into ``smoothed`` (the loop's outputs stay the forward pass's), and the record
     holds the open segment only (sample k in row ``k − segment[1]``): ``n_samples`` is then the longest
-    segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths.
+    segment's. Otherwise (0: a live chunk) sample k is in row k and the caller smooths. (The
+    checkpoints' record: :func:`footzoo.filters.checkpointed.checkpoint_record`.)
     """
     m = int(in_loop)
     smoothed = (np.zeros((m, 4)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 3)))
     return (np.empty((n_samples, n * (n + 1) // 2)), np.zeros((n_samples, PHI_WIDTH)),
             np.zeros((n_samples * max(m_max, 1), 2 * n + 1)), np.zeros(n_samples, np.int64),
-            np.zeros(n_samples, np.int64), np.array([int(m > 0), 0], np.int64), smoothed)
+            np.zeros(n_samples, np.int64), np.array([IN_LOOP if m > 0 else ROWS, 0, 0], np.int64), smoothed,
+            no_checkpoints(n))
+
+
+def no_checkpoints(n: int, n_mem: int = 0) -> tuple:
+    """Checkpoints of an ``n``-state filter with no entry (a record that keeps rows)."""
+    return np.zeros((0, 16)), np.zeros((0, n, n)), np.zeros((0, n_mem))
 
 
 #: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
@@ -87,16 +105,34 @@ def packed(P: np.ndarray) -> np.ndarray:
     return P[np.triu_indices(P.shape[0])]
 
 
-def record_tuple(out: dict[str, np.ndarray]) -> tuple:
-    """The record (of a live chunk) in the order of :func:`record_arrays` from a dict of its arrays."""
+def record_tuple(out: dict[str, np.ndarray], n: int) -> tuple:
+    """The record (of a live chunk, ``n`` states) in the order of :func:`record_arrays` from a dict of its arrays."""
     cov, phi, first, count = (out[k] for k in RECORD_KEYS)
     none = np.zeros((0, 3))
-    return cov, phi, out[ROWS_KEY], first, count, np.zeros(2, np.int64), (np.zeros((0, 4)), none, none, none, none)
+    return (cov, phi, out[ROWS_KEY], first, count, np.zeros(3, np.int64), (np.zeros((0, 4)), none, none, none, none),
+            no_checkpoints(n))
+
+
+@njit(inline=True)
+def unowned_record(record):
+    """The record with every array a view that owns no reference (:func:`footzoo.kernels.views.unowned`).
+
+    The loop reads the record's arrays at every sample; taking an owned array out of the tuple
+    costs two atomic reference counts each time (4× the loop's time without a record, measured).
+    Only for a record that outlives the loop's call (its argument).
+    """
+    cov, phi, rows, first, count, segment, smoothed, checkpoints = record
+    sq, sv, sp, sg, sa = smoothed
+    cn, cp, cm = checkpoints
+    return (unowned(cov), unowned(phi), unowned(rows), unowned(first), unowned(count), unowned(segment),
+            (unowned(sq), unowned(sv), unowned(sp), unowned(sg), unowned(sa)), (unowned(cn), unowned(cp), unowned(cm)))
 
 
 @njit(inline=True)
 def record_transition(record, k, dt, sdt, cdt):
     """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
+    if record[5][0] == CHECKPOINTS:
+        return
     phi, first, count = record[1], record[3], record[4]
     r = k - record[5][1]
     phi[r, 0] = dt
@@ -111,6 +147,8 @@ def record_transition(record, k, dt, sdt, cdt):
 @njit(inline=True)
 def record_row(record, k, h, gain, scaled_innovation):
     """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
+    if record[5][0] == CHECKPOINTS:
+        return
     rows, first, count = record[2], record[3], record[4]
     s = k - record[5][1]
     r = first[s] + count[s]
@@ -125,6 +163,8 @@ def record_row(record, k, h, gain, scaled_innovation):
 @njit(inline=True)
 def record_covariance(record, k, P):
     """Keep ``P⁺_k``: its upper triangle, row by row (P is symmetric; half the memory)."""
+    if record[5][0] == CHECKPOINTS:
+        return
     cov = record[0]
     r = k - record[5][1]
     n = P.shape[0]
@@ -133,6 +173,23 @@ def record_covariance(record, k, P):
         for j in range(i, n):
             cov[r, a] = P[i, j]
             a += 1
+
+
+@njit(inline=True)
+def take_checkpoint(record, k, nav, P, mems):
+    """Before sample k (:data:`CHECKPOINTS`): the state after sample k − 1 when a block starts there (k − 1 = j·B)."""
+    segment = record[5]
+    if segment[0] != CHECKPOINTS or (k - 1) % segment[2] != 0:
+        return
+    snap_nav, snap_P, snap_mem = record[7]
+    j = (k - 1) // segment[2]
+    for i in range(nav.shape[0]):
+        snap_nav[j, i] = nav[i]
+    for i in range(P.shape[0]):
+        for c in range(P.shape[1]):
+            snap_P[j, i, c] = P[i, c]
+    for i in range(mems.shape[0]):
+        snap_mem[j, i] = mems[i]
 
 
 @njit(inline=True)
@@ -179,7 +236,13 @@ def smooth_span(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, ac
     long span can so be read in consecutive pieces, the last first, each ending where the next
     begins (:mod:`footzoo.filters.checkpointed`); the update of sample ``hi`` is in this piece.
     """
-    cov, phi, rows, first, count = record[0], record[1], record[2], record[3], record[4]
+    # views that own no reference (the arguments outlive the call): the recursion reads and corrects them
+    # at every sample, and reference counts there would cost more than the recursion itself
+    cov, phi, rows, first, count = (unowned(record[0]), unowned(record[1]), unowned(record[2]), unowned(record[3]),
+                                    unowned(record[4]))
+    quat, vel, pos = unowned(quat), unowned(vel), unowned(pos)
+    gyro_bias, acc_bias = unowned(gyro_bias), unowned(acc_bias)
+    lam, mu, e, idx = unowned(lam), unowned(mu), unowned(e), unowned(idx)
     n = lam.shape[0]
     for j_ in range(hi - off, lo - off, -1):
         k = j_ + off

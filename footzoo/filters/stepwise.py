@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import njit
-from .smoother import smooth_segment
+from .smoother import IN_LOOP, smooth_segment
 
 #: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
 WAITS_FOR = "the end of the next stance"
@@ -81,7 +81,7 @@ def close_segment(record, k, stance, t, idx, use_ext, quat, vel, pos, gyro_bias,
     sample k. Nothing unless the record was made ``in_loop``.
     """
     segment = record[5]
-    if segment[0] and ends_segment(stance, t, k - 1, segment[1]):
+    if segment[0] == IN_LOOP and ends_segment(stance, t, k - 1, segment[1]):
         lo = segment[1]
         smooth_copy(record, lo, k - 1, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         segment[1] = k

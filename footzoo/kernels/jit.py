@@ -27,7 +27,7 @@ from typing import Any
 ENABLED = os.environ.get("FOOTZOO_DISABLE_JIT", "").strip() not in ("1", "true", "yes")
 HAVE_NUMBA = ENABLED and importlib.util.find_spec("numba") is not None
 
-_pending: list[_Kernel] = []
+_pending: list[_Kernel | _Lazy] = []
 _numba: Any = None
 _lock = threading.Lock()
 _materialised = False
@@ -97,7 +97,8 @@ def _materialise() -> None:
         _numba = numba
         kernels = {id(k): k for k in _pending}
         for k in kernels.values():
-            k.dispatcher = _compile(k.py_func, k.inline) if numba is not None else k.py_func
+            k.dispatcher = k.make() if isinstance(k, _Lazy) else (
+                _compile(k.py_func, k.inline) if numba is not None else k.py_func)
         _pending.clear()
         _materialised = True
         for name, module in list(sys.modules.items()):
@@ -105,7 +106,7 @@ def _materialise() -> None:
                 continue
             attrs = getattr(module, "__dict__", {})
             for attr, value in list(attrs.items()):
-                if id(value) in kernels and isinstance(value, _Kernel):
+                if id(value) in kernels and isinstance(value, (_Kernel, _Lazy)):
                     attrs[attr] = value.dispatcher
 
 
@@ -127,6 +128,41 @@ def njit(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
     kernel = _Kernel(fn, inline)
     _pending.append(kernel)
     return kernel
+
+
+class _Lazy:
+    """A helper of compiled code made by ``factory()`` when the kernels are materialised (``plain`` without numba)."""
+
+    def __init__(self, factory: Callable[[], Any], plain: Callable[..., Any]):
+        functools.update_wrapper(self, plain)
+        self.factory, self.plain = factory, plain
+        self.dispatcher: Any = None
+
+    def make(self) -> Any:
+        return self.factory() if _numba is not None else self.plain
+
+    def __call__(self, *args: Any) -> Any:
+        if self.dispatcher is None:
+            _materialise()
+        return self.dispatcher(*args)
+
+
+def lazy(factory: Callable[[], Any], plain: Callable[..., Any]) -> Any:
+    """A helper for kernels that needs numba to be made (an ``@intrinsic``), made when numba is imported.
+
+    ``factory()`` imports numba and returns the helper; ``plain`` is the same operation in Python,
+    used without numba. As a kernel (:func:`njit`): the module attribute naming it is rebound when
+    the kernels are materialised, so importing its module does not import numba.
+    """
+    if not HAVE_NUMBA:
+        return plain
+    if _numba is not None:
+        return factory()
+    if _materialised:  # numba failed to import
+        return plain
+    helper = _Lazy(factory, plain)
+    _pending.append(helper)
+    return helper
 
 
 def materialised() -> bool:

@@ -11,33 +11,38 @@ from __future__ import annotations
 from . import jit as _jit
 
 
-def unowned(a):
+def _plain(a):
     """``a`` itself (see below)."""
     return a
 
 
-if _jit.HAVE_NUMBA:
+def _intrinsic():
+    """The compiled form: a view of array ``a`` without an owner, numba counts no references for it.
+
+    Only for arrays that outlive every use of the view: the loop's arguments (a local array is
+    freed after its last use, which may be the call of this function), handed to functions which
+    return no array.
+    """
     try:
         from numba.core import cgutils
         from numba.extending import intrinsic
         from numba.np.arrayobj import make_array
     except ImportError:  # pragma: no cover - a broken numba: the kernels run as Python
-        pass
-    else:
+        return _plain
 
-        @intrinsic
-        def unowned(typingctx, a):  # noqa: F811 - the compiled form of the function above
-            """A view of array ``a`` without an owner: numba counts no references for it.
+    @intrinsic
+    def unowned(typingctx, a):
+        def codegen(context, builder, sig, args):
+            ary = make_array(sig.args[0])(context, builder, value=args[0])
+            ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
+            ary.parent = cgutils.get_null_value(ary.parent.type)
+            return ary._getvalue()
 
-            Only for arrays that outlive every use of the view: the loop's arguments (a local
-            array is freed after its last use, which may be the call of this function), handed
-            to functions which return no array.
-            """
+        return a(a), codegen
 
-            def codegen(context, builder, sig, args):
-                ary = make_array(sig.args[0])(context, builder, value=args[0])
-                ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
-                ary.parent = cgutils.get_null_value(ary.parent.type)
-                return ary._getvalue()
+    return unowned
 
-            return a(a), codegen
+
+#: ``unowned(a)``: a view of ``a`` that owns no reference (compiled code; ``a`` itself in Python). Made
+#: when numba is imported (at the first kernel call), so that importing a module that uses it does not.
+unowned = _jit.lazy(_intrinsic, _plain)
