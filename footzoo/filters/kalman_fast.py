@@ -75,6 +75,7 @@ from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .measurement import ACC_BIAS, ATT, BA, BG, GYRO_BIAS, POS, VEL, P, Q, V
 from .smoother import (
+    CHECKPOINTS,
     feed_back_attitude,
     record_covariance,
     record_row,
@@ -116,8 +117,10 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
     views = (unowned(m_idx), unowned(par), unowned(par_off), unowned(mem_off), unowned(data_off), unowned(hooks),
              unowned(rows))
     fault[0], fault[1], fault[2] = -1, 0, 0
+    rows_kept = False  # a record of the rows of every sample, or of the checkpoints only (read once)
     if record is not None:  # a smoother's record, its arrays as views that own no reference too
         rec = unowned_record(record)
+        rows_kept = rec[5][0] != CHECKPOINTS
     for a in range(m_max):
         z[a] = 0.0
         rdiag[a] = 0.0
@@ -125,12 +128,13 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
             H[a, b] = 0.0
     n_dyn = moving_rows(offs, n, dyn, still)
     store(0, nav, a_n, Pk, offs, out, keep_p, True, 0.0, 0)
-    if record is not None:  # smoother: P⁺ of the incoming state
+    if record is not None and rows_kept:  # smoother: P⁺ of the incoming state
         record_covariance(rec, 0, Pk)
     for k in range(1, t.shape[0]):
-        if record is not None:  # step-wise smoother, whole recording: smooth the segment that ended at k − 1
+        if record is not None and rows_kept:  # step-wise smoother, whole recording: smooth the segment that ended
             close_segment(rec, k, stance, t, idx, use_ext, out[0], out[1], out[2], out[4], out[5])
-            take_checkpoint(rec, k, nav, Pk, mems)  # RTS in bounded memory: the state at a block's start
+        elif record is not None:  # RTS in bounded memory: the state at a block's start
+            take_checkpoint(rec, k, nav, Pk, mems)
         dt = t[k] - t[k - 1]
         propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_n)
         for i in range(3):
@@ -139,7 +143,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
         sdt[0, 0], sdt[0, 1], sdt[0, 2] = 0.0, dt * f_n[2], -dt * f_n[1]
         sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * f_n[2], 0.0, dt * f_n[0]
         sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
-        if record is not None:  # smoother: Φ's blocks
+        if record is not None and rows_kept:  # smoother: Φ's blocks
             record_transition(rec, k, dt, sdt, cdt)
         propagate_rows(Pk, offs, dt, sdt, cdt)
         propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
@@ -153,7 +157,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
             for a in range(m):
                 cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
                 nis += innov * scaled
-                if record is not None:  # smoother: the row, its gain, ν / s
+                if record is not None and rows_kept:  # smoother: the row, its gain, ν / s
                     record_row(rec, k, H[a], kv, scaled)
                 for e in range(cnt):
                     H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
@@ -163,7 +167,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
             feed_back(nav, dx, offs, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
         after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
         store(k, nav, a_n, Pk, offs, out, keep_p, False, nis, m)
-        if record is not None:  # smoother: P⁺_k
+        if record is not None and rows_kept:  # smoother: P⁺_k
             record_covariance(rec, k, Pk)
 
 

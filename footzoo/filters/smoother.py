@@ -70,10 +70,10 @@ def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple
     ``(cov (N, n(n+1)/2): P⁺'s upper triangle, row by row (:func:`packed`), phi (N, 19): Φ's
     blocks, rows (R, 2n+1): the update rows h, k, ν/s one after the other, first (N,) int: each
     sample's first row in ``rows``, count (N,) int: its number of rows, segment (3,) int: the mode
-    (:data:`ROWS`, :data:`IN_LOOP`, :data:`CHECKPOINTS`), the first sample of the open segment, the
-    samples per checkpoint; smoothed (quat (M, 4), vel, pos, gyro_bias, acc_bias (M, 3)),
-    checkpoints (nav (J, 16), P (J, n, n), mems (J, s)))``. ``rows`` has room for ``m_max`` rows per
-    sample; only the rows written are touched.
+    (:data:`ROWS`, :data:`IN_LOOP`, :data:`CHECKPOINTS`), the first sample of the open segment (of
+    the next checkpoint's block), the samples per checkpoint; smoothed (quat (M, 4), vel, pos,
+    gyro_bias, acc_bias (M, 3)), checkpoints (nav (J, 16), P (J, n, n), mems (J, s)))``. ``rows``
+    has room for ``m_max`` rows per sample; only the rows written are touched.
 
     ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
     as soon as it has closed (:func:`footzoo.filters.stepwise.close_segment`), while its record is
@@ -131,8 +131,6 @@ def unowned_record(record):
 @njit(inline=True)
 def record_transition(record, k, dt, sdt, cdt):
     """Keep Φ_k's blocks (``sdt = −[f^n×] dt``, ``cdt = C dt``); sample k has no update row yet."""
-    if record[5][0] == CHECKPOINTS:
-        return
     phi, first, count = record[1], record[3], record[4]
     r = k - record[5][1]
     phi[r, 0] = dt
@@ -147,8 +145,6 @@ def record_transition(record, k, dt, sdt, cdt):
 @njit(inline=True)
 def record_row(record, k, h, gain, scaled_innovation):
     """Keep one scalar update row of sample k: ``h`` (n,), its gain ``k`` (n,) and ``ν / s``."""
-    if record[5][0] == CHECKPOINTS:
-        return
     rows, first, count = record[2], record[3], record[4]
     s = k - record[5][1]
     r = first[s] + count[s]
@@ -163,8 +159,6 @@ def record_row(record, k, h, gain, scaled_innovation):
 @njit(inline=True)
 def record_covariance(record, k, P):
     """Keep ``P⁺_k``: its upper triangle, row by row (P is symmetric; half the memory)."""
-    if record[5][0] == CHECKPOINTS:
-        return
     cov = record[0]
     r = k - record[5][1]
     n = P.shape[0]
@@ -177,12 +171,16 @@ def record_covariance(record, k, P):
 
 @njit(inline=True)
 def take_checkpoint(record, k, nav, P, mems):
-    """Before sample k (:data:`CHECKPOINTS`): the state after sample k − 1 when a block starts there (k − 1 = j·B)."""
+    """Before sample k (a :data:`CHECKPOINTS` record): the state after sample k − 1 if a block starts there.
+
+    The record's ``segment[1]`` is the next block's first sample (j·B, from 0), ``segment[2]`` B.
+    """
     segment = record[5]
-    if segment[0] != CHECKPOINTS or (k - 1) % segment[2] != 0:
+    if k - 1 != segment[1]:
         return
     snap_nav, snap_P, snap_mem = record[7]
-    j = (k - 1) // segment[2]
+    j = segment[1] // segment[2]
+    segment[1] += segment[2]
     for i in range(nav.shape[0]):
         snap_nav[j, i] = nav[i]
     for i in range(P.shape[0]):
@@ -291,7 +289,7 @@ def feed_back_attitude(q, ex, ey, ez):
     q[0], q[1], q[2], q[3] = qw / nq, qx / nq, qy / nq, qz / nq
 
 
-@njit
+@njit(inline=True)
 def correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
     """Apply the smoothed error ``e`` of sample k as the feedback is (``p ← p − e_p``, ``q ← exp(−e_φ) ⊗ q``, ...)."""
     att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
