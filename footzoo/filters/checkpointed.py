@@ -20,8 +20,9 @@ The loop run again from a checkpoint repeats the same operations on the same num
 writes the rows the single forward pass would have written, bit for bit, and the smoothed
 trajectory equals the RTS smoother's over one record of every sample exactly (a test keeps them
 equal). The cost is a second forward pass; the memory is the checkpoints (< 1 byte per sample)
-and one block's record, which stays in the processor's cache while the backward pass reads it
-(faster, on a 3·10⁵-sample walk, than one record of every sample written and read from memory).
+and one block's record, which stays in the processor's cache while the backward pass reads it:
+the second run costs about what writing one record of every sample to memory and reading it back
+did (docs/speed.md has the measurements).
 
 Block ``j`` covers samples ``a_j = j·B … b_j = min(a_j + B, N − 1)``: consecutive blocks share
 their end sample, as a stream's chunks do (row 0 of a chunk is the state it starts from, and
@@ -29,6 +30,8 @@ the update of sample ``b_j`` is in block ``j``).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -57,8 +60,8 @@ def checkpoint_record(n: int, n_state: int, n_mem: int, block: int) -> tuple:
     return (*empty[:5], np.array([CHECKPOINTS, 0, block], np.int64), empty[6], checkpoints)
 
 
-def backward(run_block, checkpoints: tuple, n: int, block: int, record: tuple, smoothed: tuple, idx: np.ndarray,
-             use_ext: bool) -> None:
+def backward(run_block: Callable[[int, int, np.ndarray, np.ndarray, np.ndarray], None], checkpoints: tuple, n: int,
+             block: int, record: tuple, smoothed: tuple, idx: np.ndarray, use_ext: bool) -> None:
     """The RTS backward pass over every block, last first, each block's record made again from its checkpoint.
 
     ``run_block(a, b, nav, P, mems)``: the compiled loop over samples ``a … b`` from the state
