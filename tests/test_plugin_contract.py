@@ -98,6 +98,25 @@ def test_within_a_run_an_array_proven_finite_is_not_scanned_again_but_any_other_
         det.detect(t, acc, gyr)  # outside: every call checks
 
 
+def test_an_output_that_passed_its_check_is_proven_finite_for_the_next_block_within_a_run_only():
+    """A block's output checked finite on return (check_array) is not scanned again as the next block's
+    input within the run; a copy of it is, and nothing is proven outside a run."""
+    from footzoo.plugins.base import inputs_checked_once
+    from footzoo.plugins.contract import Output, check_array, proven_finite
+
+    det = available("detector")["shoe"]()
+    out = np.ones((10, 3))
+    with inputs_checked_once():
+        assert not proven_finite(out)
+        check_array(det, "detect", "x_", out, Output(width=3), 10)
+        assert proven_finite(out) and not proven_finite(out.copy())
+        statistic = np.ones(10)
+        check_array(det, "detect", "statistic_", statistic, Output(finite=False), 10)
+        assert not proven_finite(statistic)  # an output that may hold NaN is not scanned, so proves nothing
+    check_array(det, "detect", "x_", out, Output(width=3), 10)
+    assert not proven_finite(out)
+
+
 def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
     class NotAPlugin:
         name = "x"

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from ..kernels.jit import njit
 from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
 from .errors import RecordingError, SensorWarning
@@ -383,6 +384,56 @@ def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) 
     return out
 
 
+@njit
+def _quiet_runs(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray, t_start: float,
+                gravity: float) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """One pass over a chunk for :class:`EstimateScan`: its still runs, its quiet runs off g, its stances.
+
+    A sample is quiet when |ω|² < :data:`STILL_GYR`²; a quiet sample is still when |‖f‖ − g| <
+    :data:`STILL_ACC`, and off g when |‖f‖ − g| > 0.5 g (the squares summed in column order, as
+    :func:`~footzoo.core.norms.row_norms` does). Returns the runs ``[s, e)`` of the still samples and
+    of the off-g ones, (2, M) and (2, K) sample indices into the chunk; the stance samples after
+    ``t_start`` (s) and the first sample after it (−1: none). 1 byte per sample of scratch.
+    """
+    n = acc.shape[0]
+    flags = np.empty(n, np.uint8)  # 0: neither, 1: still, 2: quiet and off g
+    counts = np.zeros(3, np.int64)
+    stances, first, prev = 0, -1, 0
+    for i in range(n):
+        w = 0.0
+        for j in range(gyr.shape[1]):
+            w += gyr[i, j] * gyr[i, j]
+        f = 0
+        if w < STILL_GYR * STILL_GYR:
+            a = 0.0
+            for j in range(acc.shape[1]):
+                a += acc[i, j] * acc[i, j]
+            off = abs(math.sqrt(a) - gravity)
+            f = 1 if off < STILL_ACC else (2 if off > 0.5 * gravity else 0)
+        flags[i] = f
+        if f != prev and f:
+            counts[f] += 1
+        prev = f
+        if t[i] > t_start:
+            stances += stance[i]
+            if first < 0:
+                first = i
+    still = np.empty((2, counts[1]), np.int64)
+    off_g = np.empty((2, counts[2]), np.int64)
+    filled = np.zeros(3, np.int64)
+    prev = 0
+    for i in range(n + 1):
+        f = flags[i] if i < n else 0
+        if f != prev:
+            if prev:  # a run of prev ends at i
+                (still if prev == 1 else off_g)[1, filled[prev] - 1] = i
+            if f:
+                (still if f == 1 else off_g)[0, filled[f]] = i
+                filled[f] += 1
+        prev = f
+    return still, off_g, stances, first
+
+
 class EstimateScan:
     """Physics of the estimate, fed the final estimates chunk by chunk (a batch run: one chunk of all).
 
@@ -415,22 +466,18 @@ class EstimateScan:
         """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m)."""
         if not len(t):
             return
-        moving = t > self.t_start
-        if moving.any():
-            self._stance += int(np.count_nonzero(stance[moving]))
-            if self._first is None:
-                i = int(np.argmax(moving))
-                self._first = (float(t[i]), pos[i].copy())
+        t, acc, gyr = (np.ascontiguousarray(a, dtype=float) for a in (t, acc, gyr))
+        still, off_g, stances, first = _quiet_runs(t, acc, gyr, np.ascontiguousarray(stance, dtype=bool),
+                                                   float(self.t_start), float(self.gravity))
+        self._stance += stances
+        if first >= 0 and self._first is None:
+            self._first = (float(t[first]), pos[first].copy())
         self._last = (float(t[-1]), pos[-1].copy())
-        quiet = row_norms_squared(gyr) < STILL_GYR**2
-        off_g = row_norms(acc) - self.gravity
-        self._scale(k, t, quiet, off_g)
-        still = quiet & (np.abs(off_g) < STILL_ACC)
-        if not still[0] and self._run is not None:  # the open run ended at the chunk's start
+        self._scale(k, t, acc, off_g)
+        starts, ends = still
+        if self._run is not None and not (len(starts) and starts[0] == 0):  # the open run ended at the chunk's start
             self._close(self._run)
             self._run = None
-        edges = np.flatnonzero(np.diff(np.concatenate([[False], still, [False]]).astype(np.int8)))
-        starts, ends = edges[::2], edges[1::2]
         # only the runs that can be long enough: the open ones at either end, and the long ones in between
         long = (t[ends - 1] - t[starts] >= STILL_MIN_DURATION) | (starts == 0) | (ends == len(t))
         for s, e in zip(starts[long].tolist(), ends[long].tolist(), strict=True):
@@ -446,22 +493,21 @@ class EstimateScan:
                 if s == 0:
                     self._run = None
 
-    def _scale(self, k: np.ndarray, t: np.ndarray, quiet: np.ndarray, off_g: np.ndarray) -> None:
+    def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, runs: np.ndarray) -> None:
         """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s.
 
-        ``quiet``: |ω| < STILL_GYR per sample; ``off_g``: ‖f‖ − g (m/s²).
+        ``runs``: (2, K) the chunk's runs ``[s, e)`` of quiet samples (|ω| < STILL_GYR) with ‖f‖
+        outside [0.5 g, 1.5 g] (:func:`_quiet_runs`); ``acc`` the chunk's specific force (m/s²).
         """
         if "acc_scale" in self.report:
             return
-        off = quiet & (np.abs(off_g) > 0.5 * self.gravity)
-        if not off.any() and self._off is None:
+        if not runs.shape[1] and self._off is None:
             return
-        edges = np.flatnonzero(np.diff(np.concatenate([[False], off, [False]]).astype(np.int8)))
         carried, self._off = self._off, None
-        for s, e in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):
+        for s, e in zip(runs[0].tolist(), runs[1].tolist(), strict=True):
             start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]))
             if t[e - 1] - start[1] >= SCALE_MIN_DURATION:
-                level = float(np.median(off_g[s:e])) + self.gravity  # ‖f‖ there
+                level = float(np.median(row_norms(acc[s:e]) - self.gravity)) + self.gravity  # ‖f‖ there
                 self._warn_scale(start, float(t[e - 1]), level)
                 return
             if e == len(t):  # open at the chunk's end: the next chunk may continue it

@@ -26,12 +26,10 @@ scikit-learn:
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import copy
 import functools
 import inspect
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -54,7 +52,7 @@ from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocab
     validated_init,
 )
 from ..filters.measurement import MeasurementModel, StateBlock
-from .contract import GUARDED, Output, guard
+from .contract import GUARDED, Output, guard, inputs_checked_once, mark_finite, proven_finite  # noqa: F401
 from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
 
 #: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
@@ -73,32 +71,10 @@ def _all_finite(value: np.ndarray) -> bool:
     return bool(np.isfinite(value).all())
 
 
-#: Within :func:`inputs_checked_once`: the float arrays proven finite so far, by ``id`` (held, so ids stay unique).
-_PROVEN: contextvars.ContextVar[dict[int, np.ndarray] | None] = contextvars.ContextVar("footzoo_proven_finite",
-                                                                                     default=None)
-
-
-@contextlib.contextmanager
-def inputs_checked_once() -> Iterator[None]:
-    """Within: an array argument already proven finite is not scanned again when the same object comes back.
-
-    A pipeline run hands its recording's arrays to one block after another; each action method
-    checks its inputs, and without this each block would scan the same ``t``, ``acc`` and ``gyr``
-    again. Only the very object checked is skipped (a new array, a copy or a calibrated signal is
-    checked), and only until the ``with`` block ends; outside one, every call checks.
-    """
-    token = _PROVEN.set({})
-    try:
-        yield
-    finally:
-        _PROVEN.reset(token)
-
-
 def _check_inputs(plugin: Plugin, names: list[str], args: tuple, kwargs: dict[str, Any]) -> None:
     """An action method's array inputs: a non-finite or non-numeric array argument raises a clear RecordingError."""
-    proven = _PROVEN.get()
     for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
-        if proven is not None and proven.get(id(value)) is value:
+        if proven_finite(value):
             continue
         if isinstance(value, np.ndarray) and value.dtype.kind in "fc" and not _all_finite(value):
             bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
@@ -109,8 +85,8 @@ def _check_inputs(plugin: Plugin, names: list[str], args: tuple, kwargs: dict[st
         if isinstance(value, np.ndarray) and value.dtype.kind not in "fcbiu":
             raise RecordingError(f"{plugin.kind} {plugin.name!r}: input {name!r} must be numeric, got dtype "
                                  f"{value.dtype}")
-        if proven is not None and isinstance(value, np.ndarray) and value.dtype.kind in "fc":
-            proven[id(value)] = value
+        if isinstance(value, np.ndarray) and value.dtype.kind in "fc":
+            mark_finite(value)
 
 
 class Plugin:

@@ -28,11 +28,13 @@ The checks only read; the numbers of a plug-in that keeps its contract are uncha
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import functools
 import inspect
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -76,6 +78,42 @@ class Output:
     width: int = 0
     finite: bool = True
     required: bool = True
+
+
+#: Within :func:`inputs_checked_once`: the float arrays proven finite so far, by ``id`` (held, so ids stay unique).
+_PROVEN: contextvars.ContextVar[dict[int, np.ndarray] | None] = contextvars.ContextVar("footzoo_proven_finite",
+                                                                                     default=None)
+
+
+@contextlib.contextmanager
+def inputs_checked_once() -> Iterator[None]:
+    """Within: an array argument already proven finite is not scanned again when the same object comes back.
+
+    A pipeline run hands its recording's arrays to one block after another, and one block's
+    checked outputs to the next; each action method checks its inputs, and without this each
+    block would scan the same ``t``, ``acc`` and ``gyr`` (or the calibrated signals, the attitude)
+    again. Only the very object proven is skipped (an input checked, or an output that passed
+    :func:`check_array`; a new array, a copy or a calibrated signal is checked), and only until the
+    ``with`` block ends; outside one, every call checks. Outputs are always checked.
+    """
+    token = _PROVEN.set({})
+    try:
+        yield
+    finally:
+        _PROVEN.reset(token)
+
+
+def proven_finite(value: Any) -> bool:
+    """True within :func:`inputs_checked_once` for the very array object already proven finite."""
+    proven = _PROVEN.get()
+    return proven is not None and proven.get(id(value)) is value
+
+
+def mark_finite(value: np.ndarray) -> None:
+    """Within :func:`inputs_checked_once`: ``value`` (this object) is proven finite."""
+    proven = _PROVEN.get()
+    if proven is not None:
+        proven[id(value)] = value
 
 
 def guard(method: Callable[..., Any], name: str, check_inputs: Callable[..., None] | None = None) -> Callable[..., Any]:
@@ -238,6 +276,8 @@ def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, 
         bad = np.flatnonzero(~np.isfinite(arr).reshape(len(arr), -1).all(axis=1))
         raise broken(plugin, method, f"set {label} with {len(bad)} non-finite sample(s) (NaN or inf), first at sample "
                                      f"{int(bad[0])}")
+    if (spec.finite or spec.what == "quat") and value is arr:
+        mark_finite(arr)  # finite: a later block given this very array need not scan it again
     if spec.what == "quat":
         err, k = unit_error(arr)  # max ||q|² - 1| ≈ 2 (|q| - 1)
         if err > 2 * QUAT_NORM_TOL:
