@@ -58,6 +58,18 @@ def test_euler_is_zyx_and_round_trips():
     np.testing.assert_allclose(quat_to_euler(q), rpy, atol=1e-9)
 
 
+def test_euler_into_a_strided_out_array_is_written_in_place_with_the_same_numbers():
+    """``out`` (here the transpose of a (3, N) array, as the result table passes it) is filled and returned,
+    bit for bit what a new array gets; a 90° turn to the east about down is yaw +π/2 (hand-derived)."""
+    rpy = np.column_stack([rng.uniform(-3, 3, 40), rng.uniform(-1.5, 1.5, 40), rng.uniform(-3, 3, 40)])
+    q = quat_from_euler(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    columns = np.full((3, 40), np.nan)
+    got = quat_to_euler(q, out=columns.T)
+    assert got.base is columns and np.array_equal(columns.T, quat_to_euler(q))
+    east = np.array([np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)])  # +90° about NED z (down): north -> east
+    np.testing.assert_allclose(quat_to_euler(east), [0.0, 0.0, np.pi / 2], atol=1e-15)
+
+
 def test_pitch_up_90_degrees_gives_pitch_plus_90():
     # pitch up: rotation of +90° about the body y axis (right); the toe (body x) then points up (NED -z)
     q = quat_from_rotvec(np.array([0.0, np.pi / 2, 0.0]))

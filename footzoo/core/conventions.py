@@ -145,17 +145,47 @@ def quat_from_euler(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.
     )
 
 
-def quat_to_euler(q: np.ndarray) -> np.ndarray:
-    """Z-Y-X Euler angles ``[roll, pitch, yaw]`` (rad), (..., 3), of unit quaternion(s).
+def quat_to_euler(q: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Z-Y-X Euler angles ``[roll, pitch, yaw]`` (rad), (..., 3), of unit quaternion(s) ``[w, x, y, z]``.
 
-    Roll and yaw lie in (-π, π], pitch in [-π/2, π/2].
+    roll = atan2(2 (w x + y z), 1 − 2 (x² + y²)), pitch = asin(2 (w y − x z)) (the argument
+    clipped to [−1, 1]), yaw = atan2(2 (w z + x y), 1 − 2 (y² + z²)). Roll and yaw lie in
+    (-π, π], pitch in [-π/2, π/2]. Each term is formed in ``out`` (a new array when not given;
+    it may be a strided view, e.g. the transpose of a (3, N) array) and in two scratch arrays:
+    no other temporaries, so a long recording costs three passes of numpy's vectorised arctan2
+    and arcsin, not a dozen arrays.
     """
     q = np.asarray(q, dtype=float)
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = np.arcsin(np.clip(2 * (w * y - x * z), -1.0, 1.0))
-    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return np.stack([roll, pitch, yaw], axis=-1)
+    w, x, y, z = (q[..., i] for i in range(4))
+    out = np.empty(q.shape[:-1] + (3,)) if out is None else out
+    roll, pitch, yaw = (out[..., i] for i in range(3))
+    den, term = np.empty(w.shape), np.empty(w.shape)
+    np.multiply(w, x, out=roll)
+    np.multiply(y, z, out=term)
+    roll += term
+    roll *= 2  # 2 (w x + y z)
+    np.multiply(x, x, out=den)
+    np.multiply(y, y, out=term)
+    den += term
+    den *= 2
+    np.subtract(1.0, den, out=den)  # 1 − 2 (x² + y²)
+    np.arctan2(roll, den, out=roll)
+    np.multiply(w, y, out=pitch)
+    np.multiply(x, z, out=term)
+    pitch -= term
+    pitch *= 2  # 2 (w y − x z)
+    np.arcsin(np.clip(pitch, -1.0, 1.0, out=pitch), out=pitch)
+    np.multiply(w, z, out=yaw)
+    np.multiply(x, y, out=term)
+    yaw += term
+    yaw *= 2  # 2 (w z + x y)
+    np.multiply(y, y, out=den)
+    np.multiply(z, z, out=term)
+    den += term
+    den *= 2
+    np.subtract(1.0, den, out=den)  # 1 − 2 (y² + z²)
+    np.arctan2(yaw, den, out=yaw)
+    return out
 
 
 def quat_from_rotvec(rv: np.ndarray) -> np.ndarray:

@@ -19,8 +19,8 @@ FLOAT_COLUMNS = ["t", "qw", "qx", "qy", "qz", "roll", "pitch", "yaw", "pos_n", "
                  "vel_n", "vel_e", "vel_d", "acc_n", "acc_e", "acc_d"]
 
 
-#: Samples per block of the Euler angles: numpy's vectorised arctan2 and arcsin (several times
-#: faster than a compiled loop over the math library's scalar functions) on temporaries of this size.
+#: Samples per block of the Euler angles: numpy's vectorised arctan2 and arcsin (faster than a
+#: compiled loop over the math library's scalar functions) with scratch arrays of this size.
 EULER_BLOCK = 1 << 14
 
 
@@ -28,7 +28,7 @@ def euler_columns(quat: np.ndarray) -> np.ndarray:
     """Z-Y-X Euler angles (rad), (3, N): roll, pitch, yaw of the (N, 4) attitudes, block by block."""
     out = np.empty((3, len(quat)))
     for s in range(0, len(quat), EULER_BLOCK):
-        out[:, s:s + EULER_BLOCK] = quat_to_euler(quat[s:s + EULER_BLOCK]).T
+        quat_to_euler(quat[s:s + EULER_BLOCK], out=out[:, s:s + EULER_BLOCK].T)
     return out
 
 
