@@ -524,7 +524,7 @@ def main(argv: list[str] | None = None) -> int:
         head, _, section = old.partition(FLAGSHIP_MARK)
         merged = {**accuracy_parts.read_parts(section), **blocks}  # the parts not rerun keep their blocks
         section = "\n".join(accuracy_parts.flagship_section(merged))
-        summary.write_text(f"{head.rstrip()}\n\n{FLAGSHIP_MARK}\n\n{section}")
+        summary.write_text(f"{head.rstrip()}\n\n{FLAGSHIP_MARK}\n\n{section.rstrip()}\n")
         print(f"flagship parts {flagship} in {summary}")
     return 0
 
