@@ -160,32 +160,30 @@ def quat_to_euler(q: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     out = np.empty(q.shape[:-1] + (3,)) if out is None else out
     roll, pitch, yaw = (out[..., i] for i in range(3))
     den, term = np.empty(w.shape), np.empty(w.shape)
-    np.multiply(w, x, out=roll)
-    np.multiply(y, z, out=term)
-    roll += term
-    roll *= 2  # 2 (w x + y z)
-    np.multiply(x, x, out=den)
-    np.multiply(y, y, out=term)
-    den += term
-    den *= 2
-    np.subtract(1.0, den, out=den)  # 1 − 2 (x² + y²)
-    np.arctan2(roll, den, out=roll)
+    _atan2_of_products(roll, (w, x, y, z), (x, y), den, term)
     np.multiply(w, y, out=pitch)
     np.multiply(x, z, out=term)
     pitch -= term
     pitch *= 2  # 2 (w y − x z)
     np.arcsin(np.clip(pitch, -1.0, 1.0, out=pitch), out=pitch)
-    np.multiply(w, z, out=yaw)
-    np.multiply(x, y, out=term)
-    yaw += term
-    yaw *= 2  # 2 (w z + x y)
-    np.multiply(y, y, out=den)
-    np.multiply(z, z, out=term)
+    _atan2_of_products(yaw, (w, z, x, y), (y, z), den, term)
+    return out
+
+
+def _atan2_of_products(angle: np.ndarray, products: tuple, squares: tuple, den: np.ndarray, term: np.ndarray) -> None:
+    """``angle = atan2(2 (a b + c d), 1 − 2 (e² + f²))`` in place; ``products = (a, b, c, d)``, ``squares = (e, f)``."""
+    a, b, c, d = products
+    e, f = squares
+    np.multiply(a, b, out=angle)
+    np.multiply(c, d, out=term)
+    angle += term
+    angle *= 2
+    np.multiply(e, e, out=den)
+    np.multiply(f, f, out=term)
     den += term
     den *= 2
-    np.subtract(1.0, den, out=den)  # 1 − 2 (y² + z²)
-    np.arctan2(yaw, den, out=yaw)
-    return out
+    np.subtract(1.0, den, out=den)
+    np.arctan2(angle, den, out=angle)
 
 
 def quat_from_rotvec(rv: np.ndarray) -> np.ndarray:
