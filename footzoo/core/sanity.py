@@ -384,6 +384,13 @@ def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) 
     return out
 
 
+def _read_only(a: np.ndarray, dtype: type) -> np.ndarray:
+    """``a`` as a C-contiguous array of ``dtype`` seen through a read-only view (no copy when it is one already)."""
+    view = np.ascontiguousarray(a, dtype=dtype).view()
+    view.flags.writeable = False
+    return view
+
+
 @njit
 def _quiet_runs(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray, t_start: float,
                 gravity: float) -> tuple[np.ndarray, np.ndarray, int, int]:
@@ -466,9 +473,10 @@ class EstimateScan:
         """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m)."""
         if not len(t):
             return
-        t, acc, gyr = (np.ascontiguousarray(a, dtype=float) for a in (t, acc, gyr))
-        still, off_g, stances, first = _quiet_runs(t, acc, gyr, np.ascontiguousarray(stance, dtype=bool),
-                                                   float(self.t_start), float(self.gravity))
+        # read-only views, whoever passes them (a batch run its recording's arrays, a stream its buffers):
+        # the scan then needs one compiled variant, the one a wheel ships
+        t, acc, gyr, ok = (_read_only(a, d) for a, d in ((t, float), (acc, float), (gyr, float), (stance, bool)))
+        still, off_g, stances, first = _quiet_runs(t, acc, gyr, ok, float(self.t_start), float(self.gravity))
         self._stance += stances
         if first >= 0 and self._first is None:
             self._first = (float(t[first]), pos[first].copy())
