@@ -59,7 +59,16 @@ def test_block_extraction():
     assert python_blocks('```python\n--8<-- "pyproject.toml"\n```\n')[0][1] == (ROOT / "pyproject.toml").read_text()
 
 
-@pytest.mark.parametrize("path", markdown_files(), ids=lambda p: str(p.relative_to(ROOT)))
+#: The pages whose code takes longest (a study, the tutorial's several runs: about 10 s each): with the slow tests.
+SLOW_PAGES = ("docs/getting-started.md", "docs/studies.md")
+
+
+def _page(path: Path) -> object:
+    name = str(path.relative_to(ROOT))
+    return pytest.param(path, id=name, marks=[pytest.mark.slow] if name in SLOW_PAGES else [])
+
+
+@pytest.mark.parametrize("path", [_page(p) for p in markdown_files()])
 def test_code_blocks_run(path, tmp_path):
     blocks = [b for b in python_blocks(path.read_text()) if b[2]]
     if path.name == "README.md":

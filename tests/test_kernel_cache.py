@@ -107,6 +107,7 @@ def test_a_new_process_loads_the_shipped_kernels_instead_of_compiling(shipped, c
     assert _cached_files(tmp_path / "b") == []  # nothing had to be compiled and cached
 
 
+@pytest.mark.slow  # its fixture compiles a config from nothing (about 12 s), as the other shipping tests
 def test_a_recording_read_from_a_file_without_magnetometer_needs_no_compilation_either(shipped, tmp_path):
     """The shipped code covers what readers give (pandas' read-only columns, no magnetometer), not only simulations."""
     from footzoo.io.canonical import write
