@@ -277,7 +277,7 @@ class Pipeline:
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
-        with inputs_checked_once():  # the recording's arrays are scanned for NaN once, not by every block
+        with inputs_checked_once():  # each array (the recording's, a block's checked output) is scanned for NaN once
             return self._run(rec, engine, covariance)
 
     def _run(self, rec: Recording, engine: str, covariance: bool) -> Result:
