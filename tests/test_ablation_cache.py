@@ -16,6 +16,8 @@ from footzoo.studies import CacheWarning, Study, read_trajectories, run_study
 from footzoo.studies import runner as runner_mod
 from footzoo.studies.runner import CACHE_FORMAT, read_entry
 
+from .conftest import made_once
+
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
 BASE = {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
@@ -312,34 +314,41 @@ def test_two_studies_on_one_output_folder_at_once(tmp_path):
     assert pd.read_csv(out / "results.csv").shape == table.shape
 
 
+#: A study with figures of every kind (a factor of two levels each, a sweep, the ROC, trajectories).
+FIGURES = {**SMALL, "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]}, "sweep": {"points": 5}}
+
+
+@pytest.fixture(scope="module")
+def serial_outputs(tmp_path_factory):
+    """:data:`FIGURES` run serially (once for all workers): the files the parallel runs must write alike."""
+    folder = made_once(tmp_path_factory, "figures-serial", lambda tmp: run_study(Study.from_dict(FIGURES), out=tmp))
+    files = {f.name: f.read_bytes() for f in folder.glob("*.png")}
+    assert len(files) > 5 and "roc.png" in files
+    return files, (folder / "summary.md").read_text()
+
+
 @pytest.mark.slow
-def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path):
-    study = Study.from_dict({**SMALL, "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]},
-                             "sweep": {"points": 5}})
-    run_study(study, out=tmp_path / "serial")
-    run_study(study, out=tmp_path / "parallel", jobs=2)
-    serial = {f.name: f.read_bytes() for f in (tmp_path / "serial").glob("*.png")}
+def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path, serial_outputs):
+    serial, summary = serial_outputs
+    run_study(Study.from_dict(FIGURES), out=tmp_path / "parallel", jobs=2)
     parallel = {f.name: f.read_bytes() for f in (tmp_path / "parallel").glob("*.png")}
-    assert len(serial) > 5 and "roc.png" in serial
     assert serial.keys() == parallel.keys()
     assert all(serial[name] == parallel[name] for name in serial)
+    assert (tmp_path / "parallel" / "summary.md").read_text() == summary
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("processes", [False, True])
-def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, processes):
+def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, serial_outputs, processes):
     """The cluster's workers draw in memory (one figure at a time per process), the client writes the files."""
     from dask.distributed import LocalCluster
 
-    study = Study.from_dict({**SMALL, "sweep": {"points": 5}})
-    run_study(study, out=tmp_path / "serial")
+    serial, summary = serial_outputs
     with LocalCluster(n_workers=2 if processes else 1, threads_per_worker=1 if processes else 2, processes=processes,
                       dashboard_address=None) as cluster:
-        table = run_study(study, out=tmp_path / "dask", scheduler=cluster.scheduler_address)
-    serial = {f.name: f.read_bytes() for f in (tmp_path / "serial").glob("*.png")}
+        table = run_study(Study.from_dict(FIGURES), out=tmp_path / "dask", scheduler=cluster.scheduler_address)
     dask = {f.name: f.read_bytes() for f in (tmp_path / "dask").glob("*.png")}
-    assert len(serial) > 3 and "roc.png" in serial
     assert serial.keys() == dask.keys()
     assert all(serial[name] == dask[name] for name in serial)
-    assert (tmp_path / "dask" / "summary.md").read_text() == (tmp_path / "serial" / "summary.md").read_text()
+    assert (tmp_path / "dask" / "summary.md").read_text() == summary
     assert table.attrs["failed"] == 0

@@ -121,19 +121,32 @@ def test_a_recording_read_from_a_file_without_magnetometer_needs_no_compilation_
     assert np.all(np.isfinite(warm["pos"]))
 
 
+#: The shipped kernel the damaged-folder tests change (a leaf: no other kernel calls it), and its files' stem.
+CHANGED_KERNEL, CHANGED_FILES = "_dedrift_kernel", "zvu_dedrift._dedrift_kernel-"
+
+
+def _copy_with_one_kernel(shipped: Path, to: Path) -> list[Path]:
+    """A copy of the shipped folder and the files of :data:`CHANGED_KERNEL` in it."""
+    shutil.copytree(shipped, to)
+    files = sorted(to.rglob(f"{CHANGED_FILES}*"))
+    assert {f.suffix for f in files} == {".nbi", ".nbc"}, files
+    return files
+
+
 @pytest.mark.slow
 def test_shipped_code_of_a_changed_source_file_is_ignored_not_used(shipped, cold, tmp_path):
-    changed = tmp_path / "shipped"
-    subprocess.run(["cp", "-r", str(shipped / "shipped"), str(changed)], check=True)
-    for index in _cached_files(changed):  # as if the module's source had changed since: another content hash
+    """Only the kernel whose source changed is compiled again; the others still load."""
+    files = _copy_with_one_kernel(shipped / "shipped", tmp_path / "shipped")
+    for index in (f for f in files if f.suffix == ".nbi"):  # as if its source had changed since: another hash
         with open(index, "rb") as f:
             version = pickle.load(f)
             stamp, overloads = pickle.loads(f.read())
         with open(index, "wb") as f:
             pickle.dump(version, f)
             f.write(pickle.dumps(("0" * 64, overloads)))
-    stale = json.loads(_run(RUN, cache=tmp_path / "b", shipped=changed).stdout)
-    assert sorted(stale["compiled"]) == sorted(cold["compiled"])
+    stale = json.loads(_run(RUN, cache=tmp_path / "b", shipped=tmp_path / "shipped").stdout)
+    assert CHANGED_KERNEL in cold["compiled"]
+    assert stale["compiled"] == [CHANGED_KERNEL]
     assert stale["pos"] == cold["pos"]
 
 
@@ -172,14 +185,13 @@ def test_compile_names_a_file_that_is_not_a_config(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, cold, tmp_path):
-    damaged = tmp_path / "shipped"
-    subprocess.run(["cp", "-r", str(shipped / "shipped"), str(damaged)], check=True)
-    for data in damaged.rglob("*.nbc"):
+    """Only the kernel whose machine code cannot be read is compiled; the others still load."""
+    for data in (f for f in _copy_with_one_kernel(shipped / "shipped", tmp_path / "shipped") if f.suffix == ".nbc"):
         data.write_bytes(b"not a pickle")
     proc = _run(RUN.replace('warnings.simplefilter("ignore")', 'warnings.simplefilter("default")'),
-                cache=tmp_path / "b", shipped=damaged)
+                cache=tmp_path / "b", shipped=tmp_path / "shipped")
     result = json.loads(proc.stdout)
-    assert sorted(result["compiled"]) == sorted(cold["compiled"])
+    assert result["compiled"] == [CHANGED_KERNEL]
     assert result["pos"] == cold["pos"]
     assert "could not be loaded" in proc.stderr
 
@@ -187,7 +199,10 @@ def test_a_damaged_shipped_file_is_compiled_instead_with_a_warning(shipped, cold
 @pytest.mark.slow
 def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_none_of_it(tmp_path):
     """A user's Kalman correction (the plug-in guide's example, beside its YAML) is compiled and cached like a
-    built-in one, whichever folder the command runs from."""
+    built-in one, whichever folder the command runs from. The built-in kernels come from the installed wheel
+    when there is one (conftest.py), so both processes compile only what the plug-in adds."""
+    from footzoo.kernels.installed import installed_kernels
+
     plugin = ROOT / "examples" / "plugins" / "magnetometer_heading_update.py"
     folder = tmp_path / "mine"
     folder.mkdir()
@@ -195,12 +210,14 @@ def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_non
     config = folder / "magu.yaml"
     config.write_text(f"plugins: [{plugin.name}]\norientation: {{type: ins}}\ndetector: {{type: shoe}}\n"
                       "corrections: [{type: ekf_zupt}, {type: magnetometer_heading}]\n")
-    env_run = dict(cache=tmp_path / "cache")
+    env_run = dict(cache=tmp_path / "cache", shipped=installed_kernels())
+    shipped_env = {} if env_run["shipped"] is None else {"FOOTZOO_SHIPPED_KERNELS": str(env_run["shipped"])}
     # the footzoo the other processes here run (the checkout, not an installed copy: another source, another cache)
     path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
     proc = subprocess.run([sys.executable, "-m", "footzoo", "compile", str(config)], capture_output=True, text=True,
                           cwd=tmp_path, timeout=600,
-                          env={**os.environ, "NUMBA_CACHE_DIR": str(env_run["cache"]), "PYTHONPATH": path})
+                          env={**os.environ, "NUMBA_CACHE_DIR": str(env_run["cache"]), "PYTHONPATH": path,
+                               **shipped_env})
     assert proc.returncode == 0, proc.stderr[-3000:]
     run = RUN.replace(f"footzoo.Pipeline.from_yaml({CONFIG!r})", f"footzoo.Pipeline.from_yaml({str(config)!r})")
     after = json.loads(_run(run, **env_run).stdout)
