@@ -427,7 +427,9 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
     if not xio.empty:
         lines += ["## x-io short walk (closed loop; x-io's own result: 82 mm)", "",
                   to_markdown(xio.pivot_table(index="config", columns="metric", values="value").reset_index(), 3), ""]
-    g = table[table["dataset"].str.startswith("gaitmap") & table["metric"].notna()]
+    # the per-stride comparisons and the path (a study also reports every other metric of the run)
+    g = table[table["dataset"].str.startswith("gaitmap")
+              & table["metric"].isin([*REFERENCE_METRICS["gaitmap"], "path_length_m", "steps"])]
     if not g.empty:
         gp = g.pivot_table(index=["config", "dataset"], columns="metric", values="value").reset_index()
         lines += ["## gaitmap example walk: strides against motion capture", "",
@@ -438,7 +440,8 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
                    "the left foot's turn, one reference stride over two steps, "
                   "stays unpaired.", "",
                   to_markdown(gp, 3), ""]
-    k = table[(table["dataset"] == "koroglu") & table["metric"].notna()]
+    k = table[(table["dataset"] == "koroglu")
+              & table["metric"].isin([*REFERENCE_METRICS["koroglu"], "path_length_m", "steps"])]
     if not k.empty:
         kp = k.pivot_table(index=["config", "recording"], columns="metric", values="value").reset_index()
         lines += ["## Köroğlu experiments 31–33: strides and footprints", "",

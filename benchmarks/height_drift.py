@@ -64,9 +64,14 @@ def variant(corr: dict[str, Any] | None = None, nav: dict[str, Any] | None = Non
     return cfg
 
 
+def zupt(velocity_std: float) -> dict[str, Any]:
+    """``recommended``'s ``zupt`` (its roll lever too) with another σ (m/s)."""
+    return {**base_config()["corrections"][0], "velocity_std": velocity_std}
+
+
 def accel_bias(std: float, velocity_std: float = 0.03, **more: Any) -> dict[str, Any]:
     """``ekf_zupt`` as ``recommended``'s ``zupt`` plus the accelerometer-bias block (initial σ ``std`` m/s²)."""
-    return {"type": "ekf_zupt", "velocity_std": velocity_std, "gyro_bias": False, "accel_bias": True,
+    return {**zupt(velocity_std), "type": "ekf_zupt", "gyro_bias": False, "accel_bias": True,
             "zero_rate": False, "accel_bias_std": std, "bias_limit": 0.0, **more}
 
 
@@ -77,7 +82,7 @@ LEVERS: dict[str, dict[str, Any]] = {
     "acc_bias 0.1 + gyro_bias 0.005": variant(accel_bias(0.1, gyro_bias=True, gyro_bias_std=0.005)),
     "acc_bias 0.1 + gyro_bias + zero rate": variant(accel_bias(0.1, gyro_bias=True, gyro_bias_std=0.005,
                                                                zero_rate=True, rate_std=0.05)),
-    **{f"zupt σ {v:g} m/s": variant({"type": "zupt", "velocity_std": v}) for v in (0.01, 0.1, 0.3)},
+    **{f"zupt σ {v:g} m/s": variant(zupt(v)) for v in (0.01, 0.1, 0.3)},
     **{f"impact_noise {v:g} s": variant(nav={"impact_noise": v}) for v in (1e-5, 1e-4, 3e-4)},
     **{f"velocity_noise {v:g}": variant(nav={"velocity_noise": v}) for v in (0.003, 0.3)},
     **{f"attitude_noise {v:g}": variant(nav={"attitude_noise": v}) for v in (1e-5, 1e-4)},
@@ -87,7 +92,7 @@ LEVERS: dict[str, dict[str, Any]] = {
 
 #: The cross-validated grid: accelerometer-bias σ (0: the 9-state filter) × zero-velocity σ × velocity noise.
 GRID = {f"acc_bias {ab:g}, zupt {zv:g}, vel_noise {vn:g}":
-        variant(accel_bias(ab, zv) if ab else {"type": "zupt", "velocity_std": zv}, nav={"velocity_noise": vn})
+        variant(accel_bias(ab, zv) if ab else zupt(zv), nav={"velocity_noise": vn})
         for ab, zv, vn in itertools.product((0.0, 0.01, 0.02, 0.1), (0.03, 0.1), (0.003, 0.03))}
 GRID_BASE = "acc_bias 0, zupt 0.03, vel_noise 0.03"  # recommended's own setting
 

@@ -125,9 +125,14 @@ def candidates() -> list[dict[str, Any]]:
 
 
 #: ``--refine``: the speed-adaptive detector's grid × its provisional pass's shortest swing (None: min_swing,
-#: the setting before; 0: no closing, the speed test alone closes the still gaps), the other factors at the
-#: full grid's choice (benchmarks/recommended_selection.md, "Chosen on all classes").
+#: the setting before; 0: no closing, the speed test alone closes the still gaps) × the zero-velocity update's
+#: roll lever (m; 0: constant noise, ``zupt``'s ``roll_lever``), the other factors at the full grid's choice
+#: (benchmarks/recommended_selection.md, "Chosen on all classes").
 REFINE_PROVISIONAL = [None, 0.0]
+REFINE_ROLL = [0.0, 0.1, 0.2, 0.3]
+#: The shipped setting before the roll lever (the first refinement's choice: provisional_min_swing 0, threshold
+#: 3000, speed_scale 1), which the refinement's report compares with.
+PREVIOUS_PROVISIONAL = 0.0
 REFINE_FIXED = {"noise": (1e-6, 0.03, 0.03), "impact": 0.0, "smoother": "rts", "guard": "off"}
 #: ``--refine`` also reports the height at the top of the simulated stairs at these rates (not a selection check).
 REFINE_STAIRS = {"path": "stairs", "n_strides": 6, "landing_strides": 3, "cycle": 1.2, "clearance": 0.1,
@@ -136,7 +141,7 @@ REFINE_MARK = "<!-- refinement: written by select_recommended.py --refine -->"
 
 
 def build(det: dict[str, Any], noise: tuple[float, float, float], impact: float, smoother: str,
-          guard: str) -> dict[str, Any]:
+          guard: str, roll: float = 0.0) -> dict[str, Any]:
     """One full config of the grid."""
     att, vel, vstd = noise
     cfg = copy.deepcopy(BASE)
@@ -145,6 +150,8 @@ def build(det: dict[str, Any], noise: tuple[float, float, float], impact: float,
     if impact:
         cfg["navigation"]["impact_noise"] = impact
     cfg["corrections"][0]["velocity_std"] = vstd
+    if roll:
+        cfg["corrections"][0]["roll_lever"] = roll
     if smoother != "none":
         cfg["smoother"] = smoother
     if guard == "off":
@@ -158,8 +165,8 @@ def refine_candidates() -> list[dict[str, Any]]:
     _, settings = THRESHOLDS["speed_adaptive_shoe"]
     f = REFINE_FIXED
     return [build({"type": "speed_adaptive_shoe", **v, **({} if pm is None else {"provisional_min_swing": pm})},
-                  f["noise"], f["impact"], f["smoother"], f["guard"])
-            for v in settings for pm in REFINE_PROVISIONAL]
+                  f["noise"], f["impact"], f["smoother"], f["guard"], roll)
+            for v in settings for pm in REFINE_PROVISIONAL for roll in REFINE_ROLL]
 
 
 def setting_name(cfg: dict[str, Any]) -> str:
@@ -169,6 +176,7 @@ def setting_name(cfg: dict[str, Any]) -> str:
     o = cfg["navigation"]
     return (f"{det['type']}({params})|att={o['attitude_noise']:g},vel={o['velocity_noise']:g},"
             f"zupt={cfg['corrections'][0]['velocity_std']:g}"
+            + (f",roll={cfg['corrections'][0]['roll_lever']:g}" if cfg["corrections"][0].get("roll_lever") else "")
             + (f",impact={o['impact_noise']:g}" if o.get("impact_noise") else "")
             + ("|rts" if cfg.get("smoother") == "rts" else "")
             + ("|no swing guard" if "guards" in cfg else ""))
@@ -226,7 +234,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--write", action="store_true", help="write footzoo/config/builtin/recommended.yaml")
     ap.add_argument("--progress", action="store_true")
     ap.add_argument("--refine", action="store_true",
-                    help="only the speed-adaptive detector x its provisional pass's shortest swing (REFINE_*)")
+                    help="only the speed-adaptive detector x its provisional pass's shortest swing x the roll lever "
+                         "(REFINE_*)")
     args = ap.parse_args(argv)
     os.environ.setdefault("PYTHONWARNINGS", "ignore::UserWarning")
     warnings.simplefilter("ignore", UserWarning)
@@ -315,8 +324,9 @@ def refine_section(cands: list[dict[str, Any]], err: pd.DataFrame, err3: pd.Data
                    folds: pd.DataFrame, cv: dict[str, Any], final: str, insample: dict[str, Any],
                    args: argparse.Namespace) -> list[str]:
     """The ``--refine`` section: the cross-validation on the small grid, the per-class comparison, the stairs."""
-    previous = next(c["name"] for c in cands if "provisional_min_swing" not in c["detector"]
-                    and c["detector"]["threshold"] == 3000.0 and c["detector"]["speed_scale"] == 1.0)
+    previous = next(c["name"] for c in cands if c["detector"].get("provisional_min_swing") == PREVIOUS_PROVISIONAL
+                    and c["detector"]["threshold"] == 3000.0 and c["detector"]["speed_scale"] == 1.0
+                    and not c["corrections"][0].get("roll_lever"))
     per_class = pd.DataFrame([{"class": c, "trials": int((classes == c).sum()),
                                "before: median (m)": err.loc[classes == c, previous].median(),
                                "chosen: median (m)": err.loc[classes == c, final].median(),
@@ -334,15 +344,20 @@ def refine_section(cands: list[dict[str, Any]], err: pd.DataFrame, err3: pd.Data
                                               "label": f"stairs_{r}hz"} for r in (100, 250, 400)]})
     st = run_cached(stairs, args.results / "select_recommended_stairs", args.jobs)
     st = st[st["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value")
-    return ["## Refinement: the provisional pass's shortest swing (`--refine`)", "",
+    return ["## Refinement: the provisional pass's shortest swing and the roll lever (`--refine`)", "",
             "On the simulator at 250 and 400 Hz the speed-adaptive detector took a foot that stops in the air "
             "before landing on a stair as standing from the stop on: its provisional pass (adaptive SHOE) closed "
             "the short swing after the stop, which set the strapdown speed there to zero and hid the motion from "
             "the speed test (benchmarks/accuracy.md, rate independence). `provisional_min_swing: 0` leaves the "
             "provisional swings as the adaptive test gives them; the speed test still closes the short gaps where "
-            "the foot stayed slower than `still_speed`. Grid: the speed-adaptive detector's 9 settings × "
-            f"provisional_min_swing ∈ {{min_swing, 0}}, the other factors at the full grid's choice "
-            f"({REFINE_FIXED}); the same leave-one-motion-class-out cross-validation and rate check.", "",
+            "the foot stayed slower than `still_speed` (a first refinement chose it: PyShoe's trials unchanged to "
+            "1e-6 m). The zero-velocity update's `roll_lever` ℓ (m) then weighs each stance sample by how fast "
+            "the foot turns, σ² = σ_v² + (ℓ |ω|)²: a foot rolling over its heel or its toes moves a sensor ℓ "
+            "from the pivot at ℓ |ω|, and a detected stance includes the heel rock and the toe roll. Grid: the "
+            "speed-adaptive detector's 9 settings × provisional_min_swing ∈ {min_swing, 0} × roll_lever ∈ "
+            f"{{{', '.join(f'{v:g}' for v in REFINE_ROLL)}}} m, the other factors at the full grid's choice "
+            f"({REFINE_FIXED}); the same leave-one-motion-class-out cross-validation and rate check. "
+            "`before` is the setting shipped before the roll lever.", "",
             "### Cross-validated figure", "", to_markdown(pd.DataFrame([cv]), 3), "", to_markdown(folds, 3), "",
             f"Chosen on all classes: `{final}`; before: `{previous}`.", "",
             "In-sample (optimistic) figures of the chosen setting:", "", to_markdown(pd.DataFrame([insample]), 3),

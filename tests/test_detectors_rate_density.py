@@ -7,6 +7,7 @@ simulator's σ per sample (Table II at 100 Hz) is scaled by sqrt(rate / 100 Hz) 
 import numpy as np
 import pytest
 
+from footzoo import Pipeline
 from footzoo.evaluation.metrics import stance_scores
 from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
@@ -19,13 +20,9 @@ NOISE_LIMITED = {"amvd", "mbgtd"}
 DETECTORS = sorted(name for name, cls in available("detector").items()
                    if not getattr(cls, "needs_truth", False) and name not in NOISE_LIMITED)
 #: The shipped configs' detector settings (footzoo/config/builtin/), beside every detector's defaults.
-SHIPPED = {
-    "recommended": ("speed_adaptive_shoe", {"threshold": 3000.0, "speed_scale": 1.0, "provisional_min_swing": 0.0}),
-    "yun2012": ("angular_rate_fsm", {"threshold": 0.6, "min_duration": 0.1}),
-    "nguyen2016": ("dgp", {"initial_delay": 0.8, "initial_threshold": 0.8, "min_swing": 0.2}),
-    "duong2015": ("windowed", {}),
-    "huang2016": ("huang_stance", {}),
-}
+SHIPPED = {name: (d["type"], {k: v for k, v in d.items() if k != "type"})
+           for name in ("recommended", "yun2012", "nguyen2016", "duong2015", "huang2016")
+           for d in [Pipeline.from_yaml(name).to_dict()["detector"]]}
 
 
 def _walk(rate: float):

@@ -92,7 +92,7 @@ def test_an_external_kalman_correction_runs_everywhere_like_the_builtin_it_copie
         pos = res["pos"] if isinstance(res, dict) else res.pos
         assert np.abs(pos - builtin.pos).max() <= 1e-9 * scale, how
     assert runs["auto"].config["engine"] == "fast"
-    assert runs["auto"].config["corrections"] == [{"type": "test_my_zupt", "velocity_std": 0.01}]
+    assert runs["auto"].config["corrections"] == [{"type": "test_my_zupt", "velocity_std": 0.01, "roll_lever": 0.0}]
 
 
 @pytest.mark.slow

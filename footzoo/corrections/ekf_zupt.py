@@ -20,14 +20,18 @@ from ..plugins.base import Boolean, KalmanCorrection, Real, Samples
 from ..plugins.registry import register
 
 #: Positions in the model's ``par``: σ of the velocity (m/s), zero rate on/off, σ of the rate (rad/s), the gyro
-#: and the accelerometer bias bounds (rad/s, m/s²); in ``mem``: the rows the bias guard added.
-VELOCITY_STD, ZERO_RATE, RATE_STD, GYRO_BOUND, ACC_BOUND = 0, 1, 2, 3, 4
+#: and the accelerometer bias bounds (rad/s, m/s²), the roll lever arm (m); in ``mem``: the rows the bias guard
+#: added.
+VELOCITY_STD, ZERO_RATE, RATE_STD, GYRO_BOUND, ACC_BOUND, ROLL_LEVER = 0, 1, 2, 3, 4, 5
 GUARD_ROWS = 0
 
 
 @measurement_function
 def zero_velocity_measure(ctx, rows):
     """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[ZERO_RATE]``, ``δω = ω̂ − 0`` (eq. 30).
+
+    The velocity rows' variance is ``σ_v² + (ℓ |ω̂|)²`` with ``ℓ = par[ROLL_LEVER]`` (m; 0: the
+    paper's ``σ_v²``), ``ω̂`` the bias-corrected angular rate (rad/s).
 
     In any sample, a bias estimate beyond its bound ``par[GYRO_BOUND]`` (rad/s) or
     ``par[ACC_BOUND]`` (m/s²) is measured at the bound, with σ a tenth of the
@@ -49,10 +53,12 @@ def zero_velocity_measure(ctx, rows):
     if not ctx.stance:
         return m
     vel = idx[VEL]
+    lever = par[ROLL_LEVER]
+    r = par[VELOCITY_STD] * par[VELOCITY_STD] + lever * lever * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     for i in range(3):
         H[m, vel + i] = 1.0
         z[m] = nav[V + i]
-        R[m] = par[VELOCITY_STD] * par[VELOCITY_STD]
+        R[m] = r
         m += 1
     if par[ZERO_RATE] != 0.0:
         gb = idx[GYRO_BIAS]
@@ -101,6 +107,16 @@ class EKFZUPT(KalmanCorrection):
     unchanged. 0: no guard (the paper's filter). How often it acted is in
     ``Result.diagnostics["bias_guard_rows"]``.
 
+    Rolling stance (footzoo's, ``roll_lever``): a detected stance includes the
+    heel rock after initial contact and the toe roll before toe-off, where the
+    foot turns about its heel or its toes at the angular rate ``ω``. A sensor
+    ``ℓ`` from that pivot then moves at ``ℓ |ω|`` (rigid body: ``v = ω × r``),
+    so the zero-velocity measurement is known to ``σ² = σ_v² + (ℓ |ω|)²`` only:
+    rolling samples weigh less than the still mid-stance, whatever the rate,
+    the sensor or the motion. ``ℓ`` is the largest sensor-to-pivot distance,
+    a fraction of the foot's length; 0 (the default) is the paper's constant
+    ``σ_v``.
+
     Parameters
     ----------
     gyro_bias, accel_bias : bool
@@ -117,6 +133,9 @@ class EKFZUPT(KalmanCorrection):
         Bias random-walk variance growth ((rad/s)²/s, (m/s²)²/s).
     bias_limit : float
         Bound of the bias estimates, in initial standard deviations (0: none).
+    roll_lever : float
+        Sensor-to-pivot distance ``ℓ`` of a rolling stance (m): the velocity
+        rows' variance is ``velocity_std² + (ℓ |ω|)²`` (0: constant).
     """
 
     name = "ekf_zupt"
@@ -145,6 +164,9 @@ class EKFZUPT(KalmanCorrection):
                                  source="Nguyen & La 2016's Q (zero)"),
         "bias_limit": Real("1", "[0, 1000]", "bound of the bias estimates in initial σ; 0: none",
                            source="footzoo's guard: beyond any turn-on bias of the paper's sensor (see the docstring)"),
+        "roll_lever": Real("m", "[0, 1]", "sensor-to-pivot distance of a rolling stance: σ² = σ_v² + (ℓ |ω|)²",
+                           source="footzoo's (rigid-body roll about the heel or the toes; see the docstring)",
+                           why="a foot is about 0.25 m long: beyond 1 m a turning foot's stance counts for nothing"),
     }
 
     def __init__(
@@ -159,6 +181,7 @@ class EKFZUPT(KalmanCorrection):
         gyro_bias_noise: float = 0.0,
         accel_bias_noise: float = 0.0,
         bias_limit: float = 10.0,
+        roll_lever: float = 0.0,
     ):
         if zero_rate and not gyro_bias:
             raise ConfigError("zero_rate measures the gyro bias: it needs gyro_bias: true (or set zero_rate: false)")
@@ -172,6 +195,7 @@ class EKFZUPT(KalmanCorrection):
         self.gyro_bias_noise = gyro_bias_noise
         self.accel_bias_noise = accel_bias_noise
         self.bias_limit = bias_limit
+        self.roll_lever = roll_lever
 
     def state_blocks(self) -> list[StateBlock]:
         """The core bias blocks this correction switches on (initial variance, variance growth per s)."""
@@ -191,7 +215,8 @@ class EKFZUPT(KalmanCorrection):
         return MeasurementModel(
             measure=zero_velocity_measure, max_rows=(6 if self.zero_rate else 3) + 6,
             par=np.array([self.velocity_std, 1.0 if self.zero_rate else 0.0, self.rate_std,
-                          self.bias_limit * self.gyro_bias_std, self.bias_limit * self.accel_bias_std]),
+                          self.bias_limit * self.gyro_bias_std, self.bias_limit * self.accel_bias_std,
+                          self.roll_lever]),
             mem=np.zeros(1), diagnostics=_bias_guard_report,
         )
 
@@ -211,13 +236,18 @@ class ZUPT(EKFZUPT):
     ----------
     velocity_std : float
         Standard deviation of v_zero (m/s).
+    roll_lever : float
+        Sensor-to-pivot distance of a rolling stance (m; 0, the default, is the
+        paper's constant noise): the variance is ``velocity_std² + (ℓ |ω|)²``,
+        see ``ekf_zupt``.
     """
 
     name = "zupt"
     observes = ("velocity",)
     paper = "Duong & Suh 2015, Sensors 15, eq. 23, Table 1"
     parameters = {"velocity_std": EKFZUPT.parameters["velocity_std"].replace(
-        source="Duong & Suh 2015, Table 1 (variance 0.0001)")}
+        source="Duong & Suh 2015, Table 1 (variance 0.0001)"), "roll_lever": EKFZUPT.parameters["roll_lever"]}
 
-    def __init__(self, velocity_std: float = 0.01):
-        super().__init__(gyro_bias=False, accel_bias=False, zero_rate=False, velocity_std=velocity_std)
+    def __init__(self, velocity_std: float = 0.01, roll_lever: float = 0.0):
+        super().__init__(gyro_bias=False, accel_bias=False, zero_rate=False, velocity_std=velocity_std,
+                         roll_lever=roll_lever)
