@@ -234,3 +234,47 @@ def test_measurement_functions_compile_without_reference_counting_and_allocating
     z2, H2, R2 = np.zeros(3), np.zeros((3, 9)), np.zeros(3)
     ctx = Context(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0))
     assert fn(ctx, Rows(z2, H2, R2, 0)) == 3 and np.array_equal(z2, z) and np.array_equal(H2, H)
+
+
+def _scaled_sum(x, pair, out):
+    """out[0] = sum(x) * pair[0] + pair[1].sum(): a kernel over an array and a tuple (for DirectCall)."""
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i]
+    extra = 0.0
+    for i in range(pair[1].shape[0]):
+        extra += pair[1][i]
+    out[0] = s * pair[0] + extra
+
+
+def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call():
+    """DirectCall skips numba's typing of arguments that have not changed: on every call the signature it
+    used is the one numba computes from the arguments, the result is the kernel's, and a signature not
+    compiled yet (another dtype, a strided view, a read-only array) goes through the dispatcher."""
+    from footzoo.kernels import jit as _jit
+    from footzoo.kernels.functions import DirectCall
+
+    kernel = _jit.njit(_scaled_sum)
+    call = DirectCall(kernel)
+    out, expected = np.zeros(1), np.zeros(1)
+    x64 = np.arange(10.0)
+    frozen = np.arange(4.0)
+    frozen.setflags(write=False)
+    pair = (2.0, np.ones(3))
+    cases = [(x64, pair), (x64, pair), (x64[2:], pair), (x64[::2], pair), (x64.astype(np.float32), pair),
+             (x64, (2.0, np.ones(3)[::2])), (frozen, (3, np.ones(2))), (x64[1:], pair)]
+    for x, p in cases:
+        call(x, p, out)
+        _scaled_sum(x, p, expected)  # the same function as Python
+        assert out[0] == expected[0]
+        if _jit.HAVE_NUMBA:
+            numba = _jit.load_numba()
+            assert call._types == tuple(numba.typeof(a) for a in (x, p, out))
+    if _jit.HAVE_NUMBA:  # the first call compiled every new signature; the rest ran the code compiled for it
+        assert len(_jit.compiled(kernel).overloads) == 5
+
+
+def test_a_direct_call_of_a_python_function_calls_it():
+    from footzoo.kernels.functions import DirectCall
+
+    assert DirectCall(lambda a, b: a + b)(2, 3) == 5

@@ -406,8 +406,12 @@ class KalmanEngine:
             state.bound = bind(eskf_loop, state.functions)
         return state
 
-    def step(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int) -> None:
+    def step(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out, k0: int, loop: Any = None) -> None:
         """Run the compiled loop over samples 1… of the given chunk, from ``packed``'s state.
+
+        ``loop``: how to call :func:`~footzoo.filters.kalman_fast.eskf_loop` (a
+        :class:`~footzoo.kernels.functions.DirectCall` of it for many calls of the same types; by
+        default the kernel itself).
 
         A model function that breaks its contract inside the loop (a row count it did not declare,
         or a write outside its arrays, which a plug-in's bounds-checked code turns into an exception)
@@ -422,7 +426,7 @@ class KalmanEngine:
             if packed.bound is not None:
                 packed.bound(signals, packed.core, state, arrays, outputs, k0, work, record)
             else:
-                eskf_loop(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, record)
+                (loop or eskf_loop)(signals, packed.core, state, (packed.functions, arrays), outputs, k0, work, record)
         self._raise_fault(work, caught)
 
     def _loop_arguments(self, packed: Packed, t, acc, gyr, stance, quat_ext, data, out) -> tuple:
@@ -452,7 +456,9 @@ class KalmanEngine:
         ``vel`` and ``pos`` are kept as ``*_forward``, then smoothed in place. ``packed`` ends in
         the forward filter's final state.
         """
+        from ..kernels.functions import DirectCall
         from .checkpointed import BLOCK, backward, checkpoint_record
+        from .kalman_fast import eskf_loop
         from .smoother import record_arrays
 
         nx, m_max = packed.P.shape[0], packed.core[4]
@@ -462,11 +468,14 @@ class KalmanEngine:
             out[f"{key}_forward"] = out[key].copy()
         scratch_out = self.outputs(BLOCK + 1, False)  # the block's outputs, run again: not read
         record = record_arrays(BLOCK + 1, nx, m_max)
+        loop = DirectCall(eskf_loop)  # one call per block, every one with the same argument types
+
         def run_block(a: int, b: int, nav: np.ndarray, P: np.ndarray, mems: np.ndarray) -> None:
             state = dataclasses.replace(packed, nav=nav, P=P, mems=mems)
             rows = {k: v[: b - a + 1] for k, v in scratch_out.items()}
             self.step(state, t[a:b + 1], acc[a:b + 1], gyr[a:b + 1], stance[a:b + 1],
-                      None if quat_ext is None else quat_ext[a:b + 1], data[a:b + 1], {**rows, "record": record}, a)
+                      None if quat_ext is None else quat_ext[a:b + 1], data[a:b + 1], {**rows, "record": record}, a,
+                      loop)
 
         backward(run_block, checkpoints[7], len(t), BLOCK, record,
                  (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"]), self.core_offsets(),

@@ -18,6 +18,9 @@ address). Everything numba-specific about that lives here:
   once (not at every call of the loop);
 - :func:`bind`: a loop with its functions bound in as constants (a live stream
   calls it many times with arrays only);
+- :class:`DirectCall`: a kernel called many times with arguments of the same types
+  (the whole-recording smoother's blocks), straight into its machine code, without
+  numba typing every argument of every call;
 - :func:`capture_faults`: an exception raised inside a function called through its
   address cannot unwind the loop (numba reports it as "ignored" and the call
   returns 0); this collects such exceptions so that the caller can raise them as
@@ -35,6 +38,8 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
+
+import numpy as np
 
 from . import jit as _jit
 
@@ -212,6 +217,63 @@ def bind(loop: Any, functions: tuple) -> Any:
 
         _BOUND[key] = _jit.load_numba().njit(nogil=True)(bound)
     return _BOUND[key]
+
+
+class DirectCall:
+    """``kernel(*args)`` straight into the machine code already compiled for the arguments' types.
+
+    numba's dispatcher types every argument of every call to choose the machine code; for the
+    error-state loop's tuple of first-class functions (the corrections' measurement functions)
+    that takes about 0.25 ms per call, which the whole-recording smoother paid once per block of
+    its backward pass (:mod:`footzoo.filters.checkpointed`). Here an argument that is the very
+    object of the previous call keeps its type, so does an array of the same dtype, dimensions,
+    contiguity and flags as the previous call's (what numba's type of an array is made of) and a
+    tuple (of the same class and length) whose elements all keep theirs; the others are typed as numba types them
+    (``typeof_pyval``), and the machine code compiled for that signature is called through its
+    entry point. A signature not compiled yet goes through the dispatcher, which compiles it, so
+    every call runs the code the dispatcher would have chosen. Without numba (or with
+    ``FOOTZOO_DISABLE_JIT=1``) the function is called as Python. The previous call's arguments
+    are kept (to compare them): make one per run, not one per process.
+    """
+
+    def __init__(self, kernel: Any):
+        self.kernel = kernel
+        self._args: tuple = ()
+        self._types: tuple = ()
+
+    def __call__(self, *args: Any) -> Any:
+        dispatcher = _jit.compiled(self.kernel) if _jit.HAVE_NUMBA else None
+        overloads = getattr(dispatcher, "overloads", None)
+        if overloads is None:  # plain Python
+            return self.kernel(*args)
+        last, known = self._args, self._types
+        if len(last) == len(args):
+            types = tuple(self._type(dispatcher, a, b, k) for a, b, k in zip(args, last, known, strict=True))
+        else:
+            types = tuple(dispatcher.typeof_pyval(a) for a in args)
+        self._args, self._types = args, types
+        compiled_for = overloads.get(types)
+        if compiled_for is None:
+            return dispatcher(*args)
+        return compiled_for.entry_point(*args)
+
+    @classmethod
+    def _type(cls, dispatcher: Any, value: Any, last: Any, known: Any) -> Any:
+        """numba's type of ``value``, given that ``last`` had the type ``known`` (numba interns its types)."""
+        if value is last:
+            return known
+        if type(value) is np.ndarray and type(last) is np.ndarray:  # numba's type: dtype, ndim, layout, flags
+            a, b = value.flags, last.flags
+            if (value.dtype is last.dtype and value.ndim == last.ndim and a.c_contiguous == b.c_contiguous
+                    and a.f_contiguous == b.f_contiguous and a.writeable == b.writeable and a.aligned == b.aligned):
+                return known
+            return dispatcher.typeof_pyval(value)
+        if type(value) is tuple and type(last) is tuple and len(value) == len(last) and hasattr(known, "types"):
+            inner = known.types
+            if len(inner) == len(value) and all(cls._type(dispatcher, v, b, k) is k
+                                                for v, b, k in zip(value, last, inner, strict=True)):
+                return known
+        return dispatcher.typeof_pyval(value)
 
 
 _capture = threading.local()
