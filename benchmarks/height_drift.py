@@ -191,13 +191,12 @@ def trial_gyro_scales(path: str) -> list[dict[str, Any]]:
 
 
 def scale_finders(scales: pd.DataFrame) -> pd.DataFrame:
-    """Per gyroscope axis: the scale error each trial's NIS, 2-D, 3-D and height would pick, and how they agree."""
+    """Per gyroscope axis: the scale error each trial's NIS, 2-D and 3-D error would pick, and how they agree."""
     out = []
     for axis, part in scales.groupby("axis"):
         pick = part.groupby("trial").apply(lambda g: pd.Series({
             "NIS": g.loc[g["NIS per row"].idxmin(), "scale error"], "2-D": g.loc[g["2-D (m)"].idxmin(), "scale error"],
-            "3-D": g.loc[g["3-D (m)"].idxmin(), "scale error"],
-            "height": g.loc[g["height RMS (m)"].idxmin(), "scale error"]}), include_groups=False)
+            "3-D": g.loc[g["3-D (m)"].idxmin(), "scale error"]}), include_groups=False)
         zero = part[part["scale error"] == 0.0].set_index("trial")["end height (% dist)"]
         up = part[part["scale error"] == GYRO_SCALES[-1]].set_index("trial")["end height (% dist)"]
         out.append({"axis": f"gyr_{axis}",
@@ -500,6 +499,9 @@ def main(argv: list[str] | None = None) -> int:
     motion = pd.DataFrame(par(delayed(trial_stance_motion)(f) for f in files))
     scales = pd.DataFrame([r for rows in par(delayed(trial_gyro_scales)(f) for f in files) for r in rows])
     finders = scale_finders(scales)
+    per_percent = finders["end height change per +1 % (% dist, median)"].abs()
+    corr = finders["correlation over trials, NIS pick vs 3-D pick"]
+    agree = finders["trials where the 2-D and 3-D picks agree"]
     print(f"runs: {time.time() - t0:.0f} s", flush=True)
 
     # slope of the end height (% of distance) per m/s² of accelerometer offset, per class (axis x)
@@ -586,13 +588,13 @@ def main(argv: list[str] | None = None) -> int:
         "row, against the one with the lowest 3-D error.", "",
         to_markdown(finders, digits=3), "",
         to_markdown(overall(scales.drop(columns=["axis", "scale error", "NIS per row"]), best), digits=3), "",
-        f"A 1 % scale error moves the end height by {finders.iloc[:, 1].abs().min():.2f}–"
-        f"{finders.iloc[:, 1].abs().max():.2f} % of the distance (the median end height: "
+        f"A 1 % scale error moves the end height by {per_percent.min():.2f}–{per_percent.max():.2f} % of the "
+        "distance (the median end height: "
         f"{scales.loc[scales['scale error'] == 0.0, 'end height (% dist)'].median():.2f} %), "
         "but the lowest NIS does not point to the scale that lowers the 3-D error (correlation over trials "
-        f"{finders.iloc[:, 5].min():+.2f} to {finders.iloc[:, 5].max():+.2f} on the three axes), and the scale "
-        f"that lowers the 3-D error raises the 2-D one on most trials (the two agree on {finders.iloc[:, 6].min()}"
-        f"–{finders.iloc[:, 6].max()} of 36): the innovations cannot calibrate the gyroscope, and a fixed scale "
+        f"{corr.min():+.2f} to {corr.max():+.2f} on the three axes), and the scale that lowers the 3-D error "
+        f"raises the 2-D one on most trials (the two agree on {agree.min()}–{agree.max()} of {len(files)}): "
+        "the innovations cannot calibrate the gyroscope, and a fixed scale "
         "(a calibration of PyShoe's sensor, which footzoo does not tune) trades 2-D for 3-D.", ""]
     lines += conclusion(levers, trims, motion, sim, cv_table, best, pv_table)
     args.out.write_text("\n".join(lines))

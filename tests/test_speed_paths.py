@@ -249,8 +249,9 @@ def _scaled_sum(x, pair, out):
 
 def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call():
     """DirectCall skips numba's typing of arguments that have not changed: on every call the signature it
-    used is the one numba computes from the arguments, the result is the kernel's, and a signature not
-    compiled yet (another dtype, a strided view, a read-only array) goes through the dispatcher."""
+    used is the one numba computes from the arguments (also for the same array once made read-only), the
+    result is the kernel's, and a signature not compiled yet (another dtype, a strided view, a read-only
+    array) goes through the dispatcher."""
     from footzoo.kernels import jit as _jit
     from footzoo.kernels.functions import DirectCall
 
@@ -261,9 +262,13 @@ def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call()
     frozen = np.arange(4.0)
     frozen.setflags(write=False)
     pair = (2.0, np.ones(3))
+    flipped = np.arange(6.0)  # the same array again after it was made read-only: its type changed
     cases = [(x64, pair), (x64, pair), (x64[2:], pair), (x64[::2], pair), (x64.astype(np.float32), pair),
-             (x64, (2.0, np.ones(3)[::2])), (frozen, (3, np.ones(2))), (x64[1:], pair)]
-    for x, p in cases:
+             (x64, (2.0, np.ones(3)[::2])), (frozen, (3, np.ones(2))), (x64[1:], pair), (flipped, pair),
+             (flipped, pair)]
+    for i, (x, p) in enumerate(cases):
+        if i == len(cases) - 1:
+            flipped.setflags(write=False)
         call(x, p, out)
         _scaled_sum(x, p, expected)  # the same function as Python
         assert out[0] == expected[0]
@@ -271,7 +276,7 @@ def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call()
             numba = _jit.load_numba()
             assert call._types == tuple(numba.typeof(a) for a in (x, p, out))
     if _jit.HAVE_NUMBA:  # the first call compiled every new signature; the rest ran the code compiled for it
-        assert len(_jit.compiled(kernel).overloads) == 5
+        assert len(_jit.compiled(kernel).overloads) == 6
 
 
 def test_a_direct_call_of_a_python_function_calls_it():

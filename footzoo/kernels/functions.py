@@ -219,61 +219,59 @@ def bind(loop: Any, functions: tuple) -> Any:
     return _BOUND[key]
 
 
+#: The array flags numba's type of an array depends on (C and F contiguity, writeable, aligned: NPY_ARRAY_*).
+_TYPE_FLAGS = 0x0001 | 0x0002 | 0x0400 | 0x0100
+
+
 class DirectCall:
     """``kernel(*args)`` straight into the machine code already compiled for the arguments' types.
 
     numba's dispatcher types every argument of every call to choose the machine code; for the
     error-state loop's tuple of first-class functions (the corrections' measurement functions)
     that takes about 0.25 ms per call, which the whole-recording smoother paid once per block of
-    its backward pass (:mod:`footzoo.filters.checkpointed`). Here an argument that is the very
-    object of the previous call keeps its type, so does an array of the same dtype, dimensions,
-    contiguity and flags as the previous call's (what numba's type of an array is made of) and a
-    tuple (of the same class and length) whose elements all keep theirs; the others are typed as numba types them
-    (``typeof_pyval``), and the machine code compiled for that signature is called through its
-    entry point. A signature not compiled yet goes through the dispatcher, which compiles it, so
-    every call runs the code the dispatcher would have chosen. Without numba (or with
-    ``FOOTZOO_DISABLE_JIT=1``) the function is called as Python. The previous call's arguments
-    are kept (to compare them): make one per run, not one per process.
+    its backward pass (:mod:`footzoo.filters.checkpointed`). Here each call's arguments get a cheap
+    key made of what numba's type of them depends on (:meth:`key`: an array's dtype, dimensions,
+    contiguity and flags; a Python scalar's class; a tuple's class and its elements' keys; any other
+    object itself). While the key is the previous call's, the machine code found for it is called
+    through its entry point; a new key is typed as numba types it (``typeof_pyval``) and looked
+    up, and a signature not compiled yet goes through the dispatcher, which compiles it: every call
+    runs the code the dispatcher would have chosen. Without numba (or with
+    ``FOOTZOO_DISABLE_JIT=1``) the function is called as Python. The previous call's arguments are
+    kept (their keys hold objects by identity): make one per run, not one per process.
     """
 
     def __init__(self, kernel: Any):
         self.kernel = kernel
-        self._args: tuple = ()
+        self._args: tuple = ()  # the previous call's arguments, alive while their key is compared
+        self._key: tuple | None = None
         self._types: tuple = ()
+        self._entry: Any = None  # the machine code compiled for ``_types`` (None: not compiled yet)
 
     def __call__(self, *args: Any) -> Any:
         dispatcher = _jit.compiled(self.kernel) if _jit.HAVE_NUMBA else None
         overloads = getattr(dispatcher, "overloads", None)
         if overloads is None:  # plain Python
             return self.kernel(*args)
-        last, known = self._args, self._types
-        if len(last) == len(args):
-            types = tuple(self._type(dispatcher, a, b, k) for a, b, k in zip(args, last, known, strict=True))
-        else:
-            types = tuple(dispatcher.typeof_pyval(a) for a in args)
-        self._args, self._types = args, types
-        compiled_for = overloads.get(types)
-        if compiled_for is None:
+        key = self.key(args)
+        if self._entry is None or key != self._key:
+            self._types = tuple(dispatcher.typeof_pyval(a) for a in args)
+            compiled_for = overloads.get(self._types)
+            self._entry = None if compiled_for is None else compiled_for.entry_point
+        self._args, self._key = args, key
+        if self._entry is None:
             return dispatcher(*args)
-        return compiled_for.entry_point(*args)
+        return self._entry(*args)
 
     @classmethod
-    def _type(cls, dispatcher: Any, value: Any, last: Any, known: Any) -> Any:
-        """numba's type of ``value``, given that ``last`` had the type ``known`` (numba interns its types)."""
-        if value is last:
-            return known
-        if type(value) is np.ndarray and type(last) is np.ndarray:  # numba's type: dtype, ndim, layout, flags
-            a, b = value.flags, last.flags
-            if (value.dtype is last.dtype and value.ndim == last.ndim and a.c_contiguous == b.c_contiguous
-                    and a.f_contiguous == b.f_contiguous and a.writeable == b.writeable and a.aligned == b.aligned):
-                return known
-            return dispatcher.typeof_pyval(value)
-        if type(value) is tuple and type(last) is tuple and len(value) == len(last) and hasattr(known, "types"):
-            inner = known.types
-            if len(inner) == len(value) and all(cls._type(dispatcher, v, b, k) is k
-                                                for v, b, k in zip(value, last, inner, strict=True)):
-                return known
-        return dispatcher.typeof_pyval(value)
+    def key(cls, value: Any) -> Any:
+        """What numba's type of ``value`` is made of, cheap to compute and to compare."""
+        if type(value) is np.ndarray:
+            return value.dtype, value.ndim, value.flags.num & _TYPE_FLAGS
+        if type(value) is tuple:
+            return tuple, tuple([cls.key(v) for v in value])
+        if type(value) in (int, float, bool) or value is None:
+            return type(value)
+        return type(value), id(value)
 
 
 _capture = threading.local()
