@@ -219,14 +219,28 @@ def _engine_inputs(p, rec):
     return (lambda: p.kalman_engine([c.clone() for c in p.filter_corrections], samples, "fast")), stance, q0, quat
 
 
-@pytest.mark.parametrize("block", [1, 7, 1024, 10**6])
+def _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat):
+    """The forward pass with the record of every sample, then the backward pass over it (no checkpoint)."""
+    ref = make()
+    nav0 = np.zeros(16)
+    nav0[:4] = quat[0] if quat is not None else q0
+    state = ref.start(nav0)
+    full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.models], 0, True, record=True)
+    forward = {k: full[k].copy() for k in ("quat", "vel", "pos", "acc_nav", "P_diag", "nis")}
+    ref.smooth(full, np.array([len(t) - 1]))
+    return full, forward, ref.diagnostics(state)
+
+
+@pytest.mark.parametrize(("block", "min_gap"), [(1, 32), (7, 32), (1024, 32), (10**6, 1), (10**6, 10**6)])
 @pytest.mark.parametrize("name", ["nguyen2016", "duong2015_zupt_height", "madgwick+zupt"])
-def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample_bit_for_bit(walk, name, block,
-                                                                                            monkeypatch):
-    """``smoother: rts`` keeps checkpoints and makes the record again block by block: the same smoothed
-    trajectory, bit for bit, as one record of every sample, whatever the block length (one block, blocks
-    of 2 samples, a last block shorter than the others), with biases and memory-keeping models (nguyen2016:
-    15 states and the heading reduction; the height update) and with an external attitude."""
+def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample(walk, name, block, min_gap,
+                                                                                monkeypatch):
+    """``smoother: rts`` keeps checkpoints, runs the filter again over the updates piece by piece and
+    smooths the swings in closed form: the same smoothed trajectory as one record of every sample (to
+    rounding: 1e-12 of the largest value), whatever the pieces (a piece per sample, pieces of 7 samples,
+    the last shorter, a piece per stance, one piece), with biases and memory-keeping models (nguyen2016:
+    15 states and the heading reduction; the height update) and with an external attitude; the forward
+    pass's outputs bit for bit."""
     from footzoo.filters import checkpointed
 
     if name == "madgwick+zupt":
@@ -238,21 +252,41 @@ def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample_
     t, acc, gyr, n = walk.t, walk.acc, walk.gyr, len(walk.t)
     assert n > 2 * 1024 + 1 and n % 7 != 1  # several blocks of 1024, the last shorter
     monkeypatch.setattr(checkpointed, "BLOCK", block)
-    eng = make()
-    got = eng.run(t, acc, gyr, stance, q0, quat, covariance=True, smoother="rts")
-
-    ref = make()  # the forward pass with the record of every sample, then the backward pass over it
-    nav0 = np.zeros(16)
-    nav0[:4] = quat[0] if quat is not None else q0
-    state = ref.start(nav0)
-    full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.models], 0, True, record=True)
-    forward = {k: full[k].copy() for k in ("quat", "vel", "pos", "acc_nav", "P_diag", "nis")}
-    ref.smooth(full, np.array([n - 1]))
+    monkeypatch.setattr(checkpointed, "MIN_GAP", min_gap)
+    got = make().run(t, acc, gyr, stance, q0, quat, covariance=True, smoother="rts")
+    full, forward, diagnostics = _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat)
     for key in ("quat", "vel", "pos", "gyro_bias", "acc_bias"):
-        np.testing.assert_array_equal(got[key], full[key], err_msg=key)
+        np.testing.assert_allclose(got[key], full[key], rtol=0, atol=1e-12 * max(1.0, np.abs(full[key]).max()),
+                                   err_msg=key)
     for key in ("quat", "vel", "pos"):
         np.testing.assert_array_equal(got[f"{key}_forward"], forward[key], err_msg=key)
     for key in ("acc_nav", "P_diag", "nis"):  # the forward pass's, every block's first row included
         np.testing.assert_array_equal(got[key], forward[key], err_msg=key)
-    assert got["diagnostics"].keys() == ref.diagnostics(state).keys()
+    assert got["diagnostics"].keys() == diagnostics.keys()
     assert np.abs(got["vel"] - got["vel_forward"]).max() > 1e-4  # it did smooth
+
+
+@pytest.mark.parametrize("stance_kind", ["flickering", "never", "always", "ends_in_swing"])
+def test_the_checkpointed_rts_smoother_holds_whatever_the_stance(walk, stance_kind):
+    """Pieces start at the stance's starts: a detector's stance that flickers sample by sample, that never
+    starts (no update at all: every sample in closed form), that never ends (no swing) or a recording that
+    ends in a swing give the smoother over one record of every sample too."""
+    p = Pipeline.from_yaml("duong2015_zupt")
+    make, stance, q0, quat = _engine_inputs(p, walk)
+    t, acc, gyr, n = walk.t, walk.acc, walk.gyr, len(walk.t)
+    if stance_kind == "flickering":
+        stance = stance & (np.random.default_rng(0).random(n) < 0.7)
+    elif stance_kind == "never":
+        stance = np.zeros(n, bool)
+    elif stance_kind == "always":
+        stance = np.ones(n, bool)
+    else:
+        stance = stance.copy()
+        stance[-150:] = False
+    got = make().run(t, acc, gyr, stance, q0, quat, covariance=True, smoother="rts")
+    full, _, _ = _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat)
+    for key in ("quat", "vel", "pos"):
+        np.testing.assert_allclose(got[key], full[key], rtol=0, atol=1e-12 * max(1.0, np.abs(full[key]).max()),
+                                   err_msg=key)
+    if stance_kind != "never":
+        assert np.abs(got["vel"] - got["vel_forward"]).max() > 1e-4  # it did smooth

@@ -457,29 +457,37 @@ class KalmanEngine:
         the forward filter's final state.
         """
         from ..kernels.functions import DirectCall
-        from .checkpointed import BLOCK, backward, checkpoint_record
+        from . import checkpointed as cp
         from .kalman_fast import eskf_loop
-        from .smoother import record_arrays
+        from .smoother import PHI_WIDTH
 
-        nx, m_max = packed.P.shape[0], packed.core[4]
-        checkpoints = checkpoint_record(len(t), nx, packed.mems.size, BLOCK)
-        self.step(packed, t, acc, gyr, stance, quat_ext, data, {**out, "record": checkpoints}, 0)
+        nx, n_mem, block = packed.P.shape[0], packed.mems.size, cp.BLOCK
+        forward_record = cp.checkpoint_record(stance, nx, n_mem, block, cp.MIN_GAP)
+        self.step(packed, t, acc, gyr, stance, quat_ext, data, {**out, "record": forward_record}, 0)
         for key in ("quat", "vel", "pos"):
             out[f"{key}_forward"] = out[key].copy()
-        scratch_out = self.outputs(BLOCK + 1, False)  # the block's outputs, run again: not read
-        record = record_arrays(BLOCK + 1, nx, m_max)
-        loop = DirectCall(eskf_loop)  # one call per block, every one with the same argument types
+        spans = cp.pieces(forward_record, len(t))
+        record = cp.replay_record(forward_record, nx, packed.core[4], block + 1)
+        # each piece from a copy of its checkpoint; the outputs are not written
+        replay = dataclasses.replace(packed, nav=np.empty(16), P=np.empty((nx, nx)), mems=np.empty(n_mem))
+        scratch = self.outputs(1, False)
+        loop = DirectCall(eskf_loop)  # one call per batch, every one with the same argument types
 
-        def run_block(a: int, b: int, nav: np.ndarray, P: np.ndarray, mems: np.ndarray) -> None:
-            state = dataclasses.replace(packed, nav=nav, P=P, mems=mems)
-            rows = {k: v[: b - a + 1] for k, v in scratch_out.items()}
-            self.step(state, t[a:b + 1], acc[a:b + 1], gyr[a:b + 1], stance[a:b + 1],
-                      None if quat_ext is None else quat_ext[a:b + 1], data[a:b + 1], {**rows, "record": record}, a,
-                      loop)
+        def run() -> None:
+            self.step(replay, t, acc, gyr, stance, quat_ext, data, {**scratch, "record": record}, 0, loop)
 
-        backward(run_block, checkpoints[7], len(t), BLOCK, record,
-                 (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"]), self.core_offsets(),
-                 not self.carries_attitude)
+        core = packed.core  # (idx, q, gravity, use_ext, m_max, impact): the loop's noise and gravity
+        lam = np.zeros(nx)  # λ carried from piece to piece, zero after the last sample
+        forward = (writable_array(t, float), out["quat_forward"], out["acc_nav"])
+        buffers = (np.empty((block + 1, nx)), np.empty((block + 1, PHI_WIDTH)), np.empty(nx), np.empty(nx),
+                   np.empty((3, 3)))
+        smoothed = (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"])
+
+        def smooth(j0: int, j1: int) -> None:
+            cp.smooth_pieces(record, spans, j0, j1, lam, forward, (core[1], core[5], core[2]), self.core_offsets(),
+                             not self.carries_attitude, smoothed, buffers)
+
+        cp.backward(run, record, spans, smooth, block)
 
     def fault(self, j: int, rows: int, k: int, caught: list[BaseException]) -> PluginError:
         """The :class:`PluginError` for a model that broke its contract in the loop (see :meth:`step`)."""

@@ -61,13 +61,14 @@ The arguments of :func:`eskf_loop`:
     For a smoother (:mod:`footzoo.filters.stepwise`: step-wise, or RTS over the whole recording), from
     :func:`footzoo.filters.smoother.record_arrays` with a row per sample: each sample's
     ``P⁺``, Φ's blocks and update rows are written (made ``in_loop``: each segment is smoothed
-    in place as soon as it has closed, the last one left to the caller). ``None``: compiled
-    without that code.
+    in place as soon as it has closed, the last one left to the caller). For the RTS smoother in
+    bounded memory (:mod:`footzoo.filters.checkpointed`): no rows, the state where each piece
+    starts (mode ``CHECKPOINTS``: the forward pass), or the pieces a ``REPLAY`` record names, each
+    run again from its checkpoint to its last update with a row per sample and no output written
+    (``signals`` are then the whole recording's). ``None``: compiled without that code.
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -76,15 +77,18 @@ from ..kernels.views import unowned
 from .measurement import ACC_BIAS, ATT, BA, BG, GYRO_BIAS, POS, VEL, P, Q, V
 from .smoother import (
     CHECKPOINTS,
+    REPLAY,
     feed_back_attitude,
+    mark_update,
     record_covariance,
     record_row,
     record_transition,
+    start_piece,
     take_checkpoint,
     unowned_record,
 )
 from .stepwise import close_segment
-from .strapdown import quat_product, rotvec_quat
+from .strapdown import mid_rotation, quat_product, rotvec_quat
 
 
 @njit
@@ -118,57 +122,65 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
              unowned(rows))
     fault[0], fault[1], fault[2] = -1, 0, 0
     rows_kept = False  # a record of the rows of every sample, or of the checkpoints only (read once)
+    replaying = False  # the pieces of a record's checkpoints run again, each from its own
+    j_lo, j_hi = 0, 1  # one piece: samples 0 … N − 1 from ``state``
     if record is not None:  # a smoother's record, its arrays as views that own no reference too
         rec = unowned_record(record)
-        rows_kept = rec[5][0] != CHECKPOINTS
-    for a in range(m_max):
-        z[a] = 0.0
-        rdiag[a] = 0.0
-        for b in range(n):
-            H[a, b] = 0.0
+        rows_kept, replaying = rec[5][0] != CHECKPOINTS, rec[5][0] == REPLAY
+        if replaying:
+            j_lo, j_hi = rec[5][2], rec[5][3]
+    z[:m_max], rdiag[:m_max], H[:m_max] = 0.0, 0.0, 0.0
     n_dyn = moving_rows(offs, n, dyn, still)
-    store(0, nav, a_n, Pk, offs, out, keep_p, True, 0.0, 0)
-    if record is not None and rows_kept:  # smoother: P⁺ of the incoming state
-        record_covariance(rec, 0, Pk)
-    for k in range(1, t.shape[0]):
-        if record is not None and rows_kept:  # step-wise smoother, whole recording: smooth the segment that ended
-            close_segment(rec, k, stance, t, idx, use_ext, out[0], out[1], out[2], out[4], out[5])
-        elif record is not None:  # RTS in bounded memory: the state at a block's start
-            take_checkpoint(rec, k, nav, Pk, mems)
-        dt = t[k] - t[k - 1]
-        propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_n)
-        for i in range(3):
-            for j in range(3):
-                cdt[i, j] = dt * c[i, j]
-        sdt[0, 0], sdt[0, 1], sdt[0, 2] = 0.0, dt * f_n[2], -dt * f_n[1]
-        sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * f_n[2], 0.0, dt * f_n[0]
-        sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
-        if record is not None and rows_kept:  # smoother: Φ's blocks
-            record_transition(rec, k, dt, sdt, cdt)
-        propagate_rows(Pk, offs, dt, sdt, cdt)
-        propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
-        add_process_noise(Pk, offs, qn, impact, a_n, dt)
-        st = stance[k]
-        m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
-        nis = 0.0
-        if m > 0:
-            for i in range(n):
-                dx[i] = 0.0
-            for a in range(m):
-                cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
-                nis += innov * scaled
-                if record is not None and rows_kept:  # smoother: the row, its gain, ν / s
-                    record_row(rec, k, H[a], kv, scaled)
-                for e in range(cnt):
-                    H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
-            for i in range(n):
-                for j in range(i + 1, n):
-                    Pk[j, i] = Pk[i, j]
-            feed_back(nav, dx, offs, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
-        after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
-        store(k, nav, a_n, Pk, offs, out, keep_p, False, nis, m)
-        if record is not None and rows_kept:  # smoother: P⁺_k
-            record_covariance(rec, k, Pk)
+    for piece in range(j_lo, j_hi):
+        lo, hi = 0, t.shape[0] - 1
+        if record is not None and replaying:  # from its checkpoint to its last update; no output written
+            lo, hi = start_piece(rec, piece, nav, Pk, mems)
+        else:
+            store(0, nav, a_n, Pk, offs, out, keep_p, True, 0.0, 0)
+        if record is not None and rows_kept:  # smoother: P⁺ of the incoming state
+            record_covariance(rec, lo, Pk)
+        for k in range(lo + 1, hi + 1):
+            if record is not None and rows_kept:  # step-wise smoother, whole recording: smooth the segment that ended
+                close_segment(rec, k, stance, t, idx, use_ext, out[0], out[1], out[2], out[4], out[5])
+            elif record is not None:  # RTS in bounded memory: the state where a piece starts
+                take_checkpoint(rec, k, stance, nav, Pk, mems)
+            dt = t[k] - t[k - 1]
+            propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_n)
+            for i in range(3):
+                for j in range(3):
+                    cdt[i, j] = dt * c[i, j]
+            sdt[0, 0], sdt[0, 1], sdt[0, 2] = 0.0, dt * f_n[2], -dt * f_n[1]
+            sdt[1, 0], sdt[1, 1], sdt[1, 2] = -dt * f_n[2], 0.0, dt * f_n[0]
+            sdt[2, 0], sdt[2, 1], sdt[2, 2] = dt * f_n[1], -dt * f_n[0], 0.0
+            if record is not None and rows_kept:  # smoother: Φ's blocks
+                record_transition(rec, k, dt, sdt, cdt)
+            propagate_rows(Pk, offs, dt, sdt, cdt)
+            propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
+            add_process_noise(Pk, offs, qn, impact, a_n, dt)
+            st = stance[k]
+            m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
+            nis = 0.0
+            if m > 0:
+                for i in range(n):
+                    dx[i] = 0.0
+                for a in range(m):
+                    cnt, scaled, innov = update_row(Pk, z, H, rdiag, a, dx, u, kv, g, nzc)
+                    nis += innov * scaled
+                    if record is not None and rows_kept:  # smoother: the row, its gain, ν / s
+                        record_row(rec, k, H[a], kv, scaled)
+                    for e in range(cnt):
+                        H[a, nzc[e]] = 0.0  # leave H all zero for the next sample
+                for i in range(n):
+                    for j in range(i + 1, n):
+                        Pk[j, i] = Pk[i, j]
+                feed_back(nav, dx, offs, use_ext, functions[1], views, mems, k0 + k, t[k], w, f, st, data[k])
+                if record is not None and not rows_kept:  # RTS in bounded memory: the piece's updates reach here
+                    mark_update(rec, k)
+            after(functions[2], views, k0 + k, t[k], nav, w, f, st, mems, data[k])
+            if not replaying:
+                store(k, nav, a_n, Pk, offs, out, keep_p, False, nis, m)
+            if record is not None and rows_kept:  # smoother: P⁺_k
+                record_covariance(rec, k, Pk)
 
 
 @njit(inline=True)
@@ -218,20 +230,7 @@ def propagate(nav, acc, gyr, quat_ext, k, use_ext, dt, gravity, w, f, c, a_n, f_
         # q ⊗ exp(w dt), the exact form of Nguyen & La eq. 37
         dw, dx_, dy, dz = rotvec_quat(w[0] * dt, w[1] * dt, w[2] * dt)
         nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3] = quat_product(pw, px, py, pz, dw, dx_, dy, dz)
-    dot = pw * nav[Q] + px * nav[Q + 1] + py * nav[Q + 2] + pz * nav[Q + 3]
-    sg = 1.0 if dot >= 0 else -1.0
-    mw, mx, my, mz = nav[Q] + sg * pw, nav[Q + 1] + sg * px, nav[Q + 2] + sg * py, nav[Q + 3] + sg * pz
-    nm = math.sqrt(mw * mw + mx * mx + my * my + mz * mz)
-    mw, mx, my, mz = mw / nm, mx / nm, my / nm, mz / nm
-    c[0, 0] = 1 - 2 * (my * my + mz * mz)
-    c[0, 1] = 2 * (mx * my - mw * mz)
-    c[0, 2] = 2 * (mx * mz + mw * my)
-    c[1, 0] = 2 * (mx * my + mw * mz)
-    c[1, 1] = 1 - 2 * (mx * mx + mz * mz)
-    c[1, 2] = 2 * (my * mz - mw * mx)
-    c[2, 0] = 2 * (mx * mz - mw * my)
-    c[2, 1] = 2 * (my * mz + mw * mx)
-    c[2, 2] = 1 - 2 * (mx * mx + my * my)
+    mid_rotation(pw, px, py, pz, nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3], c)
     for i in range(3):
         a_n[i] = c[i, 0] * f[0] + c[i, 1] * f[1] + c[i, 2] * f[2]
         f_n[i] = a_n[i]

@@ -30,9 +30,10 @@ step) need no special case. Per sample it costs a few products of n-vectors, whe
 gain took a Cholesky factorisation of ``P⁻`` and n triangular solves (8× the forward pass).
 
 Two smoothers run it: ``smoother: rts``, over the whole recording as one span ending at its last
-sample (offline: the compiled loop keeps checkpoints and makes the record again block by block,
-:mod:`footzoo.filters.checkpointed`, its pieces read by :func:`smooth_span`; the reference loop
-keeps the record of every sample, :func:`smooth_segments` with that one end), and ``smoother:
+sample (offline: the compiled loop keeps checkpoints and makes the record again where the filter
+was updated, :mod:`footzoo.filters.checkpointed`, its pieces read by :func:`smooth_span`, the
+samples without an update in closed form by :func:`smooth_free_span`; the reference loop keeps
+the record of every sample, :func:`smooth_segments` with that one end), and ``smoother:
 stepwise`` (:mod:`footzoo.filters.stepwise`), over each stride as it closes.
 
 What is kept per sample (:func:`record_arrays`)
@@ -51,17 +52,19 @@ import numpy as np
 
 from ..kernels.jit import njit
 from ..kernels.views import unowned
-from .strapdown import quat_product, rotvec_quat
+from .strapdown import mid_rotation, quat_product, rotvec_quat
 
 #: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
 PHI_WIDTH = 19
 
 
-#: The modes of a record (its ``segment[0]``): a row per sample, smoothed by the caller (a live chunk,
-#: or a block run again by :mod:`footzoo.filters.checkpointed`); each stride smoothed by the loop as it
-#: closes (:mod:`footzoo.filters.stepwise`); no row at all, the filter's state every ``segment[2]``
-#: samples (the forward pass of :mod:`footzoo.filters.checkpointed`).
-ROWS, IN_LOOP, CHECKPOINTS = 0, 1, 2
+#: The modes of a record (its ``segment[0]``): a row per sample, smoothed by the caller (a live chunk);
+#: each stride smoothed by the loop as it closes (:mod:`footzoo.filters.stepwise`); no row at all, the
+#: filter's state at the start of each piece (the forward pass of :mod:`footzoo.filters.checkpointed`,
+#: :func:`take_checkpoint`); a row per sample of the pieces ``segment[2] … segment[3] − 1`` of the
+#: record's checkpoints, each run again from its checkpoint to its last update (:func:`start_piece`; the
+#: loop then writes no output).
+ROWS, IN_LOOP, CHECKPOINTS, REPLAY = 0, 1, 2, 3
 
 
 def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple:
@@ -72,7 +75,7 @@ def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple
     sample's first row in ``rows``, count (N,) int: its number of rows, segment (3,) int: the mode
     (:data:`ROWS`, :data:`IN_LOOP`, :data:`CHECKPOINTS`), the first sample of the open segment (of
     the next checkpoint's block), the samples per checkpoint; smoothed (quat (M, 4), vel, pos,
-    gyro_bias, acc_bias (M, 3)), checkpoints (nav (J, 16), P (J, n, n), mems (J, s)))``. ``rows``
+    gyro_bias, acc_bias (M, 3)), checkpoints (nav (J, 16), P (J, n, n), mems (J, s), spans (J, 2) int))``. ``rows``
     has room for ``m_max`` rows per sample; only the rows written are touched.
 
     ``in_loop`` (a whole recording of that many samples): the compiled loop smooths each segment
@@ -92,7 +95,7 @@ def record_arrays(n_samples: int, n: int, m_max: int, in_loop: int = 0) -> tuple
 
 def no_checkpoints(n: int, n_mem: int = 0) -> tuple:
     """Checkpoints of an ``n``-state filter with no entry (a record that keeps rows)."""
-    return np.zeros((0, 16)), np.zeros((0, n, n)), np.zeros((0, n_mem))
+    return np.zeros((0, 16)), np.zeros((0, n, n)), np.zeros((0, n_mem)), np.zeros((0, 2), np.int64)
 
 
 #: The record's per-sample arrays (in :meth:`KalmanEngine.advance`'s outputs), then its rows.
@@ -123,9 +126,10 @@ def unowned_record(record):
     """
     cov, phi, rows, first, count, segment, smoothed, checkpoints = record
     sq, sv, sp, sg, sa = smoothed
-    cn, cp, cm = checkpoints
+    cn, cp, cm, cs = checkpoints
     return (unowned(cov), unowned(phi), unowned(rows), unowned(first), unowned(count), unowned(segment),
-            (unowned(sq), unowned(sv), unowned(sp), unowned(sg), unowned(sa)), (unowned(cn), unowned(cp), unowned(cm)))
+            (unowned(sq), unowned(sv), unowned(sp), unowned(sg), unowned(sa)),
+            (unowned(cn), unowned(cp), unowned(cm), unowned(cs)))
 
 
 @njit(inline=True)
@@ -170,17 +174,27 @@ def record_covariance(record, k, P):
 
 
 @njit(inline=True)
-def take_checkpoint(record, k, nav, P, mems):
-    """Before sample k (a :data:`CHECKPOINTS` record): the state after sample k − 1 if a block starts there.
+def take_checkpoint(record, k, stance, nav, P, mems):
+    """Before sample k (a :data:`CHECKPOINTS` record): keep the state after sample k − 1 if a piece starts there.
 
-    The record's ``segment[1]`` is the next block's first sample (j·B, from 0), ``segment[2]`` B.
+    A piece starts at sample 0; then where a stance starts (``stance[k]`` and not ``stance[k − 1]``)
+    at least ``segment[3]`` samples after the last piece's start, and wherever ``segment[2]`` samples
+    have passed since it. Its ``spans`` row is (its first sample, its last sample with an update so
+    far: :func:`mark_update`); ``segment[1]`` counts the pieces.
     """
     segment = record[5]
-    if k - 1 != segment[1]:
+    snap_nav, snap_P, snap_mem, spans = record[7]
+    j = segment[1]
+    s = k - 1
+    if j > 0:
+        gap = s - spans[j - 1, 0]
+        if gap < segment[2] and not (stance[k] and not stance[k - 1] and gap >= segment[3]):
+            return
+    if j >= spans.shape[0]:  # more pieces than checkpoint_record made room for (it counts them: not reached)
         return
-    snap_nav, snap_P, snap_mem = record[7]
-    j = segment[1] // segment[2]
-    segment[1] += segment[2]
+    segment[1] = j + 1
+    spans[j, 0] = s
+    spans[j, 1] = s
     for i in range(nav.shape[0]):
         snap_nav[j, i] = nav[i]
     for i in range(P.shape[0]):
@@ -188,6 +202,38 @@ def take_checkpoint(record, k, nav, P, mems):
             snap_P[j, i, c] = P[i, c]
     for i in range(mems.shape[0]):
         snap_mem[j, i] = mems[i]
+
+
+@njit(inline=True)
+def mark_update(record, k):
+    """Sample k updated the filter: the last sample with an update of the open piece (a :data:`CHECKPOINTS` record)."""
+    record[7][3][record[5][1] - 1, 1] = k
+
+
+@njit(inline=True)
+def start_piece(record, j, nav, P, mems):
+    """Piece j of a :data:`REPLAY` record: its checkpoint into the state, its rows next; returns its (a, u).
+
+    ``a``: the piece's first sample (the checkpoint's), ``u``: its last with an update (the loop
+    runs samples a + 1 … u). Its rows follow the previous piece's: ``segment[4]`` is the next free
+    row, ``segment[1]`` becomes the offset that puts sample a there (row = sample − ``segment[1]``).
+    """
+    segment, first, count = record[5], record[3], record[4]
+    snap_nav, snap_P, snap_mem, spans = record[7]
+    a, u = spans[j, 0], spans[j, 1]
+    for i in range(nav.shape[0]):
+        nav[i] = snap_nav[j, i]
+    for i in range(P.shape[0]):
+        for c in range(P.shape[1]):
+            P[i, c] = snap_P[j, i, c]
+    for i in range(mems.shape[0]):
+        mems[i] = snap_mem[j, i]
+    r = segment[4]
+    first[r] = first[r - 1] + count[r - 1] if r > 0 else 0
+    count[r] = 0
+    segment[1] = a - r
+    segment[4] = r + u - a + 1
+    return a, u
 
 
 @njit(inline=True)
@@ -252,21 +298,128 @@ def smooth_span(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, ac
             for i in range(n):
                 lam[i] += rows[r, i] * c
         transition_transposed(phi, j_, idx, lam, mu)
-        for i in range(n):
-            e[i] = 0.0
-        a = 0
-        for i in range(n):  # e = P⁺_{k−1} μ from P⁺'s upper triangle (P⁺ symmetric)
-            mi = mu[i]
-            e[i] += cov[j_ - 1, a] * mi
-            a += 1
-            for j in range(i + 1, n):
-                p = cov[j_ - 1, a]
-                e[i] += p * mu[j]
-                e[j] += p * mi
-                a += 1
+        packed_times(cov, j_ - 1, mu, e)  # e_{k−1} = P⁺_{k−1} μ
         correct_sample(k - 1, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
         for i in range(n):
             lam[i] = mu[i]
+
+
+@njit(inline=True)
+def packed_times(cov, r, mu, e):
+    """``e = P μ`` for the symmetric P kept as row ``r`` of ``cov``, its upper triangle (:func:`record_covariance`)."""
+    n = mu.shape[0]
+    for i in range(n):
+        e[i] = 0.0
+    a = 0
+    for i in range(n):
+        mi = mu[i]
+        e[i] += cov[r, a] * mi
+        a += 1
+        for j in range(i + 1, n):
+            p = cov[r, a]
+            e[i] += p * mu[j]
+            e[j] += p * mi
+            a += 1
+
+
+@njit(inline=True)
+def transition_row(t, quat, acc_nav, k, gravity, with_c, c, phi, r):
+    """Φ_k's blocks of a sample into row ``r`` of ``phi``, as the loop made them, from the forward pass's outputs.
+
+    ``dt = t_k − t_{k−1}``; ``−[f^n×] dt`` from the specific force in NED, ``acc_nav[k] − [0, 0, g]``
+    (``acc_nav`` is the loop's motion acceleration ``f^n + [0, 0, g]``); ``C dt`` (only ``with_c``: a
+    bias block reads it) from the attitudes ``quat[k − 1]``, ``quat[k]`` (the forward pass's, before
+    smoothing) as the loop's :func:`~footzoo.filters.strapdown.mid_rotation`; ``c`` (3, 3) work.
+    """
+    dt = t[k] - t[k - 1]
+    fx, fy, fz = acc_nav[k, 0], acc_nav[k, 1], acc_nav[k, 2] - gravity
+    phi[r, 0] = dt
+    phi[r, 1], phi[r, 2], phi[r, 3] = 0.0, dt * fz, -dt * fy
+    phi[r, 4], phi[r, 5], phi[r, 6] = -dt * fz, 0.0, dt * fx
+    phi[r, 7], phi[r, 8], phi[r, 9] = dt * fy, -dt * fx, 0.0
+    if with_c:
+        mid_rotation(quat[k - 1, 0], quat[k - 1, 1], quat[k - 1, 2], quat[k - 1, 3], quat[k, 0], quat[k, 1],
+                     quat[k, 2], quat[k, 3], c)
+        for i in range(3):
+            for j in range(3):
+                phi[r, 10 + 3 * i + j] = dt * c[i, j]
+
+
+@njit(inline=True)
+def transition_apply(phi, r, idx, e):
+    """``e ← Φ e`` in place for Φ = I + Δ (the blocks of :func:`transition_transposed`), each row from the old ``e``.
+
+    In the order of the loop's ``propagate_rows``: pos (reads vel), vel (reads att, acc_bias), att
+    (reads gyro_bias).
+    """
+    att, gb_i, pos_i, vel_i, ab_i = idx[0], idx[1], idx[2], idx[3], idx[4]
+    dt = phi[r, 0]
+    for i in range(3):
+        e[pos_i + i] += dt * e[vel_i + i]
+    if att >= 0:
+        e0, e1, e2 = e[att], e[att + 1], e[att + 2]
+        for i in range(3):
+            e[vel_i + i] += phi[r, 1 + 3 * i] * e0 + phi[r, 2 + 3 * i] * e1 + phi[r, 3 + 3 * i] * e2
+    if ab_i >= 0:
+        for i in range(3):
+            e[vel_i + i] += (phi[r, 10 + 3 * i] * e[ab_i] + phi[r, 11 + 3 * i] * e[ab_i + 1]
+                             + phi[r, 12 + 3 * i] * e[ab_i + 2])
+    if att >= 0 and gb_i >= 0:
+        for i in range(3):
+            e[att + i] += (phi[r, 10 + 3 * i] * e[gb_i] + phi[r, 11 + 3 * i] * e[gb_i + 1]
+                           + phi[r, 12 + 3 * i] * e[gb_i + 2])
+
+
+@njit
+def smooth_free_span(lo, hi, cov, r_lo, lam, forward, noise, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias,
+                     mus, phis, e, work):
+    """The recursion over samples ``lo + 1 … hi`` that have no update, in closed form; corrects ``lo … hi − 1``.
+
+    Without an update ``P⁺_k = Φ_k P⁺_{k−1} Φ_kᵀ + Q_k`` and ``λ`` only moves with Φᵀ, so with
+    ``μ_k = Φ_kᵀ μ_{k+1}`` (the ``μ`` of :func:`smooth_span`) the smoothed errors follow forwards from
+    the one at the span's start::
+
+        e_lo = P⁺_lo μ_{lo+1},    e_k = Φ_k e_{k−1} + Q_k μ_{k+1}     (k = lo + 1 … hi − 1)
+
+    the same numbers as :func:`smooth_span`'s ``e_k = P⁺_k μ_{k+1}`` (to rounding), without
+    ``P⁺_k``: the filter does not have to be run again over the span. ``λ`` (n,) comes in as
+    ``μ_{hi+1}`` (the recursion of the samples after; zero after the last sample) and leaves as
+    ``μ_{lo+1}``; ``P⁺_lo`` is row ``r_lo`` of ``cov`` (packed); ``forward`` = (t (N,) s, quat
+    (N, 4), acc_nav (N, 3) m/s²: the forward pass's outputs, for Φ: :func:`transition_row`);
+    ``noise`` = (q (n,) variance growth per second, impact s, gravity m/s²), the loop's ``Q_k``
+    (``add_process_noise``); ``mus`` (≥ hi − lo, n), ``phis`` (≥ hi − lo, 19), ``e`` (n,) and
+    ``work`` = (μ (n,), C (3, 3)) are work arrays.
+    """
+    if hi <= lo:
+        return
+    t, fq, acc_nav = forward
+    qn, impact, gravity = noise
+    mu, c = work
+    n = lam.shape[0]
+    vel_i = idx[3]
+    with_c = idx[1] >= 0 or idx[4] >= 0
+    for k in range(hi, lo, -1):  # backwards: μ_{k+1} kept for sample k, then μ_k = Φ_kᵀ μ_{k+1}
+        r = k - lo - 1
+        for i in range(n):
+            mus[r, i] = lam[i]
+        transition_row(t, fq, acc_nav, k, gravity, with_c, c, phis, r)
+        transition_transposed(phis, r, idx, lam, mu)
+        for i in range(n):
+            lam[i] = mu[i]
+    for k in range(lo, hi):  # forwards: e_lo = P⁺_lo μ_{lo+1}, then e_k = Φ_k e_{k−1} + Q_k μ_{k+1}
+        r = k - lo - 1
+        if k == lo:
+            packed_times(cov, r_lo, lam, e)
+        else:
+            transition_apply(phis, r, idx, e)
+            dt = phis[r, 0]
+            for i in range(n):
+                e[i] += qn[i] * dt * mus[r, i]
+            if impact > 0.0:
+                qa = impact * (acc_nav[k, 0] ** 2 + acc_nav[k, 1] ** 2 + acc_nav[k, 2] ** 2) * dt
+                for i in range(3):
+                    e[vel_i + i] += qa * mus[r, vel_i + i]
+        correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
 
 
 @njit

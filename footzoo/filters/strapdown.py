@@ -46,6 +46,28 @@ def rotate(w, x, y, z, fx, fy, fz):
     return gx, gy, gz
 
 
+@njit(inline=True)
+def mid_rotation(pw, px, py, pz, qw, qx, qy, qz, c):
+    """The body → NED rotation matrix at the middle of an interval into ``c`` (3, 3), from its end attitudes.
+
+    ``p`` (start) and ``q`` (end), unit quaternions scalar first: ``c = R(normalise(±p + q))``, the sign
+    taken so that the two lie in the same hemisphere (the interval-average convention above).
+    """
+    sg = 1.0 if pw * qw + px * qx + py * qy + pz * qz >= 0 else -1.0
+    mw, mx, my, mz = qw + sg * pw, qx + sg * px, qy + sg * py, qz + sg * pz
+    nm = math.sqrt(mw * mw + mx * mx + my * my + mz * mz)
+    mw, mx, my, mz = mw / nm, mx / nm, my / nm, mz / nm
+    c[0, 0] = 1 - 2 * (my * my + mz * mz)
+    c[0, 1] = 2 * (mx * my - mw * mz)
+    c[0, 2] = 2 * (mx * mz + mw * my)
+    c[1, 0] = 2 * (mx * my + mw * mz)
+    c[1, 1] = 1 - 2 * (mx * mx + mz * mz)
+    c[1, 2] = 2 * (my * mz - mw * mx)
+    c[2, 0] = 2 * (mx * mz - mw * my)
+    c[2, 1] = 2 * (my * mz + mw * mx)
+    c[2, 2] = 1 - 2 * (mx * mx + my * my)
+
+
 def sample_intervals(t: np.ndarray) -> np.ndarray:
     """``dt[k] = t[k] - t[k-1]`` (s), with ``dt[0] = 0`` (the first sample starts the clock)."""
     t = np.asarray(t, dtype=float)
