@@ -305,7 +305,33 @@ def main_table(n: int, repeat: int, slow: int, configs: list[str] | None = None)
                      f"{_frac(frac_cpu)} | {tgt} | {met} |")
         results[it.name] = {"per_s_min": best, "per_s_median": med, "per_s_cpu": cpu, "fraction": frac,
                             "fraction_cpu": frac_cpu}
-    return lines, results
+    return lines + smoother_cost(items, lim_cpu), results
+
+
+#: Issue 23: a smoother adds at most this much of its forward pass's time; the smoothed flagship runs at
+#: least at this fraction of the minimal strapdown loop.
+SMOOTHER_COST, FLAGSHIP_FRACTION = 1.5, 1 / 10
+
+
+def smoother_cost(items: list[Item], lim_cpu: float) -> list[str]:
+    """What each smoother adds to its config's forward filter, from the same run's minimum CPU times."""
+    forward = {it.name.removesuffix(", forward filter only"): it for it in items
+               if it.name.endswith(", forward filter only")}
+    lines = ["", "Smoother cost (minimum CPU time of the same run): the time a smoother adds, as a multiple of "
+             "the same config's forward filter alone, and the smoothed config's fraction of (a).", "",
+             "| config | smoother | adds × the forward filter | target | met | fraction of (a), CPU | target | met |",
+             "|---|---|---|---|---|---|---|---|"]
+    for it in items:
+        base, _, smoother = it.name.partition(" + ")
+        if base not in forward or not smoother.endswith(" smoother"):
+            continue
+        added = min(it.cpu) / min(forward[base].cpu) - 1.0
+        frac = it.n / min(it.cpu) / lim_cpu
+        met_cost, met_frac = ("yes" if ok else "no" for ok in (added <= SMOOTHER_COST, frac >= FLAGSHIP_FRACTION))
+        name = smoother.removesuffix(" smoother")
+        lines.append(f"| {base} | {name} | {added:.2f} | ≤ {SMOOTHER_COST} | {met_cost} | {_frac(frac)} | "
+                     f"1/{round(1 / FLAGSHIP_FRACTION)} | {met_frac} |")
+    return lines if len(lines) > 5 else []
 
 
 def _frac(x: float) -> str:
