@@ -290,3 +290,15 @@ def test_the_checkpointed_rts_smoother_holds_whatever_the_stance(walk, stance_ki
                                    err_msg=key)
     if stance_kind != "never":
         assert np.abs(got["vel"] - got["vel_forward"]).max() > 1e-4  # it did smooth
+
+
+def test_a_flickering_stance_costs_the_checkpoints_no_more_room_than_one_per_min_gap():
+    """The forward pass's checkpoints are allocated before the loop: sample 0, one per stance start and one per
+    block, but never more than one per min(min_gap, block) samples, since no piece starts closer to the last."""
+    from footzoo.filters.checkpointed import checkpoint_record
+
+    flicker = np.arange(10_001) % 2 == 0  # 5000 stance starts
+    nav, P, mems, spans = checkpoint_record(flicker, 21, 4, 4096, 32)[7]
+    assert len(nav) == len(P) == len(mems) == len(spans) == 1 + 10_000 // 32
+    walk_like = np.arange(10_001) % 100 < 40  # 100 stance starts, one per 100 samples
+    assert len(checkpoint_record(walk_like, 9, 0, 4096, 32)[7][0]) == 1 + 100 + 10_000 // 4096

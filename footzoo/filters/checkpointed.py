@@ -63,12 +63,16 @@ def checkpoint_record(stance: np.ndarray, n_state: int, n_mem: int, block: int, 
     :data:`~footzoo.filters.smoother.CHECKPOINTS`, ``segment`` = (mode, pieces taken, ``block``,
     ``min_gap``)), its checkpoints ``(nav (J, 16), P (J, n, n), mems (J, s), spans (J, 2) int)``
     with room for every piece the rule of :func:`~footzoo.filters.smoother.take_checkpoint` can
-    start: sample 0, one per stance start, one per ``block`` samples.
+    start: sample 0, one per stance start, one per ``block`` samples, and at most one per
+    ``min(min_gap, block)`` samples (a stance that flickers costs no more room).
     """
     n = len(stance)
     st = np.asarray(stance, dtype=bool)
     starts = int(np.count_nonzero(st[1:] & ~st[:-1])) if n > 1 else 0
-    j = min(n, 1 + starts + max(n - 1, 0) // max(block, 1)) if n > 0 else 0
+    # every piece after the first starts at a stance's start or ``block`` samples after the last piece's start,
+    # and at least min(min_gap, block) samples after it
+    spacing = max(1, min(min_gap, block))
+    j = min(1 + starts + max(n - 1, 0) // max(block, 1), 1 + max(n - 1, 0) // spacing) if n > 0 else 0
     empty = record_arrays(0, n_state, 1)
     checkpoints = (np.empty((j, 16)), np.empty((j, n_state, n_state)), np.empty((j, n_mem)),
                    np.zeros((j, 2), np.int64))
