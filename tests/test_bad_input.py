@@ -726,7 +726,7 @@ def test_declared_parameters_were_found():
 
     builtins = [cls for kind in KINDS for n, cls in available(kind).items() if not n.startswith("test_")]
     assert all(not cls.undeclared() for cls in builtins)  # every built-in parameter is declared
-    assert len(DECLARED) >= 60 and len(EDGES) >= 80 and len(SETTINGS) == 16
+    assert len(DECLARED) >= 60 and len(EDGES) >= 80 and len(SETTINGS) == 17
 
 
 # --------------------------------------------------------------------------- damaged result archives

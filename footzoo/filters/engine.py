@@ -65,6 +65,13 @@ class NavigationNoise(Settings):
         ``a`` the NED motion acceleration of the sample. Accelerometer scale-factor, misalignment
         and clipping errors grow with the acceleration, most at the heel strike (footzoo's; a
         white-noise stand-in for them; 0, the default: uniform in time, as in the papers).
+    integration_noise : float
+        κ (1): each velocity axis of sample k grows by ``(κ·|f_k − f_{k−1}|·dt)²``, ``f`` the
+        specific force as sampled: a change of the specific force at an unknown instant within
+        the interval, which a heel strike shorter than the interval makes on an accelerometer
+        that is not band-limited below the Nyquist rate; 1/√12 ≈ 0.29 when that instant is
+        uniform in the interval (:mod:`footzoo.filters.velocity_noise`). 0, the default: the
+        samples resolve the motion, as the papers assume.
     """
 
     attitude_noise: float = 0.01
@@ -74,6 +81,7 @@ class NavigationNoise(Settings):
     initial_velocity_std: float = 0.0
     initial_position_std: float = 0.0
     impact_noise: float = 0.0
+    integration_noise: float = 0.0
 
     section = "navigation"
     example = "{velocity_noise: 0.01}"
@@ -92,6 +100,10 @@ class NavigationNoise(Settings):
         "impact_noise": Real("s", "[0, 0.01]", "velocity variance growth per squared motion acceleration",
                              source="footzoo's: 0 (uniform in time, as in the papers)",
                              why="0.01 s: at a heel strike's 100 m/s² that is 100 (m/s)²/s"),
+        "integration_noise": Real("1", "[0, 1]", "velocity σ per sample per |Δf|·dt (an impact the samples do not "
+                                  "resolve)", source="footzoo's: 0 (the samples resolve the motion, as in the papers); "
+                                  "1/√12 ≈ 0.29: the change at a uniform instant within the interval",
+                                  why="1: the whole change |Δf|·dt of one interval as one σ"),
     }
 
 
@@ -176,6 +188,7 @@ class KalmanEngine:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
         self.layout, self.p0, self.q = assemble(carries_attitude, blocks, noise)
         self.impact = float(noise.impact_noise)
+        self.integration = float(noise.integration_noise)
         self.carries_attitude = carries_attitude
         self.gravity = float(gravity)
         self.names = names or [f"correction {i}" for i in range(len(models))]
@@ -290,7 +303,7 @@ class KalmanEngine:
     def start(self, nav0: np.ndarray) -> Any:
         """The filter's state before sample 0 (resumable with :meth:`advance`)."""
         if self.engine == "reference":
-            kf = ErrorStateFilter(self.layout, self.p0, self.q, self.impact)
+            kf = ErrorStateFilter(self.layout, self.p0, self.q, self.impact, self.integration)
             models = [MeasurementModel(**{**m.__dict__, "mem": np.array(m.mem, dtype=float)}) for m in self.models]
             return {"kf": kf, "models": models, "nav": np.array(nav0, dtype=float)}
         return self.pack(nav0)
@@ -364,7 +377,7 @@ class KalmanEngine:
         models = self.models
         core = (np.array([self.layout[b].start if self.layout.has(b) else -1 for b in CORE_BLOCKS], np.int64),
                 np.ascontiguousarray(self.q, dtype=float), self.gravity, not self.carries_attitude,
-                max(1, sum(m.max_rows for m in models)), self.impact)
+                max(1, sum(m.max_rows for m in models)), self.impact, self.integration)
         width = max(len(i) for i in self.idx)
         m_idx = np.full((len(models), width), -1, dtype=np.int64)
         for j, ix in enumerate(self.idx):
@@ -476,15 +489,16 @@ class KalmanEngine:
         def run() -> None:
             self.step(replay, t, acc, gyr, stance, quat_ext, data, {**scratch, "record": record}, 0, loop)
 
-        core = packed.core  # (idx, q, gravity, use_ext, m_max, impact): the loop's noise and gravity
+        core = packed.core  # (idx, q, gravity, use_ext, m_max, impact, integration): the loop's noise and gravity
+        noise = (core[1], core[5], core[2], core[6])  # q, impact, gravity, integration (smooth_free_span's order)
         lam = np.zeros(nx)  # λ carried from piece to piece, zero after the last sample
-        forward = (writable_array(t, float), out["quat_forward"], out["acc_nav"])
+        forward = (writable_array(t, float), out["quat_forward"], out["acc_nav"], writable_array(acc, float))
         buffers = (np.empty((block + 1, nx)), np.empty((block + 1, PHI_WIDTH)), np.empty(nx), np.empty(nx),
                    np.empty((3, 3)))
         smoothed = (out["quat"], out["vel"], out["pos"], out["gyro_bias"], out["acc_bias"])
 
         def smooth(j0: int, j1: int) -> None:
-            cp.smooth_pieces(record, spans, j0, j1, lam, forward, (core[1], core[5], core[2]), self.core_offsets(),
+            cp.smooth_pieces(record, spans, j0, j1, lam, forward, noise, self.core_offsets(),
                              not self.carries_attitude, smoothed, buffers)
 
         cp.backward(run, record, spans, smooth, block)

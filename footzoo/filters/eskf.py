@@ -90,9 +90,13 @@ class ErrorStateFilter:
     impact : float
         Velocity variance growth per squared motion acceleration (s): the velocity rows of Q
         grow by ``impact·|a|²·dt`` (see :class:`footzoo.filters.engine.NavigationNoise`).
+    integration : float
+        κ (1): the velocity rows of Q grow by ``(κ·|Δf|·dt)²``, ``Δf`` the change of the sampled
+        specific force over the interval (:mod:`footzoo.filters.velocity_noise`).
     """
 
-    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray, impact: float = 0.0):
+    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray, impact: float = 0.0,
+                 integration: float = 0.0):
         from filterpy.kalman import KalmanFilter  # imported here: the compiled engine does not need it
 
         self.layout = layout
@@ -100,16 +104,18 @@ class ErrorStateFilter:
         self.kf.P = np.diag(np.asarray(p0, dtype=float))
         self.q = np.asarray(q, dtype=float)
         self.impact = float(impact)
+        self.integration = float(integration)
         self.nis = 0.0
 
-    def predict(self, F: np.ndarray, dt: float, acc_sq: float = 0.0) -> None:
+    def predict(self, F: np.ndarray, dt: float, acc_sq: float = 0.0, change_sq: float = 0.0) -> None:
         """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates.
 
-        ``acc_sq``: the squared motion acceleration |a|² ((m/s²)²) of the sample, for ``impact``.
+        ``acc_sq``: the squared motion acceleration |a|² ((m/s²)²) of the sample, for ``impact``;
+        ``change_sq``: the squared change |f_k − f_{k−1}|² ((m/s²)²) of the sampled specific force,
+        for ``integration``.
         """
         q = self.q * dt
-        if self.impact > 0.0:
-            q[self.layout["vel"]] += self.impact * acc_sq * dt
+        q[self.layout["vel"]] += self.impact * acc_sq * dt + (self.integration * dt) ** 2 * change_sq
         self.kf.predict(F=F, Q=np.diag(q))
 
     def update(self, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:

@@ -36,7 +36,8 @@ The arguments of :func:`eskf_loop`:
     ``(idx (5,) int: offsets of att, gyro_bias, pos, vel, acc_bias, −1 if absent (in the
     order of :data:`~footzoo.filters.measurement.CORE_BLOCKS`); q (n,) variance growth per
     second; gravity m/s²; use_ext bool: attitude from quat_ext; m_max int: most rows of one
-    update; impact s: velocity variance growth per squared motion acceleration)``.
+    update; impact s: velocity variance growth per squared motion acceleration; integration κ (1):
+    velocity σ per sample per ``|Δf| dt``, :mod:`~footzoo.filters.velocity_noise`)``.
 ``state``
     ``(nav (16,): the nominal state, offsets Q, P, V, BG, BA of
     :mod:`~footzoo.filters.measurement`; P (n, n) covariance; mems (s,) all models' memory)``.
@@ -89,6 +90,7 @@ from .smoother import (
 )
 from .stepwise import close_segment
 from .strapdown import mid_rotation, quat_product, rotvec_quat
+from .velocity_noise import signal_velocity_variance
 
 
 @njit
@@ -102,7 +104,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
     # whole call): handing them to the models' functions and to the inlined steps costs no
     # reference counting
     t, acc, gyr, stance, quat_ext = signals
-    idx, qn, gravity, use_ext, m_max, impact = core
+    idx, qn, gravity, use_ext, m_max, impact, integration = core
     idx, qn = unowned(idx), unowned(qn)
     # the core blocks' offsets as integers, read once: the steps index P with them, and a store into P
     # cannot change an integer (as it could an array's entry), so the compiler keeps them in registers
@@ -156,7 +158,7 @@ def eskf_loop(signals, core, state, models, out, k0, work, record):
                 record_transition(rec, k, dt, sdt, cdt)
             propagate_rows(Pk, offs, dt, sdt, cdt)
             propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn)
-            add_process_noise(Pk, offs, qn, impact, a_n, dt)
+            add_process_noise(Pk, offs, qn, signal_velocity_variance(impact, integration, a_n, acc, k, dt), dt)
             st = stance[k]
             m = measure(functions[0], views, k0 + k, t[k], nav, w, f, st, mems, data[k], z, H, rdiag, fault)
             nis = 0.0
@@ -298,18 +300,18 @@ def propagate_columns(Pk, offs, dt, sdt, cdt, dyn, still, n_dyn):
 
 
 @njit(inline=True)
-def add_process_noise(Pk, offs, qn, impact, a_n, dt):
-    """``P ← P + Q dt`` (the second half of eq. 44), plus the impact noise on the velocity.
+def add_process_noise(Pk, offs, qn, qv, dt):
+    """``P ← P + Q dt`` (the second half of eq. 44), plus ``qv`` on each velocity axis.
 
-    The impact noise: accelerometer errors that grow with the motion acceleration (heel strikes).
+    ``qv`` ((m/s)²): the sample's velocity noise that follows the signals (impacts, the integration
+    over the interval: :func:`footzoo.filters.velocity_noise.signal_velocity_variance`).
     """
     for i in range(Pk.shape[0]):
         Pk[i, i] += qn[i] * dt
-    if impact > 0.0:
-        qa = impact * (a_n[0] * a_n[0] + a_n[1] * a_n[1] + a_n[2] * a_n[2]) * dt
+    if qv > 0.0:
         vel = offs[VEL]
         for i in range(3):
-            Pk[vel + i, vel + i] += qa
+            Pk[vel + i, vel + i] += qv
 
 
 @njit(inline=True)

@@ -92,7 +92,8 @@ def run_reference(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.nd
         dt = t[k] - t[k - 1]
         w, f, c, f_n, a_n = _propagate(nav, acc[k], gyr[k], quat_ext[k] if not ins else None, g_n, dt)
         F = transition(layout, c, f_n, dt)
-        kf.predict(F, dt, float(a_n @ a_n))
+        change = acc[k] - acc[k - 1]
+        kf.predict(F, dt, float(a_n @ a_n), float(change @ change))
         if record is not None:
             record_transition(record, k, F, layout, c, dt)
         st = bool(stance[k])

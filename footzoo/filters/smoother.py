@@ -53,6 +53,7 @@ import numpy as np
 from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .strapdown import mid_rotation, quat_product, rotvec_quat
+from .velocity_noise import signal_velocity_variance
 
 #: Per-sample width of Φ's blocks in the record: dt, −[f^n×] dt (3×3), C dt (3×3).
 PHI_WIDTH = 19
@@ -385,15 +386,16 @@ def smooth_free_span(lo, hi, cov, r_lo, lam, forward, noise, idx, use_ext, quat,
     ``P⁺_k``: the filter does not have to be run again over the span. ``λ`` (n,) comes in as
     ``μ_{hi+1}`` (the recursion of the samples after; zero after the last sample) and leaves as
     ``μ_{lo+1}``; ``P⁺_lo`` is row ``r_lo`` of ``cov`` (packed); ``forward`` = (t (N,) s, quat
-    (N, 4), acc_nav (N, 3) m/s²: the forward pass's outputs, for Φ: :func:`transition_row`);
-    ``noise`` = (q (n,) variance growth per second, impact s, gravity m/s²), the loop's ``Q_k``
-    (``add_process_noise``); ``mus`` (≥ hi − lo, n), ``phis`` (≥ hi − lo, 19), ``e`` (n,) and
+    (N, 4), acc_nav (N, 3) m/s²: the forward pass's outputs, for Φ: :func:`transition_row`; acc (N, 3)
+    m/s²: the specific force the loop integrated); ``noise`` = (q (n,) variance growth per second,
+    impact s, gravity m/s², integration κ), the loop's ``Q_k`` (``add_process_noise``); ``mus``
+    (≥ hi − lo, n), ``phis`` (≥ hi − lo, 19), ``e`` (n,) and
     ``work`` = (μ (n,), C (3, 3)) are work arrays.
     """
     if hi <= lo:
         return
-    t, fq, acc_nav = forward
-    qn, impact, gravity = noise
+    t, fq, acc_nav, acc = forward
+    qn, impact, gravity, integration = noise
     mu, c = work
     n = lam.shape[0]
     vel_i = idx[3]
@@ -415,10 +417,10 @@ def smooth_free_span(lo, hi, cov, r_lo, lam, forward, noise, idx, use_ext, quat,
             dt = phis[r, 0]
             for i in range(n):
                 e[i] += qn[i] * dt * mus[r, i]
-            if impact > 0.0:
-                qa = impact * (acc_nav[k, 0] ** 2 + acc_nav[k, 1] ** 2 + acc_nav[k, 2] ** 2) * dt
+            qv = signal_velocity_variance(impact, integration, acc_nav[k], acc, k, dt)
+            if qv > 0.0:
                 for i in range(3):
-                    e[vel_i + i] += qa * mus[r, vel_i + i]
+                    e[vel_i + i] += qv * mus[r, vel_i + i]
         correct_sample(k, e, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
 
 
