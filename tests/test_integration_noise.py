@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from footzoo import ConfigError, Pipeline
+from footzoo import ConfigError, Pipeline, Stream
 from footzoo.filters.engine import NavigationNoise
 from footzoo.filters.eskf import ErrorStateFilter, Layout, transition
 from footzoo.filters.velocity_noise import UNIFORM_TIMING
@@ -107,3 +107,15 @@ def test_gaitmap_stride_lengths_against_motion_capture(foot):
     cfg["navigation"] = {**cfg["navigation"], "integration_noise": UNIFORM_TIMING}
     timed = Pipeline.from_dict(cfg).run(rec).metrics["stride_length_rms_error_m"]
     assert timed < 0.03 < uniform - 0.015
+
+
+def test_live_chunks_give_the_batch_numbers(walk):
+    """The change ``f_k − f_{k−1}`` spans the chunks' borders: live (step-wise smoothing) equals the batch run."""
+    rec, _ = unresolved_impacts(walk)
+    p = Pipeline.from_dict({**with_kappa(UNIFORM_TIMING), "smoother": "stepwise"})
+    final = Stream(p, rate=rec.rate).run(rec, chunk=np.random.default_rng(2).integers(1, 40, size=101))
+    batch = p.run(rec)
+    scale = max(float(np.abs(batch.pos).max()), 1.0)
+    assert float(np.abs(final["pos"] - batch.pos).max()) <= 1e-9 * scale
+    off = Pipeline.from_dict({**BASE, "smoother": "stepwise"}).run(rec)
+    assert float(np.abs(off.pos - batch.pos).max()) > 1e-3  # the noise changed the estimate
