@@ -1,7 +1,7 @@
 """Build hook: a wheel also carries the compiled kernels of the shipped configs.
 
 Everything else is in setup.cfg. After the usual build, ``footzoo compile --ship`` runs every
-pipeline config in ``footzoo/config/builtin/`` once on a short simulated walk (in two processes side by
+pipeline config in ``configs/`` once on a short simulated walk (in two processes side by
 side where there are two cores: see GROUPS) and writes the machine code numba produces into
 ``footzoo/_compiled`` of the build: an installed footzoo then loads it at its first
 run instead of compiling (see footzoo/kernels/cache.py for when the code is valid). This needs the
@@ -15,7 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from setuptools import setup
+from setuptools import find_packages, setup
 from setuptools.command.build_py import build_py
 
 #: The shipped configs' families in groups compiled side by side on a machine with several cores: a family's
@@ -33,7 +33,7 @@ class BuildWithKernels(build_py):
         if getattr(self, "editable_mode", False) or os.environ.get("FOOTZOO_NO_PRECOMPILE", "") in ("1", "true", "yes"):
             return
         here = Path(__file__).resolve().parent
-        builtin = here / "footzoo" / "config" / "builtin"
+        builtin = here / "configs"
         configs = sorted(str(p) for p in builtin.glob("*.yaml") if not p.name.startswith("study_"))
         # the build first, then what pip's isolated build environment put on the path (its numba, numpy...)
         path = os.pathsep.join([str(build_lib), *filter(None, [os.environ.get("PYTHONPATH")]), *sys.path])
@@ -66,4 +66,9 @@ def _groups(configs):
     return groups
 
 
-setup(cmdclass={"build_py": BuildWithKernels})
+# the shipped configs live in the repository's top-level configs/ and are installed as the data package
+# footzoo.configs (footzoo.config.library finds them in either place)
+setup(cmdclass={"build_py": BuildWithKernels},
+      packages=[*find_packages(include=["footzoo", "footzoo.*"]), "footzoo.configs"],
+      package_dir={"footzoo.configs": "configs"},
+      package_data={"footzoo.configs": ["*.yaml"]})

@@ -10,7 +10,7 @@ the others score the flagship on every axis (benchmarks/accuracy_parts.py: 3-D a
 per motion class, rate independence, gait events, filter consistency, 24 mountings). Without
 ``configs`` only the chosen parts' blocks of the existing summary's flagship section are rewritten.
 
-Every config in ``footzoo/config/builtin/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
+Every config in ``configs/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
 ablation runner (one study per dataset: parallel with ``--jobs``, cached in
 ``RESULTS/<dataset>/cache`` so a rerun only computes what changed), on:
 
@@ -97,7 +97,7 @@ TARGETS = {
 
 
 def shipped_configs(names: list[str] | None = None) -> list[Path]:
-    """The pipeline configs in ``footzoo/config/builtin/`` (not the study files), optionally only ``names``."""
+    """The pipeline configs in ``configs/`` (not the study files), optionally only ``names``."""
     paths = sorted(p for p in BUILTIN.glob("*.yaml") if not p.stem.startswith("study"))
     if names:
         unknown = sorted(set(names) - {p.stem for p in paths})

@@ -333,7 +333,7 @@ def rates(jobs: int = 1) -> list[str]:
            "means are within about 2 %, with its detector and with the true stance alike; `duong2015_zupt` too. "
            "`yun2012` and `nguyen2016*`: a real rate effect that the true stance removes (then within 0.1–3 %). "
            "Their detectors' stance fractions agree across the rates within 0.3–0.9 % of the time and their "
-           "edges within a few ms (tests/test_detectors_rate_density.py); the FQA + linear-dedrift pipelines are "
+           "edges within a few ms (tests/detectors/test_rate_density.py); the FQA + linear-dedrift pipelines are "
            "that sensitive: `nguyen2016_ins_zvu` with the true stance, every stance ended 8 ms after the true "
            "toe-off: 0.26 m at 100 Hz, 0.20 m at 250 Hz; ended 12 ms after it: 2.6 and 1.6 m (seed 0). DGP's "
            "stance ends 8–12 ms after toe-off depending on where the edge falls between samples, so the rates "

@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/height_drift.py [--jobs 2] [--data ../shared/data] [--out benchmarks/height_drift.md]
 
-Every experiment starts from ``footzoo/config/builtin/recommended.yaml`` and changes one thing:
+Every experiment starts from ``configs/recommended.yaml`` and changes one thing:
 
 * **levers**: config-only changes (the ``acc_bias`` error-state block through ``ekf_zupt``, the
   zero-velocity σ, the velocity and attitude noise, the impact noise, the gyro bias with and without
@@ -48,7 +48,7 @@ from accuracy import CLASS_ORDER, DEFAULT_DATA, motion_class, pyshoe_reference  
 
 from footzoo.studies.report import to_markdown  # noqa: E402
 
-RECOMMENDED = ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml"
+RECOMMENDED = ROOT / "configs" / "recommended.yaml"
 
 
 def base_config() -> dict[str, Any]:

@@ -1,4 +1,4 @@
-"""Choose ``footzoo/config/builtin/recommended.yaml``: one setting, by leave-one-motion-class-out cross-validation.
+"""Choose ``configs/recommended.yaml``: one setting, by leave-one-motion-class-out cross-validation.
 
 Usage: python benchmarks/select_recommended.py [--jobs 2] [--results benchmarks/results/]
                                                [--data ../shared/data] [--write]
@@ -21,7 +21,7 @@ Cross-validation (never per trial): for each motion class c (walking, running/fa
 unusual, inverted), the setting with the best score on the other classes is chosen and its
 errors on c's trials are kept. Those held-out errors are the cross-validated figure (median
 ratio to PyShoe's best, medians per class, worst trial). The recommended setting is then the
-best on all classes; ``--write`` writes it to ``footzoo/config/builtin/recommended.yaml`` with the procedure
+best on all classes; ``--write`` writes it to ``configs/recommended.yaml`` with the procedure
 and the figures in its header. The selection and the figures go to
 ``benchmarks/recommended_selection.md``.
 """
@@ -231,7 +231,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--results", type=Path, default=DEFAULT_RESULTS)
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
-    ap.add_argument("--write", action="store_true", help="write footzoo/config/builtin/recommended.yaml")
+    ap.add_argument("--write", action="store_true", help="write configs/recommended.yaml")
     ap.add_argument("--progress", action="store_true")
     ap.add_argument("--refine", action="store_true",
                     help="only the speed-adaptive detector x its provisional pass's shortest swing x the roll lever "
@@ -290,7 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         "sim 100/200 Hz worst ARMSE": worst_sim.to_numpy(),
         "passes rate check": [s in qualified for s in err_all.columns],
     }).sort_values("score")
-    lines = ["# Selection of `footzoo/config/builtin/recommended.yaml`", "",
+    lines = ["# Selection of `configs/recommended.yaml`", "",
              (__doc__ or "").split("\n\n", 2)[2].strip().replace("\n", " "), "",
              f"Grid: {len(cands)} settings × {len(err)} trials (detector settings: "
              f"{len(detector_grid())}, Kalman noise settings: {len(NOISE_GRID)}, impact noise: {len(IMPACT)}, "
@@ -368,7 +368,7 @@ def refine_section(cands: list[dict[str, Any]], err: pd.DataFrame, err3: pd.Data
 
 
 def write_config(cfg: dict[str, Any], cv: dict[str, Any]) -> None:
-    """``footzoo/config/builtin/recommended.yaml`` with the selection procedure in its header."""
+    """``configs/recommended.yaml`` with the selection procedure in its header."""
     import yaml
 
     cfg = copy.deepcopy(cfg)
@@ -389,7 +389,7 @@ def write_config(cfg: dict[str, Any], cv: dict[str, Any]) -> None:
           if "guards" in cfg else []),
     ]
     body = yaml.safe_dump(json.loads(json.dumps(cfg)), sort_keys=False, default_flow_style=None, width=120)
-    (ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml").write_text("\n".join(header) + "\n" + body)
+    (ROOT / "configs" / "recommended.yaml").write_text("\n".join(header) + "\n" + body)
 
 
 if __name__ == "__main__":

@@ -58,7 +58,7 @@ def study(strides: int) -> Study:
         sim = {"path": "straight", "n_strides": strides, "rate": 100, "profile": "physical", "noise": {"scale": 1}}
     return Study.from_dict({
         "name": "scaling",
-        "base": {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012"},
+        "base": {**load_yaml(ROOT / "configs" / "yun2012.yaml"), "name": "yun2012"},
         "factors": {"detector.type": ["angular_rate_fsm", "shoe"],
                     "corrections": [[{"type": "zvu_dedrift"}], [{"type": "zupt"}]]},
         "recordings": [{"simulate": sim, "seeds": list(range(8))}],
@@ -95,12 +95,12 @@ def scale_study(settings: int, recordings: int, strides: int = 30, base: str = "
     if base == "yun2012":
         second = ("orientation.static_gain", [0.5, 0.75, 1.05, 1.3, 1.6])
         thresholds = [round(0.3 + 0.1 * k, 2) for k in range(max(1, settings // 5))]
-        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "yun2012.yaml"), "name": "yun2012",
+        cfg = {**load_yaml(ROOT / "configs" / "yun2012.yaml"), "name": "yun2012",
                "calibration": []}
     else:
         second = ("navigation.velocity_noise", [0.003, 0.01, 0.03, 0.1, 0.3])
         thresholds = [round(1000.0 + 500.0 * k, 1) for k in range(max(1, settings // 5))]
-        cfg = {**load_yaml(ROOT / "footzoo" / "config" / "builtin" / "recommended.yaml"), "name": "recommended"}
+        cfg = {**load_yaml(ROOT / "configs" / "recommended.yaml"), "name": "recommended"}
     return Study.from_dict({
         "name": "scale",
         "base": cfg,

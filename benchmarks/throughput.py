@@ -114,7 +114,7 @@ SMOOTHERS = {"rts": "RTS", "stepwise": "step-wise"}
 def config_items(rec, warm, names: list[str] | None = None) -> list[Item]:
     items = []
     for name in names or CONFIGS:
-        p = footzoo.Pipeline.from_yaml(ROOT / "footzoo" / "config" / "builtin" / f"{name}.yaml")
+        p = footzoo.Pipeline.from_yaml(ROOT / "configs" / f"{name}.yaml")
         p.run(warm)  # compile / load the compiled kernels
         n_states = kalman_states(p)
         kind = "no Kalman filter" if n_states == 0 else f"{min((9, 15, 21), key=lambda s: abs(s - n_states))}" \
@@ -351,7 +351,7 @@ if name == "(a)":
     class p:
         run = staticmethod(lambda r: strapdown(r.t, r.acc, r.gyr, np.array([1.0, 0.0, 0.0, 0.0])))
 else:
-    p = footzoo.Pipeline.from_yaml({root!r} + f"/footzoo/config/builtin/{{name}}.yaml")
+    p = footzoo.Pipeline.from_yaml({root!r} + f"/configs/{{name}}.yaml")
 p.run(walk(3000))  # load the compiled kernels, on little memory
 rec = walk(n)
 gc.collect()
@@ -436,7 +436,7 @@ def cold_start(names: list[str], wheel: bool = True) -> list[str]:
                 with tempfile.TemporaryDirectory() as cache:
                     env = {**os.environ, **extra, "NUMBA_CACHE_DIR": cache}
                     out = []
-                    script = code.format(config=str(ROOT / "footzoo" / "config" / "builtin" / f"{c}.yaml"))
+                    script = code.format(config=str(ROOT / "configs" / f"{c}.yaml"))
                     for _ in range(2):
                         proc = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True,
                                               text=True, cwd=cwd, env=env)

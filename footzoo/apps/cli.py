@@ -555,7 +555,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "run loads them from numba's cache (e.g. before a study on a new machine)")
     comp.add_argument("configs", nargs="+", type=_input_yaml,
                       help="pipeline YAML files or study files (every config of the grid), "
-                           "e.g. footzoo/config/builtin/*.yaml")
+                           "e.g. configs/*.yaml")
     comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
                       "(what setup.py does for a wheel's footzoo/_compiled)")
     comp.set_defaults(func=cmd_compile)

@@ -4,7 +4,7 @@ numba compiles each kernel at its first call (about 5 s for a Kalman pipeline) a
 machine code on disk. :func:`compile_kernels` runs each config once on two short simulated walks
 (with magnetometer and distance sensors, and without), which compiles and caches every kernel the
 config uses: run it once on a new machine, or before a study starts its workers
-(``footzoo compile footzoo/config/builtin/*.yaml``; a study file stands for every config of its grid). With
+(``footzoo compile configs/*.yaml``; a study file stands for every config of its grid). With
 ``ship`` it writes the code into a folder instead: ``setup.py`` does so when it builds a wheel,
 which then carries the compiled kernels of the shipped configs (see :mod:`footzoo.kernels.cache`).
 """

@@ -1,6 +1,8 @@
 """The configs shipped with footzoo, by name: ``Pipeline.from_yaml("recommended")`` from anywhere.
 
-The YAML files live in this package's ``builtin`` folder and are installed with it. A name
+The YAML files live in the repository's top-level ``configs/`` folder; a wheel installs them as
+``footzoo/configs/`` (``setup.py`` maps the folder into the package), so they are found by name in
+an installed footzoo and in a source checkout alike. A name
 is a file stem (``yun2012``), with or without ``.yaml``; a path to an existing file always
 wins over a name, so a user's edited copy next to their data is read instead.
 """
@@ -12,8 +14,16 @@ from pathlib import Path
 
 from ..core.errors import ConfigError, did_you_mean
 
+
+def _shipped_folder() -> Path:
+    """``footzoo/configs`` of an installed footzoo, else ``configs/`` beside the package in a source checkout."""
+    package = Path(__file__).resolve().parents[1]
+    installed = package / "configs"
+    return installed if installed.is_dir() else package.parent / "configs"
+
+
 #: Folder of the shipped YAML files.
-BUILTIN = Path(__file__).resolve().parent / "builtin"
+BUILTIN = _shipped_folder()
 
 
 def names(kind: str | None = None) -> list[str]:

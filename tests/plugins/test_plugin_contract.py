@@ -1,0 +1,288 @@
+"""Every built-in plug-in follows the plug-in contract (footzoo.apps.testing.check_plugin); its report; registration."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import footzoo
+from footzoo.apps.testing import check_plugin
+from footzoo.core.errors import RecordingError
+from footzoo.plugins.base import Detector, Real
+from footzoo.plugins.registry import KINDS, available
+
+ROOT = Path(__file__).resolve().parents[2]
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+BUILTINS = [(kind, name) for kind in KINDS for name in sorted(available(kind))]
+
+
+@pytest.mark.parametrize("kind,name", BUILTINS, ids=[f"{k}-{n}" for k, n in BUILTINS])
+def test_every_builtin_passes_check_plugin(kind, name):
+    check_plugin(available(kind)[name])
+
+
+def test_check_plugin_catches_a_detector_that_mutates_its_input():
+    @footzoo.register
+    class Mutating(Detector):
+        """Marks still samples as stance, but scribbles on its input (a bug check_plugin must catch)."""
+
+        name = "test_mutating"
+        paper = "none (test)"
+        units = {"threshold": "rad/s"}
+
+        def __init__(self, threshold: float = 0.5):
+            self.threshold = threshold
+
+        def detect(self, t, acc, gyr):
+            self.stance_ = np.linalg.norm(gyr, axis=1) < self.threshold
+            self.statistic_ = np.linalg.norm(gyr, axis=1)
+            gyr[:] = 0.0
+            return self
+
+    with pytest.raises(AssertionError, match="modified its input"):
+        check_plugin(Mutating)
+
+
+def test_check_plugin_catches_a_numeric_parameter_without_a_unit():
+    @footzoo.register
+    class NoUnit(Detector):
+        """Gyro-magnitude threshold without a declared unit."""
+
+        name = "test_no_unit"
+        paper = "none (test)"
+
+        def __init__(self, threshold: float = 0.5):
+            self.threshold = threshold
+
+        def detect(self, t, acc, gyr):
+            self.statistic_ = np.linalg.norm(gyr, axis=1)
+            self.stance_ = self.statistic_ < self.threshold
+            return self
+
+    with pytest.raises(AssertionError, match="numeric parameter 'threshold' has no unit: declare it"):
+        check_plugin(NoUnit)
+
+
+def test_nan_input_to_any_action_method_is_a_clear_error():
+    det = available("detector")["shoe"]()
+    t = np.arange(100) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (100, 1))
+    acc[40, 2] = np.nan
+    with pytest.raises(RecordingError, match=r"detector 'shoe': input 'acc' has 1 non-finite sample.*index 40"):
+        det.detect(t, acc, np.zeros((100, 3)))
+
+
+def test_within_a_run_an_array_proven_finite_is_not_scanned_again_but_any_other_is():
+    """A pipeline run scans its recording's arrays for NaN once (inputs_checked_once); a new or changed
+    array handed to a block is still checked, and outside a run every call checks."""
+    from footzoo.plugins.base import inputs_checked_once
+
+    det = available("detector")["shoe"]()
+    t = np.arange(100) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (100, 1))
+    gyr = np.zeros((100, 3))
+    with inputs_checked_once():
+        det.detect(t, acc, gyr)
+        bad = acc.copy()
+        bad[40, 2] = np.nan
+        with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 40"):
+            det.detect(t, bad, gyr)  # another object: checked
+        acc[7, 0] = np.inf  # the same object, changed behind the run's back: not scanned again
+        det.detect(t, acc, gyr)
+    with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 7"):
+        det.detect(t, acc, gyr)  # outside: every call checks
+
+
+def test_an_output_that_passed_its_check_is_proven_finite_for_the_next_block_within_a_run_only():
+    """A block's output checked finite on return (check_array) is not scanned again as the next block's
+    input within the run; a copy of it is, and nothing is proven outside a run."""
+    from footzoo.plugins.base import inputs_checked_once
+    from footzoo.plugins.contract import Output, check_array, proven_finite
+
+    det = available("detector")["shoe"]()
+    out = np.ones((10, 3))
+    with inputs_checked_once():
+        assert not proven_finite(out)
+        check_array(det, "detect", "x_", out, Output(width=3), 10)
+        assert proven_finite(out) and not proven_finite(out.copy())
+        statistic = np.ones(10)
+        check_array(det, "detect", "statistic_", statistic, Output(finite=False), 10)
+        assert not proven_finite(statistic)  # an output that may hold NaN is not scanned, so proves nothing
+    check_array(det, "detect", "x_", out, Output(width=3), 10)
+    assert not proven_finite(out)
+
+
+def test_register_rejects_a_class_of_the_wrong_base_and_a_taken_name():
+    class NotAPlugin:
+        name = "x"
+
+    with pytest.raises(TypeError, match="plug-in class"):
+        footzoo.register(NotAPlugin)
+
+    class Stray(footzoo.plugins.base.Plugin):
+        kind = "detector"
+        name = "test_stray"
+
+    with pytest.raises(TypeError, match="derives from footzoo.plugins.base.Detector"):
+        footzoo.register(Stray)
+
+    class Shoe2(Detector):
+        """Another SHOE."""
+
+        name = "shoe"
+
+    with pytest.raises(ValueError, match="already registered"):
+        footzoo.register(Shoe2)
+
+
+def test_the_engine_pipeline_and_stream_name_no_plugin():
+    """The engine, the runtime and the kernels know no plug-in by name: adding one touches none of their files."""
+    root = Path(footzoo.__file__).parent
+    files = [*sorted((root / "filters").glob("*.py")), *sorted((root / "runtime").glob("*.py")),
+             *sorted((root / "kernels").glob("*.py"))]
+    names = {name for kind in KINDS for name in available(kind) if not name.startswith("test_")}
+    for f in files:
+        text = f.read_text()
+        for name in names:
+            assert f'"{name}"' not in text and f"'{name}'" not in text, f"{f.name} names the plug-in {name!r}"
+
+
+# --------------------------------------------------------------------------- one plug-in loaded twice
+PLUGIN_FILE = '''
+import numpy as np
+
+import footzoo
+from footzoo.plugins.base import Detector, Real
+
+VERSION = {version}
+
+
+@footzoo.register
+class Twice(Detector):
+    """Stance while |ω| is small (a plug-in imported by a script and listed under plugins:)."""
+
+    name = "{name}"
+    paper = "none (test)"
+    parameters = {{"gyro_max": Real("rad/s", "(0, 10]", "bound on |ω|", source="test")}}
+
+    def __init__(self, gyro_max: float = 0.8):
+        self.gyro_max = gyro_max
+
+    def detect(self, t, acc, gyr):
+        self.statistic_ = np.linalg.norm(gyr, axis=1)
+        self.stance_ = self.statistic_ < self.gyro_max
+        return self
+'''
+
+
+def _config(path, name):
+    return {"plugins": [str(path)], "orientation": {"type": "madgwick"}, "detector": {"type": name},
+            "corrections": [{"type": "zvu_dedrift"}]}
+
+
+@pytest.mark.parametrize("script_first", [True, False], ids=["import-then-config", "config-then-import"])
+def test_a_plugin_imported_by_a_script_and_listed_under_plugins_is_one_plugin(tmp_path, monkeypatch, script_first):
+    """Issue 24: the same file loaded under two module names failed as 'already registered'."""
+    import importlib
+
+    from footzoo import Pipeline
+
+    module = f"twice_{'a' if script_first else 'b'}"
+    name = f"test_contract_{module}"
+    path = tmp_path / f"{module}.py"
+    path.write_text(PLUGIN_FILE.format(version=1, name=name))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    if script_first:
+        mine = importlib.import_module(module)
+        pipe = Pipeline.from_dict(_config(path, name))
+    else:
+        pipe = Pipeline.from_dict(_config(path, name))
+        mine = importlib.import_module(module)
+        pipe = Pipeline.from_dict(_config(path, name))
+    assert isinstance(pipe.detector, mine.Twice)  # the registry keeps the script's class
+    assert available("detector")[name] is mine.Twice
+    assert check_plugin(mine.Twice, verbose=False).checks
+
+
+def test_a_plugin_file_edited_after_the_import_replaces_it_and_another_class_is_refused(tmp_path, monkeypatch):
+    import importlib
+
+    from footzoo import Pipeline
+
+    name = "test_contract_twice_edited"
+    path = tmp_path / "twice_edited.py"
+    path.write_text(PLUGIN_FILE.format(version=1, name=name))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    importlib.import_module("twice_edited")
+    path.write_text(PLUGIN_FILE.format(version=2, name=name))
+    Pipeline.from_dict(_config(path, name))
+    registered = available("detector")[name]
+    assert sys.modules[registered.__module__].VERSION == 2  # the newest code runs, as in a study's workers
+    other = tmp_path / "other.py"
+    other.write_text(PLUGIN_FILE.format(version=1, name=name))
+    with pytest.raises(footzoo.ConfigError, match=f"a detector plug-in named '{name}' is already registered"):
+        Pipeline.from_dict(_config(other, name))
+
+
+# --------------------------------------------------------------------------- the report
+def test_check_plugin_returns_a_report_and_prints_one_line(capsys):
+    report = check_plugin(available("detector")["angular_rate_fsm"], verbose=True)
+    line = capsys.readouterr().out
+    assert line.count("\n") == 1 and line.startswith("check_plugin: detector 'angular_rate_fsm' passed ")
+    assert str(report) == line.strip() and len(report.checks) >= 5 and not report.notes
+    assert "bad values refused" in report.details()
+    check_plugin(available("detector")["shoe"], verbose=False)
+    assert capsys.readouterr().out == ""
+
+
+def test_check_plugin_from_the_command_line(tmp_path, capsys):
+    """``python -m footzoo.apps.testing FILE.py``: one line per plug-in, exit 1 when one fails."""
+    from footzoo.apps.testing import main
+
+    good = tmp_path / "good.py"
+    good.write_text(PLUGIN_FILE.format(version=1, name="test_contract_cli"))
+    assert main([str(good)]) == 0
+    assert capsys.readouterr().out.startswith("check_plugin: detector 'test_contract_cli' passed")
+    bad = tmp_path / "bad.py"
+    bad.write_text(PLUGIN_FILE.format(version=1, name="test_contract_cli_bad").replace(
+        "gyr, axis=1)\n        self.stance_", "gyr, axis=1)\n        gyr[:] = 0\n        self.stance_"))
+    assert main([str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "check_plugin: detector 'test_contract_cli_bad' FAILED: " in err and "modified its input" in err
+    assert main([str(tmp_path / "none.py")]) == 2 and "does not exist" in capsys.readouterr().err
+
+
+def test_the_testing_module_runs_as_a_script():
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", "--help"], capture_output=True, text=True,
+                          env=env)
+    assert proc.returncode == 0 and proc.stdout.startswith("usage: python -m footzoo.apps.testing")
+
+
+def test_check_plugin_checks_the_declarations():
+    @footzoo.register
+    class Unitless(Detector):
+        """A declared threshold without a unit or a source."""
+
+        name = "test_contract_unitless"
+        paper = "none (test)"
+        parameters = {"threshold": Real("", "(0, 10]", "bound on |ω|")}
+
+        def __init__(self, threshold: float = 0.5):
+            self.threshold = threshold
+
+        def detect(self, t, acc, gyr):
+            self.statistic_ = np.linalg.norm(gyr, axis=1)
+            self.stance_ = self.statistic_ < self.threshold
+            return self
+
+    with pytest.raises(AssertionError, match="gives no source of its default"):
+        check_plugin(Unitless)
+    Unitless.parameters["threshold"].source = "test"
+    with pytest.raises(AssertionError, match="declares no unit"):
+        check_plugin(Unitless)
