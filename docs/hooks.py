@@ -15,6 +15,13 @@
 
 The ``nav`` entries ``zoo/index.md``, ``readers/index.md`` and
 ``gallery/index.md`` in ``mkdocs.yml`` are expanded into sections here.
+
+**Links work in the repository and in the site.** A generated page with a hand-written page of
+the same name in ``docs/`` (``zoo/index.md``, ``gallery/index.md``, ``readers/generic.md``) is
+that page with the generated part appended, so the pages link to files that exist; a link to a
+file the site publishes under another name (``../benchmarks/accuracy.md`` -> ``benchmarks/accuracy.md``)
+is rewritten for the site (:func:`site_link`). ``tests/docs/test_links.py`` resolves every relative
+link of README.md and docs/ in the repository.
 """
 
 from __future__ import annotations
@@ -130,6 +137,49 @@ def yaml_value(v: Any) -> Any:
     return None
 
 
+def committed(uri: str) -> str | None:
+    """The hand-written page ``docs/<uri>``, or None."""
+    path = ROOT / "docs" / uri
+    return path.read_text() if path.is_file() else None
+
+
+def with_committed(uri: str, generated: str) -> str:
+    """The hand-written page ``docs/<uri>`` with ``generated`` appended (a heading of its own when it has none)."""
+    text = committed(uri)
+    if text is None:
+        return generated
+    return text.rstrip() + "\n\n" + generated
+
+
+#: Folders of the repository whose files the site publishes under another path: repository folder -> site folder.
+PUBLISHED = {"benchmarks": "benchmarks"}
+_LINK = re.compile(r"(\]\()([^)\s#]+)(#[^)\s]*)?(\))")
+
+
+def site_link(page_uri: str, target: str) -> str:
+    """``target`` (a link of the page ``docs/<page_uri>``, relative) as the site needs it.
+
+    A link that leaves ``docs/`` for a file the site publishes (``../benchmarks/accuracy.md``, a
+    summary a benchmark wrote) points at the published page; every other link stays as it is.
+    """
+    if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("/"):
+        return target
+    page_dir = (ROOT / "docs" / page_uri).parent
+    resolved = (page_dir / target).resolve()
+    for folder, site in PUBLISHED.items():
+        base = (ROOT / folder).resolve()
+        if resolved.is_relative_to(base) and not resolved.is_relative_to((ROOT / "docs").resolve()):
+            published = (ROOT / "docs" / site / resolved.relative_to(base))
+            return os.path.relpath(published, page_dir).replace(os.sep, "/")
+    return target
+
+
+def on_page_markdown(markdown, page, **_):
+    """Links to files the site publishes under another path (:func:`site_link`) point at the published page."""
+    uri = page.file.src_uri
+    return _LINK.sub(lambda m: m.group(1) + site_link(uri, m.group(2)) + (m.group(3) or "") + m.group(4), markdown)
+
+
 # --------------------------------------------------------------------------- plug-in pages
 
 
@@ -175,13 +225,8 @@ def plugin_pages() -> dict[str, str]:
             pages[uri] = "\n".join(lines)
             rows.append(f"| {kind} | [`{name}`]({kind}/{name}.md) | {md_cell(first_line(doc))} | "
                         f"{md_cell(paper)} |")
-    index = ["# Plug-in zoo", "",
-             "Every plug-in footzoo knows, generated from the registry and the plug-ins' docstrings when the "
-             "documentation is built. `footzoo list` prints the same information in a terminal; "
-             "[the plug-in guide](../plugins.md) shows how to add your own; [the config settings](settings.md) "
-             "lists the top-level blocks of a config.", "",
-             "| kind | name | what it does | paper |", "|---|---|---|---|", *rows, ""]
-    pages["zoo/index.md"] = "\n".join(index)
+    table = ["| kind | name | what it does | paper |", "|---|---|---|---|", *rows, ""]
+    pages["zoo/index.md"] = with_committed("zoo/index.md", "\n".join(table))
     pages["zoo/settings.md"] = settings_page()
     return pages
 
@@ -271,16 +316,15 @@ def reader_pages() -> dict[str, str]:
         if reader.fixed_units:
             lines += ["", "Units the format fixes: " + ", ".join(f"`{k}={v}`" for k, v in reader.fixed_units.items())
                       + " (a matching option is accepted, another one refused)."]
-        if reader.options:
-            lines += ["", "## Options", "", "Keyword arguments of `footzoo.load` for this format (command line: "
-                      "`--option NAME=VALUE`):", "", "| option | default | unit | meaning |", "|---|---|---|---|"]
-            for name, opt in reader.options.items():
-                lines.append(f"| `{name}` | {md_cell(f'`{opt.default!r}`')} | {md_cell(opt.unit)} | "
-                             f"{md_cell(opt.doc)} |")
-        lines += ["", "## Format, units, axis map and reference data", "",
+        options = reader_options_section(reader)
+        uri = f"readers/{fmt}.md"
+        if committed(uri) is not None:  # a hand-written page: it, with the options as declared
+            pages[uri] = with_committed(uri, "\n".join(options))
+            continue
+        lines += ["", *options, "## Format, units, axis map and reference data", "",
                   f"::: {modname}", "    options:", "      show_root_heading: false",
                   "      show_root_toc_entry: false", "      members: false", ""]
-        pages[f"readers/{fmt}.md"] = "\n".join(lines)
+        pages[uri] = "\n".join(lines)
     for modname in others:
         mod = importlib.import_module(modname)
         short = modname.rsplit(".", 1)[-1]
@@ -289,6 +333,17 @@ def reader_pages() -> dict[str, str]:
             f"::: {modname}", "    options:", "      show_root_heading: false", "      show_root_toc_entry: false",
             "      heading_level: 2", ""])
     return pages
+
+
+def reader_options_section(reader: Any) -> list[str]:
+    """The ``## Options`` section of a reader's page: its declared options, as ``footzoo formats`` lists them."""
+    if not reader.options:
+        return []
+    lines = ["## Options", "", "Keyword arguments of `footzoo.load` for this format (command line: "
+             "`--option NAME=VALUE`):", "", "| option | default | unit | meaning |", "|---|---|---|---|"]
+    for name, opt in reader.options.items():
+        lines.append(f"| `{name}` | {md_cell(f'`{opt.default!r}`')} | {md_cell(opt.unit)} | {md_cell(opt.doc)} |")
+    return [*lines, ""]
 
 
 def reader_nav() -> list[Any]:
@@ -312,10 +367,7 @@ def run_gallery(out: Path) -> dict[str, str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    sections = ["# Gallery", "",
-                "Figures rendered from the scripts in `docs/gallery/` each time the documentation is built "
-                "(so they always show what the current code does). Each script is short and runs as it is: "
-                "`python docs/gallery/NAME.py OUTDIR`.", ""]
+    sections: list[str] = []
     for script in gallery_scripts():
         target = out / script.stem
         target.mkdir(parents=True, exist_ok=True)
@@ -344,7 +396,7 @@ def run_gallery(out: Path) -> dict[str, str]:
         sections += [f'??? example "Source: docs/gallery/{script.name}"', "", "    ```python"]
         sections += [("    " + line).rstrip() for line in body.strip("\n").splitlines()]
         sections += ["    ```", ""]
-    return {"gallery/index.md": "\n".join(sections)}
+    return {"gallery/index.md": with_committed("gallery/index.md", "\n".join(sections))}
 
 
 # --------------------------------------------------------------------------- mkdocs events
@@ -397,7 +449,8 @@ def on_files(files, config, **_):
     for png in sorted(BENCHMARKS.glob("*.png")):
         files.append(File.generated(config, f"benchmarks/{png.name}", abs_src_path=str(png)))
     if os.environ.get("FOOTZOO_DOCS_NO_GALLERY"):
-        pages["gallery/index.md"] = "# Gallery\n\nNot rendered in this build (`FOOTZOO_DOCS_NO_GALLERY` is set).\n"
+        pages["gallery/index.md"] = with_committed("gallery/index.md", "*Not rendered in this build "
+                                                   "(`FOOTZOO_DOCS_NO_GALLERY` is set).*\n")
     else:
         _gallery_dir = Path(tempfile.mkdtemp(prefix="footzoo-gallery-"))
         pages.update(run_gallery(_gallery_dir))

@@ -39,9 +39,9 @@ from typing import Any
 
 import numpy as np
 
-from ..core.conventions import quat_to_matrix
+from ..core.conventions import axis_map_text, quat_to_matrix
 from ..core.errors import FormatError, SensorWarning
-from ..io.axes import describe_axes, parse_axes
+from ..io.axes import axes_fix, parse_axes
 from ..kernels.jit import njit
 from .gait_events import sagittal_rate, stride_directions
 
@@ -68,15 +68,6 @@ def nearest_axis_map(a: np.ndarray) -> np.ndarray | None:
     p = np.zeros((3, 3))
     p[np.arange(3), k] = np.sign(a[np.arange(3), k])
     return p if np.linalg.det(p) > 0 else None
-
-
-def axis_map_text(p: np.ndarray) -> str:
-    """``[-x, -y, z]`` for a signed permutation (rows: FRD axes in sensor coordinates)."""
-    names = []
-    for row in p:
-        k = int(np.argmax(np.abs(row)))
-        names.append(("-" if row[k] < 0 else "") + "xyz"[k])
-    return "[" + ", ".join(names) + "]"
 
 
 @njit
@@ -167,7 +158,9 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
 def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | None = None) -> None:
     """A :class:`SensorWarning` when the report finds the foot walking backwards or its pitch reversed.
 
-    ``axes`` is the axis map the recording was read with (``Recording.meta["axes"]``), named in the fix.
+    ``axes`` is the axis map the recording was read with (``Recording.meta["axes"]``): the fix is the
+    map to read the file with instead, spelled as the ``axes`` option every reader takes
+    (:func:`footzoo.io.axes.axes_fix`).
     """
     symptoms = []
     if report.get("walks_backwards"):
@@ -180,13 +173,16 @@ def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | N
         return
     where = f"recording {name!r}: " if name else ""
     suggested = report.get("suggested_axes")
-    if suggested and axes:
+    how = ""
+    if suggested:
         try:  # the map to read the raw file with: the fix applied after the map used
-            suggested = describe_axes(parse_axes(suggested.strip("[]")) @ parse_axes(axes))
+            rows = parse_axes(suggested) @ (parse_axes(axes) if axes else np.eye(3))
+            suggested, how = axis_map_text(rows), f": {axes_fix(rows)}"
         except FormatError:
             suggested = f"{suggested} on top of the axis map it was read with ({axes})"
     fix = (f"if the sensor is not mounted so on purpose (e.g. upside down), the axis map is wrong: read it with "
-           f"the axis map {suggested} (x toward the toe, y right, z down, in sensor axes)"
-           if suggested else "check the axis map (x toward the toe, y right, z down)")
+           f"the axis map {suggested} (x toward the toe, y right, z down, in sensor axes){how}"
+           if suggested else "check the axis map (x toward the toe, y right, z down) and read the file with the "
+                             "right one: --option 'axes=[...]' on the command line, footzoo.load(path, axes=...)")
     warnings.warn(f"{where}{'; '.join(symptoms)}. footzoo's strides and gait events do not depend on the "
                   f"mounting; {fix}. Details in Result.diagnostics['mounting']", SensorWarning, stacklevel=3)

@@ -159,7 +159,7 @@ def _two_feet(args: argparse.Namespace) -> bool:
     from ..io import check_input_file, detect_format
     from ..io.gaitmap import feet
 
-    fmt = args.format or detect_format(check_input_file(args.data))
+    fmt = args.format or detect_format(check_input_file(args.data), _reader_options(args))
     if fmt != "gaitmap":
         if args.foot == "both":
             raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file")
@@ -477,9 +477,13 @@ def cmd_formats(args: argparse.Namespace) -> int:
             unit = f" [{spec.unit}]" if getattr(spec, "unit", "") else ""
             print(f"{'':<16} --option {opt}=...{unit}  default {getattr(spec, 'default', None)!r}: "
                   f"{getattr(spec, 'doc', '')}")
+        if "axes" not in (getattr(reader, "options", None) or {}):
+            print(f"{'':<16} --option axes=...  default '[x, y, z]': the axes of what the reader returns -> FRD, "
+                  "applied by footzoo after the reader (footzoo.io.axes)")
     for name, reason in readers.broken.items():
         print(f"{name:<14} NOT AVAILABLE: {reason}")
-    print("read a file with: footzoo run CONFIG --data FILE [--format NAME] [--option NAME=VALUE ...]")
+    print("read a file with: footzoo run CONFIG --data FILE [--format NAME] [--option NAME=VALUE ...]; an axis map "
+          "on the command line: --option 'axes=[x, -y, -z]' (quoted) or --option axes=x,-y,-z")
     return EXIT_OK
 
 
@@ -540,8 +544,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--foot", choices=["left", "right", "both"],
                      help="foot to read from a two-foot file (gaitmap; default: both when the file has both), "
                           "or the foot a one-foot recording is from")
-    run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
-    run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
+    run.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit (default: the format's)")
+    run.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit (default: the format's)")
     run.add_argument("--option", action="append", type=_reader_option, metavar="NAME=VALUE",
                      help="a reader option (repeatable), e.g. --option rate=820; footzoo formats lists them")
     run.add_argument("--out", type=_output, help="directory for the result: samples.csv, steps.csv, metrics.json "
@@ -590,8 +594,8 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--data", required=True, help="calibration recording")
     cal.add_argument("--format", help="reader format (default: detect)")
     cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
-    cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit of a canonical file")
-    cal.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit of a canonical file")
+    cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit (default: the format's)")
+    cal.add_argument("--gyr-unit", choices=list(GYR_UNITS), help="gyroscope unit (default: the format's)")
     cal.add_argument("--still", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),
                      help="still period (s); default: found")
     cal.add_argument("--flex", nargs=2, type=_number(-1e12, 1e12, "s"), metavar=("T0", "T1"),

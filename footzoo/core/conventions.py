@@ -11,6 +11,9 @@ Conventions (binding for every module):
   about the new y, then roll φ about the new x): ``R = Rz(ψ) Ry(θ) Rx(φ)``.
   Positive pitch lifts the toe, positive yaw turns north toward east.
 * Units: s, m, m/s², rad/s, rad. Magnetometer readings may be in any unit.
+* Axis maps (how a sensor's axes become FRD) are written ``[x, -y, -z]``: the sensor axis
+  that each FRD axis is, in the order x, y, z (:func:`axis_map_text`); a map that is no signed
+  permutation is its rotation matrix, by rows: ``[[0.866025, 0, -0.5], [0, 1, 0], [0.5, 0, 0.866025]]``.
 
 All functions accept a single quaternion/vector or a stack of them (leading
 axes broadcast) and never modify their inputs.
@@ -38,6 +41,25 @@ SI_UNITS: dict[str, str] = {
 ACC_UNITS: dict[str, float] = {"m/s^2": 1.0, "m/s2": 1.0, "g": GRAVITY, "mg": GRAVITY / 1000.0}
 GYR_UNITS: dict[str, float] = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 DIST_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+
+
+def axis_map_text(rows: np.ndarray) -> str:
+    """An axis map as footzoo writes it in every message, document and option: ``[x, -y, -z]``.
+
+    ``rows`` (3, 3): the FRD axes in sensor coordinates (``v_FRD = rows · v_sensor``). A signed
+    permutation is written as the sensor axis each FRD axis is (``[x, -y, -z]``: FRD x is the
+    sensor's x, FRD y its −y, FRD z its −z); any other matrix as its rows to 6 significant digits
+    (``[[0.866025, 0, -0.5], [0, 1, 0], [0.5, 0, 0.866025]]``). Both forms read back as they are
+    (``axes=`` of every reader, ``axes:`` of a sidecar).
+    """
+    m = np.asarray(rows, dtype=float)
+    names = []
+    for row in m:
+        k = int(np.argmax(np.abs(row)))
+        if not np.isclose(abs(row[k]), 1.0) or np.count_nonzero(np.round(row, 12)) != 1:
+            return "[" + ", ".join("[" + ", ".join(f"{v:.6g}" if v else "0" for v in r) + "]" for r in m) + "]"
+        names.append(("-" if row[k] < 0 else "") + "xyz"[k])
+    return "[" + ", ".join(names) + "]"
 
 
 def gravity_ned(g: float = GRAVITY) -> np.ndarray:

@@ -549,6 +549,11 @@ def _report_gaps(rec: Recording) -> None:
     )
 
 
+#: How to declare a unit, in each place footzoo reads one (every reader takes ``acc_unit`` and ``gyr_unit``).
+UNIT_FIX = ("footzoo.load(path, {key}='{value}'), on the command line --option {key}={value}, "
+            "Recording.from_dataframe(..., {key}='{value}')")
+
+
 def _check_units(rec: Recording) -> None:
     check_units(rec.acc, rec.gyr)
 
@@ -566,11 +571,12 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
     if 0.5 < rest < 2.0:
         raise RecordingError(
             f"accelerometer magnitude at rest is {rest:.3f}: this looks like g, not m/s²; "
-            "declare acc_unit: g (Recording.from_dataframe(..., acc_unit='g'))"
+            f"declare acc_unit: g ({UNIT_FIX.format(key='acc_unit', value='g')})"
         )
     if 500.0 < rest < 2000.0:
         raise RecordingError(
-            f"accelerometer magnitude at rest is {rest:.1f}: this looks like mg; declare acc_unit: mg"
+            f"accelerometer magnitude at rest is {rest:.1f}: this looks like mg; declare acc_unit: mg "
+            f"({UNIT_FIX.format(key='acc_unit', value='mg')})"
         )
     if not 0.5 * GRAVITY < rest < 1.5 * GRAVITY:
         raise RecordingError(
@@ -582,7 +588,7 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
     if peak > GYRO_DEG_S_SUSPICION:
         raise RecordingError(
             f"gyroscope 99th-percentile rate is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
-            "this looks like deg/s; declare gyr_unit: deg/s"
+            f"this looks like deg/s; declare gyr_unit: deg/s ({UNIT_FIX.format(key='gyr_unit', value='deg/s')})"
         )
 
 

@@ -5,20 +5,22 @@ None, asks every reader whether it recognises the file (:mod:`footzoo.io.registr
 are plug-ins of the entry-point group ``footzoo.readers`` (:mod:`footzoo.io.base`): the formats
 below are registered there by footzoo itself, and an installed package adds its own the same way.
 
-Formats and their axis maps (sensor axes -> FRD):
+Every reader takes the options ``axes`` (sensor axes -> FRD, :mod:`footzoo.io.axes`),
+``acc_unit`` and ``gyr_unit``, defaulting to what its format stores (a reader plug-in without an
+``axes`` option of its own gets it here, applied to what it returns). The defaults:
 
 ============== ============================== ============================================
-format         units in the file              axis map
+format         units in the file              axis map (``axes``)
 ============== ============================== ============================================
-canonical      SI (t s, acc m/s², gyr rad/s)  already FRD
-xio            g, deg/s                       NGIMU z up: (x, −y, −z), 180° about x
-pyshoe         m/s², rad/s                    already x fwd, y right, z down; VICON ``gt``
-                                              is mirrored: truth = gt · [1, 1, −1]
-gaitmap        m/s², deg/s                    foot frame x toe, y left, z up: (x, −y, −z)
+canonical      SI (t s, acc m/s², gyr rad/s)  ``[x, y, z]``: already FRD
+xio            g, deg/s                       ``[x, -y, -z]``: NGIMU z up, 180° about x
+pyshoe         m/s², rad/s                    ``[x, y, z]``: x fwd, y right, z down; VICON
+                                              ``gt`` is mirrored: truth = gt · [1, 1, −1]
+gaitmap        m/s², deg/s                    ``[x, -y, -z]``: foot frame x toe, y left, z up,
                                               for both feet (see gaitmap.py)
-sensorconnect  g, rad/s, Gauss                MicroStrain x fwd, y right, z down: identity
-openshoe       g or m/s², rad/s, Gauss        z up in the heel: (x, −y, −z), or ``axes=``
-generic        declared in the sidecar        declared in the sidecar (``axes:``)
+sensorconnect  g, rad/s, Gauss                ``[x, y, z]``: MicroStrain x fwd, y right, z down
+openshoe       header's: g or m/s², rad/s     ``[x, -y, -z]``: z up in the heel
+generic        the description's              the description's ``axes:``
 ============== ============================== ============================================
 """
 
@@ -29,8 +31,11 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..core.data import Recording
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError
+from .axes import parse_axes
 from .base import REQUIRED, Option, Reader
 from .metadata import read_facts
 from .registry import GROUP, available, refresh
@@ -81,20 +86,28 @@ def check_input_file(path: str | Path, what: str = "recording") -> Path:
     return p
 
 
-def detect_format(path: str | Path) -> str:
-    """The format of a file: the one reader whose ``guess_can_open`` accepts it (:meth:`Readers.detect`)."""
-    return available().detect(Path(path))
+def detect_format(path: str | Path, options: Mapping[str, Any] | None = None) -> str:
+    """The format of a file: the one reader an option implies (``sidecar=``: ``generic``, a reader's
+    ``implied_by``), else the one whose ``guess_can_open`` accepts it (:meth:`Readers.detect`)."""
+    readers = available()
+    implied = [name for name, r in readers.items() if set(getattr(r, "implied_by", ()) or ()) & set(options or {})]
+    if len(implied) == 1:
+        return implied[0]
+    return readers.detect(Path(path))
 
 
-def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> tuple[dict[str, Any], Any]:
-    """The options to pass to ``reader.open`` and the declared foot (handled here when the reader has no ``foot``)."""
+def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> tuple[dict[str, Any], Any, Any]:
+    """The options to pass to ``reader.open``, the declared foot and the axis map to apply after the reader
+    (both handled here when the reader has no such option)."""
     declared: dict[str, Option] = dict(getattr(reader, "options", None) or {})
     fixed: dict[str, str] = dict(getattr(reader, "fixed_units", None) or {})
     out: dict[str, Any] = {}
-    foot = None
+    foot = axes = None
     for key, value in options.items():
         if key in declared:
             out[key] = value
+        elif key == "axes":
+            axes = parse_axes(value, "axes")  # refused before the file is read
         elif key in fixed:
             if not _same_unit(key, value, fixed[key]):
                 raise FormatError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
@@ -102,7 +115,7 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
         elif key == "foot":
             foot = value
         else:
-            valid = sorted({*declared, "foot"})
+            valid = sorted({*declared, "foot", "axes"})
             from ..core.errors import did_you_mean
 
             raise FormatError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
@@ -113,7 +126,7 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
                           + "; ".join(f"{k}: {declared[k].doc}" for k in missing))
     if foot is not None and foot not in ("left", "right"):
         raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
-    return out, foot
+    return out, foot, axes
 
 
 def _same_unit(key: str, value: Any, fixed: str) -> bool:
@@ -140,8 +153,10 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     **options
         Reader options (``footzoo.io.READERS[format].options``), e.g. ``foot="left"`` for gaitmap
         (which sensor to read; for other formats it declares the foot, and must agree with a
-        format that knows it: PyShoe's sensor is on the right foot), ``acc_unit="g"`` and
-        ``gyr_unit="deg/s"`` for canonical files (the other formats fix their units), ``duplicates="drop"``.
+        format that knows it: PyShoe's sensor is on the right foot), ``axes="[x, -y, -z]"`` (the
+        sensor's axes -> FRD, :mod:`footzoo.io.axes`: every reader takes it), ``acc_unit="g"`` and
+        ``gyr_unit="deg/s"`` (the file's units, where they differ from the format's), ``duplicates="drop"``,
+        ``sidecar=`` (a description for the ``generic`` format, which it implies).
 
     Raises
     ------
@@ -151,9 +166,9 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
     """
     p = check_input_file(path)
     readers = available()
-    fmt = readers.detect(p) if format is None else format
+    fmt = detect_format(p, options) if format is None else format
     reader = readers.get_reader(fmt)
-    kwargs, foot = _options_for(reader, fmt, p, options)
+    kwargs, foot, axes = _options_for(reader, fmt, p, options)
     origin = readers.origins.get(fmt, "footzoo")
     try:
         rec = reader.open(p, **kwargs)
@@ -183,6 +198,8 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         raise FormatError(f"the {fmt} reader ({origin}) returned {type(rec).__name__}, not a footzoo Recording; "
                           "its open() must return footzoo.Recording (fix the reader)")
     _complete_meta(rec, p, fmt, reader)
+    if axes is not None:
+        _rotate(rec, axes)
     if foot is not None:
         known = rec.meta.get("foot")
         if known is not None and known != foot:
@@ -190,6 +207,19 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
                               f"(or pass --foot {known})")
         rec.meta["foot"] = foot
     return rec
+
+
+def _rotate(rec: Recording, rows: Any) -> None:
+    """Apply ``axes`` to what a reader without that option returned: its signals, and its true attitude."""
+    from ..core.conventions import quat_from_matrix, quat_mul
+    from .axes import apply_axes, describe_axes
+
+    rec.acc, rec.gyr = apply_axes(rows, rec.acc), apply_axes(rows, rec.gyr)
+    if rec.mag is not None:
+        rec.mag = apply_axes(rows, rec.mag)
+    if rec.truth is not None and rec.truth.quat is not None:
+        rec.truth.quat = quat_mul(rec.truth.quat, np.broadcast_to(quat_from_matrix(rows.T), rec.truth.quat.shape))
+    rec.meta["axes"] = describe_axes(rows)
 
 
 def _complete_meta(rec: Recording, path: Path, fmt: str, reader: Any) -> None:

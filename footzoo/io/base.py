@@ -9,8 +9,11 @@ A reader (modelled on xarray's backend entry points) is an object with
 
 and, to be listed and documented, ``description`` (one line), ``extensions`` (the suffixes it
 claims, lower case with the dot), ``options`` (name -> :class:`Option` with default, unit and
-meaning), ``fixed_units`` (the units the format always stores, e.g. ``{"acc_unit": "g"}``: a
-matching ``acc_unit=`` is accepted and ignored, another one refused) and ``url``.
+meaning; every built-in reader declares :func:`frame_options`: ``axes``, ``acc_unit`` and
+``gyr_unit``, defaulting to what the format stores) and ``url``. A reader without an ``axes``
+option of its own gets one from :func:`footzoo.io.load`, applied to what it returns; one without
+unit options may declare ``fixed_units`` (the units the format always stores, e.g.
+``{"acc_unit": "g"}``: a matching ``acc_unit=`` is accepted and ignored, another one refused).
 
 Readers are registered under the entry-point group ``footzoo.readers`` (the built-in formats
 too, in footzoo's ``setup.cfg``); :func:`footzoo.io.load` finds them there (see
@@ -75,6 +78,33 @@ RECORDING_OPTIONS: dict[str, Option] = {
 }
 
 
+def frame_options(axes: str | None, acc_unit: str | None, gyr_unit: str | None, where: str = "") -> dict[str, Option]:
+    """The options of every built-in reader that say how the file's numbers become FRD and SI.
+
+    Parameters
+    ----------
+    axes, acc_unit, gyr_unit : str or None
+        The format's own axis map (``[x, -y, -z]``, :mod:`footzoo.io.axes`) and units; None when
+        they come from the file (``where`` says from what: "the header", "the description").
+
+    Returns
+    -------
+    dict
+        ``axes``, ``acc_unit`` and ``gyr_unit`` as :class:`Option` s: a value given replaces the
+        format's (a sensor mounted otherwise, a logger set to other units).
+    """
+    def default(value: str | None) -> str:
+        return f" (default: {where})" if value is None else ""
+
+    return {
+        "axes": Option(axes, "", "sensor axes -> FRD (x toe, y right, z down), written '[x, -y, -z]' or as a "
+                                 f"rotation matrix by rows (footzoo.io.axes){default(axes)}"),
+        "acc_unit": Option(acc_unit, "", "unit of the accelerometer in the file: 'm/s^2', 'g' or 'mg'"
+                                         + default(acc_unit)),
+        "gyr_unit": Option(gyr_unit, "", f"unit of the gyroscope in the file: 'rad/s' or 'deg/s'{default(gyr_unit)}"),
+    }
+
+
 class Reader:
     """Base class of a footzoo reader (subclassing is optional: any object with the same methods works).
 
@@ -90,17 +120,22 @@ class Reader:
     options : dict
         Keyword options of :meth:`open`: name -> :class:`Option`.
     fixed_units : dict
-        Units the format always stores (``{"acc_unit": "g", "gyr_unit": "deg/s"}``).
+        Units the format always stores (``{"acc_unit": "g", "gyr_unit": "deg/s"}``), for a reader
+        without ``acc_unit`` / ``gyr_unit`` options (the built-in ones have them, :func:`frame_options`).
     url : str
         Where the format is described.
     reads_metadata_sidecar : bool
         True when :meth:`open` applies the file's metadata sidecar ``<file>.meta.yaml`` itself;
         otherwise :func:`footzoo.load` merges its ``meta`` (without replacing what the reader set)
         and its ``closed_loop`` (:mod:`footzoo.io.metadata`).
+    implied_by : tuple of str
+        Options that only make sense for this format: given without ``format=``, they choose this
+        reader (``sidecar=`` chooses ``generic``).
     """
 
     name: ClassVar[str] = ""
     reads_metadata_sidecar: ClassVar[bool] = False
+    implied_by: ClassVar[tuple[str, ...]] = ()
     description: ClassVar[str] = ""
     extensions: ClassVar[tuple[str, ...]] = ()
     options: ClassVar[dict[str, Option]] = {}

@@ -1,6 +1,7 @@
 """Canonical CSV/Parquet: columns ``t, acc_x..z, gyr_x..z[, mag_x..z][, dist_*][, true_*]``.
 
-SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``).
+SI units and FRD axes unless declared otherwise (``acc_unit``, ``gyr_unit``, ``axes``: the
+columns' axes -> FRD, :mod:`footzoo.io.axes`).
 A file written by ``footzoo simulate`` also carries its ground truth in
 ``true_*`` columns, a metadata sidecar ``<file>.meta.yaml`` (metadata and the
 ``closed_loop`` marker, :mod:`footzoo.io.metadata`) and the true steps in
@@ -17,13 +18,24 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooWarning, FormatError, OutputError
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, input_files, text_source
+from .axes import describe_axes, parse_axes, rotate_columns
+from .base import (
+    RECORDING_OPTIONS,
+    Option,
+    Reader,
+    check_unique_columns,
+    first_line,
+    frame_options,
+    input_files,
+    text_source,
+)
 from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
@@ -49,8 +61,14 @@ def matches(header: str) -> bool:
     return "t" in cols and "acc_x" in cols and "gyr_x" in cols
 
 
-def read(path: Path, **options: Any) -> Recording:
-    """Read a canonical CSV or Parquet file (options go to ``Recording.from_dataframe``)."""
+#: Canonical columns are FRD already.
+AXES = "[x, y, z]"
+
+
+def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
+    """Read a canonical CSV or Parquet file (``axes``: :mod:`footzoo.io.axes`; other options go to
+    ``Recording.from_dataframe``)."""
+    rows = parse_axes(AXES if axes is None else axes, "axes")
     try:
         if path.suffix.lower() in PARQUET_SUFFIXES:
             df = pd.read_parquet(path)
@@ -61,8 +79,12 @@ def read(path: Path, **options: Any) -> Recording:
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
     check_unique_columns(df, path)
+    if not np.array_equal(rows, np.eye(3)):
+        rotate_columns(df, rows)
+        _rotate_truth_attitude(df, rows)
     facts = read_facts(path)
-    meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "canonical"}
+    meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "canonical",
+                            "axes": describe_axes(rows)}
     meta.update(facts.meta)
     meta["input_files"] = [str(path), *map(str, facts.files)]
     rec = Recording.from_dataframe(df, meta=meta, **options)
@@ -85,6 +107,16 @@ def read(path: Path, **options: Any) -> Recording:
     return rec
 
 
+def _rotate_truth_attitude(df: pd.DataFrame, rows: np.ndarray) -> None:
+    """The true attitude ``true_qw..qz`` of a file read with another axis map: body frame FRD, not the file's."""
+    from ..core.conventions import quat_from_matrix, quat_mul
+    from ..core.data import TRUTH_QUAT_COLS
+
+    if all(c in df.columns for c in TRUTH_QUAT_COLS):
+        q = df[TRUTH_QUAT_COLS].to_numpy(dtype=float)
+        df[TRUTH_QUAT_COLS] = quat_mul(q, np.broadcast_to(quat_from_matrix(rows.T), q.shape))
+
+
 class CanonicalReader(Reader):
     """footzoo's own format: canonical column names, SI units and FRD axes (or declared units)."""
 
@@ -93,8 +125,7 @@ class CanonicalReader(Reader):
                    "mag_x..z, dist_*, true_*), SI units unless acc_unit/gyr_unit are declared")
     extensions = (*CSV_SUFFIXES, *PARQUET_SUFFIXES)
     options = {
-        "acc_unit": Option("m/s^2", "", "unit of the acc columns: 'm/s^2', 'g' or 'mg'"),
-        "gyr_unit": Option("rad/s", "", "unit of the gyr columns: 'rad/s' or 'deg/s'"),
+        **frame_options(AXES, "m/s^2", "rad/s"),
         "dist_unit": Option("m", "", "unit of the dist columns: 'm', 'cm' or 'mm'"),
         **RECORDING_OPTIONS,
     }

@@ -6,8 +6,8 @@ sample index, at 204.8 Hz, so ``t = index / rate``. A jump in the index (rows mi
 in time: a short one is bridged with a warning, a longer one (over ``max_gap``) refused with
 the rows that are missing. The data are in gaitmap's foot frame, x toward the toe, y left, z up.
 
-* Both feet: to FRD by 180° about x, ``(x, −y, −z)`` for accelerometer and
-  gyroscope alike.
+* Both feet: to FRD by 180° about x, ``[x, -y, -z]`` for accelerometer and
+  gyroscope alike (``axes=`` replaces it, for both feet).
 
 The data README calls the right foot's frame mirrored. Checked on the file,
 the right foot's data nevertheless behave as a right-handed frame: (1) gyro
@@ -29,17 +29,17 @@ import pandas as pd
 from ..core.checks import check_positive, check_range
 from ..core.data import Recording, Truth, gap_limit
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Option, Reader, first_line, text_source
+from .axes import apply_axes, describe_axes, parse_axes
+from .base import RECORDING_OPTIONS, Option, Reader, first_line, frame_options, text_source
 from .gaitmap_reference import REFERENCE_FILES, has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8
 FEET = ("left", "right")
-AXES = ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]
-#: Sign applied to each column (acc_x..z, gyr_x..z) to reach FRD.
-TO_FRD = {
-    "left": np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0]),
-    "right": np.array([1.0, -1.0, -1.0, 1.0, -1.0, -1.0]),  # see the module docstring
-}
+COLUMNS = ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]
+#: gaitmap's foot frame (x toe, y left, z up) -> FRD, the same for both feet (see the module docstring).
+AXES = "[x, -y, -z]"
+ACC_UNIT = "m/s^2"
+GYR_UNIT = "deg/s"
 
 
 def matches(header: str) -> bool:
@@ -87,7 +87,8 @@ def sample_times(index: pd.Index, rate: float, path: Path, max_gap: float | None
     return idx / rate
 
 
-def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: Any) -> Recording:
+def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, axes: Any = AXES, acc_unit: str = ACC_UNIT,
+         gyr_unit: str = GYR_UNIT, **options: Any) -> Recording:
     """Read one foot of a gaitmap ``imu_sample.csv``.
 
     When the folder also holds gaitmap's ``mocap_sample.csv`` and
@@ -102,6 +103,10 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
         Which sensor to read (required: the file holds both feet).
     rate : float
         Sampling rate (Hz), 204.8 for the example data.
+    axes : str or sequence
+        gaitmap's foot frame -> FRD (:mod:`footzoo.io.axes`); default ``[x, -y, -z]``.
+    acc_unit, gyr_unit : str
+        The file's units (default m/s² and deg/s).
     """
     if foot not in FEET:
         raise FormatError(
@@ -109,6 +114,7 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
             "or read both with footzoo.Session.load(path) (command line: both feet unless --foot left|right)"
         )
     rate = check_range("rate", rate, 0.0, 100_000.0, "Hz", lo_open=True)
+    rows = parse_axes(AXES if axes is None else axes, "axes")
     max_gap = options.get("max_gap")
     if max_gap is not None:
         max_gap = check_positive("max_gap", max_gap, unit="s")
@@ -117,21 +123,23 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, **options: 
     if sensor not in df.columns.get_level_values(0):
         raise FormatError(f"{path}: no {sensor!r} columns; found {sorted(set(df.columns.get_level_values(0)))}")
     block = df[sensor]
-    missing = [c for c in AXES if c not in block.columns]
+    missing = [c for c in COLUMNS if c not in block.columns]
     if missing:
         raise FormatError(f"{path}: {sensor} lacks columns {missing}")
-    values = block[AXES].to_numpy(dtype=float) * TO_FRD[foot]
-    frame = pd.DataFrame(values, columns=AXES)
+    values = block[COLUMNS].to_numpy(dtype=float)
+    frame = pd.DataFrame(np.hstack([apply_axes(rows, values[:, :3]), apply_axes(rows, values[:, 3:])]),
+                         columns=COLUMNS)
     frame.insert(0, "t", sample_times(df.index, rate, path, max_gap))
     meta = {"name": f"{path.stem}_{foot}", "source": str(path), "format": "gaitmap", "foot": foot,
-            "placement": f"{foot} foot instep", "input_files": [str(path)]}
+            "placement": f"{foot} foot instep", "axes": describe_axes(rows), "input_files": [str(path)]}
     truth = None
     if has_reference(path.parent):
         meta["input_files"] += [str(path.parent / f) for f in REFERENCE_FILES if (path.parent / f).exists()]
         truth = Truth(steps=reference_strides(path.parent, foot),
                       stride_positions=reference_stride_positions(path.parent, foot),
                       source="motion capture (gaitmap)")
-    return Recording.from_dataframe(frame, acc_unit="m/s^2", gyr_unit="deg/s", meta=meta, truth=truth, **options)
+    return Recording.from_dataframe(frame, acc_unit=acc_unit or ACC_UNIT, gyr_unit=gyr_unit or GYR_UNIT, meta=meta,
+                                    truth=truth, **options)
 
 
 class GaitmapReader(Reader):
@@ -139,11 +147,11 @@ class GaitmapReader(Reader):
 
     description = "gaitmap example IMU CSV (two header rows: sensor, axis; left_sensor and right_sensor)"
     extensions = (".csv",)
-    fixed_units = {"acc_unit": "m/s^2", "gyr_unit": "deg/s"}
     url = "https://github.com/mad-lab-fau/gaitmap"
     options = {
         "foot": Option(None, "", "which sensor to read: 'left' or 'right' (required: the file holds both feet)"),
         "rate": Option(RATE_HZ, "Hz", "sampling rate: the time base is the sample index / rate"),
+        **frame_options(AXES, ACC_UNIT, GYR_UNIT),
         **RECORDING_OPTIONS,
     }
 

@@ -40,7 +40,7 @@ from ..core.data import Recording, Truth
 from ..core.errors import FormatError, did_you_mean
 from ..core.yamlsafe import load_file
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, frame_options, text_source
 
 #: Suffix of a data file's description: ``<file>.footzoo.yaml``.
 SIDECAR_SUFFIX = ".footzoo.yaml"
@@ -57,9 +57,14 @@ def sidecar_of(path: Path) -> Path:
 
 
 class _Spec:
-    """A validated description (every problem a FormatError naming the sidecar and the key)."""
+    """A validated description (every problem a FormatError naming the sidecar and the key).
 
-    def __init__(self, raw: Any, source: Path):
+    ``given``: the options that replace the description's keys (``axes``, ``acc_unit``, ``gyr_unit``);
+    a key an option gives may be left out of the description.
+    """
+
+    def __init__(self, raw: Any, source: Path, given: dict[str, Any] | None = None):
+        given = {k: v for k, v in (given or {}).items() if v is not None}
         self.source = source
         if not isinstance(raw, dict):
             self.fail("", f"expected a mapping with time, acc, gyr and axes, got {raw!r:.80}")
@@ -67,7 +72,7 @@ class _Spec:
             if key not in KEYS:
                 self.fail(str(key), f"unknown key{did_you_mean(str(key), list(KEYS))}; valid: {list(KEYS)}")
         for key in ("time", "acc", "gyr", "axes"):
-            if key not in raw:
+            if key not in raw and not (key == "axes" and "axes" in given):
                 self.fail(key, "missing: a description needs time, acc, gyr and axes (see footzoo.io.generic)")
         self.raw = raw
         self.header = self._bool("header", True)
@@ -81,10 +86,16 @@ class _Spec:
         self.comment = raw.get("comment")
         if self.comment is not None and (not isinstance(self.comment, str) or len(self.comment) != 1):
             self.fail("comment", f"must be one character such as '#', got {self.comment!r}")
-        self.rows = parse_axes(raw["axes"], f"{source}: axes")
+        self.rows = (parse_axes(given["axes"], "axes") if "axes" in given else
+                     parse_axes(raw["axes"], f"{source}: axes"))
         self.time = self._time(raw["time"])
-        self.acc = self._block("acc", ACC_UNITS, required_unit=True)
-        self.gyr = self._block("gyr", GYR_UNITS, required_unit=True)
+        self.acc = self._block("acc", ACC_UNITS, required_unit="acc_unit" not in given)
+        self.gyr = self._block("gyr", GYR_UNITS, required_unit="gyr_unit" not in given)
+        for key, block, units in (("acc_unit", self.acc, ACC_UNITS), ("gyr_unit", self.gyr, GYR_UNITS)):
+            if key in given:
+                if given[key] not in units:
+                    raise FormatError(f"{key}={given[key]!r} is not supported; use one of {list(units)}")
+                block.update(scale=units[given[key]], unit=given[key])
         self.mag = self._block("mag", None, required_unit=False) if raw.get("mag") is not None else None
         self.meta = raw.get("meta") or {}
         if not isinstance(self.meta, dict):
@@ -154,32 +165,35 @@ class _Spec:
             unit = spec.get("unit")
             if unit is None and required_unit:
                 self.fail(f"{key}.unit", f"missing; say which unit the file stores: one of {list(units)}")
-            if unit not in units:
+            if unit is not None and unit not in units:
                 self.fail(f"{key}.unit", f"{unit!r} is not supported; use one of {list(units)}")
-            scale = units[unit]
+            scale = units.get(unit, 1.0)
         return {"columns": columns, "scale": scale, "unit": spec.get("unit", "")}
 
 
-def read_description(path: Path) -> _Spec:
-    """The validated description in ``path``."""
+def read_description(path: Path, **given: Any) -> _Spec:
+    """The validated description in ``path`` (``given``: options replacing its ``axes`` and units)."""
     from ..core.errors import FormatError as Error
 
-    return _Spec(load_file(path, Error, "data description"), path)
+    return _Spec(load_file(path, Error, "data description"), path, given)
 
 
-def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recording:
+def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_unit: str | None = None,
+         gyr_unit: str | None = None, **options: Any) -> Recording:
     """Read a delimited text file as its description (``<file>.footzoo.yaml`` or ``sidecar=``) says.
 
     Parameters
     ----------
     sidecar : path, optional
         The description to use (default: ``<file>.footzoo.yaml`` next to the file).
+    axes, acc_unit, gyr_unit : optional
+        Replace the description's ``axes``, ``acc.unit`` and ``gyr.unit``.
     """
     side = Path(sidecar) if sidecar is not None else sidecar_of(path)
     if not side.exists():
         raise FormatError(f"{path}: no description {side.name} next to it; write one (see footzoo.io.generic) or "
                           "pass sidecar= (the path of a description shared by several files)")
-    spec = read_description(side)
+    spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit)
     try:
         df = pd.read_csv(text_source(path), sep=spec.delimiter, decimal=spec.decimal, skiprows=spec.skip_rows,
                          header=0 if spec.header else None, comment=spec.comment,
@@ -222,6 +236,7 @@ def read(path: Path, sidecar: str | Path | None = None, **options: Any) -> Recor
     if spec.mag is not None:
         frame[["mag_x", "mag_y", "mag_z"]] = apply_axes(spec.rows, numbers(spec.mag["columns"]))
     meta = {"name": path.stem, "source": str(path), "format": "generic", "axes": describe_axes(spec.rows),
+            "units_declared": {"acc": spec.acc["unit"], "gyr": spec.gyr["unit"]},
             **spec.meta, "input_files": [str(path), str(side)]}
     if spec.mag is not None and spec.mag["unit"]:
         meta.setdefault("mag_unit", spec.mag["unit"])
@@ -245,9 +260,12 @@ class GenericReader(Reader):
     """Any delimited text file described by ``<file>.footzoo.yaml``: columns, units, axis map."""
 
     description = "any delimited text file with a description <file>.footzoo.yaml (columns, units, axis map)"
+    implied_by = ("sidecar",)
     extensions = (".csv", ".txt", ".tsv", ".dat")
     options = {
-        "sidecar": Option(None, "", "the description to use (default: <file>.footzoo.yaml next to the file)"),
+        "sidecar": Option(None, "", "the description to use (default: <file>.footzoo.yaml next to the file); "
+                                    "giving it implies this format"),
+        **frame_options(None, None, None, where="the description's"),
         **RECORDING_OPTIONS,
     }
 

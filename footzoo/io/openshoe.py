@@ -14,7 +14,8 @@ OpenShoe's MATLAB tools read the IMU from a whitespace-separated text file, afte
   17 columns after a header of 32 ``dummy_header`` words, with specific force in **m/s²**, angular
   rate in rad/s and every other column 0 (no time stamps: pass ``rate=``).
 
-The units are read from the header (``[g]`` or ``[m/s^2]``, ``[rad/s]`` or ``[deg/s]``).
+The units are read from the header (``[g]`` or ``[m/s^2]``, ``[rad/s]`` or ``[deg/s]``);
+``acc_unit=`` / ``gyr_unit=`` replace them when the header is wrong.
 
 **Time.** When the device timer is there, ``t`` is the timer in seconds (the 3DM-GX3's timer counts
 19 660 800 ticks per second: 78 720 ticks per 250 Hz sample in OpenShoe's published measurements,
@@ -24,7 +25,7 @@ stamps are used, and without those ``rate=`` (Hz) must be given: ``t = row / rat
 ``rate=`` always wins.
 
 **Axis map.** OpenShoe's published measurements read +1 g on the sensor's z axis when the foot
-stands still: the sensor sits z up in the heel. The default map is ``(x, −y, −z)``, a 180° rotation
+stands still: the sensor sits z up in the heel. The default map is ``[x, -y, -z]``, a 180° rotation
 about x that brings z down, with the sensor's x axis taken as the toe direction (check it on your
 own mounting; ``axes=`` takes any proper rotation, see :mod:`footzoo.io.axes`). Missing
 magnetometer readings are filled by linear interpolation (their count is in
@@ -45,12 +46,12 @@ from ..core.checks import check_bool, check_range
 from ..core.data import Recording
 from ..core.errors import FootzooWarning, FormatError
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, frame_options, text_source
 
 #: Ticks per second of the MicroStrain 3DM-GX3 timer in the ``Counter`` column.
 TIMER_HZ = 19_660_800.0
 #: Default axis map: z up in the heel -> FRD, 180° about x.
-DEFAULT_AXES = "x, -y, -z"
+DEFAULT_AXES = "[x, -y, -z]"
 #: Lines searched for the header.
 HEADER_LINES = 50
 COLUMNS_17 = ["packet", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z", "counter", "checksum", "nr",
@@ -121,7 +122,7 @@ def _time_base(df: pd.DataFrame, rate: float | None, path: Path) -> tuple[np.nda
 
 
 def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnetometer: bool = True,
-         **options: Any) -> Recording:
+         acc_unit: str | None = None, gyr_unit: str | None = None, **options: Any) -> Recording:
     """Read an OpenShoe ``data_inert.txt`` and convert it to FRD/SI.
 
     Parameters
@@ -129,9 +130,11 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
     rate : float, optional
         Sampling rate (Hz); required for files without time stamps, and then ``t = row / rate``.
     axes : str or sequence, optional
-        Sensor axes -> FRD (:func:`footzoo.io.axes.parse_axes`); default ``(x, -y, -z)``.
+        Sensor axes -> FRD (:func:`footzoo.io.axes.parse_axes`); default ``[x, -y, -z]``.
     magnetometer : bool
         Read the magnetometer columns when the file has them.
+    acc_unit, gyr_unit : str, optional
+        The file's units; default: those its header names.
     """
     found = find_header(path)
     if found is None:
@@ -141,8 +144,9 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
     if rate is not None:
         rate = check_range("rate", rate, 0.0, 100_000.0, "Hz", lo_open=True)
     magnetometer = check_bool("magnetometer", magnetometer)
-    rows = parse_axes(axes, "axes")
-    acc_unit, gyr_unit = header_units(header, path)
+    rows = parse_axes(DEFAULT_AXES if axes is None else axes, "axes")
+    header_acc, header_gyr = header_units(header, path)
+    acc_unit, gyr_unit = acc_unit or header_acc, gyr_unit or header_gyr
     src = text_source(path)
     df = pd.read_csv(src, sep=r"\s+", header=None, skiprows=line + 1, dtype={0: str, 8: str},
                      na_values=["+nan", "-nan"], skip_blank_lines=True)
@@ -181,8 +185,7 @@ class OpenShoeReader(Reader):
     url = "http://www.openshoe.org"
     options = {
         "rate": Option(None, "Hz", "sampling rate; needed when the file has no time stamps (t = row / rate)"),
-        "axes": Option(DEFAULT_AXES, "", "sensor axes -> FRD, a signed permutation such as 'x, -y, -z' or a "
-                                         "rotation matrix (footzoo.io.axes)"),
+        **frame_options(DEFAULT_AXES, None, None, where="the units the header names"),
         "magnetometer": Option(True, "", "read the magnetometer columns when the file has them"),
         **RECORDING_OPTIONS,
     }

@@ -1,7 +1,9 @@
 """PyShoe VICON-room trials (Wagstaff et al.), MATLAB ``.mat`` files.
 
 ``imu`` (N×6: acc m/s², gyro rad/s) in the sensor frame x forward, y right,
-z down (already FRD); ``ts`` (s); ``gt`` (N×3, VICON position, z up). The
+z down (already FRD: the axis map is ``[x, y, z]``; a trial recorded with the
+sensor mounted otherwise, such as the upside-down 2018-02-22 trial, is read
+with ``axes=``); ``ts`` (s); ``gt`` (N×3, VICON position, z up). The
 reference is mirrored with respect to the IMU frame: a right-handed NED
 estimate matches ``gt · [1, 1, −1]`` (negate z only), which is what the
 :class:`~footzoo.core.data.Truth` holds (z down, horizontal axes VICON's, so compare
@@ -19,17 +21,25 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Reader
+from .axes import describe_axes, parse_axes, rotate_columns
+from .base import RECORDING_OPTIONS, Reader, frame_options
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
+#: The LORD MicroStrain's frame is FRD already; PyShoe stores SI units.
+AXES = "[x, y, z]"
+ACC_UNIT = "m/s^2"
+GYR_UNIT = "rad/s"
 
 
-def read(path: Path, **options: Any) -> Recording:
-    """Read a PyShoe ``.mat`` trial with its VICON reference as truth."""
+def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str = GYR_UNIT,
+         **options: Any) -> Recording:
+    """Read a PyShoe ``.mat`` trial with its VICON reference as truth (``axes``: :mod:`footzoo.io.axes`)."""
+    rows = parse_axes(AXES if axes is None else axes, "axes")
     import scipy.io as sio  # here: loading footzoo's readers does not load scipy
 
     try:
@@ -53,7 +63,7 @@ def read(path: Path, **options: Any) -> Recording:
         mirror = np.array([1.0, 1.0, -1.0])  # VICON z up and mirrored: negate z only
         truth = Truth(pos=np.asarray(d["gt"], dtype=float) * mirror, stance=stance)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe", "foot": "right",
-                            "placement": "right shoe instep (LORD MicroStrain)"}
+                            "placement": "right shoe instep (LORD MicroStrain)", "axes": describe_axes(rows)}
     meta["input_files"] = [str(path)]
     trial = _trial_row(path)
     if trial is not None:
@@ -66,7 +76,11 @@ def read(path: Path, **options: Any) -> Recording:
     if "trial_error" in d:
         errors = np.ravel(d["trial_error"]).astype(float)
         meta["pyshoe_trial_error"] = {k: float(e) for k, e in zip(TRIAL_ERROR_DETECTORS, errors, strict=True)}
-    return Recording(t=t, acc=imu[:, :3], gyr=imu[:, 3:6], meta=meta, truth=truth, **options)
+    frame = pd.DataFrame(imu[:, :6], columns=["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"])
+    frame.insert(0, "t", t)
+    rotate_columns(frame, rows)
+    return Recording.from_dataframe(frame, acc_unit=acc_unit or ACC_UNIT, gyr_unit=gyr_unit or GYR_UNIT, meta=meta,
+                                    truth=truth, **options)
 
 
 class PyShoeReader(Reader):
@@ -74,9 +88,8 @@ class PyShoeReader(Reader):
 
     description = "PyShoe VICON-room trial (MATLAB .mat with imu, ts, gt, zv_*_opt, trial_error)"
     extensions = (".mat",)
-    fixed_units = {"acc_unit": "m/s^2", "gyr_unit": "rad/s"}
     url = "https://github.com/utiasSTARS/pyshoe"
-    options = {"max_gap": RECORDING_OPTIONS["max_gap"]}
+    options = {**frame_options(AXES, ACC_UNIT, GYR_UNIT), **RECORDING_OPTIONS}
 
     def guess_can_open(self, path: Path) -> bool:
         """A ``.mat`` file with the variables ``imu`` and ``ts`` (its directory is read, not its data).

@@ -3,8 +3,9 @@
 Columns ``Time`` (s) and ``<device>:scaledAccelX/Y/Z`` (g),
 ``scaledGyroX/Y/Z`` (rad/s), ``scaledMagX/Y/Z`` (Gauss). The MicroStrain frame
 is x forward, y right, z down (at rest acc_z ≈ −1 g): the axis map is the
-identity. The sensor's own roll/pitch/yaw columns are kept in ``meta`` only
-as column names; footzoo does not use them.
+identity ``[x, y, z]``; a sensor mounted otherwise on the foot (upside down, turned)
+is read with ``axes=``, and an export in other units with ``acc_unit=`` / ``gyr_unit=``.
+The sensor's own roll/pitch/yaw columns are not read.
 
 Köroğlu's experiments ship a ``<name>.mat`` next to the CSV with the ground
 control points: ``GCP_meters`` (K×2, every footprint measured on the floor
@@ -22,13 +23,18 @@ import pandas as pd
 
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Reader, check_unique_columns, first_line, text_source
+from .axes import describe_axes, parse_axes, rotate_columns
+from .base import RECORDING_OPTIONS, Reader, check_unique_columns, first_line, frame_options, text_source
 
 SIGNALS = {
     "scaledAccelX": "acc_x", "scaledAccelY": "acc_y", "scaledAccelZ": "acc_z",
     "scaledGyroX": "gyr_x", "scaledGyroY": "gyr_y", "scaledGyroZ": "gyr_z",
     "scaledMagX": "mag_x", "scaledMagY": "mag_y", "scaledMagZ": "mag_z",
 }
+#: The MicroStrain frame is FRD already; the units SensorConnect's scaled channels use.
+AXES = "[x, y, z]"
+ACC_UNIT = "g"
+GYR_UNIT = "rad/s"
 
 
 def matches(header: str) -> bool:
@@ -36,8 +42,10 @@ def matches(header: str) -> bool:
     return "scaledAccelX" in header
 
 
-def read(path: Path, **options: Any) -> Recording:
-    """Read a SensorConnect CSV and convert to FRD/SI."""
+def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str = GYR_UNIT,
+         **options: Any) -> Recording:
+    """Read a SensorConnect CSV and convert to FRD/SI (``axes``: :mod:`footzoo.io.axes`)."""
+    rows = parse_axes(AXES if axes is None else axes, "axes")
     df = pd.read_csv(text_source(path))
     check_unique_columns(df, path)
     rename = {"Time": "t"}
@@ -51,10 +59,12 @@ def read(path: Path, **options: Any) -> Recording:
     if missing:
         raise FormatError(f"{path}: not a SensorConnect export with scaled signals, missing {missing}")
     keep = [c for c in ["t", *SIGNALS.values()] if c in df.columns]
+    frame = df[keep].copy()
+    rotate_columns(frame, rows)
     gcp = path.with_suffix(".mat")
     meta = {"name": path.stem, "source": str(path), "format": "sensorconnect", "mag_unit": "Gauss",
-            "input_files": [str(path), *([str(gcp)] if gcp.exists() else [])]}
-    return Recording.from_dataframe(df[keep], acc_unit="g", gyr_unit="rad/s", meta=meta,
+            "axes": describe_axes(rows), "input_files": [str(path), *([str(gcp)] if gcp.exists() else [])]}
+    return Recording.from_dataframe(frame, acc_unit=acc_unit or ACC_UNIT, gyr_unit=gyr_unit or GYR_UNIT, meta=meta,
                                     truth=footprint_reference(gcp), **options)
 
 
@@ -82,9 +92,8 @@ class SensorConnectReader(Reader):
 
     description = "MicroStrain SensorConnect CSV (Time, <device>:scaledAccelX, ..., scaledGyroX, ..., scaledMagX, ...)"
     extensions = (".csv",)
-    fixed_units = {"acc_unit": "g", "gyr_unit": "rad/s"}
     url = "https://www.microstrain.com/software/sensorconnect"
-    options = dict(RECORDING_OPTIONS)
+    options = {**frame_options(AXES, ACC_UNIT, GYR_UNIT), **RECORDING_OPTIONS}
 
     def guess_can_open(self, path: Path) -> bool:
         return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))

@@ -1,10 +1,11 @@
 """x-io Technologies Gait-Tracking CSV (NGIMU), e.g. ``short_walk.csv``.
 
 Columns ``Time (s), Gyroscope X/Y/Z (deg/s), Accelerometer X/Y/Z (g)``. The
-NGIMU's z axis points up, so the axis map to FRD is ``(x, −y, −z)``, a rotation
-of 180° about x (a proper rotation: gyro and accelerometer map alike). The
-sensor's x axis is taken as the foot's forward axis; it is tilted on the foot
-(the still foot reads about 30° of pitch), which the initial alignment absorbs.
+NGIMU's z axis points up, so the axis map to FRD is ``[x, -y, -z]``, a rotation
+of 180° about x (a proper rotation: gyro and accelerometer map alike; another
+mounting: ``axes=``). The sensor's x axis is taken as the foot's forward axis; it is
+tilted on the foot (the still foot reads about 30° of pitch), which the initial
+alignment absorbs.
 
 The file has exact duplicate rows (time stamp repeated) and short gaps (up to
 17 ms at 400 Hz). Duplicates are dropped with a warning that gives the count;
@@ -28,7 +29,8 @@ import pandas as pd
 from ..core.checks import check_bool
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, text_source
+from .axes import describe_axes, parse_axes, rotate_columns
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, frame_options, text_source
 from .metadata import read_facts, sha256
 
 COLUMNS = {
@@ -40,6 +42,11 @@ COLUMNS = {
     "Accelerometer Y (g)": "acc_y",
     "Accelerometer Z (g)": "acc_z",
 }
+
+#: The NGIMU's axes -> FRD: z up -> z down, 180° about x.
+AXES = "[x, -y, -z]"
+ACC_UNIT = "g"
+GYR_UNIT = "deg/s"
 
 #: x-io files known to be closed walks: (size in bytes, SHA-256) -> name. The built-in sample is the first.
 KNOWN_CLOSED_LOOPS: dict[tuple[int, str], str] = {
@@ -62,7 +69,7 @@ def known_closed_loop(path: Path) -> str | None:
 
 def read(
     path: Path, duplicates: str = "drop", max_gap: float | None = None, closed_loop: bool | None = None,
-    **options: Any,
+    axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str = GYR_UNIT, **options: Any,
 ) -> Recording:
     """Read an x-io CSV and convert to FRD/SI.
 
@@ -75,15 +82,19 @@ def read(
     closed_loop : bool, optional
         Whether the walk ends where it started. Default: true for x-io's example walk, else what
         the metadata sidecar says, else false.
+    axes : str or sequence
+        The sensor's axes -> FRD (:mod:`footzoo.io.axes`); default ``[x, -y, -z]``.
+    acc_unit, gyr_unit : str
+        The file's units (default g and deg/s, as the column names say).
     """
     df = pd.read_csv(text_source(path))
     check_unique_columns(df, path)
     missing = [c for c in COLUMNS if c not in df.columns]
     if missing:
         raise FormatError(f"{path}: not an x-io Gait-Tracking CSV, missing {missing}")
+    rows = parse_axes(AXES if axes is None else axes, "axes")
     df = df.rename(columns=COLUMNS)[list(COLUMNS.values())]
-    for c in ("acc_y", "acc_z", "gyr_y", "gyr_z"):  # z up -> z down: 180° about x
-        df[c] = -df[c]
+    rotate_columns(df, rows)
     facts = read_facts(path)
     known = known_closed_loop(path)
     if closed_loop is None:
@@ -93,9 +104,10 @@ def read(
         closed_loop = check_bool("closed_loop", closed_loop)
         source = "closed loop (declared)" if closed_loop else ""
     meta = {"name": path.stem, "source": str(path), "format": "xio", "placement": "foot (NGIMU, tilted ~30°)",
-            **facts.meta, "input_files": [str(path), *map(str, facts.files)]}
+            "axes": describe_axes(rows), **facts.meta, "input_files": [str(path), *map(str, facts.files)]}
     return Recording.from_dataframe(
-        df, acc_unit="g", gyr_unit="deg/s", duplicates=duplicates, max_gap=max_gap, meta=meta,
+        df, acc_unit=acc_unit or ACC_UNIT, gyr_unit=gyr_unit or GYR_UNIT, duplicates=duplicates, max_gap=max_gap,
+        meta=meta,
         truth=Truth(closed_loop=closed_loop, source=source), **options,
     )
 
@@ -106,9 +118,9 @@ class XioReader(Reader):
     reads_metadata_sidecar = True
     description = "x-io Technologies Gait-Tracking CSV (NGIMU): Time (s), Gyroscope X (deg/s), ..., Accelerometer X (g)"
     extensions = (".csv",)
-    fixed_units = {"acc_unit": "g", "gyr_unit": "deg/s"}
     url = "https://github.com/xioTechnologies/Gait-Tracking"
     options = {
+        **frame_options(AXES, ACC_UNIT, GYR_UNIT),
         **RECORDING_OPTIONS,
         "duplicates": Option("drop", "", "repeated time stamps: 'drop' (keep the first, warn with the count) or "
                                          "'error'"),

@@ -66,7 +66,7 @@ class Session:
         from ..io.gaitmap import feet
 
         p = Path(path)
-        fmt = format or detect_format(p)
+        fmt = format or detect_format(p, options)
         if fmt != "gaitmap":
             raise FormatError(f"{p}: a {fmt} file holds one foot; load it with footzoo.load (command line: "
                               "--foot left or --foot right), or build Session({'left': ..., 'right': ...})")

@@ -12,7 +12,7 @@ from itertools import permutations, product
 
 import numpy as np
 
-from ..core.conventions import quat_from_matrix, quat_mul
+from ..core.conventions import axis_map_text, quat_from_matrix, quat_mul
 from ..core.data import Recording
 
 
@@ -29,12 +29,8 @@ def proper_axis_permutations() -> list[np.ndarray]:
 
 
 def axis_map_name(m: np.ndarray) -> str:
-    """``x, -z, y``: the sensor axis that each body axis (rows of ``m``) is, for a signed permutation."""
-    names = []
-    for row in np.asarray(m, dtype=float):
-        k = int(np.argmax(np.abs(row)))
-        names.append(("-" if row[k] < 0 else "") + "xyz"[k])
-    return ", ".join(names)
+    """``[x, -z, y]``: the sensor axis that each body axis (rows of ``m``) is (core.conventions.axis_map_text)."""
+    return axis_map_text(m)
 
 
 def remount(rec: Recording, m: np.ndarray) -> Recording:
@@ -60,5 +56,5 @@ def remount(rec: Recording, m: np.ndarray) -> Recording:
     if truth is not None and truth.quat is not None:
         qm = np.broadcast_to(quat_from_matrix(m), truth.quat.shape)
         truth = replace(truth, quat=quat_mul(truth.quat, qm))
-    return replace(rec, acc=sensor(rec.acc), gyr=sensor(rec.gyr), mag=sensor(rec.mag), truth=truth,
-                   meta=dict(rec.meta))
+    meta = {k: v for k, v in rec.meta.items() if k != "axes"}  # the map it was read with no longer applies
+    return replace(rec, acc=sensor(rec.acc), gyr=sensor(rec.gyr), mag=sensor(rec.mag), truth=truth, meta=meta)

@@ -485,11 +485,11 @@ def _reader_problem(rec: RecordingSpec) -> str | None:
     if rec.path is None or rec.problem():
         return None
     from ..core.errors import FootzooError
-    from ..io import _options_for, available
+    from ..io import _options_for, available, detect_format
 
     readers = available()
     try:
-        fmt = rec.format or readers.detect(Path(rec.path))
+        fmt = rec.format or detect_format(Path(rec.path), rec.options)
     except FootzooError:
         return None
     try:

@@ -104,7 +104,8 @@ def test_events_and_strides_are_the_same_for_every_mounting(walk):
 
 
 @pytest.mark.parametrize("name, backwards, reversed_pitch", [
-    ("x, y, z", False, False), ("x, -y, -z", False, True), ("-x, y, -z", True, False), ("-x, -y, z", True, True),
+    ("[x, y, z]", False, False), ("[x, -y, -z]", False, True), ("[-x, y, -z]", True, False),
+    ("[-x, -y, z]", True, True),
 ])
 def test_a_walk_backwards_or_a_reversed_pitch_is_named_with_its_fix(walk, name, backwards, reversed_pitch):
     m = next(p for p in proper_axis_permutations() if axis_map_name(p) == name)
@@ -112,20 +113,21 @@ def test_a_walk_backwards_or_a_reversed_pitch_is_named_with_its_fix(walk, name, 
     rep = res.diagnostics["mounting"]
     assert rep["walks_backwards"] is backwards and rep["pitch_reversed"] is reversed_pitch
     # the fix is the map that undoes the turn: v_FRD = m · v_sensor
-    assert rep["suggested_axes"] == f"[{name}]"
+    assert rep["suggested_axes"] == name
     np.testing.assert_allclose(rep["sensor_in_foot"], m, atol=0.05)
     assert bool(warned) is (backwards or reversed_pitch)
     if warned:
         text = str(warned[0].message)
-        assert f"[{name}]" in text and "diagnostics['mounting']" in text
+        assert name in text and "diagnostics['mounting']" in text
+        assert f"--option 'axes={name}'" in text and f'footzoo.load(path, axes="{name}")' in text
         assert ("walks backwards" in text) is backwards and ("toe lifts" in text) is reversed_pitch
 
 
 def test_the_fix_is_composed_with_the_axis_map_the_file_was_read_with():
     rep = {"walks_backwards": True, "x_forward": -1.0, "pitch_reversed": True, "y_right": -1.0,
            "suggested_axes": "[-x, -y, z]"}
-    with pytest.warns(SensorWarning, match=r"axis map \(-x, y, -z\)"):
-        warn_mounting(rep, "r", axes="(x, -y, -z)")
+    with pytest.warns(SensorWarning, match=r"axis map \[-x, y, -z\].*--option 'axes=\[-x, y, -z\]'"):
+        warn_mounting(rep, "r", axes="[x, -y, -z]")
 
 
 def test_no_mounting_estimate_from_too_few_strides():
@@ -169,7 +171,7 @@ def test_gaitmap_events_and_gait_phases_against_motion_capture(foot):
     assert g["gait_phase_sample_error"] <= 0.03
 
 
-@pytest.mark.parametrize("name", ["-x, -y, z", "x, -y, -z", "y, -x, z"])
+@pytest.mark.parametrize("name", ["[-x, -y, z]", "[x, -y, -z]", "[y, -x, z]"])
 def test_gaitmap_read_with_a_wrong_right_handed_map(name):
     """The real recording through a wrong map: the same events; the reversed ones warned with the fix."""
     from footzoo.io import load
@@ -182,9 +184,9 @@ def test_gaitmap_read_with_a_wrong_right_handed_map(name):
     np.testing.assert_allclose(res.steps["to_s"], base["to_s"], atol=0.010)
     np.testing.assert_allclose(res.steps["end_s"], base["end_s"], atol=0.010)
     rep = res.diagnostics["mounting"]
-    assert rep["suggested_axes"] == f"[{name}]"
+    assert rep["suggested_axes"] == name
     flagged = rep["walks_backwards"] or rep["pitch_reversed"]
-    assert flagged is (name != "y, -x, z")  # a sensor turned 90° about z: x points left, neither symptom
+    assert flagged is (name != "[y, -x, z]")  # a sensor turned 90° about z: x points left, neither symptom
     assert bool(warned) is flagged
 
 
@@ -198,6 +200,13 @@ def test_pyshoe_upside_down_trial_is_named():
     assert rep["suggested_axes"] == "[x, -y, -z]" and warned
     steps = res.steps
     assert len(steps) > 5 and steps["events_from_rate"].mean() > 0.9
+    # the fix the warning names is an option the reader takes: read so, the trial has its pitch right
+    text = str(warned[0].message)
+    assert "--option 'axes=[x, -y, -z]'" in text and 'footzoo.load(path, axes="[x, -y, -z]")' in text
+    fixed = load(data_file("pyshoe_vicon", "2018-02-22-10-09-36.mat"), axes="[x, -y, -z]")
+    res, warned = _run(fixed)
+    assert not res.diagnostics["mounting"]["pitch_reversed"] and not warned
+    assert res.diagnostics["mounting"]["suggested_axes"] == "[x, y, z]"
 
 
 def test_the_swing_correlation_is_numpys_over_the_swing_samples():

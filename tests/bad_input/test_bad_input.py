@@ -207,7 +207,8 @@ CASES = [
     Case("unknown-format", lambda d, w: (lambda: load(_csv(d, w), format="csvv")), FormatError,
          "unknown format 'csvv'"),
     Case("unknown-reader-option", lambda d, w: (lambda: load(_pyshoe(d, w), foo=1)), FormatError,
-         "pyshoe reader: unknown option 'foo' (did you mean 'foot'?); its options are ['foot', 'max_gap']"),
+         "pyshoe reader: unknown option 'foo' (did you mean 'foot'?); its options are ['acc_unit', 'axes', "
+         "'duplicates', 'foot', 'gyr_unit', 'max_gap', 'nan_policy']"),
     Case("csv-read-as-pyshoe", lambda d, w: (lambda: load(_csv(d, w), format="pyshoe")), FormatError,
          "cannot read as a MATLAB .mat file"),
     Case("canonical-unknown-option", lambda d, w: (lambda: load(_csv(d, w), acc_units="g")), FormatError,

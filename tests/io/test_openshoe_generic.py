@@ -66,7 +66,7 @@ def test_openshoe_first_generation_file_comes_back_in_frd_si(walk, tmp_path):
     np.testing.assert_allclose(rec.t, np.arange(walk.n) * TICKS / 19_660_800)  # the device clock, not the host's
     assert rec.rate == pytest.approx(19_660_800 / TICKS)
     assert rec.acc[:20].mean(axis=0)[2] == pytest.approx(-GRAVITY, abs=0.2)  # z down at rest
-    assert rec.meta["axes"] == "(x, -y, -z)" and rec.meta["time_base"].startswith("device timer")
+    assert rec.meta["axes"] == "[x, -y, -z]" and rec.meta["time_base"].startswith("device timer")
     assert rec.meta["mag_interpolated"] == 2 and np.isfinite(rec.mag).all()
     keep = np.setdiff1d(np.arange(walk.n), [7, 8])
     np.testing.assert_allclose(rec.mag[keep], walk.mag[keep], rtol=0, atol=1e-7)
@@ -96,7 +96,7 @@ def test_openshoe_board_export_without_time_stamps_needs_the_rate(walk, tmp_path
 def test_openshoe_refuses_a_left_handed_axis_map(walk, tmp_path):
     p = tmp_path / "data_inert.txt"
     p.write_text(openshoe_text(walk, restart_at=-1))
-    with pytest.raises(FormatError, match=r"axes: the axis map \(x, y, -z\) is left-handed.*e.g. \(x, -y, -z\)"):
+    with pytest.raises(FormatError, match=r"axes: the axis map \[x, y, -z\] is left-handed.*e.g. \[x, -y, -z\]"):
         load(p, axes=["x", "y", "-z"])
 
 
@@ -155,7 +155,7 @@ def test_a_described_csv_comes_back_in_frd_si(walk, tmp_path):
     np.testing.assert_allclose(rec.gyr, walk.gyr, rtol=1e-13, atol=1e-12)
     np.testing.assert_allclose(rec.mag, walk.mag, rtol=1e-13, atol=1e-12)
     assert rec.meta["subject"] == "S07" and rec.meta["code"] == "1e3" and rec.meta["foot"] == "left"
-    assert rec.truth.closed_loop and rec.meta["axes"] == "(y, x, -z)"
+    assert rec.truth.closed_loop and rec.meta["axes"] == "[y, x, -z]"
     assert str(tmp_path / "walk.csv.footzoo.yaml") in rec.meta["input_files"]
 
 
@@ -176,7 +176,7 @@ def test_a_rotation_matrix_and_a_shared_description_without_header(walk, tmp_pat
 
 
 @pytest.mark.parametrize("change, fragment", [
-    ("axes: [x, y, -z]", r"axes: the axis map \(x, y, -z\) is left-handed"),
+    ("axes: [x, y, -z]", r"axes: the axis map \[x, y, -z\] is left-handed"),
     ("axes: [x, x, z]", "sensor axis x is used twice"),
     ("axes: [[1, 0, 0], [0, 1, 0], [0, 0.5, 1]]", "is not a rotation"),
     ("axes: [x, -w, z]", "'-w' is not a sensor axis"),

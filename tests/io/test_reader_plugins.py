@@ -156,6 +156,13 @@ def test_a_reader_from_an_installed_package_loads_a_file_by_footzoo_load(on_path
     assert footzoo.load(data, scale=1.01).acc[0, 2] == 1.01 * walk.acc[0, 2]  # the option reaches open()
     with pytest.raises(FormatError, match=r"faketsv reader: unknown option 'scal' \(did you mean 'scale'\?\)"):
         footzoo.load(data, scal=2.0)
+    # a reader without an axes option of its own gets one: applied to what it returns, named in meta
+    turned = footzoo.load(data, axes="[x, -y, -z]")
+    np.testing.assert_array_equal(turned.acc, walk.acc * [1.0, -1.0, -1.0])
+    np.testing.assert_array_equal(turned.gyr, walk.gyr * [1.0, -1.0, -1.0])
+    assert turned.meta["axes"] == "[x, -y, -z]" and "axes" not in rec.meta
+    with pytest.raises(FormatError, match=r"axes: the axis map \[x, y, -z\] is left-handed"):
+        footzoo.load(data, axes="[x, y, -z]")
 
 
 def test_broken_or_clashing_readers_are_skipped_with_the_reason_and_builtins_keep_working(on_path, walk, tmp_path):
