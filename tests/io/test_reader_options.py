@@ -1,4 +1,5 @@
-"""Every reader takes ``axes``, ``acc_unit`` and ``gyr_unit``: a sensor mounted otherwise, a logger set to other units.
+"""Every reader takes ``axes``, ``acc_unit`` and ``gyr_unit`` (a sensor mounted otherwise, a logger set to other units);
+``sidecar`` chooses the generic format.
 
 Synthetic fixtures: a simulated walk (FRD, SI) is written in each format as a sensor mounted with
 another proper rotation would record it, in units other than the format's; each reader, told the
@@ -143,3 +144,21 @@ def test_the_notation_is_one_and_its_spellings_read_alike():
     np.testing.assert_allclose(parse_axes(axis_map_text(pitched)), pitched, atol=1e-6)  # a matrix reads back too
     assert axes_fix(rows) == ("--option 'axes=[x, -y, -z]' on the command line, "
                               'footzoo.load(path, axes="[x, -y, -z]") in Python')
+
+
+def test_a_sidecar_option_implies_the_generic_format(walk, tmp_path, capsys):
+    from footzoo.apps.cli import main
+
+    path, _ = write_generic(walk, tmp_path / "trial.txt")
+    shared = tmp_path / "lab.yaml"
+    path.with_name(path.name + ".footzoo.yaml").rename(shared)  # one description for many files, not next to them
+    with pytest.raises(FormatError, match="cannot tell the format"):
+        load(path)
+    rec = load(path, sidecar=shared, axes=MOUNT, acc_unit="mg", gyr_unit="rad/s")
+    assert rec.meta["format"] == "generic" and str(shared) in rec.meta["input_files"]
+    np.testing.assert_allclose(rec.gyr, walk.gyr, rtol=0, atol=1e-9)
+    assert detect_format(path, {"sidecar": shared}) == "generic"
+    args = ["run", "yun2012", "--data", str(path), "--option", f"sidecar={shared}", "--option", f"axes={MOUNT}",
+            "--option", "acc_unit=mg", "--option", "gyr_unit=rad/s"]
+    assert main(args) == 0, capsys.readouterr().err
+    assert "strides" in capsys.readouterr().out
