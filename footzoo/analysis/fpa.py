@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
 
-from ..core.errors import ConfigError
+from ..core.errors import ConfigError, FootzooWarning
 from ..evaluation.metrics import intervals, nearest_index
 from ..kernels.jit import njit
 from ..plugins.base import Analysis, Choice, File, Real, Vector
 from ..plugins.registry import register
+from .foot_side import infer_foot
 from .foot_vector import FootVector
 
 
@@ -31,7 +33,11 @@ class HuangFPA(Analysis):
     seen from above (toward the walker's right) from ``h``; for a left foot,
     counter-clockwise: ``FPA = s · wrap(ψ_f − ψ_h)`` with ``s = +1`` (right) or
     ``−1`` (left). With ``foot: auto`` the side comes from the recording's
-    metadata (``meta["foot"]``).
+    metadata (``meta["foot"]``); a recording that does not name it is read all the
+    same: the side is read from the walk (the swing arcs outward,
+    :mod:`footzoo.analysis.foot_side`) and reported with its evidence in a warning, or,
+    when the walk does not tell, every FPA is NaN with the reason (``steps.attrs["notes"]``,
+    ``Result.metric_notes``) and the rest of the run (trajectory, strides) is unaffected.
 
     Parameters
     ----------
@@ -54,6 +60,14 @@ class HuangFPA(Analysis):
         FPA per stance after the first two heel strikes (rad; NaN before).
     heel_strikes_ : (M,) ndarray
         Sample index of each heel strike (stance onset).
+    foot_ : {"right", "left"} or None
+        The side used (None: unknown, the FPA is NaN).
+    foot_source_ : {"config", "recording", "walk", "unknown"}
+        Where the side came from.
+    foot_evidence_ : dict or None
+        What the walk said (:meth:`footzoo.analysis.foot_side.FootSide.as_dict`) when the side was read from it.
+    note_ : str
+        Why the FPA is NaN ("" when it is not).
     """
 
     name = "huang_fpa"
@@ -93,31 +107,57 @@ class HuangFPA(Analysis):
         self.calibration = calibration
         self.foot = foot
 
-    def _side(self, meta: dict) -> int:
-        foot = self.foot if self.foot != "auto" else meta.get("foot")
-        if foot not in ("right", "left"):
-            raise ConfigError(
-                "huang_fpa: the recording does not say which foot the sensor is on (meta['foot']); "
-                "set foot: right or foot: left in the analysis config"
-            )
-        return 1 if foot == "right" else -1
+    def _declared(self, meta: dict) -> tuple[str | None, str]:
+        """The side the config or the recording names, and which one named it."""
+        if self.foot != "auto":
+            return self.foot, "config"
+        foot = meta.get("foot")
+        if foot is not None and foot not in ("right", "left"):
+            raise ConfigError(f"huang_fpa: the recording says the sensor is on the foot {foot!r}; it must be 'left' or "
+                              "'right' (meta['foot']), or set foot: right or foot: left in the analysis config")
+        return foot, "recording"
 
     def check(self, meta: dict) -> None:
-        """The recording must say which foot the sensor is on, unless ``foot`` does."""
-        self._side(meta)
+        """A side the recording names must be left or right; one that names none is read from the walk."""
+        self._declared(meta)
 
     def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
                 meta: dict) -> HuangFPA:
         """FPA per stance (eqs. 12–16)."""
-        side = self._side(meta)
+        foot, self.foot_source_ = self._declared(meta)
+        self.foot_evidence_, self.note_ = None, ""
+        self.heel_strikes_ = intervals(stance)[:, 0]
+        if foot is None:
+            foot = self._side_from_walk(pos, stance, str(meta.get("name", "recording")))
+        self.foot_ = foot
+        if foot is None:
+            self.fpa_ = np.full(len(self.heel_strikes_), np.nan)
+            return self
         f_s = FootVector.load(self.calibration).vector if self.calibration else np.asarray(self.foot_vector, float)
         f_s = f_s / np.linalg.norm(f_s)
-        self.heel_strikes_ = intervals(stance)[:, 0]
         self.fpa_ = _fpa_kernel(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(quat, dtype=float),
                                 np.ascontiguousarray(pos, dtype=float), self.heel_strikes_.astype(np.int64),
                                 f_s, float(self.alpha), self.window[0], self.window[1], float(self.stance_fraction),
-                                float(side))
+                                1.0 if foot == "right" else -1.0)
         return self
+
+    def _side_from_walk(self, pos: np.ndarray, stance: np.ndarray, name: str) -> str | None:
+        """The side read from the walk (:func:`footzoo.analysis.foot_side.infer_foot`), with a warning either way."""
+        found = infer_foot(pos, stance)
+        self.foot_evidence_ = found.as_dict()
+        declare = "declare the foot: --foot right|left, footzoo.load(path, foot=...), or foot: in the analysis config"
+        if found.side is None:
+            self.foot_source_ = "unknown"
+            self.note_ = (f"the foot side is unknown (the recording does not name it, and {found.reason}); the foot "
+                          "progression angle's sign depends on it")
+            warnings.warn(FootzooWarning(f"huang_fpa: recording {name!r}: {self.note_}: every FPA is NaN, the rest "
+                                         f"of the run is unaffected; {declare}"), stacklevel=3)
+            return None
+        self.foot_source_ = "walk"
+        warnings.warn(FootzooWarning(
+            f"huang_fpa: recording {name!r} does not say which foot the sensor is on; read as the {found.side} foot "
+            f"from the walk: {found.reason}. To be sure, {declare}"), stacklevel=3)
+        return found.side
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
         """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
@@ -127,6 +167,8 @@ class HuangFPA(Analysis):
         of the stance; the other onsets are a stride away).
         """
         out = steps.copy()
+        if self.note_:  # why the column is NaN, for the metrics (Result.metric_notes) and a saved result
+            out.attrs["notes"] = {**out.attrs.get("notes", {}), "fpa_rad": self.note_}
         onsets = t[self.heel_strikes_]
         if len(onsets) == 0:
             out["fpa_rad"] = np.nan

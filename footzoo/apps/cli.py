@@ -400,7 +400,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 def cmd_ablate(args: argparse.Namespace) -> int:
     """Run a study: every config × recording cell, in parallel, cached, with tables and plots."""
     from ..studies import run_study
-    from ..studies.report import summarise, to_markdown
+    from ..studies.report import compared, readable, summarise, to_markdown
 
     out = args.out or f"ablation_{Path(args.study).stem}"
     if args.quiet:
@@ -427,8 +427,8 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         return _failed_exit_code(a["causes"])
     factors = [c for c in table.columns
                if c not in ("run", "base", "recording", "metric", "value", "error", "note")]
-    for f in factors[:3]:
-        s = summarise(table, f)
+    for f in compared(table, factors)[:3]:
+        s = readable(summarise(table, f), f)
         keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
         print(f"\n{f}:")
         print(to_markdown(keep), end="")

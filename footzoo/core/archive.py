@@ -384,7 +384,8 @@ def _result_files(result: Any, folder: Path, group: FileGroup, backend: str) -> 
                      for name in (*TRUTH_ARRAYS, *TRUTH_TABLES, "closed_loop", "stride_count", "source")}
     body = {"config": packer.pack(result.config, "config"), "versions": packer.pack(result.versions, "versions"),
             "recording": packer.pack(result.recording, "recording"),
-            "diagnostics": packer.pack(result.diagnostics, "diagnostics"), "reference": reference}
+            "diagnostics": packer.pack(result.diagnostics, "diagnostics"), "reference": reference,
+            "steps_notes": {str(k): str(v) for k, v in (result.steps.attrs.get("notes") or {}).items()}}
     for key, table in packer.tables.items():
         name, info = _write_table(table, group, folder, key, backend)
         files[name] = {"holds": "a table of result.json (diagnostics or reference)", **info}
@@ -528,7 +529,10 @@ def _load_result_files(folder: Path, files: dict[str, Any]) -> Any:
     reference = None
     if body.get("reference") is not None:
         reference = Truth(**{k: unpacker.unpack(v) for k, v in body["reference"].items()})
-    return Result(samples=table("samples"), steps=table("steps"), config=unpacker.unpack(body["config"]),
+    steps = table("steps")
+    if body.get("steps_notes"):  # why a column of the stride table is NaN (an analysis said so)
+        steps.attrs["notes"] = dict(body["steps_notes"])
+    return Result(samples=table("samples"), steps=steps, config=unpacker.unpack(body["config"]),
                   versions=unpacker.unpack(body["versions"]), recording=unpacker.unpack(body["recording"]),
                   diagnostics=unpacker.unpack(body["diagnostics"]), reference=reference)
 

@@ -340,27 +340,28 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         d = d[mask] if mask is not None else d
         return d[np.isfinite(d)]
 
+    def put(name: str, d: np.ndarray, stat) -> None:  # NaN when no matched stride has both values
+        out[name] = float(stat(d)) if d.size else float("nan")
+
     for col, name in (("end_s", "ic"), ("to_s", "to")):
         d = diff(col)
-        if d is not None and d.size:
-            out[f"{name}_error_median_abs_s"] = float(np.median(np.abs(d)))
-            out[f"{name}_error_mean_s"] = float(np.mean(d))
+        if d is not None:
+            put(f"{name}_error_median_abs_s", d, lambda v: np.median(np.abs(v)))
+            put(f"{name}_error_mean_s", d, np.mean)
     if "end_s" in m.columns and "start_s" in m.columns:
         ref_time = m["end_s"].to_numpy(float) - m["start_s"].to_numpy(float)
         d = m["est_stride_time_s"].to_numpy(float) - ref_time
-        d = d[np.isfinite(d)]
-        if d.size:
-            out["stride_time_error_median_abs_s"] = float(np.median(np.abs(d)))
+        put("stride_time_error_median_abs_s", d[np.isfinite(d)], lambda v: np.median(np.abs(v)))
     for suffix, mask in (("", None), ("_straight", straight)):
         d = diff("stride_length_m", mask)
-        if d is not None and d.size:
-            out[f"stride_length_rms_error{suffix}_m"] = float(np.sqrt(np.mean(d**2)))
-            out[f"stride_length_mean_error{suffix}_m"] = float(np.mean(d))
+        if d is not None:
+            put(f"stride_length_rms_error{suffix}_m", d, lambda v: np.sqrt(np.mean(v**2)))
+            put(f"stride_length_mean_error{suffix}_m", d, np.mean)
     d = diff("fpa_rad", straight)
-    if d is not None and d.size:
+    if d is not None:
         d = np.degrees(d)
-        out["fpa_mean_error_deg"] = float(np.mean(d))
-        out["fpa_rms_error_deg"] = float(np.sqrt(np.mean(d**2)))
+        put("fpa_mean_error_deg", d, np.mean)
+        put("fpa_rms_error_deg", d, lambda v: np.sqrt(np.mean(v**2)))
     return out
 
 
@@ -581,12 +582,11 @@ def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, referenc
             v = steps[col].to_numpy(dtype=float)
             v = v[np.isfinite(v)]
             out[f"median_{col}"] = float(np.median(v)) if v.size else float("nan")
-    if "fpa_rad" in steps.columns:
+    if "fpa_rad" in steps.columns:  # NaN when no stride has one (the analysis says why: steps.attrs["notes"])
         fpa = steps["fpa_rad"].to_numpy(dtype=float)
         fpa = fpa[np.isfinite(fpa)]
-        if fpa.size:
-            out["fpa_mean_deg"] = float(np.degrees(fpa.mean()))
-            out["median_fpa_deg"] = float(np.degrees(np.median(fpa)))
+        out["fpa_mean_deg"] = float(np.degrees(fpa.mean())) if fpa.size else float("nan")
+        out["median_fpa_deg"] = float(np.degrees(np.median(fpa))) if fpa.size else float("nan")
     if ref is None:
         return out
     if ref.stride_count is not None:

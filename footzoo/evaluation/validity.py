@@ -27,6 +27,14 @@ The rules (each applies to the reference of one recording):
     The reference has strides but no estimated stride pairs with one
     (:func:`footzoo.evaluation.metrics.match_strides`): the per-stride errors are NaN (the estimate's
     fault, not the reference's, but a number would be made up all the same).
+``the estimate says why``
+    An analysis that leaves a column of the stride table NaN says why in ``steps.attrs["notes"]``
+    (column -> reason; the foot progression angle of a recording whose foot side is unknown): the
+    metrics computed from that column are NaN with that reason (:func:`estimate_problems`).
+
+A metric a study asks for (``metrics:``) that a run cannot compute at all (no reference of that
+kind, no analysis that gives it) is never dropped either: it is NaN with the reason
+(:func:`missing_reason`).
 """
 
 from __future__ import annotations
@@ -62,6 +70,11 @@ NEEDS: dict[str, tuple[str, ...]] = {
 EVENTS = ("start_s", "to_s", "end_s")
 #: Every per-stride comparison with a reference stride table (not the counts).
 STRIDE_COMPARISONS = tuple(dict.fromkeys(m for ms in NEEDS.values() for m in ms))
+
+
+#: A column of the estimated stride table -> the metrics computed from it.
+FROM_COLUMN: dict[str, tuple[str, ...]] = {"fpa_rad": ("fpa_mean_deg", "median_fpa_deg", "fpa_mean_error_deg",
+                                                       "fpa_rms_error_deg")}
 
 
 class MetricWarning(FootzooWarning):
@@ -137,6 +150,79 @@ def _stride_problems(steps) -> dict[str, str]:
     return out
 
 
+def estimate_problems(steps: Any, reference: Any = None) -> dict[str, str]:
+    """The metrics an analysis left NaN, with its reason (``steps.attrs["notes"]``: column -> reason).
+
+    The errors against a reference column (``fpa_mean_error_deg``) only where the reference has that column.
+    """
+    notes = (getattr(steps, "attrs", None) or {}).get("notes") or {}
+    ref_steps = getattr(reference, "steps", None)
+    out: dict[str, str] = {}
+    for column, why in notes.items():
+        for name in FROM_COLUMN.get(column, ()):
+            if "error" in name and (ref_steps is None or column not in ref_steps.columns):
+                continue
+            out[name] = str(why)
+    return out
+
+
+#: Metric -> what it needs, for :func:`missing_reason`: (the reference's attribute, its column or None, the words).
+_NEEDS_REFERENCE: dict[str, tuple[str, str | None, str]] = {
+    **dict.fromkeys(("armse_3d_m", "pyshoe_error_m"), ("pos", None, "reference positions")),
+    **dict.fromkeys(("stride_count_ref", "stride_count_error"),
+                    ("stride_count", None, "a stride count (hand-counted)")),
+    **dict.fromkeys(("ref_strides", "matched_strides", "ic_error_median_abs_s", "ic_error_mean_s",
+                     "stride_time_error_median_abs_s"), ("steps", "end_s", "a stride table with initial contacts")),
+    **dict.fromkeys(("to_error_median_abs_s", "to_error_mean_s"), ("steps", "to_s", "a stride table with toe-offs")),
+    **dict.fromkeys(("stride_length_rms_error_m", "stride_length_mean_error_m", "stride_length_rms_error_straight_m",
+                     "stride_length_mean_error_straight_m"),
+                    ("steps", "stride_length_m", "a stride table with stride lengths")),
+    **dict.fromkeys(("fpa_mean_error_deg", "fpa_rms_error_deg"),
+                    ("steps", "fpa_rad", "a stride table with foot progression angles")),
+    **dict.fromkeys(("footprints_ref", "footprints_est", "footprint_error_mean_m", "footprint_error_rms_m",
+                     "footprint_error_end_m"), ("footprints", None, "measured footprints")),
+    **dict.fromkeys(("stride_path_rms_error_median_m", "stride_paths"),
+                    ("stride_positions", None, "per-stride trajectories")),
+    **dict.fromkeys((*SAMPLE_METRICS, *STEP_METRICS), ("stance", None, "a stance mask (stance or swing per sample)")),
+}
+
+
+def missing_reason(name: str, reference: Any = None, steps: Any = None) -> str:
+    """Why a run has no value for the metric ``name`` (one a study asked for): the reference or the analysis it needs.
+
+    Parameters
+    ----------
+    name : str
+        A metric (:data:`footzoo.evaluation.metrics.METRICS`).
+    reference : Truth, optional
+        The recording's reference.
+    steps : DataFrame, optional
+        The run's stride table.
+    """
+    source = getattr(reference, "source", "") or ""
+    which = f"the recording's reference ({source})" if source else "the recording's reference"
+    if name.startswith("loop_closure"):
+        return ("the recording is not known to be a closed walk (declare closed_loop: true in its metadata sidecar "
+                "<file>.meta.yaml if it ends where it started)")
+    if name in ("fpa_mean_deg", "median_fpa_deg") or (name in FROM_COLUMN["fpa_rad"] and steps is not None
+                                                      and "fpa_rad" not in getattr(steps, "columns", ())):
+        return "the pipeline has no foot-progression-angle analysis (add analysis: [{type: huang_fpa}])"
+    if name in _NEEDS_REFERENCE:
+        attr, column, words = _NEEDS_REFERENCE[name]
+        if reference is None:
+            return f"the recording has no reference; this metric needs {words}"
+        value = getattr(reference, attr, None)
+        if value is None:
+            return f"{which} has no {words.removeprefix('a ').removeprefix('an ')}"
+        if column is not None and column not in getattr(value, "columns", ()):
+            return f"{which} has a stride table without {column!r}; this metric needs {words}"
+        if attr == "steps" and len(value) == 0:
+            return f"{which} has an empty stride table"
+    if name.startswith("median_") and steps is not None and len(steps) == 0:
+        return "no stride was detected"
+    return "the run did not compute it (no reference or analysis gives it)"
+
+
 def checked_metrics(values: dict[str, float], problems: dict[str, str],
                     reference: Any = None) -> tuple[dict[str, float], dict[str, str]]:
     """``values`` with every refused metric NaN, and the reasons (metric -> reason) of the NaN ones.
@@ -167,7 +253,8 @@ def result_metrics_checked(t: np.ndarray, pos: np.ndarray, steps: Any,
     from .metrics import result_metrics
 
     values = result_metrics(t, pos, steps, reference)
-    problems = {k: why for k, why in reference_problems(t, reference).items() if k in values}
+    found = {**reference_problems(t, reference), **estimate_problems(steps, reference)}
+    problems = {k: why for k, why in found.items() if k in values}
     return checked_metrics(values, problems, reference)
 
 

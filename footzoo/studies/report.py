@@ -19,11 +19,42 @@ import pandas as pd
 
 
 def summarise(table: pd.DataFrame, factor: str) -> pd.DataFrame:
-    """Mean, median, standard deviation and count of every metric per level of one factor."""
+    """Mean, median, standard deviation and count of every metric per level of one factor.
+
+    The levels are the table's own values (a plug-in spec as JSON text); :func:`readable` labels them.
+    A metric NaN in every run of a level (refused, with the reason in the table's ``note``) has count 0.
+    """
     ok = table[table["metric"].notna()]
     g = ok.groupby([factor, "metric"], dropna=False)["value"]
     out = g.agg(["mean", "median", "std", "count"]).reset_index()
     return out.sort_values(["metric", factor]).reset_index(drop=True)
+
+
+def compared(table: pd.DataFrame, factors: list[str]) -> list[str]:
+    """What a study compares: ``base`` first when it has several base configs, then its factors.
+
+    A comparison of configs gets what a factor gets: a box plot per metric and a summary.
+    """
+    several = "base" in table.columns and table["base"].nunique(dropna=True) > 1
+    return (["base"] if several else []) + [f for f in factors if f != "base"]
+
+
+def readable(summary: pd.DataFrame, factor: str) -> pd.DataFrame:
+    """A summary (:func:`summarise`) with its levels labelled as the plots label them (:func:`level_labels`).
+
+    A plug-in spec ``{"type": "shoe", "threshold": 1e5}`` becomes ``shoe (threshold=1e+05)``, showing
+    only what differs between the levels; a number keeps its value. The levels stay as they are
+    when two would get one label.
+    """
+    levels = list(dict.fromkeys(summary[factor].tolist()))
+    names = level_labels(factor, levels)
+    leaf = factor.split(".")[-1] + "="  # the column names the factor already
+    text = {k: v.removeprefix(leaf) for k, v in names.items()}
+    if len(set(text.values())) < len(levels):
+        return summary
+    out = summary.copy()
+    out[factor] = [text[str(v)] for v in summary[factor]]
+    return out
 
 
 def to_markdown(df: pd.DataFrame, digits: int = 4) -> str:
@@ -97,7 +128,7 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
         mine = [r for r in runs if r["recording"] == rec]
         tasks.append(("trajectories", mine, {r["key"]: labels[r["key"]] for r in mine}, rec))
     ok = table[table["metric"].notna()]
-    for f in factors:
+    for f in compared(table, factors):
         for metric in sorted(m for m in ok["metric"].unique() if figures is None or m in figures):
             tasks.append(("metric", ok[ok["metric"] == metric], f, metric))
     detector_factors = [f for f in factors if f == "detector" or f.startswith("detector.")]
@@ -215,7 +246,7 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     step(1)
     md, tex = [], []
     for f in ["base", *factors]:
-        s = summarise(table, f)
+        s = readable(summarise(table, f), f)
         md.append(f"## {f}\n\n" + to_markdown(s))
         tex.append(f"% {f}\n" + to_latex(s))
     errors = table[table["error"].notna()][["run", "recording", "error"]].drop_duplicates()

@@ -73,13 +73,17 @@ def _reference_problems(rec) -> dict[str, str]:
 def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
     """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
     from ..evaluation.metrics import run_metrics
-    from ..evaluation.validity import checked_metrics
+    from ..evaluation.validity import checked_metrics, estimate_problems, missing_reason
 
     m = run_metrics(rec.t, pos, res.steps, res.stance, rec.truth)
-    m, notes = checked_metrics(m, _reference_problems(rec), rec.truth)
+    m, notes = checked_metrics(m, {**_reference_problems(rec), **estimate_problems(res.steps, rec.truth)}, rec.truth)
     if metric_names:
         m = {k: v for k, v in m.items() if k in metric_names}
         notes = {k: v for k, v in notes.items() if k in metric_names}
+        for name in metric_names:  # a metric asked for is never dropped: NaN, and why
+            if name not in m:
+                m[name] = float("nan")
+                notes[name] = missing_reason(name, rec.truth, res.steps)
     return {k: float(v) for k, v in m.items()}, notes
 
 

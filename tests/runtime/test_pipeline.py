@@ -123,16 +123,20 @@ def test_cli_reports_bad_data_cleanly(tmp_path, capsys):
 
 
 def test_an_analysis_refuses_a_recording_it_cannot_use_before_the_run_starts(monkeypatch):
-    """huang2016 without a known foot: refused at once, not after the whole run (issue 24)."""
+    """huang2016 on a recording that names an impossible foot: refused at once, not after the whole run.
+
+    A recording that names no foot is read (the side comes from the walk, tests/analysis/test_foot_side.py).
+    """
     from footzoo.sim import simulate
 
     rec = simulate(n_strides=3, rate=100.0)
-    rec.meta.pop("foot", None)
+    rec.meta["foot"] = "both"
     pipe = Pipeline.from_yaml("huang2016")
 
     def no_detection(*args, **kwargs):
         raise AssertionError("the run started")
 
     monkeypatch.setattr(type(pipe), "detect", no_detection)
-    with pytest.raises(ConfigError, match=r"does not say which foot the sensor is on.*set foot: right"):
+    with pytest.raises(ConfigError, match=r"the recording says the sensor is on the foot 'both'; it must be 'left' or "
+                                          r"'right'.*or set foot: right or foot: left"):
         pipe.run(rec)

@@ -85,3 +85,28 @@ def test_a_manifest_of_an_older_footzoo_removes_nothing(tmp_path):
     assert (tmp_path / "my_notes.txt").read_text() == "the user's own file"
     assert "my_notes.txt" not in json.loads((tmp_path / "outputs.json").read_text())["files"]
 
+
+
+def test_a_comparison_of_base_configs_is_drawn_and_summarised_as_a_factor(tmp_path):
+    """Several base configs and no factors: a box plot per metric by base, as a factor gets."""
+    fsm = STUDY["base"]
+    shoe = {**fsm, "name": "shoe", "detector": {"type": "shoe"}}
+    spec = {"name": "configs", "base": [{**fsm, "name": "fsm"}, shoe], "recordings": STUDY["recordings"],
+            "figures": "all"}
+    table = run_study(Study.from_dict(spec), out=tmp_path)
+    assert sorted(table["base"].unique()) == ["fsm", "shoe"]
+    drawn = {p.name for p in tmp_path.glob("metric_*_by_base.png")}
+    assert {f"metric_{m}_by_base.png" for m in table["metric"].dropna().unique()} == drawn
+    summary = (tmp_path / "summary.md").read_text()
+    assert "| fsm | armse_3d_m |" in summary and "| shoe | armse_3d_m |" in summary
+
+
+def test_dictionary_levels_are_labelled_readably_in_the_summary(tmp_path):
+    spec = {**STUDY, "factors": {"detector": [{"type": "shoe"}, {"type": "angular_rate_fsm", "threshold": 0.6}]},
+            "metrics": ["armse_3d_m"]}
+    table = run_study(Study.from_dict(spec), out=tmp_path)
+    assert '{"type": "shoe"}' in set(table["detector"])  # the table keeps the level as written, for programs
+    summary = (tmp_path / "summary.md").read_text()
+    section = summary.split("## detector")[1]
+    assert "| shoe | armse_3d_m |" in section and "| angular_rate_fsm (threshold=0.6) | armse_3d_m |" in section
+    assert '{"' not in section  # no raw JSON for a reader

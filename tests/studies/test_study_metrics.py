@@ -196,3 +196,49 @@ def test_result_metrics_apply_the_same_rules_as_a_study(walk, tmp_path):
     values, notes = _metrics(rec, res, res.pos, None)
     assert {k: notes[k] for k in refused} == res.metric_notes
     assert all(np.isnan(values[k]) for k in refused)
+
+
+# ------------------------------------------------------------------ a metric asked for is never dropped
+
+
+def test_a_metric_the_reference_cannot_give_is_nan_with_the_reason(walk, tmp_path):
+    """A study asks for metrics a recording's reference has nothing for: a row each, NaN, and why."""
+    rec = Recording(t=walk.t, acc=walk.acc, gyr=walk.gyr, meta=dict(walk.meta),
+                    truth=Truth(stance=walk.truth.stance))  # a stance mask only: no strides, no positions
+    write(rec, tmp_path / "stance_only.csv")
+    asked = ["ic_error_median_abs_s", "armse_3d_m", "stance_f1", "loop_closure_xy_m", "fpa_mean_deg"]
+    study = Study.from_dict({"base": "yun2012", "recordings": [{"path": str(tmp_path / "stance_only.csv")}],
+                             "metrics": asked})
+    with pytest.warns(MetricWarning, match="metrics refused"):
+        table = run_study(study, out=tmp_path / "out")
+    rows = table.set_index("metric")
+    assert sorted(rows.index) == sorted(asked)
+    assert np.isfinite(rows.loc["stance_f1", "value"]) and pd.isna(rows.loc["stance_f1", "note"])
+    notes = rows["note"].to_dict()
+    assert "has no stride table with initial contacts" in notes["ic_error_median_abs_s"]
+    assert "has no reference positions" in notes["armse_3d_m"]
+    assert "not known to be a closed walk" in notes["loop_closure_xy_m"]
+    assert "no foot-progression-angle analysis" in notes["fpa_mean_deg"]
+    assert all(np.isnan(rows.loc[m, "value"]) for m in asked if m != "stance_f1")
+    summary = (tmp_path / "out" / "summary.md").read_text()
+    assert "| yun2012 | ic_error_median_abs_s |" in summary  # in the summary too (count 0)
+
+
+def test_the_datasets_metrics_a_study_asks_for_are_kept():
+    """The issue's cases: IC timing on PyShoe (no stride events), stance F1 on gaitmap (no stance mask)."""
+    from ..conftest import data_file
+
+    pyshoe = data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat")
+    gaitmap = data_file("gaitmap_example", "imu_sample.csv")
+    study = Study.from_dict({"base": "recommended", "metrics": ["ic_error_median_abs_s", "stance_f1"],
+                             "recordings": [{"path": str(pyshoe)}, {"path": str(gaitmap), "foot": "left"}]})
+    with pytest.warns(MetricWarning):
+        table = run_study(study)
+    rows = table.set_index(["recording", "metric"])
+    assert len(rows) == 4
+    assert np.isfinite(rows.loc[("2017-11-22-11-22-03", "stance_f1"), "value"])
+    assert np.isfinite(rows.loc[("imu_sample", "ic_error_median_abs_s"), "value"])
+    note = rows.loc[("2017-11-22-11-22-03", "ic_error_median_abs_s"), "note"]
+    assert "reference (VICON (PyShoe)) has no stride table" in note
+    note = rows.loc[("imu_sample", "stance_f1"), "note"]
+    assert "reference (motion capture (gaitmap)) has no stance mask" in note
