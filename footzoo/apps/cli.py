@@ -1,5 +1,11 @@
 """Command line: ``footzoo run | simulate | calibrate | ablate (study) | tune | list | validate | formats``.
 
+Every command takes ``--quiet``: no warnings (and no progress bar) on the terminal. The warnings
+are kept all the same: in the result (``Result.diagnostics["warnings"]`` of ``footzoo run``, the
+study table's ``attrs["warnings"]``) and, for a command that writes a folder (``run --out``,
+``ablate``, ``tune``), in its ``footzoo.log``, which lists every warning of the command (or says
+there was none); a command with no such place says how many it did not show.
+
 Bad input never prints a Python traceback: the message names the input, the
 problem and the fix, and the exit code says which kind of problem it was
 (``--debug`` adds the traceback):
@@ -177,6 +183,8 @@ def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | 
 
 #: Files ``footzoo run --out DIR`` writes (a result archive with CSV tables, :mod:`footzoo.core.archive`).
 RUN_OUTPUTS = ("samples.csv", "steps.csv", "metrics.json", "result.json", "arrays.npz", "manifest.json")
+#: The log of a command that writes a folder: every warning it gave (:func:`write_log`).
+LOG = "footzoo.log"
 
 
 def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
@@ -221,12 +229,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rec = _load_recording(args)
-    for w in caught:
-        print(f"note: {w.message}", file=sys.stderr)
+    if not args.quiet:
+        for w in caught:
+            print(f"note: {w.message}", file=sys.stderr)
     if out is not None:
-        _check_outputs(out, RUN_OUTPUTS, _inputs(args, rec))
-    result = pipeline.run(rec)
-    metrics = result.metrics
+        _check_outputs(out, (*RUN_OUTPUTS, LOG), _inputs(args, rec))
+    with kept_warnings(args) as later:
+        result = pipeline.run(rec)
+        metrics = result.metrics
+    result.diagnostics["warnings"] = warning_texts([*caught, *later])
     if "pyshoe_trial_error" in rec.meta:
         metrics["pyshoe_published_best_m"] = min(rec.meta["pyshoe_trial_error"].values())
     ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
@@ -234,8 +245,58 @@ def cmd_run(args: argparse.Namespace) -> int:
                    result.metric_notes)
     if out is not None:
         written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
+        written.append(write_log(out, result.diagnostics["warnings"], _inputs(args, rec)).name)
         print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
+    else:
+        tell_unshown(args, result.diagnostics["warnings"])
     return 0
+
+
+def warning_texts(caught: list[warnings.WarningMessage]) -> list[str]:
+    """``"Category: message"`` of each distinct warning caught, in order."""
+    return list(dict.fromkeys(f"{type(w.message).__name__ if isinstance(w.message, Warning) else w.category.__name__}"
+                              f": {w.message}" for w in caught))
+
+
+class kept_warnings:
+    """Record the warnings of a block; shown as they come unless ``--quiet``, kept either way.
+
+    ``with kept_warnings(args) as caught: ...`` gives the list of :class:`warnings.WarningMessage`.
+    """
+
+    def __init__(self, args: argparse.Namespace):
+        self.quiet = bool(getattr(args, "quiet", False))
+        self._ctx = warnings.catch_warnings(record=True)
+
+    def __enter__(self) -> list[warnings.WarningMessage]:
+        self.caught = self._ctx.__enter__()  # the filters stay: what footzoo ignores on purpose stays ignored
+        return self.caught
+
+    def __exit__(self, *exc: Any) -> None:
+        self._ctx.__exit__(*exc)
+        if not self.quiet:
+            shown: set[str] = set()
+            for w in self.caught:
+                if str(w.message) not in shown:
+                    shown.add(str(w.message))
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+
+
+def write_log(folder: Path, texts: list[str], inputs: list[str] | None = None) -> Path:
+    """``folder/footzoo.log``: every warning of the command, one per line (or that there was none), atomically."""
+    from ..core.atomic import refuse_inputs, write_text
+
+    target = folder / LOG
+    refuse_inputs([target], inputs or [], "--out")
+    body = "\n".join(texts) if texts else "no warnings"
+    return write_text(target, body + "\n", what="the command's log")
+
+
+def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
+    """With ``--quiet`` and no folder to log into: one line saying how many warnings were not shown."""
+    if getattr(args, "quiet", False) and texts:
+        print(f"footzoo: {len(texts)} warning(s) not shown (--quiet); without --quiet they are printed, with --out "
+              f"they are kept in OUT/{LOG}", file=sys.stderr)
 
 
 def _run_session(args: argparse.Namespace, pipeline) -> int:
@@ -247,10 +308,16 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     inputs = [f for rec in session.recordings.values() for f in _inputs(args, rec)]
     if args.out is not None:
         out = Path(args.out)
-        _check_outputs(out, ("steps.csv", "bilateral.csv", "manifest.json"), inputs)
+        _check_outputs(out, ("steps.csv", "bilateral.csv", "manifest.json", LOG), inputs)
         for foot in session.recordings:
             _check_outputs(out / foot, RUN_OUTPUTS, inputs)
-    res = session.run(pipeline)
+    with kept_warnings(args) as caught:
+        res = session.run(pipeline)
+        for r in res.results.values():
+            _ = r.metrics  # their warnings (refused metrics) are the command's too
+    texts = warning_texts(caught)
+    for r in res.results.values():
+        r.diagnostics["warnings"] = texts  # the command's warnings, both feet's
     for foot, r in res.results.items():
         rec = session.recordings[foot]
         ref = f"; reference: {rec.truth.source}" if rec.truth is not None and rec.truth.source else ""
@@ -267,8 +334,11 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
             for foot, r in res.results.items():
                 plot_run(r, out / foot, session.recordings[foot])
-        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv and bilateral.csv to {out} "
-              f"(footzoo.SessionResult.load({str(out)!r}) reads it back)")
+        write_log(out, texts, inputs)
+        print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "
+              f"{out} (footzoo.SessionResult.load({str(out)!r}) reads it back)")
+    else:
+        tell_unshown(args, texts)
     return 0
 
 
@@ -403,12 +473,12 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     from ..studies.report import compared, readable, summarise, to_markdown
 
     out = args.out or f"ablation_{Path(args.study).stem}"
-    if args.quiet:
-        warnings.simplefilter("ignore")
     prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
              "max_bytes": None if args.cache_max_size is None else int(args.cache_max_size * 1e6)}
-    table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
-                      max_cells=args.max_cells, quiet=args.quiet, prune=prune)
+    with kept_warnings(args) as caught:
+        table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
+                          max_cells=args.max_cells, prune=prune)
+    write_log(Path(out), warning_texts(caught))
     a = table.attrs
     notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
              if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
@@ -444,10 +514,9 @@ def cmd_tune(args: argparse.Namespace) -> int:
     out = _writable_dir(args.out or f"tune_{Path(args.study).stem}")
     if args.config:
         spec.config = str(_writable_file(args.config, "--config"))
-    if args.quiet:
-        warnings.simplefilter("ignore")
-    result = tune(study, spec, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
-                  quiet=args.quiet)
+    with kept_warnings(args) as caught:
+        result = tune(study, spec, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
+    write_log(out, warning_texts(caught))
     print(f"{len(result.settings_)} settings x {len(result.values_)} recordings in {result.groups_.nunique()} "
           f"groups; objective {spec.objective} ({spec.aggregate}, {spec.direction})")
     print("leave-one-group-out (each group scored by the setting chosen without it):")
@@ -534,6 +603,8 @@ def build_parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                         help="show the Python traceback of an error")
+    common.add_argument("--quiet", action="store_true", help="no warnings and no progress bar on the terminal; the "
+                        f"warnings are kept in the result and in OUT/{LOG} (a study's: OUT/{LOG})")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
@@ -615,7 +686,6 @@ def build_parser() -> argparse.ArgumentParser:
     abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
-    abl.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
     abl.add_argument("--prune-cache", action="store_true",
                      help="remove every cache entry this study did not use (other studies' runs in the same --out)")
     abl.add_argument("--cache-max-age", type=_number(0, 1e6, "days"), default=30.0, metavar="DAYS",
@@ -634,7 +704,6 @@ def build_parser() -> argparse.ArgumentParser:
                      "tune_scores.csv, best.yaml")
     tun.add_argument("--config", type=_output, help="write the chosen config here (default: the tune block's "
                      "config, else OUT/best.yaml)")
-    tun.add_argument("--quiet", action="store_true", help="no progress bar and no warnings from the runs")
     tun.set_defaults(func=cmd_tune)
 
     lst = sub.add_parser("list", help="list plug-ins with their parameters (default, unit, accepted range, meaning, "
@@ -696,7 +765,12 @@ def main(argv: list[str] | None = None) -> int:
     if not debug:
         warnings.showwarning = _show_warning
     try:
-        return args.func(args)
+        if not getattr(args, "quiet", False):
+            return args.func(args)
+        with kept_warnings(args) as caught:  # commands with a result or a log keep their own
+            code = args.func(args)
+        tell_unshown(args, warning_texts(caught))
+        return code
     except KeyboardInterrupt:
         print("footzoo: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

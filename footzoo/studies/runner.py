@@ -441,7 +441,7 @@ def run_study(
         (what :func:`footzoo.studies.tune.tune` needs).
     quiet : bool
         Do not repeat the runs' warnings (each distinct warning of the workers is otherwise
-        issued once here, with the number of runs that gave it).
+        issued once here, with the number of runs that gave it); they stay in ``attrs["warnings"]``.
 
     Returns
     -------
@@ -450,8 +450,10 @@ def run_study(
         ``error``. ``attrs`` holds counts only: ``computed``, ``cached``, ``failed``, and
         ``recomputed`` (damaged cache entries: key -> problem), ``retried`` (failed
         cells run again because footzoo's source changed: keys), ``causes`` (the distinct
-        errors of the failed runs, most frequent first) and ``refused`` (the distinct reasons of
-        refused metrics, :mod:`footzoo.evaluation.validity`). Every config and reader option is
+        errors of the failed runs, most frequent first), ``refused`` (the distinct reasons of
+        refused metrics, :mod:`footzoo.evaluation.validity`) and ``warnings`` (the distinct
+        warnings of the runs computed now, ``"Category: message"`` -> number of runs; kept with
+        ``quiet`` too, and in each run's cache entry). Every config and reader option is
         validated before any run (:meth:`Study.check`): an invalid study raises ConfigError. Trajectories and
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
@@ -477,8 +479,7 @@ def run_study(
     finally:
         bar.close()
     if not quiet:
-        _replay_warnings(table.attrs.pop("warnings", {}), table.attrs["refused"])
-    table.attrs.pop("warnings", None)
+        _replay_warnings(table.attrs["warnings"], table.attrs["refused"])
     return table
 
 

@@ -182,7 +182,7 @@ def test_unknown_metric_names_and_bad_job_counts_are_config_errors(tmp_path, cap
 def test_trajectories_are_stored_apart_from_the_table(tmp_path):
     table = run_study(Study.from_dict(SMALL), out=tmp_path)
     assert set(table.attrs) == {"computed", "cached", "failed", "recomputed", "retried", "causes", "refused",
-                                "pruned"}
+                                "warnings", "pruned"}
     traj = read_trajectories(tmp_path)
     assert set(traj["run"]) == set(table["run"])
     # checked against a pipeline run outside the study: the stored points are its positions every 0.1 s

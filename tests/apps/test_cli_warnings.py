@@ -1,0 +1,66 @@
+"""``--quiet`` on every command: no warnings on the terminal, kept in the result and in the command's log."""
+
+from __future__ import annotations
+
+import pytest
+
+from footzoo import Result
+from footzoo.apps.cli import LOG, build_parser, main
+from footzoo.io.canonical import write
+from footzoo.sim import NoiseModel, simulate
+
+#: A straight walk: yun2012's magnetometer calibration cannot fit it and says so (a CalibrationWarning).
+WARNING = "hard_iron: magnetometer left uncalibrated"
+
+
+@pytest.fixture(scope="module")
+def straight(tmp_path_factory):
+    path = tmp_path_factory.mktemp("walk") / "walk.csv"
+    write(simulate(path="straight", n_strides=6, rate=100.0, noise=NoiseModel(seed=0)), path)
+    return path
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "yun2012"], ["simulate", "straight", "--out", "w.csv"], ["calibrate", "--data", "d", "--out", "f.yaml"],
+    ["ablate", "study_quick"], ["study", "study_quick"], ["tune", "t.yaml"], ["list"], ["formats"], ["configs"],
+    ["validate", "yun2012"], ["compile", "yun2012"],
+])
+def test_every_command_takes_quiet(argv):
+    assert build_parser().parse_args([*argv, "--quiet"]).quiet is True
+    assert build_parser().parse_args(argv).quiet is False
+
+
+def test_run_quiet_shows_no_warning_and_keeps_them_in_the_result_and_the_log(straight, tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "yun2012", "--data", str(straight), "--out", str(out), "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert "warning" not in captured.err and "strides" in captured.out
+    log = (out / LOG).read_text()
+    assert f"CalibrationWarning: {WARNING}" in log
+    kept = Result.load(out).diagnostics["warnings"]
+    assert any(WARNING in w for w in kept) and log.splitlines() == kept
+
+
+def test_run_without_quiet_shows_the_warnings_and_logs_them_too(straight, tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "yun2012", "--data", str(straight), "--out", str(out)]) == 0
+    assert f"footzoo: warning: {WARNING}" in capsys.readouterr().err
+    assert WARNING in (out / LOG).read_text()
+    # a run with no warning leaves a log that says so, not the previous run's
+    write(simulate(path="rectangle", n_strides=10, rate=100.0, noise=NoiseModel(seed=0)), tmp_path / "loop.csv")
+    assert main(["run", "recommended", "--data", str(tmp_path / "loop.csv"), "--out", str(out)]) == 0
+    assert (out / LOG).read_text() == "no warnings\n"
+
+
+def test_run_quiet_without_a_folder_says_how_many_it_did_not_show(straight, capsys):
+    assert main(["run", "yun2012", "--data", str(straight), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert WARNING not in err and "warning(s) not shown (--quiet)" in err
+
+
+def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
+    study = tmp_path / "study.yaml"
+    study.write_text(f"name: s\nbase: yun2012\nrecordings: [{{path: {straight}}}]\nmetrics: [strides]\n")
+    assert main(["ablate", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert WARNING not in capsys.readouterr().err
+    assert WARNING in (tmp_path / "out" / LOG).read_text()
