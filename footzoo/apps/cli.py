@@ -522,6 +522,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
     print("leave-one-group-out (each group scored by the setting chosen without it):")
     print(to_markdown(result.folds_), end="")
     print(f"chosen on every group: {result.best_}")
+    for edge in result.edges_:
+        print(f"  at the edge of the search: {edge}")
     print(f"wrote {spec.config or out / 'best.yaml'} (footzoo run it), {out}/tune_folds.csv, {out}/tune_scores.csv")
     return EXIT_OK
 

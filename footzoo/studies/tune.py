@@ -23,6 +23,12 @@ A tune file is a study file with a ``tune:`` block::
 
 A recording's group is its ``group:`` in the study's ``recordings`` or the ``group_by`` match.
 
+**The edge of the grid.** When the chosen value of a numeric factor (three levels or more) is the
+smallest or the largest of its grid, or, in a random or optuna search, lies in the outer 5 % of a
+``{low, high}`` range (on the log scale for a ``log`` range), the best may lie beyond it: ``tune``
+says so in a :class:`~footzoo.core.errors.FootzooWarning`, in :attr:`TuneResult.edges_` and in the
+written config's header, with the edge and a next value to try (:func:`grid_edges`).
+
 ``search: optuna`` (``pip install 'footzoo[tune]'``) searches ``space`` sample-efficiently with
 optuna's TPE sampler (Bergstra et al. 2011; seeded, so repeatable): a search of ``trials``
 settings on the training groups of every fold (nested, so the held-out group never steers the
@@ -37,6 +43,7 @@ import copy
 import json
 import math
 import re
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,7 +52,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.errors import ConfigError, did_you_mean
+from ..core.errors import ConfigError, FootzooWarning, did_you_mean
 from .study import Study, set_dotted
 
 TUNE_KEYS = {
@@ -247,6 +254,9 @@ class TuneResult:
         Each recording's group.
     settings_ : dict
         Setting name -> its factor levels.
+    edges_ : list of str
+        The chosen setting's values at an edge of what was searched, each with the edge and a value
+        to try next (:func:`grid_edges`); empty when none is.
     """
 
     best_: str
@@ -258,6 +268,7 @@ class TuneResult:
     groups_: pd.Series
     settings_: dict[str, dict[str, Any]]
     objective: str = ""
+    edges_: list[str] = field(default_factory=list)
 
     def save_config(self, path: str | Path, name: str | None = None) -> Path:
         """Write the chosen setting as a pipeline config YAML (atomically), the procedure in its header."""
@@ -270,7 +281,8 @@ class TuneResult:
         header = [f"# chosen by footzoo tune: {self.best_} ({self.objective}); leave-one-group-out over "
                   f"{self.groups_.nunique()} groups",
                   *(f"#   held out {r.group}: chose {r.chosen}, train score {r.train_score:.4g}, "
-                    f"test score {r.test_score:.4g}" for r in self.folds_.itertuples())]
+                    f"test score {r.test_score:.4g}" for r in self.folds_.itertuples()),
+                  *(f"# at the edge: {e}" for e in self.edges_)]
         body = yaml.safe_dump(json_safe(cfg), sort_keys=False, default_flow_style=None, width=120)
         return write_text(path, "\n".join(header) + "\n" + body, what="tuned config")
 
@@ -300,6 +312,80 @@ def settings_study(study: Study, spec: TuneSpec, settings: list[dict[str, Any]])
     out = Study(study.name, bases, {}, study.recordings, [spec.objective], 0, study.plugins, study.jobs,
                 study.max_cells)
     return out, named
+
+
+#: Share of a ``{low, high}`` range (of its log for a log range) that counts as its edge.
+EDGE_SHARE = 0.05
+
+
+def grid_edges(chosen: dict[str, Any], searched: dict[str, Any]) -> list[str]:
+    """The chosen values that sit at an edge of what was searched, each with the edge and a value to try next.
+
+    Parameters
+    ----------
+    chosen : dict
+        The chosen setting's levels (dotted path -> value).
+    searched : dict
+        The grid (dotted path -> list of levels) or the space (-> list, or ``{low, high, log}``).
+
+    Returns
+    -------
+    list of str
+        E.g. ``"detector.threshold = 1e+06 is the largest value of the grid [1e+04, 1e+05, 1e+06]: the
+        best may lie beyond it; extend the grid above (next: 1e+07)"``. A list of fewer than three
+        numbers, or of other values (plug-in types), has no edge worth naming.
+    """
+    out = []
+    for path, where in searched.items():
+        value = chosen.get(path)
+        if not _number(value):
+            continue
+        if isinstance(where, list):
+            levels = sorted({float(v) for v in where if _number(v)})
+            if len(levels) < 3 or len(levels) != len(where):
+                continue
+            side = "smallest" if value == levels[0] else "largest" if value == levels[-1] else ""
+            if side:
+                nxt = _beyond(levels, side == "largest")
+                grid = ", ".join(f"{v:g}" for v in levels)
+                out.append(f"{path} = {value:g} is the {side} value of the grid [{grid}]: the best may lie beyond "
+                           f"it; extend the grid {'above' if side == 'largest' else 'below'} (next: {nxt:g})")
+        elif isinstance(where, dict) and {"low", "high"} <= set(where):
+            lo, hi = float(where["low"]), float(where["high"])
+            f = (lambda x: np.log(x)) if where.get("log") else (lambda x: x)
+            share = (f(float(value)) - f(lo)) / (f(hi) - f(lo))
+            side = "low" if share <= EDGE_SHARE else "high" if share >= 1 - EDGE_SHARE else ""
+            if side:
+                nxt = _past_range(lo, hi, bool(where.get("log")), side == "high")
+                out.append(f"{path} = {value:g} is at the {side} end of the range [{lo:g}, {hi:g}] searched: the best "
+                           f"may lie beyond it; extend the range (e.g. {side}: {nxt:g})")
+    return out
+
+
+def _number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _beyond(levels: list[float], above: bool) -> float:
+    """The next value past an end of sorted ``levels``: the same ratio when they are spaced evenly on a log scale
+    (all > 0), else the same step; never across zero from positive levels (then half the smallest)."""
+    lv = np.asarray(levels, dtype=float)
+    a, b = (lv[-2], lv[-1]) if above else (lv[1], lv[0])
+    steps = np.diff(lv)
+    if (lv > 0).all():
+        logs = np.diff(np.log(lv))
+        if np.std(logs) / np.mean(logs) < np.std(steps) / np.mean(steps):
+            return float(b * (b / a))  # log-spaced: one more ratio
+    nxt = float(b + (b - a))
+    return nxt if not ((lv > 0).all() and nxt <= 0) else float(b / 2)
+
+
+def _past_range(lo: float, hi: float, log: bool, above: bool) -> float:
+    """A value past an end of a searched range: a decade for a log range, half its width otherwise (not across 0)."""
+    if log:
+        return hi * 10 if above else lo / 10
+    nxt = hi + (hi - lo) / 2 if above else lo - (hi - lo) / 2
+    return lo / 2 if not above and lo > 0 >= nxt else nxt
 
 
 def setting_label(levels: dict[str, Any], multiple_bases: bool = True) -> str:
@@ -381,7 +467,10 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     settings = run.settings
     scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
     config = run.configs[best]
-    result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective)
+    edges = grid_edges(settings[best], study.factors if spec.search == "grid" else spec.space)
+    result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective, edges)
+    for edge in edges:
+        warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=2)
     if out is not None:
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)

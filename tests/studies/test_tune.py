@@ -10,6 +10,7 @@ import yaml
 
 from footzoo import ConfigError, Pipeline
 from footzoo.apps.cli import main
+from footzoo.core.errors import FootzooWarning
 from footzoo.studies import Study, TuneSpec, cross_validate, leave_one_group_out, tune
 from footzoo.studies.tune import load_tune_file, sample_space
 
@@ -159,3 +160,33 @@ def test_optuna_search_without_optuna_names_the_fix(monkeypatch):
         tune(Study.from_dict(study), spec, quiet=True)
     with pytest.raises(ConfigError, match="optuna needs tune.space"):
         TuneSpec.from_dict({"objective": "armse_3d_m", "search": "optuna"})
+
+
+def test_the_edges_of_a_grid_and_of_a_range_are_named_with_a_next_value():
+    from footzoo.studies.tune import grid_edges
+
+    grid = {"detector.threshold": [1e4, 1e5, 1e6], "detector.window": [0.2, 0.4, 0.6, 0.8],
+            "detector.type": ["shoe", "ared", "amvd"], "x.two": [1.0, 2.0]}
+    chosen = {"base": "b", "detector.threshold": 1e6, "detector.window": 0.4, "detector.type": "shoe", "x.two": 2.0}
+    edges = grid_edges(chosen, grid)
+    # log-spaced: one more decade; the middle of a grid, a type and a two-level factor: no edge
+    assert edges == ["detector.threshold = 1e+06 is the largest value of the grid [10000, 100000, 1e+06]: the best "
+                     "may lie beyond it; extend the grid above (next: 1e+07)"]
+    edges = grid_edges({**chosen, "detector.window": 0.2}, grid)
+    assert "detector.window = 0.2 is the smallest value of the grid [0.2, 0.4, 0.6, 0.8]" in edges[1]
+    assert edges[1].endswith("extend the grid below (next: 0.1)")  # the step would reach 0: half instead
+    space = {"detector.threshold": {"low": 1e3, "high": 1e6, "log": True}, "a.b": {"low": 0.0, "high": 1.0}}
+    assert grid_edges({"detector.threshold": 1.2e3, "a.b": 0.5}, space) == [
+        "detector.threshold = 1200 is at the low end of the range [1000, 1e+06] searched: the best may lie beyond "
+        "it; extend the range (e.g. low: 100)"]
+    assert grid_edges({"detector.threshold": 3e4, "a.b": 0.97}, space)[0].startswith("a.b = 0.97 is at the high end")
+
+
+def test_tune_says_when_the_chosen_value_is_the_grid_s_edge(tmp_path):
+    study = Study.from_dict({**STUDY, "factors": {"detector.threshold": [10.0, 3.0, 1.0]}})
+    with pytest.warns(FootzooWarning, match=r"tune: the chosen detector.threshold = 10 is the largest value of the "
+                                            r"grid \[1, 3, 10\].*extend the grid above \(next: 33.3333\)"):
+        result = tune(study, {"objective": "armse_3d_m"}, out=tmp_path, quiet=True,
+                      eligible=lambda name: name == "detector.threshold=10")  # forced to the edge
+    assert result.best_ == "detector.threshold=10" and len(result.edges_) == 1
+    assert "# at the edge: detector.threshold = 10 is the largest value" in (tmp_path / "best.yaml").read_text()
