@@ -92,7 +92,7 @@ def test_a_comparison_of_base_configs_is_drawn_and_summarised_as_a_factor(tmp_pa
     fsm = STUDY["base"]
     shoe = {**fsm, "name": "shoe", "detector": {"type": "shoe"}}
     spec = {"name": "configs", "base": [{**fsm, "name": "fsm"}, shoe], "recordings": STUDY["recordings"],
-            "figures": "all"}
+            "figures": "all", "metrics": ["armse_3d_m", "strides", "stance_f1"]}
     table = run_study(Study.from_dict(spec), out=tmp_path)
     assert sorted(table["base"].unique()) == ["fsm", "shoe"]
     drawn = {p.name for p in tmp_path.glob("metric_*_by_base.png")}
