@@ -5,6 +5,8 @@ Columns ``Time`` (s) and ``<device>:scaledAccelX/Y/Z`` (g),
 is x forward, y right, z down (at rest acc_z ≈ −1 g): the axis map is the
 identity ``[x, y, z]``; a sensor mounted otherwise on the foot (upside down, turned)
 is read with ``axes=``, and an export in other units with ``acc_unit=`` / ``gyr_unit=``.
+Köroğlu's experiments 31–33 were recorded with the sensor's x axis toward the heel: the run's
+mounting warning says so, and read with ``axes="[-x, -y, z]"`` they give none.
 The sensor's own roll/pitch/yaw columns are not read.
 
 Köroğlu's experiments ship a ``<name>.mat`` next to the CSV with the ground
