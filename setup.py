@@ -67,8 +67,12 @@ def _groups(configs):
 
 
 # the shipped configs live in the repository's top-level configs/ and are installed as the data package
-# footzoo.configs (footzoo.config.library finds them in either place)
+# footzoo.configs (footzoo.config.library finds them in either place). Every package's data is listed
+# here, the one place: setup()'s package_data replaces setup.cfg's [options.package_data] as a whole.
+PACKAGE_DATA = {"footzoo.configs": ["*.yaml"], "footzoo.samples": ["*.csv.gz", "*.md"],
+                "footzoo.detectors": ["weights/*.npz"]}
+
 setup(cmdclass={"build_py": BuildWithKernels},
       packages=[*find_packages(include=["footzoo", "footzoo.*"]), "footzoo.configs"],
       package_dir={"footzoo.configs": "configs"},
-      package_data={"footzoo.configs": ["*.yaml"]})
+      package_data=PACKAGE_DATA)

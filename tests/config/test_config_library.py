@@ -75,3 +75,25 @@ def test_the_live_twin_of_recommended_differs_only_in_its_smoother():
     assert (offline.pop("name"), live.pop("name")) == ("recommended", "recommended_live")
     assert offline == live
     assert Stream(Pipeline.from_yaml("recommended_live"), rate=100.0).latency.live
+
+
+def test_a_built_package_carries_its_data_files(tmp_path):
+    """What `pip install .` installs: the configs, the built-in sample and the learned detector's weights.
+
+    setup.py's build (kernels not precompiled, a second) into a temporary folder; every data file of the
+    source tree's packages is in it.
+    """
+    import os
+    import subprocess
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "FOOTZOO_NO_PRECOMPILE": "1"}
+    run = subprocess.run([sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(tmp_path)], cwd=root,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    built = tmp_path / "footzoo"
+    for source in [*(root / "footzoo" / "samples").glob("*.csv.gz"), *(root / "footzoo").rglob("*.npz")]:
+        rel = source.relative_to(root / "footzoo")
+        assert (built / rel).is_file(), f"{rel} is not in the built package"
+    assert {p.name for p in (built / "configs").glob("*.yaml")} == {p.name for p in (root / "configs").glob("*.yaml")}
