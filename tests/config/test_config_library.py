@@ -80,19 +80,27 @@ def test_the_live_twin_of_recommended_differs_only_in_its_smoother():
 def test_a_built_package_carries_its_data_files(tmp_path):
     """What `pip install .` installs: the configs, the built-in sample and the learned detector's weights.
 
-    setup.py's build (kernels not precompiled, a second) into a temporary folder; every data file of the
-    source tree's packages is in it.
+    setup.py's build (kernels not precompiled, a second) from a clean copy of the sources (a checkout's
+    own egg-info would list the data files whatever setup.py says); every data file is in the build.
     """
     import os
+    import shutil
     import subprocess
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[2]
+    src = tmp_path / "src"
+    src.mkdir()
+    for name in ("setup.py", "setup.cfg", "pyproject.toml", "README.md"):
+        shutil.copy(root / name, src / name)
+    ignore = shutil.ignore_patterns("__pycache__", "_compiled", "*.egg-info")
+    for folder in ("footzoo", "configs"):
+        shutil.copytree(root / folder, src / folder, ignore=ignore)
     env = {**os.environ, "FOOTZOO_NO_PRECOMPILE": "1"}
-    run = subprocess.run([sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(tmp_path)], cwd=root,
-                         env=env, capture_output=True, text=True, timeout=300)
+    run = subprocess.run([sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(tmp_path / "lib")],
+                         cwd=src, env=env, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
-    built = tmp_path / "footzoo"
+    built = tmp_path / "lib" / "footzoo"
     for source in [*(root / "footzoo" / "samples").glob("*.csv.gz"), *(root / "footzoo").rglob("*.npz")]:
         rel = source.relative_to(root / "footzoo")
         assert (built / rel).is_file(), f"{rel} is not in the built package"
