@@ -135,7 +135,7 @@ def _run(rec, corrections):
 
 def test_on_the_simulators_rolling_foot_it_learns_the_contact_points_and_keeps_the_strides(rolling_walk):
     """Zero-velocity rows stop a sensor that rolls: strides 0.31 m short; the rolling model learns the heel and
-    the toe within 3 mm of the simulator's geometry from a 2-3 cm wrong prior, and keeps the strides within
+    the toe within 3 mm of the simulator's geometry from a prior 1-2 cm off, and keeps the strides within
     1 cm, better than the zero-velocity update's rolling noise (roll_lever 0.2 m: 1.6 cm short)."""
     walk, rec = rolling_walk
 
