@@ -22,8 +22,6 @@ from footzoo.evaluation.metrics import stride_errors
 from footzoo.filters.measurement import Context, Q, Rows, V
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 #: The simulator's contact points (footzoo.sim.gait.FootGeometry: sensor to heel and to toe, FRD, m).
 SIM_HEEL, SIM_TOE = [-0.10, 0.0, 0.06], [0.12, 0.0, 0.06]
 #: Error-state layout of the hand cases: attitude, gyro bias, position, velocity, no accelerometer bias, then

@@ -17,8 +17,6 @@ from footzoo.filters.measurement import ATT, POS, VEL, Context, P, Rows, V
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 #: A consumer-grade MEMS accelerometer's bias (m/s², per axis; about 15-20 mg) and a 0.2 °/s gyroscope bias.
 MEMS = {"acc_bias": (0.15, -0.10, 0.20), "gyr_bias": float(np.radians(0.2))}
 
