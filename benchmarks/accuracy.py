@@ -3,12 +3,13 @@
 Usage: python benchmarks/accuracy.py [--jobs 2] [--quick] [--results benchmarks/results/]
                                      [--data ../shared/data] [--configs yun2012,nguyen2016]
                                      [--summary benchmarks/accuracy.md]
-                                     [--parts configs,pyshoe3d,rates,events,consistency,mounting]
+                                     [--parts configs,pyshoe3d,rates,events,consistency,mounting,stillness]
 
 ``--parts`` chooses what runs (default all): ``configs`` is the table of every shipped config below;
 the others score the flagship on every axis (benchmarks/accuracy_parts.py: 3-D and height on PyShoe
-per motion class, rate independence, gait events, filter consistency, 24 mountings). Without
-``configs`` only the chosen parts' blocks of the existing summary's flagship section are rewritten.
+per motion class, rate independence, gait events, filter consistency, 24 mountings, a foot standing
+still). Only the chosen parts' blocks of the existing summary's flagship section are rewritten; the
+others are kept, with or without ``configs``.
 
 Every config in ``configs/`` that is a pipeline (not ``study_*.yaml``) runs, through footzoo's
 ablation runner (one study per dataset: parallel with ``--jobs``, cached in
@@ -518,14 +519,14 @@ def main(argv: list[str] | None = None) -> int:
     flagship = [p for p in parts if p != "configs"]
     blocks = accuracy_parts.run_parts(flagship, args.data, ref["best_error_m"], MOTION_CLASSES, CLASS_ORDER,
                                       args.jobs) if flagship else {}
+    kept = summary.read_text().partition(FLAGSHIP_MARK)[2] if summary.exists() else ""  # the parts not rerun
     if "configs" in parts:
         table = run(args.data, args.results, configs, args.jobs, args.quick, args.progress, plots=args.plots)
         write_summary(table, ref, summary, args.recommended, time.time() - t0, args.quick)
         print(f"tables in {args.results}, summary {summary}")
-    if blocks:
-        old = summary.read_text() if summary.exists() else ""
-        head, _, section = old.partition(FLAGSHIP_MARK)
-        merged = {**accuracy_parts.read_parts(section), **blocks}  # the parts not rerun keep their blocks
+    if blocks or kept:
+        head = summary.read_text().partition(FLAGSHIP_MARK)[0] if summary.exists() else ""
+        merged = {**accuracy_parts.read_parts(kept), **blocks}  # the parts not rerun keep their blocks
         section = "\n".join(accuracy_parts.flagship_section(merged))
         summary.write_text(f"{head.rstrip()}\n\n{FLAGSHIP_MARK}\n\n{section.rstrip()}\n")
         print(f"flagship parts {flagship} in {summary}")

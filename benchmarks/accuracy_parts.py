@@ -12,7 +12,9 @@ Each part runs a few pipelines directly (no study cache) and returns Markdown li
   gait phases (Nguyen & La's error rate);
 * ``consistency``: the Kalman filter's position standard deviation against the simulator's truth
   (share of samples within 2σ, mean NEES; expected 95 % and 3 for a consistent filter);
-* ``mounting``: the 24 proper axis permutations of one simulated walk.
+* ``mounting``: the 24 proper axis permutations of one simulated walk;
+* ``stillness``: ten minutes lying still in every shipped Kalman config, offline and live, and the still
+  periods of the real recordings (benchmarks/stillness.py).
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import NoiseModel, axis_map_name, proper_axis_permutations, remount, simulate
 from footzoo.studies.report import to_markdown
 
-PARTS = ("pyshoe3d", "rates", "events", "consistency", "mounting")
+PARTS = ("pyshoe3d", "rates", "events", "consistency", "mounting", "stillness")
 #: Configs scored by the parts (the flagship first).
 CONFIGS = ("recommended", "yun2012")
 #: Targets of the flagship (visible PyShoe trials, one setting).
@@ -500,6 +502,10 @@ def run_parts(parts: list[str], data: Path, best: pd.Series, classes: dict[str, 
             out = events(data)
         elif part == "rates":
             out = rates(jobs)
+        elif part == "stillness":
+            from stillness import stillness
+
+            out = stillness(data)
         else:
             out = globals()[part]()
         print(f"part {part}: {time.time() - t0:.0f} s", flush=True)

@@ -250,6 +250,9 @@ STILL_ACC = 0.5
 STILL_MIN_DURATION = 5.0
 #: Displacement of the estimate over a still period above which it is reported as drift (m).
 STILL_MAX_DRIFT = 0.25
+#: Share of a drifting still period's samples taken for stance above which the drift is the correction's, not the
+#: detector's.
+STILL_STANCE_SHARE = 0.9
 #: Shortest motion after the still start (s) for which "no stance at all" is reported.
 NO_STANCE_MIN_DURATION = 5.0
 #: Shortest quiet period (s) whose specific force far from g (outside [0.5 g, 1.5 g]) is reported as a scale fault.
@@ -449,7 +452,9 @@ class EstimateScan:
       pure strapdown drift (a detector that never fires on this motion, with the guard off).
     * **drift while still** — the data say the sensor lies still (|ω| < :data:`STILL_GYR`,
       |‖f‖ − g| < :data:`STILL_ACC`) for :data:`STILL_MIN_DURATION` s or longer, and the estimate
-      moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness.
+      moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness, or
+      (when it takes at least :data:`STILL_STANCE_SHARE` of those samples for stance) the velocity
+      correction does not hold a standing foot.
     * **accelerometer scale** — the gyroscope is quiet (|ω| < :data:`STILL_GYR`) for
       :data:`SCALE_MIN_DURATION` s or longer while ‖f‖ stays outside [0.5 g, 1.5 g]: a foot that
       does not turn does not fall or push at half or twice g for that long, so the accelerometer's
@@ -490,7 +495,9 @@ class EstimateScan:
         long = (t[ends - 1] - t[starts] >= STILL_MIN_DURATION) | (starts == 0) | (ends == len(t))
         for s, e in zip(starts[long].tolist(), ends[long].tolist(), strict=True):
             run = self._run if (s == 0 and self._run is not None) else {
-                "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0}
+                "first": int(k[s]), "t0": float(t[s]), "pos0": pos[s].copy(), "drift": 0.0, "stance": 0, "n": 0}
+            run["stance"] += int(np.count_nonzero(ok[s:e]))
+            run["n"] += e - s
             moved = pos[s:e] - run["pos0"]
             run["drift"] = max(run["drift"], float(row_norms(moved).max()))
             run["last"], run["t1"] = int(k[e - 1]), float(t[e - 1])
@@ -537,15 +544,22 @@ class EstimateScan:
         duration = run["t1"] - run["t0"]
         if duration < STILL_MIN_DURATION or run["drift"] <= STILL_MAX_DRIFT:
             return
+        share = run["stance"] / max(run["n"], 1)
         finding = {"first": run["first"], "last": run["last"], "t0": run["t0"], "t1": run["t1"],
-                   "duration_s": duration, "drift_m": run["drift"]}
+                   "duration_s": duration, "drift_m": run["drift"], "stance_share": share}
         self.report.setdefault("still_drift", []).append(finding)
+        if share >= STILL_STANCE_SHARE:
+            why = (f"the detector {self.detector!r} takes {share:.0%} of these samples for stance, yet the velocity "
+                   "correction does not hold the standing foot. With zupt or ekf_zupt keep hold_after > 0 (the "
+                   "stillness hold, footzoo.corrections.stillness)")
+        else:
+            why = (f"the detector {self.detector!r} misses this stillness ({share:.0%} of these samples are stance), "
+                   "so the velocity drifts. Raise its threshold, choose another detector, or keep the stance guard "
+                   "on (guards.max_swing)")
         warnings.warn(
             f"{self.name}: the sensor lies still from t = {run['t0']:.2f} s to {run['t1']:.2f} s (samples "
             f"{run['first']}–{run['last']}, {duration:.1f} s: |ω| < {STILL_GYR:g} rad/s, |a| ≈ g) but the estimate "
-            f"moves {run['drift']:.2f} m meanwhile: the detector {self.detector!r} misses this stillness, so the "
-            "velocity drifts. Raise its threshold, choose another detector, or keep the stance guard on "
-            "(guards.max_swing). Details in diagnostics['sensor']",
+            f"moves {run['drift']:.2f} m meanwhile: {why}. Details in diagnostics['sensor']",
             SensorWarning, stacklevel=5,
         )
 

@@ -3,6 +3,7 @@
 from .ekf_zupt import EKFZUPT, ZUPT
 from .hdr import HDR
 from .height import HeightDistance, HeightFlatFloor, load_calibration, save_calibration
+from .rolling_stance import RollingStance
 from .zvu_dedrift import ZVUDedrift, zvu_dedrift
 
 __all__ = [
@@ -11,6 +12,7 @@ __all__ = [
     "ZUPT",
     "HeightDistance",
     "HeightFlatFloor",
+    "RollingStance",
     "ZVUDedrift",
     "load_calibration",
     "save_calibration",

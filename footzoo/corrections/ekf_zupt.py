@@ -14,21 +14,24 @@ from ..filters.measurement import (
     MeasurementModel,
     StateBlock,
     V,
+    after_function,
     measurement_function,
 )
 from ..plugins.base import Boolean, KalmanCorrection, Real, Samples
 from ..plugins.registry import register
+from .stillness import HOLD_DEFAULTS, HOLD_MEM, HOLD_PARAMETERS, HOLD_ROWS, hold_constants, hold_measure, hold_track
 
 #: Positions in the model's ``par``: σ of the velocity (m/s), zero rate on/off, σ of the rate (rad/s), the gyro
-#: and the accelerometer bias bounds (rad/s, m/s²), the roll lever arm (m); in ``mem``: the rows the bias guard
-#: added.
-VELOCITY_STD, ZERO_RATE, RATE_STD, GYRO_BOUND, ACC_BOUND, ROLL_LEVER = 0, 1, 2, 3, 4, 5
-GUARD_ROWS = 0
+#: and the accelerometer bias bounds (rad/s, m/s²), the roll lever arm (m), then the stillness hold's constants
+#: (:mod:`footzoo.corrections.stillness`); in ``mem``: the rows the bias guard added, then the hold's memory.
+VELOCITY_STD, ZERO_RATE, RATE_STD, GYRO_BOUND, ACC_BOUND, ROLL_LEVER, HOLD = 0, 1, 2, 3, 4, 5, 6
+GUARD_ROWS, HOLD_STATE = 0, 1
 
 
 @measurement_function
 def zero_velocity_measure(ctx, rows):
-    """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[ZERO_RATE]``, ``δω = ω̂ − 0`` (eq. 30).
+    """In stance: ``δv = v̂ − 0`` (eq. 29) and, with ``par[ZERO_RATE]``, ``δω = ω̂ − 0`` (eq. 30); while the
+    foot is held, ``δp = p̂ − p_0`` (:mod:`footzoo.corrections.stillness`).
 
     The velocity rows' variance is ``σ_v² + (ℓ |ω̂|)²`` with ``ℓ = par[ROLL_LEVER]`` (m; 0: the
     paper's ``σ_v²``), ``ω̂`` the bias-corrected angular rate (rad/s).
@@ -67,7 +70,13 @@ def zero_velocity_measure(ctx, rows):
             z[m] = w[i]
             R[m] = par[RATE_STD] * par[RATE_STD]
             m += 1
-    return m
+    return hold_measure(ctx.stance, w, nav, idx, par, HOLD, mem, HOLD_STATE, z, H, R, m)
+
+
+@after_function
+def zero_velocity_after(ctx):
+    """Follow the foot's still run for the stillness hold (:func:`footzoo.corrections.stillness.hold_track`)."""
+    hold_track(ctx.t, ctx.stance, ctx.w, ctx.nav, ctx.par, HOLD, ctx.mem, HOLD_STATE)
 
 
 def _bias_guard_report(mem: np.ndarray) -> dict[str, int]:
@@ -117,6 +126,16 @@ class EKFZUPT(KalmanCorrection):
     a fraction of the foot's length; 0 (the default) is the paper's constant
     ``σ_v``.
 
+    Stillness hold (footzoo's, ``hold_after``, ``hold_std``, ``hold_rate``): once
+    the foot has been still (stance and ``|ω̂| < hold_rate``) for ``hold_after``
+    seconds, each further still sample also measures the position against its
+    estimate at the start of the still run (σ ``hold_std``), so a foot that
+    stands for minutes stays where it stood; see
+    :mod:`footzoo.corrections.stillness` for why zero-velocity rows alone let it
+    creep at ``a·dt/2`` for any unmodelled acceleration ``a``. 0 s: no hold (the
+    paper's filter). The stances of walking and running are shorter than the
+    default 2 s, so the hold acts only where a person stands.
+
     Parameters
     ----------
     gyro_bias, accel_bias : bool
@@ -136,6 +155,12 @@ class EKFZUPT(KalmanCorrection):
     roll_lever : float
         Sensor-to-pivot distance ``ℓ`` of a rolling stance (m): the velocity
         rows' variance is ``velocity_std² + (ℓ |ω|)²`` (0: constant).
+    hold_after : float
+        Stillness (s) after which the foot's position is held; 0: no hold.
+    hold_std : float
+        σ of the position rows while held (m).
+    hold_rate : float
+        Largest ``|ω̂|`` of a still sample (rad/s).
     """
 
     name = "ekf_zupt"
@@ -167,6 +192,7 @@ class EKFZUPT(KalmanCorrection):
         "roll_lever": Real("m", "[0, 1]", "sensor-to-pivot distance of a rolling stance: σ² = σ_v² + (ℓ |ω|)²",
                            source="footzoo's (rigid-body roll about the heel or the toes; see the docstring)",
                            why="a foot is about 0.25 m long: beyond 1 m a turning foot's stance counts for nothing"),
+        **HOLD_PARAMETERS,
     }
 
     def __init__(
@@ -182,6 +208,9 @@ class EKFZUPT(KalmanCorrection):
         accel_bias_noise: float = 0.0,
         bias_limit: float = 10.0,
         roll_lever: float = 0.0,
+        hold_after: float = HOLD_DEFAULTS["hold_after"],
+        hold_std: float = HOLD_DEFAULTS["hold_std"],
+        hold_rate: float = HOLD_DEFAULTS["hold_rate"],
     ):
         if zero_rate and not gyro_bias:
             raise ConfigError("zero_rate measures the gyro bias: it needs gyro_bias: true (or set zero_rate: false)")
@@ -196,6 +225,9 @@ class EKFZUPT(KalmanCorrection):
         self.accel_bias_noise = accel_bias_noise
         self.bias_limit = bias_limit
         self.roll_lever = roll_lever
+        self.hold_after = hold_after
+        self.hold_std = hold_std
+        self.hold_rate = hold_rate
 
     def state_blocks(self) -> list[StateBlock]:
         """The core bias blocks this correction switches on (initial variance, variance growth per s)."""
@@ -211,13 +243,15 @@ class EKFZUPT(KalmanCorrection):
         return self.gyro_bias or self.zero_rate
 
     def model(self, samples: Samples) -> MeasurementModel:
-        """Velocity rows (and angular-rate rows with ``zero_rate``) in every stance sample."""
+        """Velocity rows (and angular-rate rows with ``zero_rate``) in every stance sample; position rows while
+        the foot is held."""
         return MeasurementModel(
-            measure=zero_velocity_measure, max_rows=(6 if self.zero_rate else 3) + 6,
+            measure=zero_velocity_measure, after=zero_velocity_after,
+            max_rows=(6 if self.zero_rate else 3) + 6 + HOLD_ROWS,
             par=np.array([self.velocity_std, 1.0 if self.zero_rate else 0.0, self.rate_std,
                           self.bias_limit * self.gyro_bias_std, self.bias_limit * self.accel_bias_std,
-                          self.roll_lever]),
-            mem=np.zeros(1), diagnostics=_bias_guard_report,
+                          self.roll_lever, *hold_constants(self.hold_after, self.hold_std, self.hold_rate)]),
+            mem=np.zeros(1 + HOLD_MEM), diagnostics=_bias_guard_report,
         )
 
 
@@ -240,14 +274,20 @@ class ZUPT(EKFZUPT):
         Sensor-to-pivot distance of a rolling stance (m; 0, the default, is the
         paper's constant noise): the variance is ``velocity_std² + (ℓ |ω|)²``,
         see ``ekf_zupt``.
+    hold_after, hold_std, hold_rate : float
+        The stillness hold (s, m, rad/s; ``hold_after`` 0: none, the paper's
+        filter), see ``ekf_zupt``.
     """
 
     name = "zupt"
     observes = ("velocity",)
     paper = "Duong & Suh 2015, Sensors 15, eq. 23, Table 1"
     parameters = {"velocity_std": EKFZUPT.parameters["velocity_std"].replace(
-        source="Duong & Suh 2015, Table 1 (variance 0.0001)"), "roll_lever": EKFZUPT.parameters["roll_lever"]}
+        source="Duong & Suh 2015, Table 1 (variance 0.0001)"), "roll_lever": EKFZUPT.parameters["roll_lever"],
+        **HOLD_PARAMETERS}
 
-    def __init__(self, velocity_std: float = 0.01, roll_lever: float = 0.0):
+    def __init__(self, velocity_std: float = 0.01, roll_lever: float = 0.0,
+                 hold_after: float = HOLD_DEFAULTS["hold_after"], hold_std: float = HOLD_DEFAULTS["hold_std"],
+                 hold_rate: float = HOLD_DEFAULTS["hold_rate"]):
         super().__init__(gyro_bias=False, accel_bias=False, zero_rate=False, velocity_std=velocity_std,
-                         roll_lever=roll_lever)
+                         roll_lever=roll_lever, hold_after=hold_after, hold_std=hold_std, hold_rate=hold_rate)

@@ -29,6 +29,18 @@ def test_quick_run_without_datasets_skips_them_and_writes_table_and_summary(accu
     assert "## Simulator scenarios" in text and "## PyShoe" not in text
 
 
+@pytest.mark.slow
+def test_the_configs_table_alone_keeps_the_flagship_blocks(accuracy, tmp_path):
+    summary = tmp_path / "summary.md"
+    summary.write_text(f"# an old configs table\n\n{accuracy.FLAGSHIP_MARK}\n\n<!-- part: rates -->\n"
+                       "### Rates, from an earlier run\n")
+    assert accuracy.main(["--quick", "--parts", "configs", "--data", str(tmp_path / "absent"), "--results",
+                          str(tmp_path / "res"), "--configs", "duong2015_zupt", "--summary", str(summary)]) == 0
+    text = summary.read_text()
+    assert "an old configs table" not in text and "## Simulator scenarios" in text
+    assert text.count(accuracy.FLAGSHIP_MARK) == 1 and "### Rates, from an earlier run" in text
+
+
 def test_motion_classes_follow_the_recording_day(accuracy):
     assert accuracy.motion_class("2017-11-22-11-22-03") == "walking"
     assert accuracy.motion_class("2017-12-15-18-01-18") == "running/fast"

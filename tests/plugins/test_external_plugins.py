@@ -92,7 +92,8 @@ def test_an_external_kalman_correction_runs_everywhere_like_the_builtin_it_copie
         pos = res["pos"] if isinstance(res, dict) else res.pos
         assert np.abs(pos - builtin.pos).max() <= 1e-9 * scale, how
     assert runs["auto"].config["engine"] == "fast"
-    assert runs["auto"].config["corrections"] == [{"type": "test_my_zupt", "velocity_std": 0.01, "roll_lever": 0.0}]
+    assert runs["auto"].config["corrections"] == [{"type": "test_my_zupt", "velocity_std": 0.01, "roll_lever": 0.0,
+                                                   "hold_after": 2.0, "hold_std": 0.001, "hold_rate": 0.2}]
 
 
 @pytest.mark.slow
