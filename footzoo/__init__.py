@@ -18,17 +18,12 @@ The package, from the bottom up (each layer imports only the ones below it):
 
 The names below are imported at their first use (PEP 562), so ``import footzoo``
 does not load pandas, scipy or numba; ``footzoo.Pipeline`` and
-``from footzoo import Pipeline`` work as usual. Modules that moved in 0.3 (``footzoo.pipeline``,
-``footzoo.plugin``, ...) still import from their old names, with a :class:`DeprecationWarning`.
+``from footzoo import Pipeline`` work as usual.
 """
 
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.machinery
-import sys
-import warnings
 from typing import TYPE_CHECKING, Any
 
 from ._version import __version__
@@ -77,70 +72,6 @@ __all__ = [
     "tune",
     "__version__",
 ]
-
-#: Modules that moved in footzoo 0.3, old name -> new name.
-MOVED = {
-    "footzoo.conventions": "footzoo.core.conventions",
-    "footzoo.errors": "footzoo.core.errors",
-    "footzoo.checks": "footzoo.core.checks",
-    "footzoo.data": "footzoo.core.data",
-    "footzoo._table": "footzoo.core.table",
-    "footzoo.sanity": "footzoo.core.sanity",
-    "footzoo.yamlsafe": "footzoo.core.yamlsafe",
-    "footzoo.metrics": "footzoo.evaluation.metrics",
-    "footzoo.plots": "footzoo.evaluation.plots",
-    "footzoo._jit": "footzoo.kernels.jit",
-    "footzoo._kernel_cache": "footzoo.kernels.cache",
-    "footzoo.plugin": "footzoo.plugins.base",
-    "footzoo.registry": "footzoo.plugins.registry",
-    "footzoo.extensions": "footzoo.plugins.extensions",
-    "footzoo.alignment": "footzoo.runtime.alignment",
-    "footzoo.guards": "footzoo.runtime.guards",
-    "footzoo.pipeline": "footzoo.runtime.pipeline",
-    "footzoo.stream": "footzoo.runtime.stream",
-    "footzoo.session": "footzoo.runtime.session",
-    "footzoo.config_check": "footzoo.runtime.validate",
-    "footzoo.cli": "footzoo.apps.cli",
-    "footzoo.compat": "footzoo.apps.compat",
-    "footzoo.testing": "footzoo.apps.testing",
-    "footzoo.precompile": "footzoo.apps.compile",
-    "footzoo.ablation": "footzoo.studies",
-    "footzoo.ablation.study": "footzoo.studies.study",
-    "footzoo.ablation.runner": "footzoo.studies.runner",
-    "footzoo.ablation.report": "footzoo.studies.report",
-}
-
-
-class _MovedLoader(importlib.abc.Loader):
-    """Loads a moved module under its old name: the new module itself, with a DeprecationWarning."""
-
-    def __init__(self, old: str, new: str):
-        self.old, self.new = old, new
-
-    def create_module(self, spec: importlib.machinery.ModuleSpec) -> Any:
-        warnings.warn(f"{self.old} moved to {self.new} in footzoo 0.3; import it from there",
-                      DeprecationWarning, stacklevel=6)
-        module = importlib.import_module(self.new)
-        self.spec = module.__spec__  # the import system sets the alias's spec on the module: put its own back
-        return module
-
-    def exec_module(self, module: Any) -> None:
-        module.__spec__ = self.spec
-        sys.modules[self.old] = module
-
-
-class _MovedFinder(importlib.abc.MetaPathFinder):
-    """Finds the modules of :data:`MOVED` under their old names."""
-
-    def find_spec(self, name: str, path: Any = None, target: Any = None) -> importlib.machinery.ModuleSpec | None:
-        new = MOVED.get(name)
-        if new is None:
-            return None
-        return importlib.machinery.ModuleSpec(name, _MovedLoader(name, new))
-
-
-if not any(isinstance(f, _MovedFinder) for f in sys.meta_path):
-    sys.meta_path.insert(0, _MovedFinder())
 
 if TYPE_CHECKING:
     from .apps.testing import check_plugin

@@ -529,30 +529,6 @@ FIGURE_METRICS: tuple[str, ...] = (
     "gait_phase_error_rate",
 )
 
-#: Old metric names -> their names now (accepted with a DeprecationWarning).
-METRIC_ALIASES: dict[str, str] = {"steps": "strides"}
-
-
-def metric_name(name: str) -> str:
-    """The current name of a metric: ``name`` itself, or the new name of a deprecated alias (with a warning).
-
-    Raises
-    ------
-    KeyError
-        For a name that is neither a metric nor an alias.
-    """
-    if name in METRICS:
-        return name
-    if name in METRIC_ALIASES:
-        import warnings
-
-        new = METRIC_ALIASES[name]
-        warnings.warn(f"metric {name!r} is now called {new!r} (as in footzoo run and Result.metrics); "
-                      f"use {new!r}: the old name will go", DeprecationWarning, stacklevel=3)
-        return new
-    raise KeyError(name)
-
-
 def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, reference=None) -> dict[str, float]:
     """The numbers ``footzoo run`` prints: a summary of the run and its errors against the reference.
 

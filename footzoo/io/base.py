@@ -150,10 +150,6 @@ class Reader:
         """Read the file into a :class:`~footzoo.core.data.Recording` (FRD, SI)."""
         raise NotImplementedError(f"{type(self).__name__}.open")
 
-    def __call__(self, path: Path, **options: Any) -> Recording:
-        """The same as :meth:`open` (``footzoo.io.READERS[name](path)`` reads a file, as in footzoo 0.2)."""
-        return self.open(Path(path), **options)
-
     def __repr__(self) -> str:
         return f"<footzoo reader {self.name or type(self).__name__!r}: {self.description}>"
 

@@ -212,16 +212,11 @@ class Plugin:
 
 
 def _context(ctx: Any) -> RunContext:
-    """A :class:`RunContext` from a context (or, as in footzoo 0.2, a rate in Hz, with a DeprecationWarning)."""
+    """``ctx``, checked to be a :class:`RunContext`."""
     if isinstance(ctx, RunContext):
         return ctx
-    if isinstance(ctx, (int, float, np.floating)) and not isinstance(ctx, bool):
-        import warnings
-
-        warnings.warn("begin(rate) takes a footzoo.core.context.RunContext since footzoo 0.3: "
-                      "begin(RunContext(rate=...))", DeprecationWarning, stacklevel=3)
-        return RunContext(rate=float(ctx))
-    raise ConfigError(f"begin() takes a footzoo.core.context.RunContext, got {type(ctx).__name__} {ctx!r}")
+    hint = f": begin(RunContext(rate={ctx!r}))" if isinstance(ctx, (int, float)) and not isinstance(ctx, bool) else ""
+    raise ConfigError(f"begin() takes a footzoo.core.context.RunContext, got {type(ctx).__name__} {ctx!r}{hint}")
 
 
 def run_context(ctx: RunContext | None, t: np.ndarray) -> RunContext:
@@ -230,10 +225,10 @@ def run_context(ctx: RunContext | None, t: np.ndarray) -> RunContext:
 
 
 def call(method: Callable[..., Any], *args: Any, ctx: RunContext) -> Any:
-    """``method(*args, ctx=ctx)``, or ``method(*args)`` for a plug-in written before the run context.
+    """``method(*args, ctx=ctx)``, or ``method(*args)`` for an action method that takes no ``ctx``.
 
-    footzoo 0.2's action methods took no ``ctx``; such a plug-in computes its durations from the
-    time stamps itself (it still runs, in batch).
+    ``ctx`` is optional in an action method's signature: one without it computes its durations
+    from the time stamps itself (and runs in batch).
     """
     if _takes_context(method):
         return method(*args, ctx=ctx)

@@ -19,7 +19,7 @@ from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
-from ..evaluation.metrics import FIGURE_METRICS, METRICS, metric_name
+from ..evaluation.metrics import FIGURE_METRICS, METRICS
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
 from ..sim.scenarios import check_spec
 
@@ -238,7 +238,7 @@ class Cell:
 
 
 def _metric_names(value: Any, key: str, also: str = "") -> list[str] | None:
-    """The metric names a study lists under ``key`` (a name or a list; aliases renamed), or None if absent."""
+    """The metric names a study lists under ``key`` (a name or a list), or None if absent."""
     if value is None:
         return None
     if isinstance(value, str):
@@ -246,15 +246,12 @@ def _metric_names(value: Any, key: str, also: str = "") -> list[str] | None:
     if not isinstance(value, list) or not all(isinstance(m, str) for m in value):
         raise ConfigError(f"{key} must be a list of metric names{', ' + also if also else ''}, got {value!r}; "
                           f"valid: {list(METRICS)}")
-    named = []
     for m in value:
-        try:
-            named.append(metric_name(m))
-        except KeyError:
+        if m not in METRICS:
             where = "" if key == "metrics" else f" in {key}"
             raise ConfigError(f"unknown metric {m!r}{did_you_mean(str(m), list(METRICS))}{where}; "
-                              f"valid metrics: {list(METRICS)}") from None
-    return list(dict.fromkeys(named))
+                              f"valid metrics: {list(METRICS)}")
+    return list(dict.fromkeys(value))
 
 
 @dataclass

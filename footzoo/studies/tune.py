@@ -98,7 +98,7 @@ class TuneSpec:
     @classmethod
     def from_dict(cls, d: Any) -> TuneSpec:
         """Check and build from a mapping."""
-        from ..evaluation.metrics import METRICS, metric_name
+        from ..evaluation.metrics import METRICS
 
         if not isinstance(d, dict) or "objective" not in d:
             raise ConfigError("a tune file needs a 'tune:' block with at least 'objective: METRIC'")
@@ -106,11 +106,10 @@ class TuneSpec:
             if key not in TUNE_KEYS:
                 raise ConfigError(f"unknown tune key {key!r}{did_you_mean(str(key), list(TUNE_KEYS))}; "
                                   f"valid keys: {list(TUNE_KEYS)}")
-        try:
-            objective = metric_name(str(d["objective"]))
-        except KeyError:
+        objective = str(d["objective"])
+        if objective not in METRICS:
             raise ConfigError(f"tune.objective {d['objective']!r} is not a metric"
-                              f"{did_you_mean(str(d['objective']), list(METRICS))}; valid: {list(METRICS)}") from None
+                              f"{did_you_mean(objective, list(METRICS))}; valid: {list(METRICS)}")
         spec = cls(objective, **{k: v for k, v in d.items() if k != "objective"})
         for name, value, allowed in (("direction", spec.direction, ("minimize", "maximize")),
                                      ("aggregate", spec.aggregate, tuple(AGGREGATES)),

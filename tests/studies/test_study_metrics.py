@@ -6,7 +6,7 @@ import pytest
 
 from footzoo import ConfigError, Pipeline
 from footzoo.core.data import Recording, Truth
-from footzoo.evaluation.metrics import METRIC_ALIASES, METRICS, result_metrics, run_metrics
+from footzoo.evaluation.metrics import METRICS, result_metrics, run_metrics
 from footzoo.evaluation.validity import (
     MIN_STANCE_S,
     STEP_METRICS,
@@ -142,11 +142,11 @@ def test_a_study_reports_gait_metrics_by_footzoo_runs_names(walk, tmp_path):
             "gait_phase_error_rate", "median_stance_time_s"} <= set(table["metric"])
 
 
-def test_old_metric_names_are_deprecated_aliases():
+def test_a_metric_is_named_by_its_one_name():
     d = {"base": "yun2012", "recordings": [{"simulate": {"path": "straight", "n_strides": 4}}]}
-    assert METRIC_ALIASES["steps"] == "strides"
-    with pytest.warns(DeprecationWarning, match="'steps' is now called 'strides'"):
-        assert Study.from_dict({**d, "metrics": ["steps"]}).metrics == ["strides"]
+    assert Study.from_dict({**d, "metrics": ["strides", "strides"]}).metrics == ["strides"]
+    with pytest.raises(ConfigError, match=r"unknown metric 'steps' \(did you mean 'strides'\?\); valid metrics"):
+        Study.from_dict({**d, "metrics": ["steps"]})
     with pytest.raises(ConfigError, match=r"unknown metric 'stride' \(did you mean 'strides'\?\)"):
         Study.from_dict({**d, "metrics": ["stride"]})
 
