@@ -19,16 +19,17 @@ The checks:
 * every constructor parameter has a default; declared parameters (``parameters``, see
   :mod:`footzoo.core.params`) have a meaning, a unit where they are numbers and the source of their
   default, and every value their declaration refuses (wrong types, NaN, infinities, values just out
-  of range) is refused by the constructor and by ``set_params`` with a ``ConfigError`` naming the
-  parameter, while the edges of the accepted ranges are accepted; a plug-in without declarations
+  of range) is refused where footzoo builds the plug-in (:meth:`~footzoo.plugins.base.Plugin.validate_params`,
+  as a config is built) and by ``set_params`` with a ``ConfigError`` naming the parameter, while the
+  edges of the accepted ranges are accepted; a plug-in without declarations
   needs a unit in ``units`` for every numeric parameter (and the report suggests declaring);
   parameters are stored as attributes under their own names (``get_params``), constructing
   from ``get_params()`` gives the same parameters (idempotent), ``set_params`` works and
   rejects unknown names with a ``ConfigError``;
 * YAML round trip: ``spec()`` dumps with ``yaml.safe_dump`` and builds back to the same
   parameters; ``clone()`` gives an equal, unfitted, independent copy;
-* the action method leaves its inputs untouched, returns results of the documented shapes,
-  finite, and refuses NaN input with a footzoo error;
+* the action method, called as footzoo calls it (:func:`footzoo.plugins.contract.checked`), leaves
+  its inputs untouched and returns results of the documented shapes, finite;
 * a calibration returns corrected copies shaped like its inputs and a ``report_`` dict, and
   passes a recording without a magnetometer through;
 * a block that implements the incremental protocol (``begin``/``step``/``finish``, see
@@ -65,6 +66,7 @@ from ..plugins.base import (
     Plugin,
     VelocityCorrection,
 )
+from ..plugins.contract import checked
 from ..plugins.incremental import Latency, concat
 from ..plugins.registry import available, build, same_plugin
 
@@ -143,7 +145,7 @@ def check_plugin(cls: type[Plugin], verbose: bool | None = None) -> CheckReport:
     report.passed("YAML round trip and clone")
     try:
         _check_behaviour(instance, report)
-    except PluginError as err:  # the contract enforced at every call (footzoo.plugins.contract) names the fault
+    except PluginError as err:  # the contract footzoo checks at every call (footzoo.plugins.contract) names the fault
         edit = " (the action method modified its input arrays)" if "read-only" in str(err) else ""
         raise AssertionError(f"{cls.__name__}: {err}{edit}") from err
     if verbose if verbose is not None else _interactive():
@@ -155,26 +157,26 @@ def _check_behaviour(instance: Plugin, report: CheckReport) -> None:
     """The kind's behaviour checks on a simulated walk."""
     if isinstance(instance, Calibration):
         _check_calibration(instance)
-        report.passed("calibrate on a simulated walk, with and without magnetometer, NaN refused")
+        report.passed("calibrate on a simulated walk, with and without magnetometer")
     elif isinstance(instance, Detector):
         _check_detector(instance)
-        report.passed("detect on a simulated walk, NaN refused" + (", chunked = batch" if instance.causal else ""))
+        report.passed("detect on a simulated walk" + (", chunked = batch" if instance.causal else ""))
     elif isinstance(instance, Orientation):
         _check_orientation(instance)
-        report.passed("estimate on a simulated walk (unit quaternions), NaN refused")
+        report.passed("estimate on a simulated walk (unit quaternions)")
     elif isinstance(instance, KalmanCorrection) and not isinstance(instance, (VelocityCorrection,
                                                                               AccelerationCorrection)):
         _check_kalman(instance)
         report.passed("compiled = reference engine" + (" = live stream" if instance.causal else ""))
     elif isinstance(instance, (VelocityCorrection, AccelerationCorrection)):
         _check_batch_correction(instance)
-        report.passed("batch correction on a simulated walk, NaN refused")
+        report.passed("batch correction on a simulated walk")
         if isinstance(instance, KalmanCorrection):
             _check_kalman(instance)
             report.passed("compiled = reference engine" + (" = live stream" if instance.causal else ""))
     elif isinstance(instance, Analysis):
         _check_analysis(instance)
-        report.passed("analyze and annotate on a simulated walk, NaN refused")
+        report.passed("analyze and annotate on a simulated walk")
 
 
 def _interactive() -> bool:
@@ -195,7 +197,8 @@ def _check_declaration(cls: type[Plugin]) -> None:
 
 
 def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
-    """Declarations complete; every value a declaration refuses is refused by the constructor and set_params."""
+    """Declarations complete; every value a declaration refuses is refused as a config builds the plug-in and by
+    set_params."""
     declaration = cls.declaration()
     undeclared = cls.undeclared()
     if undeclared:
@@ -214,12 +217,12 @@ def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
     refused = accepted = 0
     for name, d in declaration.items():
         for bad in d.param.invalid_values():
-            for how in ("the constructor", "set_params"):
+            for how in ("validate_params", "set_params"):
                 try:
                     if how == "set_params":
                         base.clone().set_params(**{name: copy.deepcopy(bad)})
                     else:
-                        cls(**{name: copy.deepcopy(bad)})
+                        _build(cls, {name: copy.deepcopy(bad)})
                 except ConfigError as err:
                     assert name in str(err), f"{cls.__name__}: {how} refused {name}={bad!r} without naming it: {err}"
                     refused += 1
@@ -230,7 +233,7 @@ def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
                 raise AssertionError(f"{cls.__name__}: {how} accepted {name}={bad!r}, which its declaration refuses")
         for edge in d.param.edge_values(d.default):
             try:
-                cls(**{name: copy.deepcopy(edge)})
+                _build(cls, {name: copy.deepcopy(edge)})
                 accepted += 1
             except ConfigError:
                 pass  # a cross-parameter rule may refuse an edge together with the other defaults
@@ -238,6 +241,11 @@ def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
                 raise AssertionError(f"{cls.__name__}: {name}={edge!r} (within its declared range) raised "
                                      f"{type(err).__name__} ({err}), not a ConfigError") from None
     report.passed(f"declared parameters ({refused} bad values refused, {accepted} edge values accepted)")
+
+
+def _build(cls: type[Plugin], params: dict[str, Any]) -> Plugin:
+    """The plug-in as footzoo builds it from a config (:func:`footzoo.plugins.registry.build`): validated, then made."""
+    return cls(**cls.validate_params(params))
 
 
 def _check_params(cls: type[Plugin], p: Plugin) -> None:
@@ -302,22 +310,6 @@ def _unchanged(before: tuple[np.ndarray, ...], after: tuple[np.ndarray, ...], wh
         assert np.array_equal(a, b), f"{who}: the action method modified its input arrays"
 
 
-def _expect_nan_error(fn, who: str) -> None:
-    try:
-        fn()
-    except FootzooError:
-        return
-    except Exception as err:  # noqa: BLE001 - the check reports what it got
-        raise AssertionError(f"{who}: NaN input raised {type(err).__name__} ({err}), not a footzoo error") from None
-    raise AssertionError(f"{who}: NaN input was accepted silently")
-
-
-def _nan(a: np.ndarray) -> np.ndarray:
-    b = a.copy()
-    b[len(b) // 2] = np.nan
-    return b
-
-
 def _stance(rec) -> np.ndarray:
     return rec.truth.stance.copy()
 
@@ -327,15 +319,13 @@ def _check_detector(d: Detector) -> None:
     t, acc, gyr, mag = _signals(rec)
     who = f"detector {d.name!r}"
     args = (t, acc, gyr, rec.truth) if d.needs_truth else (t, acc, gyr)
-    out = d.clone().detect(*args)
+    out = checked(d.clone().detect, *args)
     assert out is not None, f"{who}: detect() must return self"
     _unchanged((rec.t, rec.acc, rec.gyr), (t, acc, gyr), who)
     stance = np.asarray(out.stance_)
     assert stance.shape == t.shape and stance.dtype == bool, f"{who}: stance_ must be (N,) bool, got {stance.dtype}"
     assert np.asarray(out.statistic_).shape == t.shape, f"{who}: statistic_ must be (N,)"
     assert stance.any() and not stance.all(), f"{who}: found no stance or no swing in a simulated walk"
-    if not d.needs_truth:
-        _expect_nan_error(lambda: d.clone().detect(t, _nan(acc), gyr), who)
     if d.incremental() and not d.needs_truth:
         _check_live(who, d, (RunContext.of(rec),), {"t": t, "acc": acc, "gyr": gyr}, {"stance": stance})
 
@@ -343,25 +333,25 @@ def _check_detector(d: Detector) -> None:
 def _check_live(who: str, block: Plugin, begin: tuple, inputs: dict[str, np.ndarray],
                 expected: dict[str, np.ndarray], step: str = "step") -> None:
     """The incremental protocol against the batch outputs: chunks of random sizes, then one sample at a time."""
-    lat = block.latency(begin[0])
+    lat = checked(block.latency, begin[0])
     assert isinstance(lat, Latency), f"{who}: latency(ctx) must return a footzoo.plugins.incremental.Latency"
     n = len(next(iter(inputs.values())))
     rng = np.random.default_rng(0)
     for sizes in (rng.integers(1, 40, size=64), np.ones(1, dtype=int)):
         live = block.clone()
-        live.begin(*begin)
+        checked(live.begin, *begin)
         parts, k, i = [], 0, 0
         stop = n if sizes.size > 1 else min(n, 300)  # one sample at a time: the first 3 s
         while k < stop:
             m = min(int(sizes[i % sizes.size]), stop - k)
-            parts.append(getattr(live, step)(*(v[k:k + m] for v in inputs.values())))
+            parts.append(checked(getattr(live, step), *(v[k:k + m] for v in inputs.values())))
             k, i = k + m, i + 1
             if i % 9 == 0:  # a guess for (at most) the samples pushed but not final
                 pending = k - len(concat(parts).get(next(iter(expected)), ()))
-                for key, value in live.provisional().items():
+                for key, value in checked(live.provisional).items():
                     assert len(value) <= pending, (f"{who}: provisional() gives {len(value)} {key!r} for "
                                                    f"{pending} pending samples")
-        parts.append(live.finish())
+        parts.append(checked(live.finish))
         out = concat(parts)
         for key, want in expected.items():
             got = np.asarray(out.get(key, np.zeros(0)))
@@ -381,7 +371,7 @@ def _check_calibration(c: Calibration) -> None:
     for m in (mag, None):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            out = c.clone().calibrate(t, acc, gyr, m)
+            out = checked(c.clone().calibrate, t, acc, gyr, m)
         _unchanged((rec.t, rec.acc, rec.gyr, rec.mag), (t, acc, gyr, mag), who)
         for name, before in (("acc", acc), ("gyr", gyr), ("mag", m)):
             after = getattr(out, f"{name}_", "missing")
@@ -395,7 +385,6 @@ def _check_calibration(c: Calibration) -> None:
             yaml.safe_dump(out.report_)
         except yaml.YAMLError as err:
             raise AssertionError(f"{who}: report_ must hold plain values (numbers, text, lists): {err}") from None
-    _expect_nan_error(lambda: c.clone().calibrate(t, _nan(acc), gyr, mag), who)
 
 
 def _check_orientation(o: Orientation) -> None:
@@ -403,12 +392,11 @@ def _check_orientation(o: Orientation) -> None:
     t, acc, gyr, mag = _signals(rec)
     who = f"orientation {o.name!r}"
     q0 = rec.truth.quat[0].copy()
-    out = o.clone().estimate(t, acc, gyr, mag, _stance(rec), q0)
+    out = checked(o.clone().estimate, t, acc, gyr, mag, _stance(rec), q0)
     _unchanged((rec.t, rec.acc, rec.gyr, rec.mag), (t, acc, gyr, mag), who)
     quat = np.asarray(out.quat_)
     assert quat.shape == (len(t), 4) and np.isfinite(quat).all(), f"{who}: quat_ must be finite (N, 4)"
     assert np.allclose(np.linalg.norm(quat, axis=1), 1.0, atol=1e-6), f"{who}: quat_ must be unit quaternions"
-    _expect_nan_error(lambda: o.clone().estimate(t, acc, _nan(gyr), mag, _stance(rec), q0), who)
     if o.incremental():
         _check_live(who, o, (RunContext.of(rec), q0), {"t": t, "acc": acc, "gyr": gyr, "mag": mag,
                                                        "stance": _stance(rec)}, {"quat": quat})
@@ -424,19 +412,17 @@ def _check_batch_correction(c: Plugin) -> None:
     before = acc_nav.copy()
     stance = _stance(rec)
     if isinstance(c, VelocityCorrection):
-        out = c.clone().apply(t, acc_nav, stance)
+        out = checked(c.clone().apply, t, acc_nav, stance)
         _unchanged((before,), (acc_nav,), who)
         assert out.vel_.shape == acc_nav.shape and out.pos_.shape == acc_nav.shape, f"{who}: vel_/pos_ must be (N, 3)"
         assert np.isfinite(out.pos_).all(), f"{who}: non-finite positions"
-        _expect_nan_error(lambda: c.clone().apply(t, _nan(acc_nav), stance), who)
         if c.incremental():
             _check_live(who, c, (RunContext.of(rec),), {"t": t, "acc_nav": acc_nav, "stance": stance},
                         {"vel": out.vel_, "pos": out.pos_})
     if isinstance(c, AccelerationCorrection):
-        new = c.clone().apply_acceleration(rec.truth.quat.copy(), acc_nav, stance)
+        new = checked(c.clone().apply_acceleration, rec.truth.quat.copy(), acc_nav, stance)
         _unchanged((before,), (acc_nav,), who)
         assert np.shape(new) == acc_nav.shape and np.isfinite(new).all(), f"{who}: must return a finite (N, 3) array"
-        _expect_nan_error(lambda: c.clone().apply_acceleration(rec.truth.quat, _nan(acc_nav), stance), who)
         if c.incremental():
             _check_live(who, c, (RunContext.of(rec),), {"quat": rec.truth.quat, "acc_nav": acc_nav,
                                                         "stance": stance}, {"acc_nav": new}, step="step_acceleration")
@@ -489,11 +475,10 @@ def _check_analysis(a: Analysis) -> None:
     res = Pipeline.from_dict({"orientation": {"type": "madgwick"}, "detector": {"type": "shoe"},
                               "corrections": [{"type": "zvu_dedrift"}]}).run(rec)
     t, quat, pos, stance = rec.t.copy(), res.quat.copy(), res.pos.copy(), res.stance.copy()
-    out = a.clone().analyze(t, quat, pos, stance, dict(rec.meta, foot="right"))
+    out = checked(a.clone().analyze, t, quat, pos, stance, dict(rec.meta, foot="right"))
     _unchanged((rec.t, res.quat, res.pos), (t, quat, pos), who)
-    steps = out.annotate(res.steps.copy(), t)
+    steps = checked(out.annotate, res.steps.copy(), t)
     assert len(steps) == len(res.steps), f"{who}: annotate() must keep one row per step"
-    _expect_nan_error(lambda: a.clone().analyze(t, _nan(quat), pos, stance, dict(rec.meta, foot="right")), who)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -51,11 +51,9 @@ covered without writing tests for it.
 from __future__ import annotations
 
 import copy
-import functools
-import inspect
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -657,34 +655,6 @@ def declared(cls: type, defaults: Mapping[str, Any]) -> dict[str, Declared]:
                                 f"{err}") from None
         out[name] = Declared(name, p, default)
     return out
-
-
-def validated_init(init: Callable[..., None], declaration: Callable[[], dict[str, Declared]]) -> Callable[..., None]:
-    """``init`` wrapped: the declared arguments are validated (and converted) before its body runs.
-
-    Only the outermost constructor of an object validates: a subclass's ``__init__`` that calls
-    ``super().__init__`` validates against the subclass's declarations (which may redeclare a range),
-    and the base's body then receives the values as they are.
-    """
-    sig = inspect.signature(init)
-
-    @functools.wraps(init)
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        if self.__dict__.get("_footzoo_validating"):
-            return init(self, *args, **kwargs)
-        bound = sig.bind(self, *args, **kwargs)
-        bound.apply_defaults()  # the defaults in their declared type too (a tuple default becomes a list)
-        for name, d in declaration().items():
-            if name in bound.arguments:
-                bound.arguments[name] = d.validate(bound.arguments[name])
-        self.__dict__["_footzoo_validating"] = True
-        try:
-            init(*bound.args, **bound.kwargs)
-        finally:
-            self.__dict__.pop("_footzoo_validating", None)
-
-    __init__.__footzoo_validated__ = True  # type: ignore[attr-defined]
-    return __init__
 
 
 def describe(declaration: Mapping[str, Declared], indent: str = "      ") -> list[str]:

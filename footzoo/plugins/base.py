@@ -8,11 +8,14 @@ scikit-learn:
 * ``__init__`` takes every parameter as a keyword with its paper's default, stores it under the
   same name, and does nothing else that depends on data;
 * ``parameters`` declares each of them once (:mod:`footzoo.core.params`: type, unit, accepted
-  range, one line of meaning, the source of the default); the declared arguments are validated
-  before the body of ``__init__`` runs (so it receives them converted to their type, equal to what
-  was given) and the declaration drives ``set_params``, ``footzoo list``, the documentation and
-  the fuzz tests. ``paper`` gives the reference, the class docstring the equations. (A plug-in
-  without declarations, with a ``units`` dict and its own checks, works as before;
+  range, one line of meaning, the source of the default). The declarations are checked where a
+  plug-in is put to use, not in ``__init__`` (which runs as written): :meth:`Plugin.validate_params`
+  validates and converts the arguments of a config before :func:`footzoo.plugins.registry.build`
+  constructs the plug-in, :meth:`Plugin.set_params` does the same, and a
+  :class:`~footzoo.runtime.pipeline.Pipeline` calls :meth:`Plugin.check_params` on every block it is
+  given. The declarations also drive ``footzoo list``, the documentation and the fuzz tests.
+  ``paper`` gives the reference, the class docstring the equations. (A plug-in without
+  declarations, with a ``units`` dict and its own checks in ``__init__``, works too;
   ``check_plugin`` then suggests declaring.)
 * the one action method (``calibrate``, ``estimate``, ``detect``, ``apply``, ``apply_acceleration``,
   ``analyze``; a Kalman correction's ``model``) sets results as attributes ending in ``_`` and
@@ -21,22 +24,28 @@ scikit-learn:
   ``needs_truth``, ``needs_distance``, ``causal`` (the output at a sample depends only on samples
   up to it, so it can run live in :class:`footzoo.runtime.stream.Stream`).
 
-``footzoo.apps.testing.check_plugin`` runs a plug-in through this contract.
+The classes are plain :mod:`abc` classes: a method a kind requires is an ``abc.abstractmethod``
+(``Calibration.calibrate``, ``KalmanCorrection.model``, ``Analysis.analyze`` and ``annotate``);
+an optional one has a default implementation (a detector writes ``detect``, or ``step`` and gets
+``detect`` from it). footzoo wraps none of a plug-in's methods: its callers check the contract at
+each call (:func:`footzoo.plugins.contract.checked`), and
+``footzoo.apps.testing.check_plugin`` runs a plug-in through it.
 """
 
 from __future__ import annotations
 
+import abc
 import copy
 import functools
 import inspect
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.errors import ConfigError, RecordingError, did_you_mean
+from ..core.errors import ConfigError, did_you_mean
 from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocabulary, re-exported for plug-ins
     REQUIRED,
     Boolean,
@@ -49,47 +58,13 @@ from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocab
     Vector,
     Vectors,
     declared,
-    validated_init,
 )
 from ..filters.measurement import MeasurementModel, StateBlock
-from .contract import GUARDED, Output, guard, inputs_checked_once, mark_finite, proven_finite  # noqa: F401
+from .contract import Output, checked, inputs_checked_once  # noqa: F401 - the callers' side of the contract
 from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
 
-#: The action methods whose array inputs are checked (finite, numeric) before the plug-in sees them.
-ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
 
-
-def _all_finite(value: np.ndarray) -> bool:
-    """``np.isfinite(value).all()`` without its (N,) temporary: a sum is finite only if every term is.
-
-    A NaN or an infinity makes the sum non-finite; a finite sum therefore proves the array
-    finite. Only a non-finite sum (a bad sample, or an overflow of huge values) needs the exact check.
-    """
-    with np.errstate(over="ignore", invalid="ignore"):
-        if np.isfinite(value.sum()):
-            return True
-    return bool(np.isfinite(value).all())
-
-
-def _check_inputs(plugin: Plugin, names: list[str], args: tuple, kwargs: dict[str, Any]) -> None:
-    """An action method's array inputs: a non-finite or non-numeric array argument raises a clear RecordingError."""
-    for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
-        if proven_finite(value):
-            continue
-        if isinstance(value, np.ndarray) and value.dtype.kind in "fc" and not _all_finite(value):
-            bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
-            raise RecordingError(
-                f"{plugin.kind} {plugin.name!r}: input {name!r} has {len(bad)} non-finite sample(s) (NaN or inf), "
-                f"first at index {int(bad[0])}; repair or drop them before running (footzoo.Recording does)"
-            )
-        if isinstance(value, np.ndarray) and value.dtype.kind not in "fcbiu":
-            raise RecordingError(f"{plugin.kind} {plugin.name!r}: input {name!r} must be numeric, got dtype "
-                                 f"{value.dtype}")
-        if isinstance(value, np.ndarray) and value.dtype.kind in "fc":
-            mark_finite(value)
-
-
-class Plugin:
+class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plug-in must write
     """Base of every plug-in: parameters in ``__init__``, estimates in attributes ending in ``_``."""
 
     kind: ClassVar[str] = ""
@@ -104,16 +79,13 @@ class Plugin:
     needs_distance: ClassVar[bool] = False
     causal: ClassVar[bool] = False
     #: The per-sample outputs of the kind (attributes ``<name>_`` of the action method, columns of ``step``),
-    #: checked on return (:mod:`footzoo.plugins.contract`).
+    #: checked on return by the caller (:func:`footzoo.plugins.contract.checked`).
     outputs: ClassVar[dict[str, Output]] = {}
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Check the class's parameter declarations when it is defined (see :func:`_declare`); nothing is wrapped."""
         super().__init_subclass__(**kwargs)
         _declare(cls)
-        for name in GUARDED:  # the contract around every method a plug-in defines (plugins/contract.py)
-            method = cls.__dict__.get(name)
-            if inspect.isfunction(method) and not getattr(method, "__footzoo_checked__", False):
-                setattr(cls, name, guard(method, name, _check_inputs if name in ACTIONS else None))
 
     @classmethod
     def param_names(cls) -> list[str]:
@@ -139,12 +111,49 @@ class Plugin:
         decl = cls.declaration()
         return [p for p in cls.param_names() if p not in decl]
 
+    @classmethod
+    def validate_params(cls, params: Mapping[str, Any]) -> dict[str, Any]:
+        """The constructor's arguments for ``params``: every declared parameter validated, in its declared type.
+
+        Each declared parameter comes back — the value given in ``params``, else its default —
+        equal to what it was, converted (an int given for a float as that float, a tuple for a
+        vector as a list); undeclared arguments pass as they are. :func:`footzoo.plugins.registry.build`
+        and :meth:`set_params` construct a plug-in from the arguments this returns.
+
+        Raises
+        ------
+        ConfigError
+            A value its declaration refuses, naming the parameter, the unit, the accepted range and the fix.
+        """
+        out = dict(params)
+        for name, d in cls.declaration().items():
+            if name in params or d.default is not REQUIRED:
+                out[name] = d.validate(params[name] if name in params else d.default)
+        return out
+
+    def check_params(self) -> Plugin:
+        """Refuse a declared parameter whose current value its declaration refuses; returns ``self``.
+
+        A plug-in constructed in Python (``SHOE(threshold=35)``) stores what it was given; a
+        :class:`~footzoo.runtime.pipeline.Pipeline` calls this on each block it is given.
+
+        Raises
+        ------
+        ConfigError
+            As :meth:`validate_params`, prefixed with the plug-in's kind and name.
+        """
+        try:
+            self.validate_params(self.get_params())
+        except ConfigError as err:
+            raise ConfigError(f"{self.kind} {self.name!r}: {err}") from None
+        return self
+
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """Current parameter values (scikit-learn style; ``deep`` is accepted for compatibility)."""
         return {p: getattr(self, p) for p in self.param_names()}
 
     def set_params(self, **params: Any) -> Plugin:
-        """Change parameters, validated as the constructor validates them; returns ``self``.
+        """Change parameters, validated against their declarations (:meth:`validate_params`); returns ``self``.
 
         Raises
         ------
@@ -157,7 +166,7 @@ class Plugin:
                 raise ConfigError(f"{self.kind} {self.name!r}: unknown parameter {key!r}"
                                   f"{did_you_mean(key, names)}; valid parameters: {names}")
         try:
-            fresh = type(self)(**{**self.get_params(), **params})
+            fresh = type(self)(**self.validate_params({**self.get_params(), **params}))
         except (TypeError, ValueError) as err:  # ConfigError is a ValueError; a plug-in's own checks may raise either
             raise ConfigError(f"{self.kind} {self.name!r}: {err}") from None
         self.__dict__.clear()
@@ -180,9 +189,11 @@ class Plugin:
     # ------------------------------------------------------------------ the incremental protocol
     @classmethod
     def incremental(cls) -> bool:
-        """Whether the class implements ``step`` (runs live, see :mod:`footzoo.plugins.incremental`)."""
-        step = getattr(cls, "step", None)
-        return callable(step) and not getattr(step, "__footzoo_abstract__", False)
+        """Whether the class implements the incremental protocol (runs live, see :mod:`footzoo.plugins.incremental`).
+
+        Default: no; each kind that has the protocol says whether the class implements its ``step``.
+        """
+        return False
 
     def latency(self, ctx: RunContext) -> Latency:
         """How long after a sample this block's output for it is final (:class:`~footzoo.plugins.incremental.Latency`).
@@ -211,6 +222,13 @@ class Plugin:
         return f"{type(self).__name__}({args})"
 
 
+def check_parameters(blocks: list[Any]) -> None:
+    """:meth:`Plugin.check_params` of each plug-in among ``blocks`` (a pipeline's, when it is assembled)."""
+    for block in blocks:
+        if isinstance(block, Plugin):
+            block.check_params()
+
+
 def _context(ctx: Any) -> RunContext:
     """``ctx``, checked to be a :class:`RunContext`."""
     if isinstance(ctx, RunContext):
@@ -225,14 +243,15 @@ def run_context(ctx: RunContext | None, t: np.ndarray) -> RunContext:
 
 
 def call(method: Callable[..., Any], *args: Any, ctx: RunContext) -> Any:
-    """``method(*args, ctx=ctx)``, or ``method(*args)`` for an action method that takes no ``ctx``.
+    """``method(*args, ctx=ctx)``, or ``method(*args)`` for an action method that takes no ``ctx``, under the
+    plug-in contract (:func:`footzoo.plugins.contract.checked`).
 
     ``ctx`` is optional in an action method's signature: one without it computes its durations
     from the time stamps itself (and runs in batch).
     """
     if _takes_context(method):
-        return method(*args, ctx=ctx)
-    return method(*args)
+        return checked(method, *args, ctx=ctx)
+    return checked(method, *args)
 
 
 @functools.lru_cache(maxsize=1024)
@@ -249,32 +268,26 @@ def run_whole(block: Plugin, ctx: RunContext, *arrays: Any) -> Chunk:
     """A block's outputs over whole arrays through its incremental protocol: begin, one step, finish."""
     block.begin(ctx)
     return concat([block.step(*arrays), block.finish()], copy=False)
+
+
 def _declaration(cls: type[Plugin]) -> dict[str, Declared]:
     defaults = {k: (REQUIRED if v is inspect.Parameter.empty else v) for k, v in cls.defaults().items()}
     return declared(cls, defaults)
 
 
 def _declare(cls: type[Plugin]) -> None:
-    """Bind a new plug-in class's declarations to its constructor (see :mod:`footzoo.core.params`).
+    """Bind a new plug-in class's declarations to its constructor's names and defaults (:mod:`footzoo.core.params`).
 
-    The constructor is wrapped so that the declared arguments are validated before its body runs;
-    ``units`` is derived from the declarations unless the class sets it. Mistakes in the
-    declarations (a name that is no parameter, a default the declaration refuses) raise a
-    ``TypeError`` here, when the class is defined.
+    Keeps them as ``cls._footzoo_declaration`` (see :meth:`Plugin.declaration`) and derives
+    ``units`` from them unless the class sets it. Mistakes in the declarations (a name that is
+    no parameter, a default the declaration refuses) raise a ``TypeError`` here, when the class
+    is defined. The constructor is left as written.
     """
     decl = _declaration(cls)
     cls._footzoo_declaration = decl  # type: ignore[attr-defined]
-    if not decl:
-        return
-    if "units" not in cls.__dict__:
+    if decl and "units" not in cls.__dict__:
         inherited = {k: v for k, v in cls.units.items() if k in cls.param_names()}
         cls.units = {**inherited, **{n: d.param.unit for n, d in decl.items() if d.param.unit}}
-    init = cls.__dict__.get("__init__")
-    if init is None and "parameters" in cls.__dict__:  # redeclared without a constructor of its own
-        init = cls.__init__
-    if init is not None:
-        raw = init.__wrapped__ if getattr(init, "__footzoo_validated__", False) else init
-        cls.__init__ = validated_init(raw, lambda: decl)  # type: ignore[method-assign]
 
 
 def _plain(value: Any) -> Any:
@@ -315,9 +328,9 @@ class Calibration(Plugin):
     #: The signals the fit is made from: without any of them there is nothing to fit (nor to wait for, live).
     fits_on: ClassVar[tuple[str, ...]] = ("acc", "gyr", "mag")
 
+    @abc.abstractmethod
     def calibrate(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None) -> Calibration:
         """Set ``acc_``, ``gyr_``, ``mag_`` and ``report_``; returns ``self``."""
-        raise NotImplementedError
 
     def is_fitted(self) -> bool:
         """Whether the parameters already give the fit (nothing to fit on the data): it can run live as it is."""
@@ -335,8 +348,6 @@ class Calibration(Plugin):
         if mag is not None:
             out["mag"] = self.mag_
         return out
-
-    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
 
     @classmethod
     def incremental(cls) -> bool:
@@ -381,7 +392,10 @@ class Orientation(Plugin):
         """Push the next samples (with their final stance); ``{"quat": (m, 4)}`` of those now final."""
         raise NotImplementedError(f"orientation {self.name!r} does not implement the incremental protocol (step)")
 
-    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
+    @classmethod
+    def incremental(cls) -> bool:
+        """Whether the class implements :meth:`step` (runs live)."""
+        return cls.step is not Orientation.step
 
 
 class Detector(Plugin):
@@ -415,7 +429,10 @@ class Detector(Plugin):
         """Push the next samples; ``{"stance": ...}`` of the samples whose stance became final."""
         raise NotImplementedError(f"detector {self.name!r} does not implement the incremental protocol (step)")
 
-    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
+    @classmethod
+    def incremental(cls) -> bool:
+        """Whether the class implements :meth:`step` (runs live)."""
+        return cls.step is not Detector.step
 
 
 class Correction(Plugin):
@@ -445,7 +462,10 @@ class VelocityCorrection(Correction):
         """Push the next samples; ``{"vel": (m, 3), "pos": (m, 3)}`` of those now final."""
         raise NotImplementedError(f"correction {self.name!r} does not implement the incremental protocol (step)")
 
-    step.__footzoo_abstract__ = True  # type: ignore[attr-defined]
+    @classmethod
+    def incremental(cls) -> bool:
+        """Whether the class implements :meth:`step` (runs live)."""
+        return cls.step is not VelocityCorrection.step
 
 
 class AccelerationCorrection(Correction):
@@ -467,12 +487,10 @@ class AccelerationCorrection(Correction):
         raise NotImplementedError(f"correction {self.name!r} does not implement the incremental protocol "
                                   "(step_acceleration)")
 
-    step_acceleration.__footzoo_abstract__ = True  # type: ignore[attr-defined]
-
     @classmethod
     def incremental(cls) -> bool:
-        """Whether the class implements ``step_acceleration`` (runs live)."""
-        return not getattr(cls.step_acceleration, "__footzoo_abstract__", False)
+        """Whether the class implements :meth:`step_acceleration` (runs live)."""
+        return cls.step_acceleration is not AccelerationCorrection.step_acceleration
 
 
 @dataclass
@@ -518,9 +536,9 @@ class KalmanCorrection(Correction):
         """Per-sample inputs of the model, (N, d); default: none."""
         return np.zeros((len(samples.t), 0))
 
+    @abc.abstractmethod
     def model(self, samples: Samples) -> MeasurementModel:
         """The measurement model for a run that starts with ``samples`` (see :class:`Samples`)."""
-        raise NotImplementedError
 
 
 class Analysis(Plugin):
@@ -532,10 +550,10 @@ class Analysis(Plugin):
 
     kind: ClassVar[str] = "analysis"
 
+    @abc.abstractmethod
     def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
                 meta: dict[str, Any]) -> Analysis:
         """Analyse a trajectory; returns ``self``."""
-        raise NotImplementedError
 
     def check(self, meta: dict[str, Any]) -> None:
         """Refuse a recording the analysis cannot use (from its metadata) before a run spends any time on it.
@@ -543,9 +561,9 @@ class Analysis(Plugin):
         Raise a footzoo error that names what is missing and the fix; default: accept every recording.
         """
 
+    @abc.abstractmethod
     def annotate(self, steps: Any, t: np.ndarray) -> Any:
         """The steps table with this analysis' columns."""
-        raise NotImplementedError
 
 
 #: Base class of each kind.

@@ -1,12 +1,16 @@
-"""The plug-in contract, enforced at every call: read-only inputs, faults named, results checked on return.
+"""The plug-in contract, checked by the caller: read-only inputs, faults named, results checked on return.
 
-:class:`footzoo.plugins.base.Plugin` wraps each method of :data:`GUARDED` that a plug-in class
-defines with :func:`guard` (once, when the class is defined), so that every caller — a batch
-run, a :class:`footzoo.Stream`, a study, a test — gets the same guarantees:
+A plug-in class is plain Python: footzoo wraps none of its methods. Whoever calls a plug-in on
+footzoo's behalf — :class:`~footzoo.runtime.pipeline.Pipeline`, the stages of a
+:class:`~footzoo.Stream`, a study, :func:`~footzoo.apps.testing.check_plugin` — calls it through
+:func:`checked` (``checked(detector.detect, t, acc, gyr)`` instead of ``detector.detect(t, acc, gyr)``),
+so that every such caller gets the same guarantees:
 
-* **inputs are read-only**: every array argument is passed as a ``writeable=False`` view (and
-  the arrays of a :class:`~footzoo.plugins.base.Samples`). A plug-in that writes into its input
-  raises, and the caller's recording never changes; the fix is to copy first
+* **inputs are checked and read-only**: the array arguments of an action method (:data:`ACTIONS`)
+  must be numeric and finite (a NaN or inf is a :class:`~footzoo.core.errors.RecordingError` naming
+  the input and the first bad sample); every array argument is passed as a ``writeable=False``
+  view (and the arrays of a :class:`~footzoo.plugins.base.Samples`). A plug-in that writes into its
+  input raises, and the caller's recording never changes; the fix is to copy first
   (``acc = np.array(acc)``).
 * **faults are the plug-in's**: any exception raised inside the method (``SystemExit`` and
   other ``BaseException`` included; ``KeyboardInterrupt`` and ``MemoryError`` excepted) becomes
@@ -23,7 +27,9 @@ run, a :class:`footzoo.Stream`, a study, a test — gets the same guarantees:
   The chunks of ``step``/``finish``/``provisional`` are checked the same way (their length is
   the samples that became final, so only their columns' agreement is checked).
 
-The checks only read; the numbers of a plug-in that keeps its contract are unchanged.
+The checks only read; the numbers of a plug-in that keeps its contract are unchanged. A plug-in
+method called directly (``detector.detect(t, acc, gyr)`` in a script) runs exactly as written,
+without them.
 """
 
 from __future__ import annotations
@@ -41,13 +47,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import FootzooError, PluginError
+from ..core.errors import FootzooError, PluginError, RecordingError
 from ..core.norms import unit_error
 
-#: Methods whose faults are the plug-in's: each one a plug-in class defines is wrapped by :func:`guard`.
-GUARDED = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze", "annotate", "check",
-           "begin", "step", "step_acceleration", "finish", "provisional", "fixed", "latency",
-           "model", "sample_data", "state_blocks", "requires_attitude_state")
+#: The action methods whose array inputs :func:`checked` checks (finite, numeric) before the plug-in sees them.
+ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
 #: Methods that return the plug-in itself (``return self``).
 RETURNS_SELF = ("calibrate", "estimate", "detect", "apply", "analyze", "begin")
 #: Methods that return a chunk of per-sample outputs (:data:`footzoo.plugins.incremental.Chunk`).
@@ -80,9 +84,10 @@ class Output:
     required: bool = True
 
 
-#: Within :func:`inputs_checked_once`: the float arrays proven finite so far, by ``id`` (held, so ids stay unique).
-_PROVEN: contextvars.ContextVar[dict[int, np.ndarray] | None] = contextvars.ContextVar("footzoo_proven_finite",
-                                                                                     default=None)
+#: Within :func:`inputs_checked_once`: the float arrays proven finite so far (the objects themselves, compared by
+#: identity: an array is held while it is listed, so another array can never pass for it).
+_PROVEN: contextvars.ContextVar[list[np.ndarray] | None] = contextvars.ContextVar("footzoo_proven_finite",
+                                                                                default=None)
 
 
 @contextlib.contextmanager
@@ -90,13 +95,13 @@ def inputs_checked_once() -> Iterator[None]:
     """Within: an array argument already proven finite is not scanned again when the same object comes back.
 
     A pipeline run hands its recording's arrays to one block after another, and one block's
-    checked outputs to the next; each action method checks its inputs, and without this each
-    block would scan the same ``t``, ``acc`` and ``gyr`` (or the calibrated signals, the attitude)
-    again. Only the very object proven is skipped (an input checked, or an output that passed
-    :func:`check_array`; a new array, a copy or a calibrated signal is checked), and only until the
-    ``with`` block ends; outside one, every call checks. Outputs are always checked.
+    checked outputs to the next; :func:`checked` checks each action method's inputs, and without
+    this each block would scan the same ``t``, ``acc`` and ``gyr`` (or the calibrated signals, the
+    attitude) again. Only the very object proven is skipped (an input checked, or an output that
+    passed :func:`check_array`; a new array, a copy or a calibrated signal is checked), and only
+    until the ``with`` block ends; outside one, every call checks. Outputs are always checked.
     """
-    token = _PROVEN.set({})
+    token = _PROVEN.set([])
     try:
         yield
     finally:
@@ -106,39 +111,83 @@ def inputs_checked_once() -> Iterator[None]:
 def proven_finite(value: Any) -> bool:
     """True within :func:`inputs_checked_once` for the very array object already proven finite."""
     proven = _PROVEN.get()
-    return proven is not None and proven.get(id(value)) is value
+    return proven is not None and any(value is p for p in proven)
 
 
 def mark_finite(value: np.ndarray) -> None:
     """Within :func:`inputs_checked_once`: ``value`` (this object) is proven finite."""
     proven = _PROVEN.get()
-    if proven is not None:
-        proven[id(value)] = value
+    if proven is not None and not any(value is p for p in proven):
+        proven.append(value)
 
 
-def guard(method: Callable[..., Any], name: str, check_inputs: Callable[..., None] | None = None) -> Callable[..., Any]:
-    """``method`` (a plug-in's method ``name``) with the contract of this module around it.
+def all_finite(value: np.ndarray) -> bool:
+    """``np.isfinite(value).all()`` without its (N,) temporary: a sum is finite only if every term is.
 
-    ``check_inputs(plugin, names, args, kwargs)`` runs first when given (the action methods' input checks).
+    A NaN or an infinity makes the sum non-finite; a finite sum therefore proves the array
+    finite. Only a non-finite sum (a bad sample, or an overflow of huge values) needs the exact check.
     """
-    names = [p for p in inspect.signature(method).parameters if p != "self"]
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(value.sum()):
+            return True
+    return bool(np.isfinite(value).all())
 
-    @functools.wraps(method)
-    def guarded(self, *args, **kwargs):
-        if check_inputs is not None:
-            check_inputs(self, names, args, kwargs)
-        args = tuple(read_only(a) for a in args)
-        kwargs = {k: read_only(v) for k, v in kwargs.items()}
-        try:
-            result = method(self, *args, **kwargs)
-        except PASSED_ON:
-            raise
-        except BaseException as err:  # noqa: BLE001 - SystemExit in a plug-in is its fault too
-            raise fault(self, name, err) from err
-        return returned(self, name, names, args, kwargs, result)
 
-    guarded.__footzoo_checked__ = True  # type: ignore[attr-defined]
-    return guarded
+def check_inputs(plugin: Any, method: str, names: list[str], args: tuple, kwargs: dict[str, Any]) -> None:
+    """An action method's array inputs: a non-finite or non-numeric array argument raises a clear RecordingError."""
+    for name, value in [*zip(names, args, strict=False), *kwargs.items()]:
+        if not isinstance(value, np.ndarray) or proven_finite(value):
+            continue
+        if value.dtype.kind in "fc" and not all_finite(value):
+            bad = np.flatnonzero(~np.isfinite(value).reshape(len(value), -1).all(axis=1)) if value.ndim else [0]
+            raise RecordingError(
+                f"{who(plugin)}: input {name!r} has {len(bad)} non-finite sample(s) (NaN or inf), "
+                f"first at index {int(bad[0])}; repair or drop them before running (footzoo.Recording does)"
+            )
+        if value.dtype.kind not in "fcbiu":
+            raise RecordingError(f"{who(plugin)}: input {name!r} of {method}() must be numeric, got dtype "
+                                 f"{value.dtype}")
+        if value.dtype.kind in "fc":
+            mark_finite(value)
+
+
+@functools.lru_cache(maxsize=4096)
+def _argument_names(function: Callable[..., Any]) -> tuple[str, ...]:
+    """The names of a method's arguments after ``self`` (held by the function object itself)."""
+    return tuple(list(inspect.signature(function).parameters)[1:])
+
+
+def checked(method: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """``method(*args, **kwargs)`` — a bound method of a plug-in — under the contract of this module.
+
+    The action methods' (:data:`ACTIONS`) array inputs are checked first; every array argument is
+    passed read-only; an exception of the plug-in becomes a :class:`PluginError` naming it; the
+    result is checked on return (see the module docstring).
+
+    Raises
+    ------
+    RecordingError
+        A non-finite or non-numeric array input of an action method.
+    PluginError
+        A fault of the plug-in, or a result that breaks the contract.
+    """
+    plugin = getattr(method, "__self__", None)
+    function = getattr(method, "__func__", None)
+    if plugin is None or function is None:
+        raise TypeError(f"checked() takes a bound method of a plug-in (plugin.detect), got {method!r}")
+    name = function.__name__
+    names = list(_argument_names(function))
+    if name in ACTIONS:
+        check_inputs(plugin, name, names, args, kwargs)
+    args = tuple(read_only(a) for a in args)
+    kwargs = {k: read_only(v) for k, v in kwargs.items()}
+    try:
+        result = method(*args, **kwargs)
+    except PASSED_ON:
+        raise
+    except BaseException as err:  # noqa: BLE001 - SystemExit in a plug-in is its fault too
+        raise fault(plugin, name, err) from err
+    return returned(plugin, name, names, args, kwargs, result)
 
 
 def read_only(value: Any) -> Any:

@@ -149,7 +149,7 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
                 f"{did_you_mean(key, allowed)}; valid parameters: {allowed}"
             )
     try:
-        return cls(**params)
+        return cls(**cls.validate_params(params))  # the declared arguments checked before the constructor runs
     except ConfigError as err:
         raise ConfigError(f"{where} ({cls.name}): {err}") from None
     except (TypeError, ValueError) as err:

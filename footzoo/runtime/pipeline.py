@@ -46,6 +46,8 @@ from ..plugins.base import (
     Samples,
     VelocityCorrection,
     call,
+    check_parameters,
+    checked,
     inputs_checked_once,
 )
 from ..plugins.extensions import load_plugins
@@ -132,6 +134,7 @@ class Pipeline:
                            else NavigationNoise.from_dict(navigation))
         self.plugins = list(plugins or [])
         self.guards = guards if isinstance(guards, StanceGuard) else StanceGuard.from_dict(guards)
+        check_parameters([*self.calibration, orientation, detector, *self.corrections, *self.analysis])
         check_compatibility(orientation, detector, self.corrections)
         if smoother not in self.SMOOTHERS:
             raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
@@ -208,8 +211,9 @@ class Pipeline:
         The blocks' look-aheads add up: the detector's, the guard's, the orientation filter's (a
         warm-up at most), the corrections' and the smoother's.
         """
-        parts = [self.detector.latency(ctx), self.guards.latency(ctx)]
-        parts += [b.latency(ctx) for b in self.blocks() if b is not self.detector and not isinstance(b, Calibration)]
+        parts = [checked(self.detector.latency, ctx), self.guards.latency(ctx)]
+        parts += [checked(b.latency, ctx) for b in self.blocks() if b is not self.detector
+                  and not isinstance(b, Calibration)]
         if self.smoother == "rts":
             parts.append(Latency(until=(WHOLE_RECORDING,)))
         elif self.smoother == "stepwise":  # a stride closes at its stance's last sample, seen at the next one
@@ -248,7 +252,7 @@ class Pipeline:
         if reports is None or len(reports) != len(self.calibration):
             raise ConfigError(f"with_fits: give one fit per calibration ({len(self.calibration)}), got {reports!r:.80}")
         out = copy.copy(self)
-        out.calibration = [c.fixed(r) for c, r in zip(self.calibration, reports, strict=True)]
+        out.calibration = [checked(c.fixed, r) for c, r in zip(self.calibration, reports, strict=True)]
         return out
 
     # ------------------------------------------------------------------- run
@@ -336,7 +340,7 @@ class Pipeline:
                 raise RecordingError(f"{p.kind} {p.name!r} needs a magnetometer; the recording {rec.name!r} has none: "
                                      f"load one with mag_x, mag_y, mag_z or choose another {p.kind}")
         for a in self.analysis:
-            a.check(dict(rec.meta))
+            checked(a.check, dict(rec.meta))
 
     def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
         """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""
@@ -345,7 +349,7 @@ class Pipeline:
         out = copy.copy(rec)
         reports = []
         for c in self.calibration:
-            fitted = c.clone().calibrate(out.t, out.acc, out.gyr, out.mag)
+            fitted = checked(c.clone().calibrate, out.t, out.acc, out.gyr, out.mag)
             out.acc, out.gyr, out.mag = _calibrated(c, out, fitted)
             reports.append({"type": c.name, **fitted.report_})
         return out, reports
@@ -355,7 +359,7 @@ class Pipeline:
         ctx = ctx or self.context(rec)
         detector = self.detector.clone()
         if detector.needs_truth:
-            return detector.detect(rec.t, rec.acc, rec.gyr, rec.truth)
+            return checked(detector.detect, rec.t, rec.acc, rec.gyr, rec.truth)
         return call(detector.detect, rec.t, rec.acc, rec.gyr, ctx=ctx)
 
     def guard(self, rec: Recording, detector: Detector,
@@ -412,10 +416,10 @@ class Pipeline:
         """The error-state engine for these (fresh) corrections, with their models built from ``samples``."""
         models = []
         for c in kalman:
-            m = c.model(samples)
-            m.data = np.ascontiguousarray(c.sample_data(samples), dtype=float)
+            m = checked(c.model, samples)
+            m.data = np.ascontiguousarray(checked(c.sample_data, samples), dtype=float)
             models.append(m)
-        blocks = [b for c in kalman for b in c.state_blocks()]
+        blocks = [b for c in kalman for b in checked(c.state_blocks)]
         return KalmanEngine(self.orientation.carried_by_filter, blocks, models, self.navigation, self.gravity, engine,
                             names=[f"correction {c.name!r}" for c in kalman])
 
@@ -428,7 +432,7 @@ class Pipeline:
         """
         steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat, stances=stances, sagittal=sagittal)
         for a in self.analysis:
-            steps = a.clone().analyze(rec.t, quat, pos, stance, rec.meta).annotate(steps, rec.t)
+            steps = checked(checked(a.clone().analyze, rec.t, quat, pos, stance, rec.meta).annotate, steps, rec.t)
         return steps
 
 
@@ -540,7 +544,7 @@ def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list
             seen[quantity] = c.name
     if not orientation.carried_by_filter:
         for c in kalman:
-            if c.requires_attitude_state():
+            if checked(c.requires_attitude_state):
                 raise ConfigError(
                     f"{c.name}: inside the Kalman filter {filter_only} it observes the attitude error, which is a "
                     f"filter state only with an orientation the filter carries (orientation: ins); got "

@@ -33,6 +33,7 @@ from ..plugins.base import (
     Orientation,
     Samples,
     VelocityCorrection,
+    checked,
 )
 from ..plugins.incremental import Chunk, Columns, concat, length, take
 from .guards import StanceGuard
@@ -112,15 +113,15 @@ class CalibrationStage:
             if c.is_fitted():
                 self.reports.append({"type": c.name, "applied": True, "given": True, **_fit_of(c)})
             else:
-                fitted = c.clone().calibrate(chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag"))
+                fitted = checked(c.clone().calibrate, chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag"))
                 self.reports.append({"type": c.name, **fitted.report_})
-                self.blocks[i] = c.fixed(fitted.report_)
+                self.blocks[i] = checked(c.fixed, fitted.report_)
 
     def apply(self, chunk: Chunk) -> Chunk:
         """The chunk with the calibrated signals."""
         out = dict(chunk)
         for c in self.blocks:
-            res = c.step(out["t"], out["acc"], out["gyr"], out.get("mag"))
+            res = checked(c.step, out["t"], out["acc"], out["gyr"], out.get("mag"))
             out.update({k: v for k, v in res.items() if k in ("acc", "gyr", "mag")})
         return out
 
@@ -143,7 +144,7 @@ class DetectorStage:
     """The detector (its ``begin``/``step``/``finish``) and the maximum-swing guard after it."""
 
     def __init__(self, detector: Detector, guard: StanceGuard, ctx: RunContext):
-        self.detector = detector.clone().begin(ctx)
+        self.detector = checked(detector.clone().begin, ctx)
         self.guard = guard.stream(ctx)
         self.ctx, self.max_swing = ctx, guard.max_swing
         self.raw = Queue()  # samples pushed whose detector stance is not final
@@ -152,9 +153,9 @@ class DetectorStage:
 
     def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
         self.raw.put(chunk)
-        out = self.detector.step(chunk["t"], chunk["acc"], chunk["gyr"]) if length(chunk) else {}
+        out = checked(self.detector.step, chunk["t"], chunk["acc"], chunk["gyr"]) if length(chunk) else {}
         if finish:
-            out = concat([out, self.detector.finish()])
+            out = concat([out, checked(self.detector.finish)])
         done = self._decided(self.raw, out)
         if self.guard is not None:
             self.guarding.put(done)
@@ -203,7 +204,7 @@ class DetectorStage:
             parts.append({**guarding, "stance": np.concatenate([mine, guarding["stance"][len(mine):]])})
         if length(pending):
             last = bool(parts[-1]["stance"][-1]) if parts else self.last
-            parts.append({**pending, "stance": pad_to(self.detector.provisional(), pending, "stance", last)})
+            parts.append({**pending, "stance": pad_to(checked(self.detector.provisional), pending, "stance", last)})
         return concat(parts)
 
 
@@ -211,16 +212,16 @@ class OrientationStage:
     """An orientation filter (``begin(ctx, q0)``/``step``): the attitude of every sample once its stance is final."""
 
     def __init__(self, orientation: Orientation, ctx: RunContext, q0: np.ndarray, use_mag: bool):
-        self.block = orientation.clone().begin(ctx, q0)
+        self.block = checked(orientation.clone().begin, ctx, q0)
         self.use_mag = use_mag
         self.waiting = Queue()  # samples of the filter's warm-up
         self.last_q = np.asarray(q0, dtype=float)
 
     def _step(self, block: Orientation, chunk: Chunk, finish: bool = False) -> Chunk:
-        out = block.step(chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag") if self.use_mag else None,
+        out = checked(block.step, chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag") if self.use_mag else None,
                          chunk["stance"]) if length(chunk) else {}
         if finish:
-            out = concat([out, block.finish()])
+            out = concat([out, checked(block.finish)])
         return out
 
     def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
@@ -280,7 +281,7 @@ class KalmanStage:
         rows = concat([prev, chunk]) if prev is not None else chunk
         samples = Samples(rows["t"], rows["acc"], rows["gyr"], rows.get("mag"), rows.get("dist"),
                           rows["init"].astype(bool))
-        data = [np.ascontiguousarray(c.sample_data(samples), dtype=float) for c in self.corrections]
+        data = [np.ascontiguousarray(checked(c.sample_data, samples), dtype=float) for c in self.corrections]
         out = self.engine.advance(state, rows["t"], rows["acc"], rows["gyr"], rows["stance"].astype(bool),
                                   rows["quat"] if self.external else None, data, int(rows["k"][0]), covariance=False,
                                   record=record)
@@ -352,9 +353,9 @@ class BatchNavigationStage:
 
     def __init__(self, corrections: list[Any], ctx: RunContext, gravity: float):
         self.ctx, self.gravity = ctx, gravity
-        self.accel = [c.clone().begin(ctx) for c in corrections if isinstance(c, AccelerationCorrection)]
+        self.accel = [checked(c.clone().begin, ctx) for c in corrections if isinstance(c, AccelerationCorrection)]
         velocity = [c for c in corrections if isinstance(c, VelocityCorrection)]
-        self.velocity = velocity[0].clone().begin(ctx) if velocity else None
+        self.velocity = checked(velocity[0].clone().begin, ctx) if velocity else None
         self.integrator = None if velocity else Integrator()
         self.waiting = Queue()
         self.q_prev: np.ndarray | None = None  # the last attitude (the mid-interval rotation needs it)
@@ -367,7 +368,7 @@ class BatchNavigationStage:
             a = motion_acceleration(np.vstack([q_prev[None], quat]), np.vstack([chunk["acc"][:1], chunk["acc"]]),
                                     self.gravity)[1:]
         for c in accel:
-            a = c.step_acceleration(quat, a, chunk["stance"])["acc_nav"]
+            a = checked(c.step_acceleration, quat, a, chunk["stance"])["acc_nav"]
         return a
 
     def _navigate(self, chunk: Chunk, velocity: Any, integrator: Any, q_prev: np.ndarray | None,
@@ -375,9 +376,9 @@ class BatchNavigationStage:
         """(final outputs, the chunk's rows with acc_nav)."""
         rows = {**chunk, "acc_nav": self._acc_nav(chunk, q_prev, accel)} if length(chunk) else {}
         if velocity is not None:
-            out = velocity.step(rows["t"], rows["acc_nav"], rows["stance"]) if length(rows) else {}
+            out = checked(velocity.step, rows["t"], rows["acc_nav"], rows["stance"]) if length(rows) else {}
             if finish:
-                out = concat([out, velocity.finish()])
+                out = concat([out, checked(velocity.finish)])
         elif length(rows):
             vel = integrator.velocity(rows["acc_nav"], rows["t"])
             out = {"vel": vel, "pos": integrator.position(vel, rows["t"])}
@@ -409,7 +410,7 @@ class BatchNavigationStage:
         if not length(samples):
             return {}
         if velocity is not None:
-            out = concat([out, velocity.provisional()])
+            out = concat([out, checked(velocity.provisional)])
         if not length(out):
             return {}
         return {**samples, "vel": pad_to(out, samples, "vel", out["vel"][-1]),

@@ -39,7 +39,7 @@ from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..core.sanity import EstimateScan, SignalScan
 from ..filters.consistency import ConsistencyScan
-from ..plugins.base import Samples
+from ..plugins.base import Samples, checked
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window, initial_attitude
 from .pipeline import STREAM_WARMUP
@@ -437,7 +437,7 @@ class Stream:
     def _calibrations(self) -> list[Any]:
         cals = [c.clone() for c in self.pipeline.calibration]
         if self._fits:
-            cals = [c.fixed(r) for c, r in zip(cals, self._fits, strict=True)]
+            cals = [checked(c.fixed, r) for c, r in zip(cals, self._fits, strict=True)]
         return cals
 
     def _no_start_message(self) -> str:

@@ -89,6 +89,7 @@ def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple
 
 def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     """Threshold sweep from the detector's statistic (stance where the statistic is below the threshold)."""
+    from ..plugins.contract import checked
     from ..plugins.registry import build
 
     if rec.truth is None or rec.truth.stance is None:
@@ -96,7 +97,7 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     det = build("detector", dict(detector_spec))
     if getattr(det, "needs_truth", False):
         return []
-    det.detect(rec.t, rec.acc, rec.gyr)
+    checked(det.detect, rec.t, rec.acc, rec.gyr)
     stat, truth = np.asarray(getattr(det, "statistic_", None) if getattr(det, "statistic_", None) is not None
                              else np.full(rec.n, np.nan), float), rec.truth.stance
     if not np.isfinite(stat).any():  # the detector has no statistic (an optional output): no ROC curve

@@ -25,7 +25,7 @@ from footzoo.detectors.angular_rate_fsm import AngularRateFSM
 from footzoo.io.canonical import write
 from footzoo.orientation.madgwick import Madgwick
 from footzoo.plugins.base import Analysis, Calibration, Detector, Orientation, VelocityCorrection
-from footzoo.plugins.contract import QUAT_NORM_TOL
+from footzoo.plugins.contract import QUAT_NORM_TOL, checked
 from footzoo.plugins.extensions import load_plugins
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
@@ -222,7 +222,7 @@ BATCH = [
     ("nan_stance", _config(detector={"type": "test_fault_nan_stance"}), "detect", "NaN is not stance"),
     ("short_stance", _config(detector={"type": "test_fault_short_stance"}), "detect", r"shape \(\d+,\)"),
     ("mutating", _config(detector={"type": "test_fault_mutating"}), "detect", "copy it first"),
-    ("non_unit_quat", _config(orientation={"type": "test_fault_scaled_quat"}), "step", "non-unit quaternions"),
+    ("non_unit_quat", _config(orientation={"type": "test_fault_scaled_quat"}), "estimate", "non-unit quaternions"),
     ("nan_velocity", _config(corrections=[{"type": "test_fault_nan_velocity"}]), "apply", "non-finite"),
     ("analysis", _config(analysis=[{"type": "test_fault_analysis"}]), "analyze", "KeyError"),
     ("calibration", _config(calibration=[{"type": "test_fault_calibration"}]), "calibrate", r"shape \(\d+, 2\)"),
@@ -366,7 +366,8 @@ def test_property_any_exception_of_a_plugin_is_a_plugin_error(exc):
 
     t = np.arange(10) / 100.0
     with pytest.raises(PluginError, match=f"test_fault_any.*estimate.*{exc.__name__}") as info:
-        Any_().estimate(t, np.zeros((10, 3)), np.zeros((10, 3)), None, np.ones(10, bool), np.array([1.0, 0, 0, 0]))
+        checked(Any_().estimate, t, np.zeros((10, 3)), np.zeros((10, 3)), None, np.ones(10, bool),
+                np.array([1.0, 0, 0, 0]))
     assert isinstance(info.value.__cause__, exc)
 
 

@@ -16,6 +16,7 @@ from footzoo.calibration import HardIron, fit_hard_iron
 from footzoo.core.conventions import quat_to_matrix
 from footzoo.core.errors import CalibrationWarning, ConfigError, PluginError
 from footzoo.plugins.base import Calibration
+from footzoo.plugins.registry import build
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
@@ -127,9 +128,9 @@ def test_hard_iron_follows_the_plugin_contract():
 
 def test_bad_parameters_are_refused_with_the_name():
     with pytest.raises(ConfigError, match="offset"):
-        HardIron(offset=[1, 2])
+        build("calibration", {"type": "hard_iron", "offset": [1, 2]})
     with pytest.raises(ConfigError, match="min_spread"):
-        HardIron(min_spread=0.5)
+        HardIron(min_spread=0.5).check_params()
 
 
 def test_the_pipeline_calibrates_a_copy_and_reports_it(loop):

@@ -176,7 +176,7 @@ def _detector(parameters, init, name):
     return type("T" + name, (Detector,), namespace)
 
 
-def test_the_constructor_validates_and_converts_before_its_body_runs():
+def test_the_declarations_are_checked_where_the_plugin_is_used_and_the_constructor_runs_as_written():
     seen = {}
 
     def __init__(self, threshold: float = 0.6, window: list | tuple = (0.2, 0.8)):
@@ -185,11 +185,17 @@ def test_the_constructor_validates_and_converts_before_its_body_runs():
 
     cls = _detector({"threshold": Real("rad/s", "(0, 10]", "t", source="test"),
                      "window": Vector(2, "1", "w", source="test")}, __init__, "test_params_convert")
-    p = cls(threshold=1)
+    p = cls(**cls.validate_params({"threshold": 1}))  # as a config builds it (registry.build): validated, then made
     assert seen == {"threshold": 1.0, "window": [0.2, 0.8]} and type(p.threshold) is float
     assert p.get_params() == {"threshold": 1.0, "window": [0.2, 0.8]}
     with pytest.raises(ConfigError, match=r"threshold = 35 rad/s is out of range"):
-        cls(threshold=35)
+        cls.validate_params({"threshold": 35})
+    direct = cls(threshold=35)  # in Python, __init__ stores what it is given ...
+    assert seen == {"threshold": 35, "window": (0.2, 0.8)} and direct.threshold == 35
+    with pytest.raises(ConfigError, match=r"detector 'test_params_convert': threshold = 35 rad/s is out of range"):
+        direct.check_params()  # ... and a pipeline refuses it when it is given the plug-in
+    with pytest.raises(ConfigError, match=r"threshold = 35 rad/s is out of range"):
+        footzoo.Pipeline(orientation=available("orientation")["madgwick"](), detector=direct)
     assert cls.units == {"threshold": "rad/s", "window": "1"}
 
 
@@ -218,7 +224,7 @@ def test_a_subclass_declares_only_what_it_changes():
     assert Tighter.declaration()["window"].param is base.declaration()["window"].param
     assert str(Tighter.declaration()["threshold"].param.interval) == "(0, 1e5]"
     with pytest.raises(ConfigError, match=r"threshold = 200000.0 is out of range: it must lie in \(0, 1e5\]"):
-        Tighter(threshold=2e5)
+        Tighter(threshold=2e5).check_params()
     assert base(threshold=2e5).threshold == 2e5  # the base's own declaration is unchanged
 
 

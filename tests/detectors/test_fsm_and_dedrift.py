@@ -37,9 +37,13 @@ def test_detector_threshold_and_sample_count_from_seconds():
 @pytest.mark.parametrize("bad", [{"threshold": -1}, {"threshold": "x"}, {"min_duration": -0.1}])
 def test_detector_rejects_bad_parameters(bad):
     from footzoo.core.errors import ConfigError
+    from footzoo.plugins.registry import build
 
-    with pytest.raises(ConfigError):
-        AngularRateFSM(**bad)
+    name = next(iter(bad))
+    with pytest.raises(ConfigError, match=name):
+        build("detector", {"type": "angular_rate_fsm", **bad})
+    with pytest.raises(ConfigError, match=name):
+        AngularRateFSM(**bad).check_params()
 
 
 def test_dedrift_removes_a_constant_bias_exactly():

@@ -93,7 +93,7 @@ def test_a_subclass_with_its_own_test_gets_the_moments():
 
 
 def test_the_finite_check_without_a_temporary_equals_isfinite_all():
-    from footzoo.plugins.base import _all_finite
+    from footzoo.plugins.contract import all_finite
 
     rng = np.random.default_rng(0)
     big = np.finfo(float).max
@@ -101,7 +101,7 @@ def test_the_finite_check_without_a_temporary_equals_isfinite_all():
              np.array([big, big, np.nan]), np.array([-big, big, 1.0]), np.zeros((0, 3)), np.array([1 + 2j, np.nan]),
              rng.normal(size=(20, 4)).astype(np.float32), np.array([np.inf])]
     for x in cases:
-        assert _all_finite(x) == bool(np.isfinite(x).all())
+        assert all_finite(x) == bool(np.isfinite(x).all())
 
 
 def test_the_sample_table_wraps_the_outputs_and_copies_time_and_stance():

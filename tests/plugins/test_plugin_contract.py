@@ -12,6 +12,7 @@ import footzoo
 from footzoo.apps.testing import check_plugin
 from footzoo.core.errors import RecordingError
 from footzoo.plugins.base import Detector, Real
+from footzoo.plugins.contract import checked
 from footzoo.plugins.registry import KINDS, available
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -68,13 +69,41 @@ def test_check_plugin_catches_a_numeric_parameter_without_a_unit():
         check_plugin(NoUnit)
 
 
-def test_nan_input_to_any_action_method_is_a_clear_error():
+def test_nan_input_to_any_action_method_footzoo_calls_is_a_clear_error():
     det = available("detector")["shoe"]()
     t = np.arange(100) / 100.0
     acc = np.tile([0.0, 0.0, -9.81], (100, 1))
     acc[40, 2] = np.nan
     with pytest.raises(RecordingError, match=r"detector 'shoe': input 'acc' has 1 non-finite sample.*index 40"):
-        det.detect(t, acc, np.zeros((100, 3)))
+        checked(det.detect, t, acc, np.zeros((100, 3)))
+
+
+def test_a_plugin_class_is_plain_its_methods_run_as_written():
+    """footzoo wraps nothing: the constructor and the methods are the functions the author wrote; a method the
+    kind requires is an abc.abstractmethod; a direct call runs without the caller's checks."""
+    from footzoo.plugins.base import Calibration, KalmanCorrection
+
+    def __init__(self, threshold: float = 0.5):
+        self.threshold = threshold
+
+    def detect(self, t, acc, gyr):
+        self.statistic_ = np.linalg.norm(gyr, axis=1)
+        self.stance_ = self.statistic_ < self.threshold
+        gyr[0] = 0.0  # writes into its input: only the caller's check refuses it
+        return self
+
+    Plain = type("Plain", (Detector,), {"__init__": __init__, "detect": detect, "name": "test_plain",
+                                        "parameters": {"threshold": Real("rad/s", "(0, 10]", "t", source="test")}})
+    assert Plain.__init__ is __init__ and Plain.detect is detect and not Plain.incremental()
+    gyr = np.ones((5, 3))
+    assert Plain(threshold=50).detect(np.arange(5) / 100.0, np.ones((5, 3)), gyr).threshold == 50
+    assert gyr[0].tolist() == [0.0, 0.0, 0.0]  # as written: no read-only view, no validation
+    with pytest.raises(footzoo.PluginError, match="writes into an input array"):
+        checked(Plain().detect, np.arange(5) / 100.0, np.ones((5, 3)), np.ones((5, 3)))
+    for kind, method in ((Calibration, "calibrate"), (KalmanCorrection, "model")):
+        with pytest.raises(TypeError, match=f"abstract method.*{method}"):
+            type("Incomplete", (kind,), {"name": "test_incomplete"})()
+    assert not [name for name in dir(Detector) if "footzoo" in name and name.startswith("__")]
 
 
 def test_within_a_run_an_array_proven_finite_is_not_scanned_again_but_any_other_is():
@@ -87,15 +116,15 @@ def test_within_a_run_an_array_proven_finite_is_not_scanned_again_but_any_other_
     acc = np.tile([0.0, 0.0, -9.81], (100, 1))
     gyr = np.zeros((100, 3))
     with inputs_checked_once():
-        det.detect(t, acc, gyr)
+        checked(det.detect, t, acc, gyr)
         bad = acc.copy()
         bad[40, 2] = np.nan
         with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 40"):
-            det.detect(t, bad, gyr)  # another object: checked
+            checked(det.detect, t, bad, gyr)  # another object: checked
         acc[7, 0] = np.inf  # the same object, changed behind the run's back: not scanned again
-        det.detect(t, acc, gyr)
+        checked(det.detect, t, acc, gyr)
     with pytest.raises(RecordingError, match=r"input 'acc' has 1 non-finite sample.*index 7"):
-        det.detect(t, acc, gyr)  # outside: every call checks
+        checked(det.detect, t, acc, gyr)  # outside: every call checks
 
 
 def test_an_output_that_passed_its_check_is_proven_finite_for_the_next_block_within_a_run_only():

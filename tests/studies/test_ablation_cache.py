@@ -166,7 +166,7 @@ def test_a_one_off_run_cell_checks_the_cache_too(tmp_path):
 def test_unknown_metric_names_and_bad_job_counts_are_config_errors(tmp_path, capsys):
     with pytest.raises(ConfigError, match=r"unknown metric 'armse_3d' \(did you mean 'armse_3d_m'\?\); "
                                           r"valid metrics: \['duration_s', 'path_length_m'"):
-        Study.from_dict({**SMALL, "metrics": ["steps", "armse_3d"]})
+        Study.from_dict({**SMALL, "metrics": ["strides", "armse_3d"]})
     with pytest.raises(ConfigError, match=r"jobs must be a number of worker processes .* got 0"):
         run_study(Study.from_dict(SMALL), jobs=0)
     study = tmp_path / "study.yaml"
