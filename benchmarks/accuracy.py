@@ -191,7 +191,7 @@ def run_dataset(name: str, recs: list[dict[str, Any]], configs: list[Path], resu
 # ------------------------------------------------------------------------- per-stride references
 
 
-#: Per dataset: benchmark metric <- key of :attr:`footzoo.core.data.Result.metrics`, which compares the
+#: Per dataset: benchmark metric <- key of :attr:`footzoo.evaluation.result.Result.metrics`, which compares the
 #: stride table with the reference the reader loads (:func:`footzoo.evaluation.metrics.stride_errors` for
 #: gaitmap's motion capture, :func:`footzoo.evaluation.metrics.footprint_errors` for Köroğlu's footprints):
 #: the benchmark, ``footzoo run`` and :class:`footzoo.Session` report the same numbers.

@@ -252,12 +252,12 @@ def _timed_report(write_outputs):
 
 def makespan(s: Study, out: Path, workers: int) -> float:
     """CPU seconds until the last worker is done, the chunks handed out in order to the first free one."""
-    from footzoo.studies import runner
+    from footzoo.studies import cache, runner
 
     cells = s.cells()
     identity = {id(r): r.identity() for r in s.recordings}
     keys = [c.key(identity[id(c.recording)]) for c in cells]
-    cpu = {k: runner.read_entry(out / "cache" / f"{k}.json", k)[0]["cpu_s"] for k in set(keys)}
+    cpu = {k: cache.read_entry(out / "cache" / f"{k}.json", k)[0]["cpu_s"] for k in set(keys)}
     chunks = runner._chunks(list(range(len(cells))), cells, identity, workers)
     return lpt([sum(cpu[keys[i]] for i in chunk) for chunk in chunks], workers)
 
@@ -272,12 +272,12 @@ def lpt(costs: list[float], workers: int) -> float:
 
 def figure_cpu(s: Study, out: Path, table) -> list[float]:
     """CPU seconds of each figure task the workers drew, measured again here one after the other."""
-    from footzoo.studies import report, runner
+    from footzoo.studies import cache, report
 
     runs = []
     for key, (_, row) in zip(table["run"], table.iterrows(), strict=True):
         if not runs or runs[-1]["key"] != key:
-            rec = runner.read_entry(out / "cache" / f"{key}.json", key)[0]
+            rec = cache.read_entry(out / "cache" / f"{key}.json", key)[0]
             runs.append({**rec, "recording": row["recording"], "base": row["base"]})
     costs = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -39,7 +39,7 @@ _EXPORTS = {
     "Pipeline": "runtime.pipeline",
     "Stream": "runtime.stream",
     "Recording": "core.data",
-    "Result": "core.data",
+    "Result": "evaluation.result",
     "Truth": "core.data",
     "Session": "runtime.session",
     "SessionResult": "runtime.session",
@@ -75,7 +75,7 @@ __all__ = [
 
 if TYPE_CHECKING:
     from .apps.testing import check_plugin
-    from .core.data import Recording, Result, Truth
+    from .core.data import Recording, Truth
     from .core.errors import (
         ConfigError,
         FootzooError,
@@ -85,6 +85,7 @@ if TYPE_CHECKING:
         RecordingError,
         SensorWarning,
     )
+    from .evaluation.result import Result
     from .io import load
     from .plugins.registry import register
     from .runtime.pipeline import Pipeline

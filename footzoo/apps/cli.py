@@ -35,8 +35,15 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from ..core.atomic import atomic_path, check_target, refuse_inputs
+from ..core.context import RunContext
 from ..core.conventions import ACC_UNITS, GYR_UNITS
 from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
+from ..core.params import describe as describe_parameters
+from ..plugins.base import BASES
+from ..plugins.registry import describe
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -51,6 +58,7 @@ def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def _reader_option(text: str) -> tuple[str, Any]:
     """An argparse ``type``: ``NAME=VALUE`` (the value read as a YAML scalar: 820 is a number, true a boolean)."""
+    # deferred: yaml, read only for an option given
     from ..core.yamlsafe import load_text
 
     name, sep, value = text.partition("=")
@@ -135,7 +143,6 @@ def _writable_dir(path: str, option: str = "--out") -> Path:
 
 def _writable_file(path: str, option: str = "--out") -> Path:
     """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
-    from ..core.atomic import check_target
 
     p = check_target(path, f"{option} {path!r}")
     if p.exists() and not os.access(p, os.W_OK):
@@ -144,6 +151,7 @@ def _writable_file(path: str, option: str = "--out") -> Path:
 
 
 def _load_recording(args: argparse.Namespace):
+    # deferred: pandas and the readers: the command line starts without them
     from ..io import builtin_sample, load
 
     if args.data is None:
@@ -162,6 +170,7 @@ def _two_feet(args: argparse.Namespace) -> bool:
         return False
     if args.foot not in (None, "both"):
         return False
+    # deferred: pandas and the readers: the command line starts without them
     from ..io import check_input_file, detect_format
     from ..io.gaitmap import feet
 
@@ -199,7 +208,6 @@ def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
 
 def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], option: str = "--out") -> None:
     """Refuse, before the run, an output folder whose files would replace an input."""
-    from ..core.atomic import refuse_inputs
 
     refuse_inputs([folder / n for n in names], inputs, option)
 
@@ -209,6 +217,7 @@ def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list
     folder = result.save(out, backend="csv", inputs=inputs)
     written = sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS)
     if plot:
+        # deferred: matplotlib's figures, drawn only with --plot
         from ..evaluation.plots import plot_run
 
         written += [p.name for p in plot_run(result, out, rec)]
@@ -217,6 +226,7 @@ def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Run a pipeline on a recording (or both feet of a session); print metrics; optionally write outputs."""
+    # deferred: pandas and the engine: the command line starts without them
     from ..runtime.pipeline import Pipeline
 
     pipeline = Pipeline.from_yaml(args.config)
@@ -301,6 +311,7 @@ def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
 
 def _run_session(args: argparse.Namespace, pipeline) -> int:
     """Both feet of a gaitmap file: per-foot metrics, the bilateral table, per-foot outputs."""
+    # deferred: pandas and the engine: the command line starts without them
     from ..runtime.session import Session
 
     options = _reader_options(args)
@@ -330,6 +341,7 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
         res.save(out, backend="csv", inputs=inputs)
         written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
         if args.plot:
+            # deferred: matplotlib's figures, drawn only with --plot
             from ..evaluation.plots import plot_run
 
             for foot, r in res.results.items():
@@ -344,7 +356,6 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
 def cmd_list(args: argparse.Namespace) -> int:
     """Print every plug-in (or one kind, or one by name) with its parameters, and the config's settings."""
-    from ..plugins.registry import describe
 
     if args.kind == "settings" or (args.kind is None and args.name is None):
         plugins = describe() if args.kind is None else ""
@@ -356,7 +367,7 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def describe_settings() -> str:
     """The settings of a pipeline config (``gravity``, ``init``, ``navigation``, ``guards``), as declared."""
-    from ..core.params import describe as describe_parameters
+    # deferred: pandas and the engine: the command line starts without them
     from ..runtime.validate import settings_declarations
 
     lines = ["settings (top-level blocks of a pipeline config):"]
@@ -366,6 +377,7 @@ def describe_settings() -> str:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     """Check a config without running it: ``plugins:`` loaded as ``footzoo run`` loads them, every problem listed."""
+    # deferred: yaml, pandas and the engine: the command line starts without them
     from ..config.library import resolve
     from ..config.schema import load_yaml
     from ..runtime.pipeline import Pipeline
@@ -387,7 +399,6 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def live_summary(pipeline: Any) -> str:
     """One line: the pipeline's latency live (at 100 Hz), or why it cannot run live."""
-    from ..core.context import RunContext
 
     problems = pipeline.live_problems()
     if problems:
@@ -397,6 +408,7 @@ def live_summary(pipeline: Any) -> str:
 
 def cmd_compile(args: argparse.Namespace) -> int:
     """Compile and cache the kernels of pipeline configs (or write them into a wheel's folder with --ship)."""
+    # deferred: numba, loaded only to compile
     from .compile import compile_kernels
 
     for config, seconds in compile_kernels(args.configs, ship=args.ship):
@@ -406,8 +418,8 @@ def cmd_compile(args: argparse.Namespace) -> int:
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     """Simulate a recording with ground truth and write it as canonical CSV/Parquet."""
-    import numpy as np
 
+    # deferred: pandas and scipy (the simulator): the command line starts without them
     from ..io.canonical import check_output, write
     from ..sim import (
         DistanceSensors,
@@ -442,10 +454,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """Foot vector from a calibration recording (Huang et al. 2016, eq. 11), saved as YAML."""
-    import numpy as np
 
+    # deferred: pandas and the readers: the command line starts without them
     from ..analysis.foot_vector import calibrate_foot_vector, calibration_trial_problems
-    from ..core.atomic import atomic_path, refuse_inputs
 
     target = _writable_file(args.out)
     rec = _load_recording(args)
@@ -469,6 +480,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
 def cmd_ablate(args: argparse.Namespace) -> int:
     """Run a study: every config × recording cell, in parallel, cached, with tables and plots."""
+    # deferred: pandas, scipy and the study runner: the command line starts without them
     from ..studies import run_study
     from ..studies.report import compared, readable, summarise, to_markdown
 
@@ -507,6 +519,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
 
 def cmd_tune(args: argparse.Namespace) -> int:
     """Choose a setting by leave-one-group-out cross-validation; write it as a config YAML."""
+    # deferred: pandas, scipy and the study runner: the command line starts without them
     from ..studies.report import to_markdown
     from ..studies.tune import load_tune_file, tune
 
@@ -536,6 +549,7 @@ def _failed_exit_code(causes: dict[str, int]) -> int:
 
 def cmd_formats(args: argparse.Namespace) -> int:
     """Print every reader footzoo can use (built-in and installed): name, extensions, description, options."""
+    # deferred: pandas and the readers: the command line starts without them
     from ..io.registry import available
 
     readers = available()
@@ -560,6 +574,7 @@ def cmd_formats(args: argparse.Namespace) -> int:
 
 def cmd_list_compat(args: argparse.Namespace) -> int:
     """Print which orientation × correction combinations validate, with the reasons for the others."""
+    # deferred: pandas and the engine (it builds pipelines): the command line starts without them
     from .compat import compatibility_matrix
 
     print(compatibility_matrix(), end="")
@@ -568,6 +583,7 @@ def cmd_list_compat(args: argparse.Namespace) -> int:
 
 def cmd_configs(args: argparse.Namespace) -> int:
     """List the shipped configs with the first line of their description, or copy one (``--copy``)."""
+    # deferred: yaml: the command line starts without it
     from ..config import library
 
     if args.copy:
@@ -575,6 +591,7 @@ def cmd_configs(args: argparse.Namespace) -> int:
         print(f"wrote {target} (a copy of the shipped {library.path(args.copy).stem}); edit it and run "
               f"footzoo run {target}")
         return EXIT_OK
+    # deferred: pandas and the engine: the command line starts without them
     from ..runtime.pipeline import Pipeline
 
     for kind in ("pipeline", "study"):
@@ -735,7 +752,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _kinds() -> list[str]:
     """The plug-in kinds (``calibration``, ``orientation``, ``detector``, ``correction``, ``analysis``)."""
-    from ..plugins.base import BASES
 
     return list(BASES)
 

@@ -7,6 +7,7 @@ from typing import Any
 
 from ..core.errors import ConfigError
 from ..plugins.registry import available
+from ..runtime.pipeline import Pipeline
 
 #: Parameters that make a correction usable without the INS attitude (the variants worth listing).
 VARIANTS: dict[str, list[dict[str, Any]]] = {
@@ -31,7 +32,6 @@ def combinations(max_corrections: int = 2) -> list[dict[str, Any]]:
 
 def check(config: dict[str, Any]) -> str | None:
     """None when the config validates, else the reason."""
-    from ..runtime.pipeline import Pipeline
 
     try:
         Pipeline.from_dict(config)

@@ -72,6 +72,7 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
     if numba is None:
         raise RuntimeError("footzoo compile needs numba (pip install numba): without it the kernels run as Python")
     if ship is not None:
+        # deferred: numba, loaded only when kernels are shipped
         from ..kernels import cache as _kernel_cache
 
         _kernel_cache.ship(ship)

@@ -56,6 +56,7 @@ import yaml
 from ..core.context import RunContext
 from ..core.errors import ConfigError, FootzooError, PluginError
 from ..core.params import Real
+from ..filters.strapdown import motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
     Analysis,
@@ -67,8 +68,12 @@ from ..plugins.base import (
     VelocityCorrection,
 )
 from ..plugins.contract import checked
+from ..plugins.extensions import load_plugins
 from ..plugins.incremental import Latency, concat
-from ..plugins.registry import available, build, same_plugin
+from ..plugins.registry import KINDS, available, build, same_plugin
+from ..runtime.pipeline import Pipeline
+from ..runtime.stream import Stream
+from ..sim import NoiseModel, simulate
 
 _WALK: Any = None
 
@@ -77,8 +82,6 @@ def _walk():
     """A short simulated walk with magnetometer, two distance sensors and truth (cached)."""
     global _WALK
     if _WALK is None:
-        from ..sim import NoiseModel, simulate
-
         _WALK = simulate(n_strides=5, profile="physical", rate=100.0, noise=NoiseModel(seed=7),
                          distance_sensors=True, clearance=0.1)
     return _WALK
@@ -403,8 +406,6 @@ def _check_orientation(o: Orientation) -> None:
 
 
 def _check_batch_correction(c: Plugin) -> None:
-    from ..filters.strapdown import motion_acceleration
-
     rec = _walk()
     who = f"correction {c.name!r}"
     t = rec.t.copy()
@@ -429,9 +430,6 @@ def _check_batch_correction(c: Plugin) -> None:
 
 
 def _check_kalman(c: KalmanCorrection) -> None:
-    from ..runtime.pipeline import Pipeline
-    from ..runtime.stream import Stream
-
     rec = _walk()
     who = f"correction {c.name!r}"
     base = {"orientation": {"type": "ins"}, "detector": {"type": "dgp", "min_swing": 0.2}}
@@ -468,8 +466,6 @@ def _close(a, b, who: str, what: str) -> None:
 
 
 def _check_analysis(a: Analysis) -> None:
-    from ..runtime.pipeline import Pipeline
-
     rec = _walk()
     who = f"analysis {a.name!r}"
     res = Pipeline.from_dict({"orientation": {"type": "madgwick"}, "detector": {"type": "shoe"},
@@ -483,8 +479,6 @@ def _check_analysis(a: Analysis) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m footzoo.apps.testing PLUGIN.py|module [...]``: check every plug-in the files register."""
-    from ..plugins.extensions import load_plugins
-    from ..plugins.registry import KINDS
 
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] in ("-h", "--help"):

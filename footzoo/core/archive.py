@@ -44,7 +44,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._version import __version__
 from .atomic import FileGroup, dumps_json
+from .data import Truth
 from .errors import FootzooWarning, FormatError, OutputError
 
 FORMAT = "footzoo-result"
@@ -419,8 +421,6 @@ def _rename_table_refs(value: Any, key: str, name: str) -> None:
 
 
 def _manifest(kind: str, backend: str, files: dict[str, Any], **extra: Any) -> str:
-    from .._version import __version__
-
     return dumps_json({"format": kind, "format_version": FORMAT_VERSION, "footzoo_version": __version__,
                        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                        "backend": backend, **extra, "files": files})
@@ -509,9 +509,7 @@ def _read_manifest(folder: Path, kind: str) -> dict[str, Any]:
     return data
 
 
-def _load_result_files(folder: Path, files: dict[str, Any]) -> Any:
-    from .data import Result, Truth
-
+def _result_fields(folder: Path, files: dict[str, Any]) -> dict[str, Any]:
     def table(stem: str) -> pd.DataFrame:
         for suffix in (".parquet", ".csv"):
             if stem + suffix in files:
@@ -532,17 +530,20 @@ def _load_result_files(folder: Path, files: dict[str, Any]) -> Any:
     steps = table("steps")
     if body.get("steps_notes"):  # why a column of the stride table is NaN (an analysis said so)
         steps.attrs["notes"] = dict(body["steps_notes"])
-    return Result(samples=table("samples"), steps=steps, config=unpacker.unpack(body["config"]),
-                  versions=unpacker.unpack(body["versions"]), recording=unpacker.unpack(body["recording"]),
-                  diagnostics=unpacker.unpack(body["diagnostics"]), reference=reference)
+    return {"samples": table("samples"), "steps": steps, "config": unpacker.unpack(body["config"]),
+            "versions": unpacker.unpack(body["versions"]), "recording": unpacker.unpack(body["recording"]),
+            "diagnostics": unpacker.unpack(body["diagnostics"]), "reference": reference}
 
 
 #: What reading a damaged archive file raises (json, numpy's npz, pandas, pyarrow: ArrowInvalid is a ValueError).
 _DAMAGED = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
 
 
-def load_result(path: str | os.PathLike) -> Any:
-    """The :class:`~footzoo.core.data.Result` saved in the folder ``path`` (see the module doc).
+def read_result(path: str | os.PathLike) -> dict[str, Any]:
+    """The fields of the :class:`~footzoo.evaluation.result.Result` saved in the folder ``path`` (see the module doc):
+    ``samples``, ``steps``, ``config``, ``versions``, ``recording``, ``diagnostics`` and ``reference`` (a
+    :class:`~footzoo.core.data.Truth` or None); :meth:`Result.load <footzoo.evaluation.result.Result.load>` makes
+    the result from them.
 
     A file of the archive that is truncated, overwritten or otherwise damaged is a FormatError
     naming the folder and the cause (never a raw parser error).
@@ -550,7 +551,7 @@ def load_result(path: str | os.PathLike) -> Any:
     folder = Path(path)
     data = _read_manifest(folder, FORMAT)
     try:
-        return _load_result_files(folder, data["files"])
+        return _result_fields(folder, data["files"])
     except FormatError:
         raise
     except _DAMAGED as err:
@@ -587,11 +588,11 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
     return folder
 
 
-def load_session(path: str | os.PathLike) -> tuple[str, dict[str, Any]]:
-    """``(name, {foot: Result})`` of a session saved by :func:`save_session`."""
+def read_session(path: str | os.PathLike) -> tuple[str, dict[str, dict[str, Any]]]:
+    """``(name, {foot: the fields of its Result})`` of a session saved by :func:`save_session` (:func:`read_result`)."""
     folder = Path(path)
     data = _read_manifest(folder, SESSION_FORMAT)
-    results = {str(foot): load_result(folder / str(foot)) for foot in data.get("feet") or []}
+    results = {str(foot): read_result(folder / str(foot)) for foot in data.get("feet") or []}
     return str(data.get("name", folder.name)), results
 
 

@@ -401,6 +401,7 @@ def folder_lock(folder: PathLike, what: str = "output folder") -> Iterator[Path]
 
 def _try_lock(fh: IO[Any]) -> bool:
     try:
+        # deferred: the platform's own locking module (fcntl on POSIX, msvcrt on Windows)
         import fcntl
     except ImportError:  # Windows
         import msvcrt

@@ -1,4 +1,4 @@
-"""The per-sample table of a :class:`~footzoo.core.data.Result`, wrapped around the stages' outputs.
+"""The per-sample table of a :class:`~footzoo.evaluation.result.Result`, wrapped around the stages' outputs.
 
 The attitude, position, velocity and acceleration arrays that the stages wrote are
 the table's columns as they are (the DataFrame keeps a view of each column, no

@@ -17,12 +17,14 @@ same data give the same weights.
 from __future__ import annotations
 
 import argparse
+import io
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
+from ..core.atomic import write_bytes
 from .learned_zv import HIDDEN, SHIPPED_WEIGHTS, features, probability
 
 #: PyShoe's zero-velocity labels, in the order of its ``trial_error``.
@@ -33,6 +35,7 @@ DEFAULT_DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "pyshoe
 
 def trial_data(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """``(features (N, 16), labels (N,) bool)`` of one PyShoe trial, the labels of its best detector."""
+    # deferred: scipy and the readers, for training only: the plug-in registry imports this module
     from scipy.io import loadmat
 
     from ..io import load
@@ -102,9 +105,6 @@ def accuracy(weights: dict[str, np.ndarray], trial: tuple[np.ndarray, np.ndarray
 
 def save(weights: dict[str, np.ndarray], path: str | Path) -> Path:
     """Write the weights as ``.npz`` (atomically)."""
-    import io
-
-    from ..core.atomic import write_bytes
 
     buf = io.BytesIO()
     np.savez(buf, **weights)

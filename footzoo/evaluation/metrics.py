@@ -300,7 +300,7 @@ def match_strides(estimated: pd.DataFrame, reference: pd.DataFrame, on: str | tu
 def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: float = 0.3) -> dict[str, float]:
     """Per-stride errors (estimate − reference) of the matched strides (:func:`match_strides`).
 
-    The one implementation of the stride comparison: :attr:`footzoo.core.data.Result.metrics`,
+    The one implementation of the stride comparison: :attr:`footzoo.evaluation.result.Result.metrics`,
     :class:`footzoo.Session` and the accuracy benchmark all report these values.
 
     Parameters
@@ -473,7 +473,7 @@ def run_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, stance: np.
 
 
 #: Every metric a run can report, with its meaning: the keys of :func:`run_metrics`, of
-#: :attr:`footzoo.core.data.Result.metrics` (all but the stance ones) and of a study's table.
+#: :attr:`footzoo.evaluation.result.Result.metrics` (all but the stance ones) and of a study's table.
 METRICS: dict[str, str] = {
     "duration_s": "duration of the recording (s)",
     "path_length_m": "horizontal path length (m)",
@@ -546,7 +546,7 @@ def result_metrics(t: np.ndarray, pos: np.ndarray, steps: pd.DataFrame, referenc
     Returns
     -------
     dict
-        Keys carry their unit; see :attr:`footzoo.core.data.Result.metrics`.
+        Keys carry their unit; see :attr:`footzoo.evaluation.result.Result.metrics`.
     """
     ref = reference
     closed = bool(ref is not None and ref.closed_loop)
@@ -688,6 +688,7 @@ def nis_summary(nis: np.ndarray, rows: np.ndarray, confidence: float = 0.95) -> 
         it is too cautious), ``nis_inside``: the share of updates inside the acceptance region
         (``confidence`` expected), ``updates`` and ``rows``.
     """
+    # deferred: scipy, only for the consistency summary (covariance=True)
     from scipy.stats import chi2
 
     nis, rows = np.asarray(nis, dtype=float), np.asarray(rows, dtype=float)

@@ -11,6 +11,8 @@ without magnetometer cannot know its absolute heading.
 from __future__ import annotations
 
 import functools
+import io
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
@@ -19,9 +21,11 @@ import numpy as np
 import pandas as pd
 
 from ..core.atomic import atomic_path
-from ..core.data import Recording, Result
+from ..core.conventions import quat_to_euler
+from ..core.data import Recording
 from ..core.errors import ConfigError, RecordingError
-from .metrics import rotate_about_vertical, yaw_alignment
+from .metrics import match_strides, rotate_about_vertical, yaw_alignment
+from .result import Result
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -50,8 +54,7 @@ STYLE: dict[str, Any] = {
 
 def pyplot():
     """``matplotlib.pyplot``, on the non-interactive Agg backend unless pyplot was already imported."""
-    import sys
-
+    # deferred: matplotlib, loaded at the first figure (footzoo runs without it)
     import matplotlib
 
     if "matplotlib.pyplot" not in sys.modules:
@@ -90,6 +93,7 @@ def save(fig: Figure, path: str | Path) -> Path:
     fmt = out.suffix.lstrip(".").lower() or "png"
     with atomic_path(out, what="figure") as tmp:
         fig.savefig(tmp, format=fmt, dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
+    # deferred: matplotlib, loaded at the first figure (footzoo runs without it)
     import matplotlib.pyplot as plt
 
     plt.close(fig)
@@ -102,8 +106,8 @@ def png_bytes(fig: Figure) -> bytes:
     For figures drawn by workers that cannot see the output folder (a Dask cluster): they send
     the bytes and the client writes them.
     """
-    import io
 
+    # deferred: matplotlib, loaded at the first figure (footzoo runs without it)
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
@@ -271,7 +275,6 @@ def reference_strides(steps: pd.DataFrame, recording: Recording | None) -> tuple
     ref = recording.truth.steps if recording is not None and recording.truth is not None else None
     if ref is None or len(ref) == 0 or len(steps) == 0:
         return None
-    from .metrics import match_strides
 
     try:
         matched = match_strides(steps, ref)
@@ -382,7 +385,6 @@ def states_figure(result: Result, recording: Recording | None = None,
     window : (t0, t1), optional
         Time span to show (s); default: the whole recording. A few strides read best.
     """
-    from ..core.conventions import quat_to_euler
 
     check_pair(result, recording)
     plt = pyplot()

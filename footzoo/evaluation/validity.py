@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import FootzooWarning
-from .metrics import intervals
+from .metrics import intervals, reference_steps, result_metrics
 
 MIN_STANCE_S = 0.1  #: shortest plausible stance phase (s); a running stance lasts about 0.2 s
 MAX_FRAGMENT_SHARE = 0.25  #: largest share of reference stance phases shorter than MIN_STANCE_S
@@ -104,8 +104,6 @@ def reference_problems(t: np.ndarray, reference: Any) -> dict[str, str]:
         out.update(_stance_problems(np.asarray(t, float), np.asarray(stance, bool)))
     steps = getattr(reference, "steps", None)
     if steps is not None:
-        from .metrics import reference_steps
-
         out.update(_stride_problems(reference_steps(steps)))
     return out
 
@@ -247,10 +245,9 @@ def result_metrics_checked(t: np.ndarray, pos: np.ndarray, steps: Any,
                            reference: Any = None) -> tuple[dict[str, float], dict[str, str]]:
     """:func:`footzoo.evaluation.metrics.result_metrics` under this module's rules, and the reasons of the NaN ones.
 
-    What :attr:`footzoo.core.data.Result.metrics` reports: the same keys as the unchecked metrics
+    What :attr:`footzoo.evaluation.result.Result.metrics` reports: the same keys as the unchecked metrics
     (a refused metric is NaN, never dropped nor added), the same rules and reasons as a study's.
     """
-    from .metrics import result_metrics
 
     values = result_metrics(t, pos, steps, reference)
     found = {**reference_problems(t, reference), **estimate_problems(steps, reference)}

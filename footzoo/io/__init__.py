@@ -27,14 +27,18 @@ generic        the description's              the description's ``axes:``
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterator, Mapping
+from importlib.resources import as_file, files
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..core.data import Recording
-from ..core.errors import FootzooError, FormatError, PluginError, RecordingError
+from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS
+from ..core.data import Recording, Truth
+from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
+from . import xio
 from .axes import parse_axes
 from .base import REQUIRED, Option, Reader
 from .metadata import read_facts
@@ -116,7 +120,6 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
             foot = value
         else:
             valid = sorted({*declared, "foot", "axes"})
-            from ..core.errors import did_you_mean
 
             raise FormatError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
                               f"{valid} (see footzoo.io.READERS[{fmt!r}].options)")
@@ -131,7 +134,6 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
 
 def _same_unit(key: str, value: Any, fixed: str) -> bool:
     """True when ``value`` names the unit ``fixed`` (``m/s2`` is ``m/s^2``)."""
-    from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS
 
     table = {"acc_unit": ACC_UNITS, "gyr_unit": GYR_UNITS, "dist_unit": DIST_UNITS}.get(key, {})
     if isinstance(value, str) and value in table and fixed in table:
@@ -234,8 +236,6 @@ def _complete_meta(rec: Recording, path: Path, fmt: str, reader: Any) -> None:
         for key, value in facts.meta.items():
             rec.meta.setdefault(key, value)
         if facts.closed_loop is not None:
-            from ..core.data import Truth
-
             if rec.truth is None:
                 rec.truth = Truth(source="closed loop (metadata sidecar)")
             rec.truth.closed_loop = facts.closed_loop
@@ -249,10 +249,6 @@ __all__ = ["GROUP", "READERS", "Option", "Reader", "builtin_sample", "check_inpu
 
 def builtin_sample() -> Recording:
     """The built-in sample recording: x-io's ``short_walk.csv`` (MIT), a closed walk."""
-    import warnings
-    from importlib.resources import as_file, files
-
-    from . import xio
 
     with as_file(files("footzoo.samples") / "xio_short_walk.csv.gz") as p, warnings.catch_warnings():
         # the file's 205 exact duplicate rows are dropped on purpose; the count is in meta

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..core.archive import parquet_available
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.data import Recording, Truth
@@ -148,8 +149,6 @@ def check_output(path: str | Path) -> Path:
         raise OutputError(f"{str(p)!r}: footzoo writes recordings as .csv or .parquet, not "
                           f"{suffix or 'a file without extension'!r}; choose one of these extensions")
     if suffix in PARQUET_SUFFIXES:
-        from ..core.archive import parquet_available
-
         if not parquet_available():
             raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
                               "or write .csv")

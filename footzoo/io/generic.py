@@ -173,9 +173,7 @@ class _Spec:
 
 def read_description(path: Path, **given: Any) -> _Spec:
     """The validated description in ``path`` (``given``: options replacing its ``axes`` and units)."""
-    from ..core.errors import FormatError as Error
-
-    return _Spec(load_file(path, Error, "data description"), path, given)
+    return _Spec(load_file(path, FormatError, "data description"), path, given)
 
 
 def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_unit: str | None = None,

@@ -99,6 +99,7 @@ class PyShoeReader(Reader):
         """
         if Path(path).suffix.lower() != ".mat":
             return False
+        # deferred: scipy, only for .mat files
         import scipy.io as sio
 
         try:
@@ -116,7 +117,6 @@ def _trial_row(path: Path) -> dict[str, Any] | None:
     table = path.with_name("trials.csv")
     if not table.exists():
         return None
-    import pandas as pd
 
     df = pd.read_csv(table, dtype={"trial": str})
     rows = df[df["trial"] == path.stem]

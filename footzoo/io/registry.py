@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import FootzooWarning, FormatError, did_you_mean
+from .base import first_line
 
 #: The entry-point group readers register under.
 GROUP = "footzoo.readers"
@@ -170,7 +171,6 @@ class Readers(Mapping[str, Any]):
             raise FormatError(f"{p}: more than one reader recognises this file ({', '.join(accepted)}); say which "
                               f"one to use: format={accepted[0]!r} or format={accepted[1]!r} "
                               "(command line: --format NAME)")
-        from .base import first_line
 
         head = ""
         try:
@@ -195,6 +195,7 @@ class Readers(Mapping[str, Any]):
 
 def _mat_contents(p: Path) -> str:
     """What a ``.mat`` file no reader claims holds: its variables, or that MATLAB's format cannot list them."""
+    # deferred: scipy, only for .mat files
     import scipy.io as sio
 
     try:

@@ -74,6 +74,7 @@ def footprint_reference(path: Path) -> Truth | None:
     """Köroğlu's ground control points (``GCP_meters``, ``numberOfStrides``) from a ``.mat`` file, if present."""
     if not path.exists():
         return None
+    # deferred: scipy, only for .mat files
     import scipy.io as sio
 
     try:

@@ -18,6 +18,7 @@ import importlib.util
 import sys
 import threading
 import traceback
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -141,7 +142,6 @@ def load_entry_points() -> list[dict[str, Any]]:
     with _LOCK:
         if _ENTRY_POINTS is not None:
             return list(_ENTRY_POINTS)
-        from importlib.metadata import entry_points
 
         loaded = []
         for ep in entry_points(group=ENTRY_POINT_GROUP):

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.checks import check_bool, check_positive, check_range, check_vector  # noqa: F401 - re-exported for plug-ins
+from ..core.context import RunContext
 from ..core.errors import ConfigError, did_you_mean
 from ..core.params import describe as describe_parameters
 from .base import BASES, KalmanCorrection, Plugin
@@ -158,7 +159,6 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
 
 def _live(cls: type[Plugin]) -> str:
     """The plug-in's latency with its defaults at 100 Hz, or why it does not run live."""
-    from ..core.context import RunContext
 
     if cls.needs_truth:
         return "no (it reads the reference)"

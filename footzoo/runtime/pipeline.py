@@ -26,11 +26,12 @@ from ..config.library import resolve
 from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level, load_yaml
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
-from ..core.data import Recording, Result
+from ..core.data import Recording
 from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
 from ..evaluation.metrics import nis_summary
+from ..evaluation.result import Result
 from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT

@@ -18,8 +18,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.data import Recording, Result
+from ..core.archive import read_session, save_session
+from ..core.data import Recording
 from ..core.errors import FormatError
+from ..evaluation.result import Result
+from ..io import detect_format, load
+from ..io.gaitmap import feet
 from .pipeline import Pipeline
 
 FEET = ("left", "right")
@@ -62,8 +66,6 @@ class Session:
         FormatError
             When the file holds one foot only (use :func:`footzoo.io.load`).
         """
-        from ..io import detect_format, load
-        from ..io.gaitmap import feet
 
         p = Path(path)
         fmt = format or detect_format(p, options)
@@ -125,17 +127,15 @@ class SessionResult:
 
         Atomic as one unit and never over an input (see :mod:`footzoo.core.archive`).
         """
-        from ..core.archive import save_session
 
         return save_session(self, path, backend=backend, inputs=inputs)
 
     @classmethod
     def load(cls, path: str | Path) -> SessionResult:
         """A session saved by :meth:`save` (the stride and bilateral tables are recomputed)."""
-        from ..core.archive import load_session
 
-        name, results = load_session(path)
-        return cls(results=results, name=name)
+        name, fields = read_session(path)
+        return cls(results={foot: Result(**f) for foot, f in fields.items()}, name=name)
 
     @cached_property
     def steps(self) -> pd.DataFrame:
@@ -148,7 +148,7 @@ class SessionResult:
 
     @property
     def per_foot(self) -> pd.DataFrame:
-        """One row per foot: :attr:`footzoo.core.data.Result.metrics` (errors against each foot's reference)."""
+        """One row per foot: :attr:`footzoo.evaluation.result.Result.metrics` (errors against each foot's reference)."""
         return pd.DataFrame({f: r.metrics for f, r in self.results.items()}).T.rename_axis("foot")
 
     @property

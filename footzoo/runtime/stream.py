@@ -257,8 +257,9 @@ class Stream:
         Its samples are the final estimates, its steps and analyses computed on them as a batch
         run computes them; ``meta`` describes the recording (``name``, ``foot``, ...).
         """
-        from ..core.data import Recording, Result
+        from ..core.data import Recording
         from ..core.table import samples_frame
+        from ..evaluation.result import Result
         from .pipeline import versions
 
         if not self.keep:

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.conventions import quat_from_euler, quat_mul
+from ..core.conventions import quat_from_euler, quat_mul, quat_to_matrix
 from .profiles import GaussianSwing, rotation_progress
 
 #: Table I angles (rad): initial contact −6.5 rad/s × 0.1 s, pre-swing −7.5 rad/s × 0.1 s.
@@ -339,7 +339,6 @@ class GaitTimeline:
         # body rate: ω_foot = Ry(θ)^T [0, 0, ψ̇] + [0, θ̇, 0]; ω_body = R_mount^T ω_foot
         w_foot = np.einsum("nji,j->ni", _ry(out["theta"]), np.array([0.0, 0.0, 1.0])) * out["psi_dot"][:, None]
         w_foot[:, 1] += out["theta_dot"]
-        from ..core.conventions import quat_to_matrix
 
         out["w"] = w_foot @ quat_to_matrix(q_mount)
         return out

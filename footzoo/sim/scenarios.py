@@ -10,6 +10,7 @@ range of every distance sample.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from dataclasses import asdict
 from typing import Any
@@ -19,9 +20,9 @@ import pandas as pd
 
 from ..core.conventions import GRAVITY, quat_conj, quat_rotate
 from ..core.data import Recording, Truth
-from ..core.errors import ConfigError
+from ..core.errors import ConfigError, did_you_mean
 from . import paths
-from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec
+from .gait import FootGeometry, Footstep, GaitTimeline, StrideSpec, calibration_timeline
 from .sensors import DistanceSensors, MagneticDisturbance, NoiseModel, magnetic_field_ned, sample_imu
 
 #: Walking speeds Nguyen & La tested (m/s) and a run, as
@@ -76,9 +77,6 @@ PATH_OPTIONS = ("length", "width", "radius", "heading", "rise", "going", "landin
 
 def check_spec(spec: dict[str, Any]) -> None:
     """A ``simulate(**spec)`` mapping (a study's ``simulate:`` entry): unknown names and bad values refused."""
-    import inspect
-
-    from ..core.errors import did_you_mean
 
     known = [p for p in inspect.signature(simulate).parameters if p != "path_options"] + list(PATH_OPTIONS)
     for key in spec:
@@ -261,7 +259,6 @@ def simulate_calibration(
     ``meta["calibration_still"]`` and ``meta["calibration_flex"]`` hold the two
     periods (s); the truth's quaternion gives the mounting to recover.
     """
-    from .gait import calibration_timeline
 
     geometry = FootGeometry(mount_yaw=mount_yaw, mount_pitch=mount_pitch, side=1 if foot == "right" else -1)
     timeline = calibration_timeline(geometry, **options)

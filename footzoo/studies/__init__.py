@@ -4,8 +4,9 @@
 ``tune(tune_yaml) -> TuneResult``: a setting chosen by leave-one-group-out cross-validation (:mod:`.tune`).
 """
 
+from .cache import CacheWarning
 from .report import run_frames, summarise, to_latex, to_markdown
-from .runner import CacheWarning, read_trajectories, run_cell, run_chunk, run_study, tidy
+from .runner import read_trajectories, run_cell, run_chunk, run_study, tidy
 from .study import METRICS, Cell, RecordingSpec, Study, set_dotted
 from .tune import TuneResult, TuneSpec, cross_validate, leave_one_group_out, tune
 

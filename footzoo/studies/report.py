@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import os
@@ -16,6 +17,10 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
+from ..evaluation.plots import REFERENCE_STYLE, png_bytes, pyplot, save, styled
+from .cache import HEAVY, with_heavy
 
 
 def summarise(table: pd.DataFrame, factor: str) -> pd.DataFrame:
@@ -163,9 +168,7 @@ def _figure(task: tuple) -> tuple[Any, str]:
 
 def loaded(task: tuple) -> tuple:
     """A figure task with its runs' trajectories or sweeps read back from the cache (a study keeps them
-    on disk, :func:`footzoo.studies.runner.light`); a task that has them is returned as it is."""
-    from .runner import with_heavy
-
+    on disk, :func:`footzoo.studies.cache.light`); a task that has them is returned as it is."""
     if task[0] == "trajectories":
         return (task[0], with_heavy(task[1], ("trajectory", "reference")), *task[2:])
     if task[0] == "roc":
@@ -175,7 +178,6 @@ def loaded(task: tuple) -> tuple:
 
 def draw_figure(task: tuple, out: Path) -> Path | None:
     """Draw and save one task of :func:`figure_tasks` into ``out``; the file written, or None (nothing to draw)."""
-    from ..evaluation.plots import save
 
     fig, name = _figure(task)
     return None if fig is None else save(fig, Path(out) / name)
@@ -187,7 +189,6 @@ _DRAWING = threading.Lock()
 
 def render_figure(task: tuple) -> tuple[str, bytes] | None:
     """One task of :func:`figure_tasks` drawn in memory: its file name and the bytes :func:`draw_figure` would write."""
-    from ..evaluation.plots import png_bytes
 
     with _DRAWING:
         fig, name = _figure(task)
@@ -200,8 +201,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
     table = table.copy()
     table.attrs = {}  # counts and cache notes describe this execution, not the results
     if scheduler is not None:
-        import contextlib
-
+        # deferred: dask, an optional extra (footzoo[distributed])
         from dask.distributed import Client, as_completed
 
         connected = contextlib.nullcontext(scheduler) if isinstance(scheduler, Client) else Client(scheduler)
@@ -223,6 +223,7 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
         return
     drawn = None
     if jobs != 1:  # started first: the workers draw while this process writes the tables
+        # deferred: joblib, only for parallel figures
         from joblib import Parallel, delayed
 
         drawn = Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(
@@ -263,14 +264,13 @@ FRAME_BATCH = 200
 
 def _write_frames(runs: list[dict[str, Any]], out: Path) -> None:
     """``trajectories.parquet`` and ``roc.parquet``, written :data:`FRAME_BATCH` runs at a time."""
-    from .runner import HEAVY, with_heavy
-
     if len(runs) <= FRAME_BATCH:
         trajectories, roc = run_frames(with_heavy(runs, HEAVY))
         _to_parquet(trajectories, out / "trajectories.parquet")
         _to_parquet(roc, out / "roc.parquet")
         return
     try:
+        # deferred: pyarrow, an optional extra (footzoo[parquet])
         import pyarrow as pa
         import pyarrow.parquet as pq
     except ImportError:
@@ -482,8 +482,6 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
     one axis with the legend below it; more get one small panel each (same
     scale), the reference repeated in every panel.
     """
-    from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
-    from ..evaluation.plots import REFERENCE_STYLE, pyplot, styled
 
     runs = [r for r in runs if _has(r, "trajectory")]
     if not runs:
@@ -585,7 +583,6 @@ def _scale(ax, values: np.ndarray, axis: str = "y") -> str:
 
 def metric_figure(d: pd.DataFrame, factor: str, metric: str):
     """Box plot of one metric per level of one factor, every run as a dot; log scale when outliers dominate."""
-    from ..evaluation.plots import pyplot, styled
 
     @styled
     def build():
@@ -601,6 +598,7 @@ def metric_figure(d: pd.DataFrame, factor: str, metric: str):
         else:
             width = max(4.5, 0.9 * len(raw) + 2)
             fig, ax = plt.subplots(figsize=(width, 4), layout="constrained")
+        # deferred: matplotlib (loaded by pyplot above), for its ticker
         import matplotlib
 
         # matplotlib 3.10 renamed vert= to orientation=
@@ -653,7 +651,6 @@ def roc_figure(runs: list[dict[str, Any]], labels: dict[str, str], log_fpr: bool
     by default it does when every curve's AUC exceeds 0.9, i.e. when the curves
     crowd into the top-left corner.
     """
-    from ..evaluation.plots import pyplot, styled
 
     groups: dict[str, dict[str, np.ndarray]] = {}
     for r in runs:

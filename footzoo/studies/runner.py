@@ -18,7 +18,7 @@ How a study runs:
 
 from __future__ import annotations
 
-import base64
+import builtins
 import contextlib
 import hashlib
 import json
@@ -36,44 +36,54 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..core import errors
+from ..core.errors import ConfigError
+from ..evaluation.metrics import reference_steps, run_metrics
+from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
+from ..plugins.contract import checked
+from ..plugins.extensions import load_plugins
+from ..plugins.registry import build
+from ..runtime.pipeline import Pipeline
+from .cache import (
+    CACHE_MAX_AGE_DAYS,
+    CacheWarning,
+    light,
+    prune_cache,
+    read_entry,
+    touch,
+    write_entry,
+)
+from .report import write_outputs
 from .study import Cell, Study, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
-CACHE_FORMAT = "footzoo-ablation-cache/3"
 RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
 CHUNKS_PER_WORKER = 4  # aim for this many chunks per worker (load balance vs. loading a recording again)
-
-
-class CacheWarning(UserWarning):
-    """A cache entry was damaged, truncated, edited or foreign; its cell was run again."""
 
 
 # --------------------------------------------------------------------------- metrics of one run
 
 
-_PROBLEMS: dict[int, tuple[Any, dict[str, str]]] = {}  # id(truth) -> (truth, its refused metrics), per process
+_PROBLEMS: list[tuple[Any, dict[str, str]]] = []  # (truth, its refused metrics), per process, found by identity
 
 
 def _reference_problems(rec) -> dict[str, str]:
     """:func:`footzoo.evaluation.validity.reference_problems` of a recording, once per recording and process."""
-    from ..evaluation.validity import reference_problems
 
     with _RECORDINGS_LOCK:
-        known = _PROBLEMS.get(id(rec.truth))
-    if known is not None and known[0] is rec.truth:
-        return known[1]
+        known = next((problems for truth, problems in _PROBLEMS if truth is rec.truth), None)
+    if known is not None:
+        return known
     problems = reference_problems(rec.t, rec.truth)
     with _RECORDINGS_LOCK:
         if len(_PROBLEMS) > 4 * RECORDINGS_PER_PROCESS:
             _PROBLEMS.clear()
-        _PROBLEMS[id(rec.truth)] = (rec.truth, problems)
+        _PROBLEMS.append((rec.truth, problems))
     return problems
 
 
 def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple[dict[str, float], dict[str, str]]:
     """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
-    from ..evaluation.metrics import run_metrics
-    from ..evaluation.validity import checked_metrics, estimate_problems, missing_reason
 
     m = run_metrics(rec.t, pos, res.steps, res.stance, rec.truth)
     m, notes = checked_metrics(m, {**_reference_problems(rec), **estimate_problems(res.steps, rec.truth)}, rec.truth)
@@ -89,8 +99,6 @@ def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple
 
 def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     """Threshold sweep from the detector's statistic (stance where the statistic is below the threshold)."""
-    from ..plugins.contract import checked
-    from ..plugins.registry import build
 
     if rec.truth is None or rec.truth.stance is None:
         return []
@@ -111,149 +119,6 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     return out
 
 
-# --------------------------------------------------------------------------- cache entries
-
-
-def write_entry(path: Path, key: str, record: dict[str, Any]) -> None:
-    """Write one cache entry atomically: a header line (format, key, checksum, size) then the JSON record."""
-    payload = json.dumps(record, sort_keys=True, separators=(",", ":"), default=_pack).encode()
-    header = {"format": CACHE_FORMAT, "key": key, "sha256": hashlib.sha256(payload).hexdigest(),
-              "bytes": len(payload)}
-    tmp = path.with_suffix(f".{os.getpid()}.{time.monotonic_ns()}.tmp")
-    tmp.write_bytes(json.dumps(header).encode() + b"\n" + payload)
-    tmp.replace(path)  # atomic: an interrupted study leaves only complete entries
-
-
-def _pack(value: Any) -> Any:
-    """JSON for an array of a run record (a trajectory): its float64 bytes in base64, exact and fast."""
-    if isinstance(value, np.ndarray):
-        a = np.ascontiguousarray(value, dtype="<f8")
-        return {"__array__": base64.b64encode(a.tobytes()).decode(), "shape": list(a.shape)}
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
-
-
-def _unpack(d: dict[str, Any]) -> Any:
-    if "__array__" in d and "shape" in d and len(d) == 2:
-        return np.frombuffer(base64.b64decode(d["__array__"]), dtype="<f8").reshape(d["shape"])
-    return d
-
-
-def read_entry(path: Path, key: str) -> tuple[dict[str, Any] | None, str | None]:
-    """``(record, None)`` for a sound entry of this cell, ``(None, problem)`` otherwise; never raises."""
-    try:
-        raw = path.read_bytes()
-    except OSError as err:
-        return None, f"unreadable ({err.strerror or err})"
-    line, _, payload = raw.partition(b"\n")
-    try:
-        header = json.loads(line)
-    except ValueError:
-        header = None
-    if not isinstance(header, dict) or header.get("format") != CACHE_FORMAT:
-        return None, "not a footzoo cache entry of this version (foreign file or older format)"
-    if header.get("key") != key:
-        return None, f"belongs to another cell (key {str(header.get('key'))[:24]!r})"
-    if len(payload) != header.get("bytes"):
-        return None, f"truncated or extended ({len(payload)} of {header.get('bytes')} bytes)"
-    if hashlib.sha256(payload).hexdigest() != header.get("sha256"):
-        return None, "checksum mismatch (edited or damaged)"
-    try:
-        record = json.loads(payload, object_hook=_unpack)
-    except ValueError:
-        return None, "checksum matches but the content is not JSON"
-    if not isinstance(record, dict) or record.get("key") != key:
-        return None, "checksum matches but the record is not this cell's"
-    return record, None
-
-
-#: Cache entries no study used for this many days are removed after a study (``run_study(prune=...)``).
-CACHE_MAX_AGE_DAYS = 30.0
-
-
-def prune_cache(cache_dir: str | Path, keep: set[str] | frozenset[str] = frozenset(),
-                max_age_days: float | None = CACHE_MAX_AGE_DAYS, max_bytes: int | None = None) -> dict[str, int]:
-    """Remove old cache entries: those not in ``keep`` and unused for ``max_age_days``, then, while the
-    cache is larger than ``max_bytes``, the least recently used ones not in ``keep``.
-
-    An entry's age is the time since a study last wrote or read it (its modification time; a study
-    touches every entry it reads). ``max_age_days=0`` removes every entry not in ``keep``.
-
-    Returns
-    -------
-    dict
-        ``removed`` (entries), ``kept`` (entries), ``bytes`` (the cache's size after pruning).
-    """
-    folder = Path(cache_dir)
-    entries = []
-    for f in folder.glob("*.json"):
-        try:
-            st = f.stat()
-        except OSError:
-            continue
-        entries.append((st.st_mtime, st.st_size, f))
-    for f in folder.glob("*.tmp"):  # left by a killed writer
-        with contextlib.suppress(OSError):
-            if time.time() - f.stat().st_mtime > 3600:
-                f.unlink()
-    entries.sort()  # oldest first
-    now, removed = time.time(), 0
-    alive = []
-    for mtime, size, f in entries:
-        old = max_age_days is not None and now - mtime >= max_age_days * 86400.0
-        if old and f.stem not in keep:
-            with contextlib.suppress(OSError):
-                f.unlink()
-                removed += 1
-                continue
-        alive.append((mtime, size, f))
-    total = sum(size for _, size, _ in alive)
-    if max_bytes is not None:
-        for i, (_, size, f) in enumerate(list(alive)):
-            if total <= max_bytes:
-                break
-            if f.stem not in keep:
-                with contextlib.suppress(OSError):
-                    f.unlink()
-                    removed += 1
-                    total -= size
-                    alive[i] = (0, 0, None)
-    return {"removed": removed, "kept": sum(1 for *_, f in alive if f is not None), "bytes": total}
-
-
-def _touch(path: Path) -> None:
-    """Mark a cache entry as used now (its age for :func:`prune_cache`)."""
-    with contextlib.suppress(OSError):
-        os.utime(path)
-
-
-#: The parts of a run record that grow with the recording: kept in its cache entry, not in memory.
-HEAVY = ("trajectory", "reference", "roc")
-
-
-def light(record: dict[str, Any], keep: bool = True) -> dict[str, Any]:
-    """A run record without its trajectories and sweeps, which its cache entry (``record["entry"]``) holds.
-
-    A study's memory then stays bounded whatever its size: the report reads them back a few runs at a
-    time (:func:`with_heavy`). A record without an entry keeps them when ``keep`` (the report needs
-    them), else they are dropped (nothing reads them).
-    """
-    if "entry" not in record and keep:
-        return record
-    return {k: v for k, v in record.items() if k not in HEAVY}
-
-
-def with_heavy(runs: list[dict[str, Any]], fields: tuple[str, ...] = HEAVY) -> list[dict[str, Any]]:
-    """The runs with their ``fields`` read back from their cache entries (see :func:`light`)."""
-    out = []
-    for r in runs:
-        if "entry" in r and any(f not in r for f in fields):
-            record, _ = read_entry(Path(r["entry"]), r["key"])
-            if record is not None:
-                r = {**r, **{f: record.get(f, []) for f in fields if f not in r}}
-        out.append(r)
-    return out
-
-
 # --------------------------------------------------------------------------- one cell, one chunk
 
 _RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
@@ -269,7 +134,6 @@ def _recording(cell: Cell, identity: str):
             return rec
     rec = _read_only(cell.recording.load())
     if rec.truth is not None and rec.truth.steps is not None:  # footzoo's column names once, not per run
-        from ..evaluation.metrics import reference_steps
 
         rec.truth.steps = reference_steps(rec.truth.steps)
     with _RECORDINGS_LOCK:
@@ -308,8 +172,6 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
     out = _new_record(cell, key)
     caught: list[warnings.WarningMessage] = []
     try:
-        from ..runtime.pipeline import Pipeline
-
         with warnings.catch_warnings(record=True) as caught:  # sent back with the record (see _replay_warnings)
             warnings.simplefilter("always")
             # wall and CPU seconds of the pipeline itself and of its metrics (benchmarks/study_scaling.py)
@@ -344,7 +206,6 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
     Never raises: a plug-in, recording or run failure is recorded in the cells it concerns. Each
     finished cell is written to the cache at once, so an interrupted study keeps it.
     """
-    from ..plugins.extensions import load_plugins
 
     setup_error: BaseException | None = None
     rec = None
@@ -463,8 +324,6 @@ def run_study(
     if jobs is None:
         jobs = study.jobs or 1
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
-        from ..core.errors import ConfigError
-
         raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
     study.check(max_cells)
     bar = _Progress(progress, "study")
@@ -486,10 +345,6 @@ def run_study(
 
 def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
     """Issue each distinct warning of the runs once, with the number of runs that gave it."""
-    import builtins
-
-    from ..core import errors
-    from ..evaluation.validity import MetricWarning
 
     for text, n in worker.items():
         name, _, message = text.partition(": ")
@@ -550,7 +405,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
             retried.append(key)
             todo.append(i)
         else:  # the same run may be shared by cells with other labels (e.g. two copies of one file)
-            _touch(path)
+            touch(path)
             cell = cells[i]
             results[i] = light({**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
                                 "cached": True, "entry": str(path)}, keep=out is not None and report)
@@ -583,8 +438,6 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
                                             **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
     if out is not None and report:
-        from .report import write_outputs
-
         if recomputed:
             _log_damaged(Path(out), recomputed)
         bar.phase("report")
@@ -673,6 +526,7 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
     if not todo:
         return
     if scheduler is not None:
+        # deferred: dask, an optional extra (footzoo[distributed])
         from dask.distributed import as_completed
 
         with _connected(scheduler) as client:
@@ -686,6 +540,7 @@ def _execute(todo, cells, keys, identity, args, jobs, scheduler, bar):
                 bar.update(len(records))
                 yield idx, records
     elif jobs != 1:
+        # deferred: joblib, only for parallel runs
         from joblib import Parallel, delayed
 
         chunks = _chunks(todo, cells, identity, (os.cpu_count() or 1) if jobs < 0 else int(jobs))
@@ -709,6 +564,7 @@ class _Cluster:
     @property
     def client(self) -> Any:
         if self._client is None:
+            # deferred: dask, an optional extra (footzoo[distributed])
             from dask.distributed import Client
 
             self._client = Client(self.address)
@@ -722,6 +578,7 @@ class _Cluster:
 
 def _connected(scheduler: Any) -> Any:
     """A context giving a Dask client: the study's (left open) for a :class:`_Cluster`, else a new one."""
+    # deferred: dask, an optional extra (footzoo[distributed])
     from dask.distributed import Client
 
     return contextlib.nullcontext(scheduler.client) if isinstance(scheduler, _Cluster) else Client(scheduler)
@@ -773,6 +630,7 @@ class _Progress:
         self.bar = None
         if show:
             try:
+                # deferred: tqdm, optional (a progress bar when installed)
                 from tqdm import tqdm
             except ImportError:  # tqdm is a dependency, but a bar is not worth failing for
                 return

@@ -6,21 +6,33 @@ import copy
 import functools
 import glob
 import hashlib
+import inspect
 import itertools
 import json
 import os
 import stat
+import sys
+import types
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .. import _version
 from ..config.library import is_name, resolve
 from ..config.library import path as library_path
 from ..config.schema import load_yaml
-from ..core.errors import ConfigError, did_you_mean, prefixed
+from ..core.errors import ConfigError, FootzooError, RecordingError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import FIGURE_METRICS, METRICS
+from ..io import _options_for, detect_format
+from ..io import available as available_readers
+from ..io import load as load_recording
+from ..plugins.base import Plugin
 from ..plugins.extensions import load_plugins, resolve_specs, source_hash
+from ..plugins.registry import KINDS, available
+from ..runtime.pipeline import Pipeline
+from ..runtime.validate import config_errors
+from ..sim import NoiseModel, simulate
 from ..sim.scenarios import check_spec
 
 #: Largest grid (bases × factor levels × recordings) a study runs unless its ``max_cells`` says more.
@@ -58,7 +70,6 @@ def code_fingerprint() -> str:
 
 def _builtin_plugin_files() -> set[Path]:
     """The files of footzoo that define a registered plug-in (each has its own cache identity)."""
-    from ..plugins.registry import KINDS, available
 
     root = Path(__file__).resolve().parents[1]
     out = set()
@@ -84,8 +95,6 @@ def engine_fingerprint() -> str:
 
 
 def _source_file(obj: Any) -> Path | None:
-    import inspect
-
     try:
         f = inspect.getsourcefile(obj)
     except (TypeError, OSError):
@@ -98,11 +107,7 @@ def plugin_sources(config: dict[str, Any]) -> list[Path]:
     classes (and of the plug-ins inside it), and the plug-in modules those import from, transitively.
     footzoo's engine (:func:`engine_fingerprint`), installed libraries and the plug-ins the config does
     not name are not among them."""
-    import sys
-    import types
 
-    from ..plugins.base import Plugin
-    from ..runtime.pipeline import Pipeline
 
     pipeline = Pipeline.from_dict(copy.deepcopy(config))
     instances = [*pipeline.calibration, pipeline.orientation, pipeline.detector, *pipeline.corrections,
@@ -141,13 +146,12 @@ def config_code(config: dict[str, Any]) -> str:
 
     Editing a plug-in's file changes the identity of the cells whose config uses it, and only theirs.
     """
-    from .._version import __version__
 
     h = hashlib.sha256()
     for f in plugin_sources(config):
         h.update(str(f).encode())
         h.update(hashlib.sha256(f.read_bytes()).digest())
-    return json.dumps({"footzoo": __version__, "engine": engine_fingerprint(), "plugins": h.hexdigest()},
+    return json.dumps({"footzoo": _version.__version__, "engine": engine_fingerprint(), "plugins": h.hexdigest()},
                       sort_keys=True)
 
 
@@ -174,10 +178,9 @@ class RecordingSpec:
             problem = self.problem()
             data = {"problem": problem, "path": self.path} if problem else {"file": _file_digest(self.path)}
             return json.dumps({**data, "format": self.format, "options": self.options}, sort_keys=True, default=str)
-        from .._version import __version__
 
-        return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": __version__}, sort_keys=True,
-                          default=str)
+        return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": _version.__version__},
+                          sort_keys=True, default=str)
 
     def problem(self) -> str | None:
         """Why the recording's file cannot be read (None for a simulated recording or a readable file)."""
@@ -205,13 +208,9 @@ class RecordingSpec:
         if self.path is not None:
             problem = self.problem()
             if problem:
-                from ..core.errors import RecordingError
-
                 raise RecordingError(f"recording {problem}")
-            from ..io import load
 
-            return load(self.path, format=self.format, **self.options)
-        from ..sim import NoiseModel, simulate
+            return load_recording(self.path, format=self.format, **self.options)
 
         spec = copy.deepcopy(self.simulate)
         noise = spec.pop("noise", None)
@@ -297,9 +296,8 @@ class Study:
         With footzoo's own source in the key, a result computed before an edit of a built-in
         plug-in (an editable install, a benchmark) is never read back as if it were current.
         """
-        from .._version import __version__
 
-        return json.dumps({"footzoo": __version__, "source": code_fingerprint(),
+        return json.dumps({"footzoo": _version.__version__, "source": code_fingerprint(),
                            "plugins": source_hash(self.plugins)}, sort_keys=True)
 
     @classmethod
@@ -430,7 +428,6 @@ class Study:
         ConfigError
             Listing the first distinct problems, each with the factor levels that lead to it.
         """
-        from ..runtime.validate import config_errors
 
         self.check_size(max_cells)
         problems: dict[str, list[dict[str, Any]]] = {}
@@ -481,10 +478,8 @@ def _reader_problem(rec: RecordingSpec) -> str | None:
     """
     if rec.path is None or rec.problem():
         return None
-    from ..core.errors import FootzooError
-    from ..io import _options_for, available, detect_format
 
-    readers = available()
+    readers = available_readers()
     try:
         fmt = rec.format or detect_format(Path(rec.path), rec.options)
     except FootzooError:

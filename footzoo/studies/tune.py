@@ -51,8 +51,14 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import yaml
 
+from ..config.library import resolve
+from ..core.atomic import json_safe, write_text
 from ..core.errors import ConfigError, FootzooWarning, did_you_mean
+from ..core.yamlsafe import load_file
+from ..evaluation.metrics import METRICS
+from .runner import run_study
 from .study import Study, set_dotted
 
 TUNE_KEYS = {
@@ -98,7 +104,6 @@ class TuneSpec:
     @classmethod
     def from_dict(cls, d: Any) -> TuneSpec:
         """Check and build from a mapping."""
-        from ..evaluation.metrics import METRICS
 
         if not isinstance(d, dict) or "objective" not in d:
             raise ConfigError("a tune file needs a 'tune:' block with at least 'objective: METRIC'")
@@ -271,9 +276,6 @@ class TuneResult:
 
     def save_config(self, path: str | Path, name: str | None = None) -> Path:
         """Write the chosen setting as a pipeline config YAML (atomically), the procedure in its header."""
-        import yaml
-
-        from ..core.atomic import json_safe, write_text
 
         cfg = copy.deepcopy(self.best_config_)
         cfg["name"] = name or str(cfg.get("name", "tuned"))
@@ -473,7 +475,6 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     if out is not None:
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
-        from ..core.atomic import write_text
 
         write_text(folder / "tune_folds.csv", folds.to_csv(index=False), what="tune folds")
         write_text(folder / "tune_scores.csv", scores.rename("score").to_csv(index_label="setting"),
@@ -501,7 +502,6 @@ class _Runner:
 
     def evaluate(self, settings: dict[str, dict[str, Any]] | list[dict[str, Any]]) -> list[str]:
         """Run the settings not run yet; returns the names of all of them, in order."""
-        from .runner import run_study
 
         levels = list(settings.values()) if isinstance(settings, dict) else list(settings)
         cands, named = settings_study(self.study, self.spec, levels)
@@ -558,6 +558,7 @@ def optuna_search(run: _Runner, spec: TuneSpec, score: Score,
     chosen setting. Seeded with ``spec.seed`` (fold i: seed + i), so a rerun proposes the same settings.
     """
     try:
+        # deferred: optuna, an optional extra (footzoo[tune])
         import optuna
     except ImportError:
         raise ConfigError("tune.search: optuna needs the optuna package: pip install 'footzoo[tune]' "
@@ -601,8 +602,6 @@ def optuna_search(run: _Runner, spec: TuneSpec, score: Score,
 
 def load_tune_file(path: str | Path) -> tuple[Study, TuneSpec]:
     """A tune file: the study (without its ``tune:`` block) and the spec; paths relative to the file."""
-    from ..config.library import resolve
-    from ..core.yamlsafe import load_file
 
     p = resolve(path)
     data = load_file(p, ConfigError, "tune file")

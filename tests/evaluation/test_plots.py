@@ -74,7 +74,7 @@ def test_reference_is_aligned_onto_the_estimate(walk):
     turned = np.column_stack([c * truth[:, 0] - s * truth[:, 1], s * truth[:, 0] + c * truth[:, 1], truth[:, 2]])
     samples = res.samples.copy()
     samples[["pos_n", "pos_e", "pos_d"]] = turned + [5.0, -2.0, 0.3]
-    fake = footzoo.core.data.Result(samples=samples, steps=res.steps, config=res.config, versions=res.versions)
+    fake = footzoo.evaluation.result.Result(samples=samples, steps=res.steps, config=res.config, versions=res.versions)
     assert np.allclose(aligned_reference(fake, rec), fake.pos, atol=1e-9)
     fig = trajectory_figure(res, rec)
     assert "reference (yaw-aligned)" in legend_texts(fig)
@@ -121,7 +121,7 @@ def test_strides_figure_uses_gait_event_columns_and_reference(walk):
     rec, res = walk
     steps = res.steps.copy()
     steps["fpa_deg"] = 8.0  # as the huang_fpa analysis adds it
-    res2 = footzoo.core.data.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
+    res2 = footzoo.evaluation.result.Result(samples=res.samples, steps=steps, config=res.config, versions=res.versions,
                                diagnostics=res.diagnostics)
     fig = strides_figure(res2, rec)
     titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_visible()]
@@ -151,7 +151,7 @@ def test_stride_table_without_units_in_its_names(walk):
     legacy = pd.DataFrame({"start": st["start_s"], "end": st["end_s"], "stride_time": st["stride_time_s"],
                            "stride_length": st["stride_length_m"], "speed": st["speed_m_s"],
                            "heading": st["heading_rad"], "max_clearance": st["max_clearance_m"], "fpa": 0.1})
-    res2 = footzoo.core.data.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
+    res2 = footzoo.evaluation.result.Result(samples=res.samples, steps=legacy, config=res.config, versions=res.versions,
                                diagnostics=res.diagnostics)
     fig = strides_figure(res2, rec)
     titles = {ax.get_title(loc="left").split(":")[0] for ax in fig.axes if ax.get_visible()}
@@ -186,7 +186,7 @@ def test_robust_limits_keep_a_precise_series_and_drop_a_standing_stride():
 
 def test_no_strides(walk):
     rec, res = walk
-    empty = footzoo.core.data.Result(samples=res.samples, steps=res.steps.iloc[:0], config=res.config,
+    empty = footzoo.evaluation.result.Result(samples=res.samples, steps=res.steps.iloc[:0], config=res.config,
                                 versions=res.versions)
     assert strides_figure(empty, rec) is None
     assert fpa_figure(empty, rec) is None

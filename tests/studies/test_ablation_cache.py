@@ -14,7 +14,7 @@ from footzoo.io.canonical import write
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import CacheWarning, Study, read_trajectories, run_study
 from footzoo.studies import runner as runner_mod
-from footzoo.studies.runner import CACHE_FORMAT, read_entry
+from footzoo.studies.cache import CACHE_FORMAT, read_entry
 
 from ..conftest import made_once
 

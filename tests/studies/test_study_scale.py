@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from footzoo.studies import Study, read_trajectories, report, run_study
-from footzoo.studies.runner import HEAVY, light, with_heavy
+from footzoo.studies.cache import HEAVY, light, with_heavy
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

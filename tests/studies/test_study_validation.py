@@ -114,7 +114,7 @@ def test_old_cache_entries_are_pruned(tmp_path):
     import os
     import time
 
-    from footzoo.studies.runner import prune_cache
+    from footzoo.studies.cache import prune_cache
 
     cache = tmp_path / "cache"
     cache.mkdir()
