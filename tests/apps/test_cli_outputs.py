@@ -1,9 +1,10 @@
-"""The command line's outputs: atomic, strict JSON, loadable, and never written over an input (issue 25, item 3)."""
+"""The command line's outputs: atomic, strict JSON, loadable, never written over an input; columns carry units."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -135,3 +136,13 @@ def test_run_out_is_a_loadable_result_with_strict_json(walk, tmp_path, monkeypat
     assert {"samples.csv", "steps.csv", "metrics.json", "result.json", "manifest.json"} <= names
     back = Result.load(out)
     assert str(data) in back.recording["input_files"] and len(back.samples) == walk.n
+
+
+def test_steps_csv_columns_carry_units(tmp_path):
+    rec = simulate(n_strides=4, rate=50.0)
+    path = write(rec, tmp_path / "walk.csv")
+    assert main(["run", "huang2016", "--data", str(path), "--out", str(tmp_path / "out")]) == 0
+    cols = pd.read_csv(tmp_path / "out" / "steps.csv").columns
+    unit = re.compile(r"_(s|m|m_s|rad|steps_min)$")
+    assert all(unit.search(c) for c in cols if c != "events_from_rate"), list(cols)
+    assert "fpa_rad" in cols and "heading_rad" in cols

@@ -1,0 +1,50 @@
+"""The command line reading data: unit options for a file in g and °/s, a unit the data contradict, a
+header it does not recognise (each a data error whose message names the fix).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from footzoo.apps.cli import main
+from footzoo.sim import simulate
+
+YUN = "yun2012"
+
+
+def test_acc_and_gyr_unit_options_read_a_canonical_file_in_g_and_deg_s(tmp_path, capsys):
+    rec = simulate(n_strides=4, rate=50.0)
+    df = rec.to_dataframe()
+    df[["acc_x", "acc_y", "acc_z"]] /= 9.81
+    df[["gyr_x", "gyr_y", "gyr_z"]] = np.degrees(df[["gyr_x", "gyr_y", "gyr_z"]])
+    path = tmp_path / "in_g.csv"
+    df.to_csv(path, index=False)
+    assert main(["run", YUN, "--data", str(path)]) == 3  # a data error
+    assert "acc_unit: g" in capsys.readouterr().err  # the message names the fix ...
+    assert main(["run", YUN, "--data", str(path), "--acc-unit", "g", "--gyr-unit", "deg/s"]) == 0  # ... which exists
+    assert "strides" in capsys.readouterr().out
+
+
+def test_a_unit_option_the_data_contradict_is_refused(tmp_path, capsys):
+    from footzoo.samples import __file__ as samples
+
+    sample = Path(samples).with_name("xio_short_walk.csv.gz")
+    import gzip
+
+    path = tmp_path / "walk.csv"
+    path.write_bytes(gzip.decompress(sample.read_bytes()))
+    # every reader takes the unit options; the data, in g, refuse m/s²
+    assert main(["run", YUN, "--data", str(path), "--acc-unit", "m/s^2"]) == 3  # a data error
+    assert "this looks like g, not m/s²" in capsys.readouterr().err
+
+
+def test_an_unrecognised_header_lists_the_expected_columns(tmp_path, capsys):
+    odd = tmp_path / "odd.csv"
+    odd.write_text("time,ax,ay,az,gx,gy,gz\n0,0,0,-9.8,0,0,0\n")
+    assert main(["run", YUN, "--data", str(odd)]) == 3  # a data error
+    err = capsys.readouterr().err
+    for expected in ("t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z", "Gyroscope X (deg/s)", "left_sensor",
+                     "scaledAccelX", "--format"):
+        assert expected in err

@@ -1,0 +1,38 @@
+"""Bad configs: a plug-in type that is not a name, a config file that does not exist (run and validate alike)."""
+
+from __future__ import annotations
+
+import pytest
+
+import footzoo
+
+NOT_A_NAME = r"the {} type must be a plug-in's name \(text\), got {}"
+
+
+@pytest.mark.parametrize("part, value, message", [
+    ("orientation", {"type": {"type": "ins"}}, "orientation: " + NOT_A_NAME.format("orientation", "dict")),
+    ("detector", {"type": ["shoe"]}, "detector: " + NOT_A_NAME.format("detector", "list")),
+    ("detector", {"type": 3}, "detector: " + NOT_A_NAME.format("detector", "int")),
+])
+def test_a_type_that_is_not_a_name_is_a_config_error_in_run_and_validate(part, value, message, tmp_path):
+    from footzoo.apps.cli import main
+
+    cfg = {"name": "odd", "orientation": {"type": "ins"}, "detector": {"type": "shoe"},
+           "corrections": [{"type": "ekf_zupt"}], part: value}
+    with pytest.raises(footzoo.ConfigError, match=message):
+        footzoo.Pipeline.from_dict(cfg)
+    import yaml
+
+    (tmp_path / "odd.yaml").write_text(yaml.safe_dump(cfg))
+    assert main(["validate", str(tmp_path / "odd.yaml")]) == 2  # a config error, not "internal error"
+
+
+def test_a_missing_yaml_file_is_called_missing_not_an_unknown_shipped_name(tmp_path, monkeypatch):
+    from footzoo.config.library import resolve
+
+    monkeypatch.chdir(tmp_path)
+    missing = r"'my_study\.yaml': no such file in .*no shipped config has that name"
+    with pytest.raises(footzoo.ConfigError, match=missing):
+        resolve("my_study.yaml")
+    with pytest.raises(footzoo.ConfigError, match=r"no shipped config named 'recomended' \(did you mean 'recommended'"):
+        resolve("recomended")

@@ -1,0 +1,39 @@
+"""Bad input in memory: complex samples, a path given for a recording, a result folder named like a file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import footzoo
+from footzoo.core.errors import RecordingError
+from footzoo.sim import simulate
+
+
+@pytest.fixture(scope="module")
+def sim_walk():
+    from footzoo.sim import NoiseModel
+
+    return simulate(n_strides=10, rate=100.0, noise=NoiseModel(seed=1))
+
+
+def test_complex_samples_are_refused_not_cast():
+    t = np.arange(300) / 100.0
+    acc = np.tile([0.0, 0.0, -9.81], (300, 1)) + 1j
+    with pytest.raises(RecordingError, match=r"acc holds complex numbers.*acc\.real"):
+        footzoo.Recording(t=t, acc=acc, gyr=np.zeros((300, 3)))
+
+
+def test_running_a_path_instead_of_a_recording_says_how_to_load_it():
+    with pytest.raises(TypeError, match=r"load it first, Pipeline\.run\(footzoo\.load\('walk\.csv'\)\)"):
+        footzoo.Pipeline.from_yaml("yun2012").run("walk.csv")
+
+
+def test_a_result_folder_named_like_a_file_is_refused(sim_walk, tmp_path):
+    from footzoo.core.errors import OutputError
+
+    res = footzoo.Pipeline.from_yaml("yun2012").run(sim_walk)
+    with pytest.raises(OutputError, match=r"looks like a file name \(\.xlsx\).*saved as a folder"):
+        res.save(tmp_path / "result.xlsx")
+    assert not (tmp_path / "result.xlsx").exists()
+    assert res.save(tmp_path / "result.v2").is_dir()  # a dotted folder name that is no file type is fine

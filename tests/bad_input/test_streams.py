@@ -1,0 +1,49 @@
+"""Bad live input: a stream made with the wrong rate, an accelerometer whose unit changes mid-stream."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import footzoo
+from footzoo.core.errors import RecordingError
+from footzoo.sim import simulate
+
+
+@pytest.fixture(scope="module")
+def sim_walk():
+    from footzoo.sim import NoiseModel
+
+    return simulate(n_strides=10, rate=100.0, noise=NoiseModel(seed=1))
+
+
+def test_a_stream_made_with_the_wrong_rate_refuses_at_its_start(sim_walk):
+    from footzoo import Pipeline, Stream
+
+    stream = Stream(Pipeline.from_yaml("nguyen2016"), rate=2 * sim_walk.rate)
+    with pytest.raises(RecordingError, match=r"come at 100 Hz, but the stream was made with rate=200 Hz.*rate=100"):
+        stream.run(sim_walk)
+    near = Stream(Pipeline.from_yaml("nguyen2016"), rate=sim_walk.rate * 1.05)  # a nominal rate, 5 % off: fine
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert np.isfinite(near.run(sim_walk)["pos"]).all()
+
+
+def test_an_accelerometer_unit_that_changes_mid_stream_is_warned_where_it_changes(sim_walk):
+    from footzoo import Pipeline, Stream
+    from footzoo.core.errors import SensorWarning
+
+    half = sim_walk.n // 2
+    stream = Stream(Pipeline.from_yaml("nguyen2016"), rate=sim_walk.rate)
+    with pytest.warns(SensorWarning, match=r"accelerometer reads 0\.99\d? \(≈ 1: in g\?"):
+        for i in range(sim_walk.n):
+            stream.push(sim_walk.t[i], sim_walk.acc[i] / (9.81 if i >= half else 1.0), sim_walk.gyr[i])
+        stream.close()
+    finding = stream.sensor["acc_scale"]
+    assert finding["first"] >= half and finding["magnitude"] == pytest.approx(1.0, abs=0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SensorWarning)  # the same walk in m/s² throughout: no finding
+        res = footzoo.Pipeline.from_yaml("nguyen2016").run(sim_walk)
+    assert "acc_scale" not in res.diagnostics["sensor"]

@@ -1,0 +1,60 @@
+"""Bad study files: a bad simulate entry, two recordings with one name, a factor that cannot be set or repeats a
+level; each refused before any run.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import footzoo
+from footzoo.io.canonical import write
+from footzoo.sim import simulate
+
+
+@pytest.fixture(scope="module")
+def walk_csv(tmp_path_factory):
+    path = tmp_path_factory.mktemp("walk") / "walk.csv"
+    write(simulate(n_strides=4, rate=50.0), path)
+    return path
+
+
+@pytest.mark.parametrize("simulate_spec, message", [
+    ({"path": "straigt"}, r"recordings\[0\]\.simulate: unknown path 'straigt'"),
+    ({"path": "straight", "n_strides": -4}, r"n_strides must be a whole number in \[0, 100000\].*got -4"),
+    ({"path": "straight", "n_stride": 4}, r"unknown option 'n_stride' \(did you mean 'n_strides'\?\)"),
+    ({"path": "straight", "rate": 0}, r"rate must be a number in \(0, 20000\] Hz, got 0"),
+])
+def test_a_study_refuses_a_bad_simulate_entry_before_running(simulate_spec, message):
+    from footzoo.studies import Study
+
+    with pytest.raises(footzoo.ConfigError, match=message):
+        Study.from_dict({"base": "yun2012", "recordings": [{"simulate": simulate_spec}]})
+
+
+def test_two_recordings_with_one_name_are_refused_and_labels_tell_them_apart(walk_csv, tmp_path):
+    import shutil
+
+    from footzoo.studies import Study
+
+    for d in ("a", "b"):
+        (tmp_path / d).mkdir()
+        shutil.copy(walk_csv, tmp_path / d / "walk.csv")
+    same = [{"path": str(tmp_path / d / "walk.csv")} for d in ("a", "b")]
+    with pytest.raises(footzoo.ConfigError, match=r"both called 'walk'.*give each entry its own label"):
+        Study.from_dict({"base": "yun2012", "recordings": same})
+    labelled = [{**r, "label": d} for r, d in zip(same, ("a", "b"), strict=True)]
+    study = Study.from_dict({"base": "yun2012", "recordings": labelled})
+    assert [r.label for r in study.recordings] == ["a", "b"]
+
+
+@pytest.mark.parametrize("factors, message", [
+    ({"detector.threshold.x": [1, 2]}, r"'detector\.threshold' is a value .* one level too deep"),
+    ({"detector.threshold": [0.5, 0.5]}, r"lists the level 0\.5 more than once"),
+])
+def test_a_factor_that_cannot_be_set_or_repeats_a_level_is_refused(factors, message, tmp_path):
+    from footzoo.studies import Study, run_study
+
+    with pytest.raises(footzoo.ConfigError, match=message):
+        study = Study.from_dict({"base": "yun2012", "factors": factors,
+                                 "recordings": [{"simulate": {"path": "straight", "n_strides": 4}}]})
+        run_study(study, out=tmp_path / "out", quiet=True)

@@ -1,0 +1,20 @@
+"""A study's output files without pyarrow: a warning names what was not written, the CSV is written."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+
+def test_missing_pyarrow_warns_instead_of_silently_skipping_parquet(tmp_path, monkeypatch):
+    from footzoo.studies.report import write_outputs
+
+    def no_pyarrow(*args, **kwargs):
+        raise ImportError("Unable to find a usable engine; tried using: 'pyarrow'")
+
+    monkeypatch.setattr(pd.DataFrame, "to_parquet", no_pyarrow)
+    table = pd.DataFrame({"run": ["a"], "base": ["yun2012"], "recording": ["r"], "metric": ["m"], "value": [1.0],
+                          "error": [None]})
+    with pytest.warns(UserWarning, match="results.parquet was not written"):
+        write_outputs(table, [], [], tmp_path)
+    assert (tmp_path / "results.csv").exists() and not (tmp_path / "results.parquet").exists()
