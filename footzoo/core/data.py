@@ -259,7 +259,7 @@ class Recording:
             if dup.any():
                 warnings.warn(
                     f"dropped {int(dup.sum())} row(s) whose time stamp repeats the previous one",
-                    stacklevel=2,
+                    FootzooWarning, stacklevel=2,
                 )
                 df = df.loc[~dup].reset_index(drop=True)
                 t = t[~dup]

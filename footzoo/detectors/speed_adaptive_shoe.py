@@ -324,7 +324,8 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         g_max = max(self.max_threshold, self.threshold)
         starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
         speed_k = speed_per_sample(t, starts, ends, peaks, self.REACH)
-        threshold = np.minimum(self.threshold * np.exp(speed_k / self.speed_scale), g_max)
+        with np.errstate(over="ignore"):  # a tiny speed_scale overflows exp to inf: the threshold is then g_max
+            threshold = np.minimum(self.threshold * np.exp(speed_k / self.speed_scale), g_max)
         # a sample the strapdown sees moving faster than still_speed is no stance, whatever the test says
         candidate = (statistic < threshold) & (speed <= self.still_speed)
         closed = close_still_gaps(candidate, m, speed, self.still_speed)

@@ -102,7 +102,8 @@ class Windowed(Detector):
         dacc[lag:] = scale * row_norms(np.ascontiguousarray(acc[lag:] - acc[:-lag]))
         gyro = window_max(row_norms(np.ascontiguousarray(gyr, dtype=float)), half_g)
         accs = window_max(dacc, half_a)
-        statistic = np.maximum(gyro / self.gyro_threshold, accs / self.acc_diff_threshold)
+        with np.errstate(over="ignore"):  # a threshold near 0 overflows the ratio to inf: no stance, as it should
+            statistic = np.maximum(gyro / self.gyro_threshold, accs / self.acc_diff_threshold)
         return {"stance": statistic <= 1.0, "statistic": statistic, "gyro_statistic": gyro, "acc_statistic": accs}
 
     def detect(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext | None = None) -> Windowed:

@@ -21,10 +21,12 @@ from typing import Any
 
 import numpy as np
 
+from ..core.errors import FootzooWarning
+
 CACHE_FORMAT = "footzoo-ablation-cache/3"
 
 
-class CacheWarning(UserWarning):
+class CacheWarning(FootzooWarning):
     """A cache entry was damaged, truncated, edited or foreign; its cell was run again."""
 
 

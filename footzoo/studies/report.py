@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..core.errors import FootzooWarning
 from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
 from ..evaluation.plots import REFERENCE_STYLE, png_bytes, pyplot, save, styled
 from .cache import HEAVY, with_heavy
@@ -328,7 +329,7 @@ def _to_parquet(df: pd.DataFrame, path: Path) -> None:
         df.to_parquet(path, index=False)
     except ImportError:  # pyarrow not installed: CSV only, and say so
         warnings.warn(f"pyarrow is not installed: {path.name} was not written (results.csv has the table; "
-                      "pip install 'footzoo[parquet]' or pyarrow to get it)", stacklevel=2)
+                      "pip install 'footzoo[parquet]' or pyarrow to get it)", FootzooWarning, stacklevel=2)
 
 
 # --------------------------------------------------------------------------- human labels

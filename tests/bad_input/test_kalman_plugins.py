@@ -22,8 +22,6 @@ from footzoo.plugins.base import KalmanCorrection
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 @measurement_function
 def three_rows(ctx, rows):

@@ -30,8 +30,6 @@ from footzoo.plugins.extensions import load_plugins
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 @pytest.fixture(scope="module")
 def walk():

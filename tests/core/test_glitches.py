@@ -73,8 +73,9 @@ def test_a_clipped_axis_is_saturation_not_a_glitch_and_a_burst_is_not_clipping(w
     gyr = walk.gyr.copy()
     k = int(np.searchsorted(walk.t, 3.3))
     gyr[k:k + 15, 0] = 34.9  # a burst of one value (a stuck packet) stands out of the signal: a glitch
-    stuck = Recording(t=walk.t, acc=walk.acc, gyr=gyr, meta={"name": "stuck"})
+    stuck, found = _sensor_warnings(lambda: Recording(t=walk.t, acc=walk.acc, gyr=gyr, meta={"name": "stuck"}))
     assert stuck.meta["sanity"]["gyro_glitches"] == list(range(k, k + 15))
+    assert any("15 isolated gyroscope spike(s)" in m for m in found), found
 
 
 def test_bursts_longer_than_the_limit_are_not_called_glitches(walk):

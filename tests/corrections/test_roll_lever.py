@@ -11,8 +11,6 @@ from footzoo.evaluation.metrics import stride_errors
 from footzoo.filters.measurement import ACC_BIAS, ATT, GYRO_BIAS, POS, VEL, Context, Rows, V
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 def _config(lever: float, **detector) -> dict:
     return {"orientation": {"type": "ins"}, "detector": {"type": "shoe", **detector},

@@ -17,7 +17,7 @@ from footzoo.detectors.speed_adaptive_shoe import (
 )
 from footzoo.evaluation.metrics import intervals, stance_scores
 
-from ..conftest import data_file
+from ..conftest import KOROGLU_MOUNTING, data_file
 from .sims import GAITS, RATES, walk
 
 
@@ -151,6 +151,8 @@ def test_pyshoe_strides_walking_and_running_match_the_hand_counts():
         assert abs(found - row["n_strides_manual_koroglu"]) <= 0.2 * row["n_strides_manual_koroglu"], trial
 
 
+# the mounting report finds these sensors' x axis pointing backwards (expected warning; strides do not depend on it)
+@pytest.mark.filterwarnings(KOROGLU_MOUNTING)
 @pytest.mark.parametrize("experiment", [31, 32, 33])
 def test_koroglu_strides_exact_and_no_stance_in_mid_swing(experiment):
     """Köroğlu's walks (200 Hz): the hand-counted strides exactly.

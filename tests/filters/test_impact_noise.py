@@ -10,7 +10,6 @@ from footzoo.filters.engine import NavigationNoise
 from footzoo.filters.eskf import ErrorStateFilter, Layout, transition
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 BASE = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}]}
 
 

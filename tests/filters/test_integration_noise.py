@@ -15,7 +15,6 @@ from footzoo.filters.eskf import ErrorStateFilter, Layout, transition
 from footzoo.filters.velocity_noise import UNIFORM_TIMING
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 BASE = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}],
         "smoother": "rts"}
 GAITMAP = Path(__file__).resolve().parents[3] / "shared" / "data" / "gaitmap_example"

@@ -8,7 +8,7 @@ from footzoo.evaluation.metrics import armse, rotate_about_vertical
 from footzoo.io import builtin_sample, detect_format, load
 from footzoo.io.canonical import write
 
-from ..conftest import data_file
+from ..conftest import GAPS_BRIDGED, data_file
 
 G = 9.81
 
@@ -46,6 +46,8 @@ def test_pyshoe_reference_and_estimate_agree_in_handedness():
     assert proper < 0.15 < 3 * proper < mirrored
 
 
+# x-io's walk has gaps in its time stamps, which the reader bridges (expected warning)
+@pytest.mark.filterwarnings(GAPS_BRIDGED)
 def test_xio_reads_g_and_deg_s_with_duplicates_dropped():
     path = data_file("xio_gait_tracking", "short_walk.csv")
     assert detect_format(path) == "xio"
@@ -103,6 +105,8 @@ def test_builtin_sample_is_the_xio_walk():
     assert_still_foot(rec, max_tilt_deg=35)
 
 
+# x-io's walk has gaps in its time stamps, which the reader bridges (expected warning)
+@pytest.mark.filterwarnings(GAPS_BRIDGED)
 def test_canonical_round_trip_csv_and_parquet(tmp_path):
     rec = builtin_sample()
     for name in ("walk.csv", "walk.parquet"):
@@ -128,6 +132,8 @@ def test_unreadable_inputs(tmp_path):
         load(odd, format="xoi")
 
 
+# x-io's walk has gaps in its time stamps, which the reader bridges (expected warning)
+@pytest.mark.filterwarnings(GAPS_BRIDGED)
 def test_canonical_in_g_needs_a_declared_unit(tmp_path):
     rec = builtin_sample()
     df = rec.to_dataframe()

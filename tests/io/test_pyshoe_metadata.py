@@ -8,6 +8,8 @@ from footzoo.io import load
 from footzoo.runtime.pipeline import Pipeline
 from tests.conftest import data_file
 
+from ..conftest import STANCES_GUARDED, UPSIDE_DOWN_TRIAL
+
 
 def test_pyshoe_sensor_is_on_the_right_foot_so_huang2016_runs():
     rec = load(data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat"))
@@ -20,6 +22,10 @@ def test_pyshoe_sensor_is_on_the_right_foot_so_huang2016_runs():
     assert pyshoe_error(res.pos, rec.truth.pos) < 0.1
 
 
+# windowed misses the stances of part of this unusual trial; the guard marks them (expected warning)
+# its subject: the sensor is mounted upside down, which the mounting report names (expected warning)
+@pytest.mark.filterwarnings(UPSIDE_DOWN_TRIAL)
+@pytest.mark.filterwarnings(STANCES_GUARDED)
 def test_upside_down_trial_is_aligned_from_gravity():
     rec = load(data_file("pyshoe_vicon", "2018-02-22-10-09-36.mat"))
     assert rec.acc[:50, 2].mean() > 9.0  # mounted upside down: +g on z at rest

@@ -17,8 +17,6 @@ from footzoo.evaluation.metrics import intervals
 from footzoo.filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 def _reference_motion_acceleration(q, acc, g):
     prev = np.concatenate([q[:1], q[:-1]])

@@ -12,8 +12,6 @@ from footzoo.core.conventions import GRAVITY
 from footzoo.orientation.magnetic import REFERENCE_DURATION, field_norm_and_dip, magnetometer_valid
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 def _reference_magnetometer_valid(t, acc, mag, still, norm_tolerance, dip_tolerance):
     mn, dip = field_norm_and_dip(acc, mag)

@@ -11,7 +11,6 @@ from footzoo.detectors import Windowed
 from footzoo.evaluation.metrics import step_detection
 from footzoo.sim import NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 CONFIGS = ("duong2015", "duong2015_zupt", "duong2015_zupt_height")
 
 

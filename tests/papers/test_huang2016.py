@@ -15,7 +15,6 @@ from footzoo.sim import NoiseModel, simulate, simulate_calibration
 
 from ..conftest import data_file
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 TO_AHRS = np.array([1.0, -1.0, -1.0])  # FRD/NED -> the z-up frames ahrs' Madgwick expects: 180° about x
 
 

@@ -11,8 +11,6 @@ from footzoo.evaluation.metrics import loop_closure, step_detection
 from footzoo.filters.eskf import Layout, skew, transition
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 
 def test_transition_matches_the_linearised_strapdown():
     """Φ against finite differences of one strapdown step (hand-derived error dynamics)."""

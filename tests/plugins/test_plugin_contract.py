@@ -17,8 +17,6 @@ from footzoo.plugins.registry import KINDS, available
 
 ROOT = Path(__file__).resolve().parents[2]
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 BUILTINS = [(kind, name) for kind in KINDS for name in sorted(available(kind))]
 
 

@@ -13,7 +13,6 @@ from footzoo import Pipeline
 from footzoo.filters.measurement import Context, Rows, measurement_function
 from footzoo.sim import MagneticDisturbance, NoiseModel, simulate
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 ROOT = Path(__file__).resolve().parents[2]
 KALMAN = ["nguyen2016", "duong2015", "duong2015_zupt", "duong2015_zupt_height"]
 

@@ -11,8 +11,6 @@ from footzoo import ConfigError
 from footzoo.apps.compat import check, combinations
 from footzoo.studies import Study, run_study, set_dotted
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 SMALL = {
     "name": "small",
     "base": {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},

@@ -18,8 +18,6 @@ from footzoo.studies.cache import CACHE_FORMAT, read_entry
 
 from ..conftest import made_once
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 BASE = {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
         "corrections": [{"type": "zvu_dedrift"}]}
 SIM = {"simulate": {"path": "straight", "n_strides": 4, "rate": 50, "noise": {"scale": 1}}, "seeds": [0, 1]}

@@ -13,8 +13,6 @@ from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 # A detector defined outside the package: Yun's angular-rate FSM under a new name, so its results must
 # equal the built-in's exactly; THRESHOLD is what the "edit" tests change.
 PLUGIN = '''

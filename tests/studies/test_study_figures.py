@@ -6,8 +6,6 @@ from footzoo import ConfigError
 from footzoo.evaluation.metrics import FIGURE_METRICS, METRICS
 from footzoo.studies import Study, run_study
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 STUDY = {
     "name": "figures",
     "base": {"orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},

@@ -5,6 +5,8 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
+from footzoo.core.errors import FootzooWarning
+
 
 def test_missing_pyarrow_warns_instead_of_silently_skipping_parquet(tmp_path, monkeypatch):
     from footzoo.studies.report import write_outputs
@@ -15,6 +17,8 @@ def test_missing_pyarrow_warns_instead_of_silently_skipping_parquet(tmp_path, mo
     monkeypatch.setattr(pd.DataFrame, "to_parquet", no_pyarrow)
     table = pd.DataFrame({"run": ["a"], "base": ["yun2012"], "recording": ["r"], "metric": ["m"], "value": [1.0],
                           "error": [None]})
-    with pytest.warns(UserWarning, match="results.parquet was not written"):
+    with pytest.warns(FootzooWarning) as caught:
         write_outputs(table, [], [], tmp_path)
+    for name in ("results", "trajectories", "roc"):
+        assert any(f"pyarrow is not installed: {name}.parquet was not written" in str(w.message) for w in caught)
     assert (tmp_path / "results.csv").exists() and not (tmp_path / "results.parquet").exists()

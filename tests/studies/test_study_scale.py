@@ -8,8 +8,6 @@ import pytest
 from footzoo.studies import Study, read_trajectories, report, run_study
 from footzoo.studies.cache import HEAVY, light, with_heavy
 
-pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
-
 STUDY = {
     "name": "scale",
     "base": {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},

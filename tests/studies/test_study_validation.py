@@ -13,6 +13,8 @@ from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 from footzoo.studies.study import MAX_CELLS
 
+from ..conftest import HARD_IRON_NOT_FITTED
+
 SIM = {"simulate": {"path": "straight", "n_strides": 4, "rate": 50, "noise": {"scale": 1}}, "seeds": [0]}
 BASE = {"name": "small", "base": "yun2012", "recordings": [SIM]}
 
@@ -132,6 +134,8 @@ def test_old_cache_entries_are_pruned(tmp_path):
     assert prune_cache(cache, keep=set(), max_age_days=0)["kept"] == 0
 
 
+# yun2012 fits a hard-iron calibration, which this straight simulated walk cannot give (expected warning)
+@pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)
 def test_a_study_prunes_other_studies_entries_on_request(tmp_path):
     out = tmp_path / "out"
     one = {**BASE, "recordings": [SIM]}
