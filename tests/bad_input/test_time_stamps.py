@@ -16,7 +16,7 @@ from footzoo.core.errors import FootzooWarning, SensorWarning
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
-from ..conftest import data_file
+from ..conftest import GAPS_BRIDGED, data_file
 
 
 def _sensor_warnings(fn):
@@ -96,6 +96,8 @@ def _real_recordings() -> list[Recording]:
     return recs
 
 
+# a restamped trial keeps its gaps, which the recording bridges again (expected warning)
+@pytest.mark.filterwarnings(GAPS_BRIDGED)
 @pytest.mark.slow
 def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_are():
     from footzoo.filters.consistency import ConsistencyScan

@@ -13,6 +13,8 @@ from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 
+from ..conftest import STANCES_GUARDED
+
 # A detector defined outside the package: Yun's angular-rate FSM under a new name, so its results must
 # equal the built-in's exactly; THRESHOLD is what the "edit" tests change.
 PLUGIN = '''
@@ -199,6 +201,8 @@ def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tm
     assert serial.equals(distributed)
 
 
+# the edited threshold, below the gyroscope's noise, misses stances; the guard marks them (expected warning)
+@pytest.mark.filterwarnings(STANCES_GUARDED)
 @pytest.mark.slow
 def test_editing_the_plugin_reruns_its_cells_only(tmp_path):
     write_plugin(tmp_path, threshold=0.6)
