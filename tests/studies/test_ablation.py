@@ -46,7 +46,7 @@ def test_serial_joblib_and_dask_give_identical_tables():
 
     serial = run_study(Study.from_dict(SMALL))
     parallel = run_study(Study.from_dict(SMALL), jobs=2)
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0") as cluster:
         distributed = run_study(Study.from_dict(SMALL), scheduler=cluster.scheduler_address)
     assert len(serial) > 0 and serial["error"].isna().all()
     for other in (parallel, distributed):

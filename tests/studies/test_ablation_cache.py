@@ -343,7 +343,7 @@ def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, serial
 
     serial, summary = serial_outputs
     with LocalCluster(n_workers=2 if processes else 1, threads_per_worker=1 if processes else 2, processes=processes,
-                      dashboard_address=None) as cluster:
+                      dashboard_address=":0") as cluster:
         table = run_study(Study.from_dict(FIGURES), out=tmp_path / "dask", scheduler=cluster.scheduler_address)
     dask = {f.name: f.read_bytes() for f in (tmp_path / "dask").glob("*.png")}
     assert serial.keys() == dask.keys()

@@ -195,7 +195,7 @@ def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tm
     write_plugin(tmp_path)
     study = Study.from_dict(study_dict("my_detector.py", det_name(tmp_path)), root=tmp_path)
     serial = run_study(study)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         distributed = run_study(study, scheduler=cluster.scheduler_address)
     assert distributed["error"].isna().all()
     assert serial.equals(distributed)

@@ -48,7 +48,7 @@ def test_the_report_reads_trajectories_back_in_batches(tmp_path, monkeypatch):
 def test_a_study_on_a_dask_cluster_writes_the_same_outputs(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     serial = run_study(Study.from_dict(STUDY), out=tmp_path / "serial")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   silence_logs=logging.CRITICAL) as cluster:
         dask = run_study(Study.from_dict(STUDY), scheduler=cluster.scheduler_address, out=tmp_path / "dask")
     assert dask.equals(serial)
