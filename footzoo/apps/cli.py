@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.atomic import atomic_path, check_target, refuse_inputs
+from ..core.atomic import atomic_path, check_target, refuse_inputs, write_text
 from ..core.context import RunContext
 from ..core.conventions import ACC_UNITS, GYR_UNITS
 from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
@@ -294,7 +294,6 @@ class kept_warnings:
 
 def write_log(folder: Path, texts: list[str], inputs: list[str] | None = None) -> Path:
     """``folder/footzoo.log``: every warning of the command, one per line (or that there was none), atomically."""
-    from ..core.atomic import refuse_inputs, write_text
 
     target = folder / LOG
     refuse_inputs([target], inputs or [], "--out")

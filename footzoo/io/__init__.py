@@ -35,11 +35,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS
+from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
 from . import xio
-from .axes import parse_axes
+from .axes import apply_axes, describe_axes, parse_axes
 from .base import REQUIRED, Option, Reader
 from .metadata import read_facts
 from .registry import GROUP, available, refresh
@@ -213,8 +213,6 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
 
 def _rotate(rec: Recording, rows: Any) -> None:
     """Apply ``axes`` to what a reader without that option returned: its signals, and its true attitude."""
-    from ..core.conventions import quat_from_matrix, quat_mul
-    from .axes import apply_axes, describe_axes
 
     rec.acc, rec.gyr = apply_axes(rows, rec.acc), apply_axes(rows, rec.gyr)
     if rec.mag is not None:

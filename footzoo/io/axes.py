@@ -31,6 +31,7 @@ import numpy as np
 
 from ..core.conventions import axis_map_text
 from ..core.errors import FormatError
+from ..core.yamlsafe import load_text
 
 #: The identity map.
 IDENTITY = "[x, y, z]"
@@ -105,8 +106,6 @@ def _split(text: str, where: str) -> list[Any]:
     """The three axis names of ``"[x, -y, -z]"`` (brackets, parentheses, commas or spaces), or a matrix's rows."""
     text = text.replace("\u2212", "-").strip()
     if text.startswith("[["):
-        from ..core.yamlsafe import load_text
-
         return load_text(text, where, FormatError)
     for ch in "[]();,":
         text = text.replace(ch, " ")

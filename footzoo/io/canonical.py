@@ -24,7 +24,8 @@ import pandas as pd
 from ..core.archive import parquet_available
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
-from ..core.data import Recording, Truth
+from ..core.conventions import quat_from_matrix, quat_mul
+from ..core.data import TRUTH_QUAT_COLS, Recording, Truth
 from ..core.errors import FootzooWarning, FormatError, OutputError
 from .axes import describe_axes, parse_axes, rotate_columns
 from .base import (
@@ -110,8 +111,6 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
 
 def _rotate_truth_attitude(df: pd.DataFrame, rows: np.ndarray) -> None:
     """The true attitude ``true_qw..qz`` of a file read with another axis map: body frame FRD, not the file's."""
-    from ..core.conventions import quat_from_matrix, quat_mul
-    from ..core.data import TRUTH_QUAT_COLS
 
     if all(c in df.columns for c in TRUTH_QUAT_COLS):
         q = df[TRUTH_QUAT_COLS].to_numpy(dtype=float)

@@ -20,6 +20,7 @@ from footzoo.corrections.rolling_stance import (
 )
 from footzoo.evaluation.metrics import stride_errors
 from footzoo.filters.measurement import Context, Q, Rows, V
+from footzoo.plugins.registry import build
 from footzoo.sim import NoiseModel, simulate
 
 #: The simulator's contact points (footzoo.sim.gait.FootGeometry: sensor to heel and to toe, FRD, m).
@@ -109,8 +110,11 @@ def test_the_levers_are_fed_back_as_estimate_minus_truth():
 
 @pytest.mark.parametrize("bad", [{"heel": [0.0, 0.0]}, {"toe": [0.0, 0.0, 0.9]}, {"contact_spread": -0.1}])
 def test_bad_parameters_are_refused(bad):
-    with pytest.raises(ConfigError):
-        RollingStance(**bad)
+    name = next(iter(bad))
+    with pytest.raises(ConfigError, match=name):
+        build("correction", {"type": "rolling_stance", **bad})  # a config
+    with pytest.raises(ConfigError, match=name):
+        RollingStance(**bad).check_params()  # made in Python: refused when a pipeline is given it
 
 
 @pytest.fixture(scope="module")
