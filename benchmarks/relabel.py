@@ -152,21 +152,22 @@ def run_case(pipeline: footzoo.Pipeline, name: str, case: dict[str, Any]) -> dic
 
 
 def summarise(table: pd.DataFrame) -> pd.DataFrame:
-    """Per case: recordings, caught, right fix (of them as the alternative), wrong fix, missed, other warnings."""
+    """Per case: recordings, false positives (as recorded) or caught, right fix (of them as the alternative), wrong
+    fix, missed, and the cases with other warnings."""
     rows = []
     for case, g in table.groupby("case", sort=False):
         clean = g["kind"].iloc[0] == "clean"
+        right = int((g["right"] | g["alternative"]).sum())
+        alternative = int(g["alternative"].sum())
         rows.append({"case": case, "recordings": len(g),
-                     "caught" if not clean else "false positives": int(g["caught"].sum()),
-                     "right fix": "" if clean else f"{int((g['right'] | g['alternative']).sum())}"
-                     + (f" ({int(g['alternative'].sum())} as the alternative)" if g["alternative"].any() else ""),
+                     "false positives": int(g["caught"].sum()) if clean else "",
+                     "caught": "" if clean else int(g["caught"].sum()),
+                     "right fix": "" if clean else f"{right}" + (f" ({alternative} as the alternative)"
+                                                                 if alternative else ""),
                      "wrong fix": "" if clean else int((g["caught"] & ~g["right"] & ~g["alternative"]).sum()),
                      "missed": "" if clean else int((~g["caught"]).sum()),
                      "other warnings": int((g["others"] != "").sum())})
-    out = pd.DataFrame(rows)
-    out["caught"] = out["caught"].fillna("").map(lambda v: "" if v == "" else int(v))
-    out["false positives"] = out["false positives"].fillna("").map(lambda v: "" if v == "" else int(v))
-    return out
+    return pd.DataFrame(rows, dtype=object)
 
 
 def markdown(df: pd.DataFrame) -> str:
@@ -191,11 +192,15 @@ def write(tables: dict[str, pd.DataFrame], path: Path, elapsed: float) -> None:
         lines += [f"## `{config}`", "",
                   f"False positives on the {len(clean)} recordings as recorded: **{int(clean['caught'].sum())}**.", "",
                   markdown(summarise(table)), ""]
-        bad = table[(table["kind"] != "clean") & ~(table["right"] | table["alternative"])]
-        if len(bad):
-            lines += ["Cases without the right fix:", "",
-                      markdown(bad[["recording", "case", "named", "others"]].rename(
-                          columns={"named": "named instead", "others": "other warnings"})), ""]
+        unright = (table["kind"] != "clean") & ~(table["right"] | table["alternative"])
+        required = table["kind"].isin(["acc", "gyr"]) | table["case"].str.contains("|".join(
+            f"×{label}," for label in ("2", "½", "1.5")))
+        for title, rows in (("The required cases (×2, ×½, ×1.5, units) without the right fix:", unright & required),
+                            ("A wrong fix named in the other cases:", unright & ~required & table["caught"])):
+            if rows.any():
+                bad = table[rows].assign(named=lambda d: d["named"].where(d["named"] != "", "(nothing)"))
+                lines += [title, "", markdown(bad[["recording", "case", "named", "others"]].rename(
+                    columns={"named": "named instead", "others": "other warnings"})), ""]
         fp = clean[clean["caught"]]
         if len(fp):
             lines += ["False positives:", "", markdown(fp[["recording", "named", "others"]]), ""]

@@ -34,27 +34,33 @@ cadence vs speed          ≤ 150 + 15 v     walkers step at 95–160 steps/min 
                                            raise their cadence with speed, to 3.0 ± 0.2 steps/s
                                            at 65–70 % of their top speed and 4.5–5 at the top
                                            (Ae et al., PMC8523042; Weyand et al. 2000)
-rolling ratio L/θ (m/rad) 0.24–0.45        footzoo's measurement: the foot turns through
-                                           0.8–4.6 rad of |ω| per swing and covers 0.29–0.40 m
-                                           per radian on all 42 real recordings of the data
-                                           folder (walking, running, stairs, shuffling,
-                                           crawling), ``benchmarks/relabel.md``
+rolling ratio L/θ (m/rad) 0.24–0.45        footzoo's measurement: the stride length per radian
+                                           the foot turns in its swing is 0.26–0.40 m/rad on
+                                           every walk and run of the data folder, 0.21–0.40
+                                           (median 0.34) on all 42 real recordings, crawling
+                                           and shuffling included (``benchmarks/relabel.md``)
 ========================  ===============  ====================================================
 
 The cost of a hypothesis is the sum, over these quantities, of the squared distance outside
 the range in units of :data:`TOLERANCE` (25 %), each capped at :data:`CAP` (a run that is no
 gait at all — crawling, a pipeline whose detector missed most stances — cannot outvote the
-rest), plus the gyroscope–accelerometer evidence of the rate
+rest; a gait that no hypothesis brings within :data:`GAIT_INFORMATIVE` is no evidence at all),
+plus the gyroscope–accelerometer evidence of the rate
 (:meth:`footzoo.filters.consistency.ConsistencyScan.time_scales`: the swings integrated with the
-time scaled by ``F``, whose residual is lowest where the rate is right; its excess over the
-lowest in units of :data:`CONSISTENCY_TOLERANCE`, 30 %), plus :data:`PRIOR` for any hypothesis
-but the declared one. When the best hypothesis costs :data:`MARGIN` less than the declared rate,
-one :class:`~footzoo.core.errors.SensorWarning` names it, with the strides as declared and as
-corrected, the likely rate (the declared one divided by ``F``, rounded to a common rate of
-:data:`COMMON_RATES` within 3 %) and the fix. The gait alone names a rate only when the
-gyroscope–accelerometer evidence does not point the other way. On the real recordings no
-correctly labelled recording is named, and relabelled at ×2, ×½ or ×1.5 most are
-(``benchmarks/relabel.md`` has the table).
+time scaled by ``F``, whose residual is lowest where the rate is right — on real recordings
+1.0–1.1 times the right scale, so the lowest residual within :data:`SCALE_WINDOW` of ``F``
+counts; its excess over the lowest in units of :data:`CONSISTENCY_TOLERANCE`, 30 %), plus
+:data:`PRIOR` for any hypothesis but the declared one. When the best hypothesis costs
+:data:`MARGIN` less than the declared rate, one :class:`~footzoo.core.errors.SensorWarning`
+names it, with the strides as declared and as corrected, the likely rate (the declared one
+divided by ``F``, rounded to a common rate of :data:`COMMON_RATES` within 3 %) and the fix.
+The gait alone decides only without the residuals (too few swings); with them, a rate is named
+only if they prefer it by :data:`SUPPORT`, and the factor named is the one, on that side of 1,
+whose residual is lowest (the gait's ranges tell that the rate is wrong more than by how much).
+As recorded, none of the 42 real recordings of the data folder is named, and none of 162
+simulated walks, runs and stairs at 50–200 Hz; relabelled at ×2, ×½ or ×1.5, 37, 37 and 35 of
+the 42 real ones are named with the real rate (``recommended``; ``benchmarks/relabel.md``), and
+479 of the 486 simulated ones.
 
 A gyroscope in rad/s declared as deg/s reads 57.3 times too slow: the accelerometer shows a
 foot that moves (|‖f‖ − g| above :data:`MOTION_ACC` for :data:`MOTION_TIME` s) while the
@@ -100,9 +106,9 @@ TOLERANCE = math.log(1.25)
 CAP = 9.0
 #: One unit of cost of the gyroscope-accelerometer evidence: a residual 30 % above the lowest.
 CONSISTENCY_TOLERANCE = math.log(1.3)
-#: The residual counted for a time scale is the lowest within this ratio of it (real recordings: lowest at 1.0–1.1×
-#: the right scale, 1.09 in the median over the 42 real recordings as recorded; a simulation: at it).
-SCALE_WINDOW = 1.1
+#: The residual counted for a time scale is the lowest between these multiples of it (real recordings: lowest at
+#: 1.0–1.1× the right scale, 1.09 in the median over the 42 real recordings as recorded; a simulation: at it).
+SCALE_WINDOW = (0.98, 1.12)
 #: With the gyroscope-accelerometer evidence, a rate is named only if it lowers that evidence's cost by this much
 #: (the gait alone does not overrule residuals that do not depend on the time scale).
 SUPPORT = 1.0
@@ -116,8 +122,10 @@ AMBIGUOUS = 2.0
 #: Fewest strides and swings the rate is judged on.
 MIN_STRIDES = 6
 MIN_SWINGS = 4
-#: The strides after which the rate is judged live (then at the end of the data on every stride).
+#: The strides after which the rate is judged live (then at the end of the data on every stride measured).
 CHECKPOINTS = (12, 24, 48)
+#: Most strides measured (the scan's memory is bounded; a rate does not change within a recording).
+MAX_STRIDES = 256
 #: Longest stride, stance and swing (s) measured: a longer one is a pause or a missed stance.
 MAX_STRIDE_TIME = 4.0
 MAX_STANCE_TIME = 3.0
@@ -193,15 +201,15 @@ def gait_costs(gait: dict[str, float], factor: float) -> dict[str, float]:
 def consistency_cost(evidence: dict[str, Any] | None, factor: float) -> float:
     """Cost of the time scale ``factor`` by the gyroscope–accelerometer residuals (0 without evidence).
 
-    The lowest residual within :data:`SCALE_WINDOW` of ``factor`` counts: on real recordings the
-    residual is lowest a little above the right time scale (1.09× it, the median over the 42 real
-    recordings as recorded), on a simulation at it.
+    The lowest residual between ``factor`` times the ends of :data:`SCALE_WINDOW` counts: on real
+    recordings the residual is lowest a little above the right time scale (1.09× it, the median over
+    the 42 real recordings as recorded), on a simulation at it.
     """
     if evidence is None:
         return 0.0
     scales, residual = np.log(evidence["scales"]), np.log(np.maximum(evidence["residual"], 1e-12))
     order = np.argsort(scales)
-    around = math.log(factor) + np.linspace(-math.log(SCALE_WINDOW), math.log(SCALE_WINDOW), 9)
+    around = math.log(factor) + np.append(np.linspace(math.log(SCALE_WINDOW[0]), math.log(SCALE_WINDOW[1]), 9), 0.0)
     at = float(np.min(np.interp(around, scales[order], residual[order])))
     return ((at - float(residual.min())) / CONSISTENCY_TOLERANCE) ** 2
 
@@ -228,7 +236,9 @@ def judge_rate(gait: dict[str, float] | None, evidence: dict[str, Any] | None) -
     -------
     dict
         ``costs`` ({factor: cost}, 1 the declared rate), ``gait_informative``, ``factor`` (the named
-        factor of :data:`FACTORS`, or None), ``alternative`` (a second one almost as likely, or None).
+        factor of :data:`FACTORS`, or None: the declared rate costs :data:`MARGIN` more than the best;
+        with the gyroscope–accelerometer evidence, the factor on the best one's side of 1 whose residual
+        is lowest), ``alternative`` (a second one almost as likely, or None).
     """
     informative = gait is not None and min(sum(gait_costs(gait, f).values()) for f in (1.0, *FACTORS)) \
         <= GAIT_INFORMATIVE
@@ -238,15 +248,23 @@ def judge_rate(gait: dict[str, float] | None, evidence: dict[str, Any] | None) -
         return c + (0.0 if f == 1.0 else PRIOR)
 
     costs = {f: cost(f) for f in (1.0, *FACTORS)}
-    order = sorted(FACTORS, key=costs.get)
-    best, out = order[0], {"costs": costs, "gait_informative": informative, "factor": None, "alternative": None}
+    best, out = min(FACTORS, key=costs.get), {"costs": costs, "gait_informative": informative, "factor": None,
+                                              "alternative": None}
     if costs[1.0] - costs[best] < MARGIN:
         return out
-    if evidence is not None and consistency_cost(evidence, 1.0) - consistency_cost(evidence, best) < SUPPORT:
-        return out  # the gyroscope and the accelerometer do not prefer it: the gait alone does not decide
-    out["factor"] = best
-    second = order[1]
-    if costs[second] - costs[best] < AMBIGUOUS and (second > 1.0) == (best > 1.0):
+    if evidence is not None:
+        fit = {f: consistency_cost(evidence, f) for f in (1.0, *FACTORS)}
+        if fit[1.0] - fit[best] < SUPPORT:
+            return out  # the gyroscope and the accelerometer do not prefer it: the gait alone does not decide
+        # which factor: the residuals, which depend on it directly (the gait's ranges only tell that one is wrong)
+        side = [f for f in FACTORS if (f > 1.0) == (best > 1.0)]
+        order = sorted(side, key=lambda f: (fit[f], costs[f]))
+        spread = fit
+    else:
+        order, spread = sorted(FACTORS, key=costs.get), costs
+    out["factor"] = best = order[0]
+    second = next((f for f in order[1:] if (f > 1.0) == (best > 1.0)), None)
+    if second is not None and spread[second] - spread[best] < AMBIGUOUS:
         out["alternative"] = second
     return out
 
@@ -269,7 +287,7 @@ class GaitScan:
         self.report: dict[str, Any] = {}
         self._rows: list[list[float]] = []  # per stride: T, L, h, rot, peak, swing, last sample, samples spanned
         self._buf: dict[str, np.ndarray] | None = None
-        self._pending = list(CHECKPOINTS)
+        self._pending: list[int] | None = list(CHECKPOINTS)  # None once judged at the end
         self._motion = [0.0, 0, 0]  # moving time (s), moving samples, of them turning
         self._t_last: float | None = None
 
@@ -286,6 +304,8 @@ class GaitScan:
         w = row_norms(gyr)
         if "gyro_unit" not in self.report:
             self._gyro_unit(np.asarray(k), t, acc, w)
+        if len(self._rows) >= MAX_STRIDES:
+            return  # every stride the scan judges is measured: the rest of the data changes nothing
         new = {"k": np.asarray(k), "t": np.asarray(t, dtype=float), "w": w, "stance": np.asarray(stance, dtype=bool),
                "pos": np.asarray(pos, dtype=float)}
         self._buf = new if self._buf is None else {n: np.concatenate([self._buf[n], v]) for n, v in new.items()}
@@ -298,8 +318,10 @@ class GaitScan:
         self._decide(final=False)
 
     def finish(self) -> dict[str, Any]:
-        """End of the data: judge what is still pending, then every stride; the finding (empty: none)."""
-        self._decide(final=True)
+        """End of the data: judge what is still pending, then every stride measured; the finding (empty: none)."""
+        if self._pending is not None:
+            self._decide(final=True)
+            self._pending = None  # judged once
         return self.report
 
     # ------------------------------------------------------------------ strides
@@ -319,6 +341,8 @@ class GaitScan:
                 continue  # a pause, or a stance the detector missed
             swing = slice(b0 - 1, a1 + 1)
             rot = float(np.sum(w[b0 - 1:a1] * np.diff(t[swing])))
+            if len(self._rows) >= MAX_STRIDES:
+                break
             self._rows.append([T, float(np.hypot(*(pos[m1, :2] - pos[m0, :2]))),
                                float(pos[m0, 2] - pos[swing, 2].min()), rot, float(w[swing].max()),
                                t[a1] - t[b0 - 1], int(b["k"][m1]), int(b["k"][m1] - b["k"][m0])])
@@ -365,7 +389,7 @@ class GaitScan:
     # ------------------------------------------------------------------ the rate
     def _decide(self, final: bool) -> None:
         """Judge the rate at each checkpoint whose evidence is complete (all of them at the end, then every stride)."""
-        if "rate" in self.report or "gyro_unit" in self.report:
+        if self._pending is None or "rate" in self.report or "gyro_unit" in self.report or not (self._pending or final):
             return
         rows = np.asarray(self._rows, dtype=float).reshape(-1, 8)
         while self._pending and len(rows) >= self._pending[0]:
@@ -379,7 +403,6 @@ class GaitScan:
             if self._judge(rows[:m], until):
                 return
         if final:  # every stride, or the gyroscope-accelerometer evidence alone when the detector found too few
-            self._pending = []
             self._judge(rows, int(rows[-1, 6]) if len(rows) >= MIN_STRIDES else None)
 
     def _judge(self, rows: np.ndarray, until: int | None) -> bool:
@@ -438,4 +461,5 @@ class GaitScan:
             f"{declared:.4g} Hz: every duration is off by {f:.3g}× and every distance by about {f * f:.3g}×. Declare "
             f"the real rate (a sidecar's time: {{rate: {likely:g}}}; --option rate={likely:g} or "
             f"footzoo.load(path, rate={likely:g}) where the reader has a rate option), or, with a time column, fix "
-            f"its unit or scale (t × {f:.3g}). Details in diagnostics['sensor']['plausibility']")
+            f"its unit or scale (t × {f:.3g}); the run's other findings (swings without a stance, drift, the "
+            "mounting) may follow from it. Details in diagnostics['sensor']['plausibility']")
