@@ -60,14 +60,22 @@ ISSUE = relabelled({**WALK, "cadence_steps_min": 81.5, "stride_length_m": 0.7, "
                     "rolling_m_rad": 0.3}, 2.0)
 
 
-def test_the_issues_walk_read_at_twice_its_rate_is_named_from_its_gait_alone():
+def test_the_gait_alone_names_no_rate():
+    # outside the ranges of human gait, but a detector that splits every stride in two looks the same
     verdict = judge_rate(ISSUE, None)
-    assert verdict["factor"] == 2.0 and verdict["costs"][1.0] - verdict["costs"][2.0] >= MARGIN
+    assert verdict["factor"] is None and verdict["costs"][1.0] - verdict["costs"][2.0] >= MARGIN
 
 
-def test_a_walk_within_the_ranges_of_human_gait_at_either_rate_is_not_named_from_its_gait_alone():
+def test_the_gait_tips_residuals_too_shallow_to_name_a_rate_alone():
+    shallow = {**evidence(2.0), "residual": 0.08 * 1.5 ** np.abs(np.log2(evidence(2.0)["scales"] / 2.0))}
+    assert judge_rate(WALK, shallow)["factor"] is None  # a human gait as declared: the residuals are not enough
+    assert judge_rate(ISSUE, shallow)["factor"] == 2.0  # the issue's gait outside the human ranges: named
+
+
+def test_a_walk_within_the_ranges_of_human_gait_at_either_rate_is_named_by_its_residuals():
     # 158 steps/min, 0.58 m strides: a quick short-stepped walk, humanly possible (and so is 105 at 1.3 m)
-    assert judge_rate(relabelled(WALK, 1.5), None)["factor"] is None
+    assert judge_rate(relabelled(WALK, 1.5), evidence(1.0))["factor"] is None
+    assert judge_rate(relabelled(WALK, 1.5), evidence(1.5))["factor"] == 1.5
 
 
 @pytest.mark.parametrize("f", [2.0, 0.5, 1.5, 2.0 / 3.0])
