@@ -380,8 +380,9 @@ class GaitScan:
             f"{MOTION_ACC:g} m/s², {count} samples) but the gyroscope turns faster than {TURN_RATE:g} rad/s in "
             f"only {turning} of them, at most {peak:.3g} rad/s: a moving foot turns at 5–20 rad/s. The gyroscope's "
             f"values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} rad/s): declare "
-            "gyr_unit: rad/s (a sidecar's gyr: {..., unit: rad/s}; --option gyr_unit=rad/s where the reader has "
-            "it), or check that the gyroscope works. Details in diagnostics['sensor']['plausibility']",
+            "gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line --option gyr_unit=rad/s, "
+            "a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. Details in "
+            "diagnostics['sensor']['plausibility']",
             SensorWarning, stacklevel=5,
         )
 
