@@ -133,7 +133,7 @@ MAX_STRIDES = 256
 #: Longest stride, stance and swing (s) measured: a longer one is a pause or a missed stance.
 MAX_STRIDE_TIME = 4.0
 MAX_STANCE_TIME = 3.0
-#: Longest stretch (s) kept while waiting for a stance to end (the memory of the scan is bounded).
+#: Longest stretch (s) kept while waiting for the first stance to end (the memory of the scan is bounded).
 MAX_PENDING = 10.0
 #: Sampling rates of common IMUs (Hz): the likely rate is rounded to one of them (:data:`SNAP`).
 COMMON_RATES = (10.0, 12.5, 20.0, 25.0, 30.0, 40.0, 50.0, 60.0, 64.0, 100.0, 102.4, 104.0, 120.0, 125.0, 128.0,
@@ -325,34 +325,38 @@ class GaitScan:
 
     # ------------------------------------------------------------------ strides
     def _strides(self) -> None:
-        """Measure every stride whose two stances have ended; keep the samples from the last ended stance on."""
+        """Measure every stride whose two stances have ended; keep the samples from the last ended stance on
+        (vectorised over the strides of the chunk)."""
         b = self._buf
+        t, w, pos, k = b["t"], b["w"], b["pos"], b["k"]
         edges = np.flatnonzero(np.diff(np.concatenate([[0], b["stance"].astype(np.int8), [0]])))
         starts, ends = edges[::2], edges[1::2]
-        closed = ends < len(b["t"])  # a stance still going on at the chunk's end has no middle yet
+        closed = ends < len(t)  # a stance still going on at the chunk's end has no middle yet
         starts, ends = starts[closed], ends[closed]
-        t, w, pos = b["t"], b["w"], b["pos"]
-        for (a0, b0), (a1, b1) in zip(zip(starts[:-1], ends[:-1], strict=True), zip(starts[1:], ends[1:],
-                                                                                  strict=True), strict=True):
+        if len(starts) >= 2:
+            a0, b0, a1, b1 = starts[:-1], ends[:-1], starts[1:], ends[1:]
             m0, m1 = (a0 + b0 - 1) // 2, (a1 + b1 - 1) // 2
             T, stance = t[m1] - t[m0], t[b0 - 1] - t[a0]
-            if T > MAX_STRIDE_TIME or stance > MAX_STANCE_TIME:
-                continue  # a pause, or a stance the detector missed
-            swing = slice(b0 - 1, a1 + 1)
-            rot = float(np.sum(w[b0 - 1:a1] * np.diff(t[swing])))
-            if len(self._rows) >= MAX_STRIDES:
-                break
-            self._rows.append([T, float(np.hypot(*(pos[m1, :2] - pos[m0, :2]))),
-                               float(pos[m0, 2] - pos[swing, 2].min()), rot, float(w[swing].max()),
-                               t[a1] - t[b0 - 1], int(b["k"][m1]), int(b["k"][m1] - b["k"][m0])])
-        if len(starts):
-            keep = int(starts[-1])
-        elif t[-1] - t[0] > MAX_PENDING:  # no stance has ended for a long time: keep the one going on, if any
-            open_run = np.flatnonzero(~b["stance"])
-            keep = int(open_run[-1]) + 1 if len(open_run) else 0
+            ok = np.flatnonzero((T <= MAX_STRIDE_TIME) & (stance <= MAX_STANCE_TIME))  # else a pause, a missed stance
+            ok = ok[:MAX_STRIDES - len(self._rows)]
+            if len(ok):
+                a0, b0, a1, m0, m1, T = a0[ok], b0[ok], a1[ok], m0[ok], m1[ok], T[ok]
+                # the swing of each stride: samples b0 - 1 .. a1 (the last stance sample to the first of the next)
+                swing = np.column_stack([b0 - 1, a1 + 1]).ravel()  # a1 + 1 <= b1 < len(t): closed stances
+                turned = np.concatenate([[0.0], np.cumsum(w[:-1] * np.diff(t))])  # ∫|ω| dt from the buffer's start
+                rows = np.column_stack([
+                    T, np.hypot(*(pos[m1, :2] - pos[m0, :2]).T),
+                    pos[m0, 2] - np.minimum.reduceat(pos[:, 2], swing)[::2], turned[a1] - turned[b0 - 1],
+                    np.maximum.reduceat(w, swing)[::2], t[a1] - t[b0 - 1], k[m1], k[m1] - k[m0]])
+                self._rows.extend(rows.tolist())
+        if len(starts) and t[-1] - t[(starts[-1] + ends[-1] - 1) // 2] <= MAX_STRIDE_TIME:
+            keep = int(starts[-1])  # the next stride starts at the middle of the last stance that ended
+        else:  # no stride can end in what follows (or no stance has ended yet): keep the stance going on, if any
+            moving = np.flatnonzero(~b["stance"])
+            keep = int(moving[-1]) + 1 if len(moving) else 0
+            if not len(starts) and t[-1] - t[0] <= MAX_PENDING:
+                keep = 0  # the first stance is still to end
             keep = min(keep, len(t) - 1)
-        else:
-            keep = 0
         self._buf = {n: v[keep:] for n, v in b.items()}
 
     # ------------------------------------------------------------------ gyroscope unit
