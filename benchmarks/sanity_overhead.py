@@ -94,6 +94,9 @@ def main() -> None:
         def finish(self) -> dict[str, Any]:
             return {}
 
+        def use_evidence(self, *a: Any) -> None:
+            pass
+
     print(f"live ({live.n} samples, guess=False):")
     for chunk in (1, 50):
         timing: dict[str, list[float]] = {"with the scans": [], "scans off": []}

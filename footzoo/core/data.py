@@ -557,9 +557,15 @@ def _check_units(rec: Recording) -> None:
 
 
 def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
-    """Refuse an accelerometer in g or mg and a gyroscope in deg/s declared as SI (a RecordingError with the fix).
+    """Refuse an accelerometer or a gyroscope in another unit than the one declared (a RecordingError with the fix).
 
-    Run on every recording and, live, on a stream's first samples (:class:`footzoo.Stream`).
+    The accelerometer at rest reads g: in g or mg declared as m/s² it reads about 1 or 1000; in m/s²
+    declared as g or mg, about 96 or 0.096; in g declared as mg or the reverse, 0.0098 or 9807. Each
+    is named with the declaration that reads g. A gyroscope in deg/s declared as rad/s turns faster
+    than any foot (99th percentile above :data:`GYRO_DEG_S_SUSPICION`). The reverse (rad/s declared as
+    deg/s: a foot that moves but does not turn) needs motion to be seen, and is named by the gait
+    scan (:mod:`footzoo.core.plausibility`). Run on every recording and, live, on a stream's first
+    samples (:class:`footzoo.Stream`).
     """
     acc_norm = row_norms(acc)
     gyr_norm = row_norms(gyr)
@@ -577,6 +583,14 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
             f"({UNIT_FIX.format(key='acc_unit', value='mg')})"
         )
     if not 0.5 * GRAVITY < rest < 1.5 * GRAVITY:
+        for true, declared in (("m/s^2", "g"), ("m/s^2", "mg"), ("g", "mg"), ("mg", "g")):
+            read = GRAVITY * ACC_UNITS[declared] / ACC_UNITS[true]  # what g in `true` reads as `declared`, in m/s²
+            if abs(np.log(rest / read)) < np.log(1.3):
+                raise RecordingError(
+                    f"accelerometer magnitude at rest is {rest:.4g} m/s² as declared, {rest / GRAVITY:.4g} g: this "
+                    f"is what g reads in {true} declared as {declared}; declare acc_unit: {true} "
+                    f"({UNIT_FIX.format(key='acc_unit', value=true)})"
+                )
         raise RecordingError(
             f"accelerometer magnitude at rest is {rest:.3f} m/s², far from g = {GRAVITY}; "
             "check the unit (acc_unit) and the sensor's calibration"

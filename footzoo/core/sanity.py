@@ -32,9 +32,9 @@ Run by :func:`footzoo.core.data.validate_recording` on every :class:`~footzoo.co
 Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording`` and
 ``Result.diagnostics["sensor"]``). Live, :class:`SignalScan` finds the same glitches chunk by
 chunk, and saturation against each axis's extremes so far. :class:`EstimateScan` checks a
-run's estimate (batch and live): no stance at all, and drift while the data say still.
-
-Findings also go to ``Recording.meta["sanity"]`` (and so to ``Result.recording``).
+run's estimate (batch and live): no stance at all, drift while the data say still (its cause
+checked against what the detector marked), and the gait against the ranges of human gait
+(:mod:`footzoo.core.plausibility`).
 """
 
 from __future__ import annotations
@@ -50,6 +50,7 @@ from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
 from .errors import RecordingError, SensorWarning
 from .norms import row_norms, row_norms_squared
+from .plausibility import GaitScan, RateEvidence
 
 #: Fewest consecutive samples at an axis's exact extreme reported as saturation.
 SATURATION_MIN_RUN = 3
@@ -257,6 +258,11 @@ STILL_STANCE_SHARE = 0.9
 NO_STANCE_MIN_DURATION = 5.0
 #: Shortest quiet period (s) whose specific force far from g (outside [0.5 g, 1.5 g]) is reported as a scale fault.
 SCALE_MIN_DURATION = 0.2
+#: ... when ‖f‖ is steady there: its 10th to 90th percentiles within this fraction of its level (a still sensor
+#: read in the wrong unit is steady; a moving foot whose gyroscope reads too little is not).
+SCALE_STEADY = 0.25
+#: ... and its direction steady: the mean of its unit vectors at least this long (about 11° around their mean).
+SCALE_STEADY_DIRECTION = 0.98
 
 
 class SignalScan:
@@ -457,8 +463,13 @@ class EstimateScan:
       correction does not hold a standing foot.
     * **accelerometer scale** — the gyroscope is quiet (|ω| < :data:`STILL_GYR`) for
       :data:`SCALE_MIN_DURATION` s or longer while ‖f‖ stays outside [0.5 g, 1.5 g]: a foot that
-      does not turn does not fall or push at half or twice g for that long, so the accelerometer's
-      unit or scale is wrong there (e.g. a stream whose unit changed to g mid-way).
+      does not turn does not fall or push at half or twice g for that long, steadily (10th–90th
+      percentiles of ‖f‖ within :data:`SCALE_STEADY` of its level, its direction within about 11°:
+      :data:`SCALE_STEADY_DIRECTION`), so the accelerometer's unit or scale is wrong there (e.g. a
+      stream whose unit changed to g mid-way).
+    * **human gait** — the strides against the ranges of human gait, and the wrong rate or
+      gyroscope unit that explains them (:class:`~footzoo.core.plausibility.GaitScan`; the
+      gyroscope–accelerometer evidence of the rate comes with :meth:`use_evidence`).
 
     Findings are warned (:class:`~footzoo.core.errors.SensorWarning`, with the samples and the
     fix) as soon as they are known, and kept in :attr:`report`.
@@ -472,6 +483,7 @@ class EstimateScan:
         self._last: tuple[float, np.ndarray] | None = None
         self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
         self._off: tuple[int, float] | None = None  # a quiet run off g open at the chunk's end: (k, t)
+        self.gait = GaitScan(name, gravity)  # the strides against the ranges of human gait (core.plausibility)
 
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
              pos: np.ndarray) -> None:
@@ -481,6 +493,8 @@ class EstimateScan:
         # read-only views, whoever passes them (a batch run its recording's arrays, a stream its buffers):
         # the scan then needs one compiled variant, the one a wheel ships
         t, acc, gyr, ok = (_read_only(a, d) for a, d in ((t, float), (acc, float), (gyr, float), (stance, bool)))
+        self.gait.push(k, t, acc, gyr, ok, pos)
+        self._plausibility()
         still, off_g, stances, first = _quiet_runs(t, acc, gyr, ok, float(self.t_start), float(self.gravity))
         self._stance += stances
         if first >= 0 and self._first is None:
@@ -519,10 +533,18 @@ class EstimateScan:
         if not runs.shape[1] and self._off is None:
             return
         carried, self._off = self._off, None
+        slow = self.gait.report.get("gyro_unit", {}).get("sample")  # from there on the gyroscope reads too little
         for s, e in zip(runs[0].tolist(), runs[1].tolist(), strict=True):
             start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]))
+            if slow is not None and slow <= start[0]:
+                return  # its quiet says nothing of the foot: the gait scan named the gyroscope's unit
             if t[e - 1] - start[1] >= SCALE_MIN_DURATION:
-                level = float(np.median(row_norms(acc[s:e]) - self.gravity)) + self.gravity  # ‖f‖ there
+                norms = row_norms(acc[s:e])
+                level = float(np.median(norms - self.gravity)) + self.gravity  # ‖f‖ there
+                heading = np.linalg.norm(np.mean(acc[s:e] / np.maximum(norms, 1e-12)[:, None], axis=0))
+                if (np.percentile(norms, 90) - np.percentile(norms, 10) > SCALE_STEADY * level
+                        or heading < SCALE_STEADY_DIRECTION):
+                    continue  # f swings: a foot in motion whose gyroscope reads too little, not a scale
                 self._warn_scale(start, float(t[e - 1]), level)
                 return
             if e == len(t):  # open at the chunk's end: the next chunk may continue it
@@ -563,11 +585,23 @@ class EstimateScan:
             SensorWarning, stacklevel=5,
         )
 
+    def use_evidence(self, evidence: RateEvidence) -> None:
+        """Weigh the gyroscope–accelerometer evidence of the rate (a ConsistencyScan fed the same samples) in the
+        plausibility of the gait (:class:`~footzoo.core.plausibility.GaitScan`)."""
+        self.gait.use_evidence(evidence)
+        self._plausibility()
+
+    def _plausibility(self) -> None:
+        if self.gait.report:
+            self.report["plausibility"] = self.gait.report
+
     def finish(self) -> dict[str, Any]:
-        """End of the data: the still run open at the end, no stance at all; the findings."""
+        """End of the data: the still run open at the end, no stance at all, the gait's plausibility; the findings."""
         if self._run is not None:
             self._close(self._run)
             self._run = None
+        self.gait.finish()
+        self._plausibility()
         if self._first is not None and self._last is not None and self._stance == 0:
             duration = self._last[0] - self._first[0]
             if duration > NO_STANCE_MIN_DURATION:

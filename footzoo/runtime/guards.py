@@ -219,13 +219,20 @@ class StanceGuard(Settings):
         if not long:
             return
         total = sum(e - s for s, e in long)
+        if report["stances_added"]:  # the foot did come to rest there: the detector missed it
+            cause = (f"The stance guard marked {report['stances_added']} still instant(s) (|ω| ≤ {self.still_rate:g} "
+                     "rad/s) there as stance: the trajectory in those swings is suspect — the detector misses the "
+                     "stances of this motion (running?); choose one made for it, or switch the guard off with "
+                     "guards: {max_swing: 0}")
+        else:  # nor did the angular rate ever come to rest: no detector would find a stance there
+            cause = (f"The angular rate never fell to {self.still_rate:g} rad/s there either, so the guard marked no "
+                     "stance and the detector is not shown to be at fault: the foot did not come to rest (not a gait "
+                     "the zero-velocity methods follow, or a sensor not on the foot); the trajectory in those swings "
+                     "is strapdown drift")
         warnings.warn(
             f"{recording}: detector {detector!r} found no stance for {report['longest_swing']:.1f} s (longest of "
             f"{len(long)} swing(s) over max_swing = {self.max_swing:g} s, {total:.1f} s in all, the first from "
-            f"t = {long[0][0]:.2f} s). The stance guard marked {report['stances_added']} still instant(s) "
-            f"(|ω| ≤ {self.still_rate:g} rad/s) there as stance: the trajectory in those swings is suspect — the "
-            "detector misses the stances of this motion (running?); choose one made for it, or switch the guard off "
-            "with guards: {max_swing: 0}. Details in Result.diagnostics['guards']",
+            f"t = {long[0][0]:.2f} s). {cause}. Details in Result.diagnostics['guards']",
             GuardWarning, stacklevel=4,
         )
 

@@ -306,6 +306,7 @@ class Pipeline:
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
         axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
         axes.push_recording(rec.t, rec.acc, rec.gyr)
+        scan.use_evidence(axes)  # the gait's plausibility weighs the gyroscope-accelerometer evidence of the rate
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():
             sensor["consistency"] = axes.report

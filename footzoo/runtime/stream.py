@@ -399,6 +399,7 @@ class Stream:
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
         self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
         self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
+        self._estimates.use_evidence(self._axes)  # the gait's plausibility weighs the evidence of the rate
 
         def scan_final(k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
                        pos: np.ndarray) -> None:

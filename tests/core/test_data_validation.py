@@ -1,5 +1,7 @@
 """Every bad-input case gets an error that names the problem and the fix."""
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -81,6 +83,20 @@ def test_acc_in_g_is_recognised():
     with pytest.raises(RecordingError, match="looks like g.*acc_unit: g"):
         Recording.from_dataframe(frame(acc_scale=1 / 9.81))
     rec = Recording.from_dataframe(frame(acc_scale=1 / 9.81), acc_unit="g")
+    assert np.linalg.norm(rec.acc[0]) == pytest.approx(9.81, rel=0.01)
+
+
+@pytest.mark.parametrize("values, declared, real", [
+    (1.0, "g", "m/s^2"),  # m/s² declared as g: g reads 9.81 g = 96 m/s²
+    (1.0, "mg", "m/s^2"),  # ... as mg: 0.0098 g
+    (1 / 9.80665, "mg", "g"),  # g declared as mg: 0.001 g
+    (1000 / 9.80665, "g", "mg"),  # mg declared as g: 1000 g
+])
+def test_an_accelerometer_declared_in_another_unit_is_named_with_the_unit_that_reads_g(values, declared, real):
+    with pytest.raises(RecordingError, match=re.escape(f"this is what g reads in {real} declared as {declared}; "
+                                                       f"declare acc_unit: {real}")):
+        Recording.from_dataframe(frame(acc_scale=values), acc_unit=declared)
+    rec = Recording.from_dataframe(frame(acc_scale=values), acc_unit=real)  # the unit it names reads g
     assert np.linalg.norm(rec.acc[0]) == pytest.approx(9.81, rel=0.01)
 
 

@@ -202,3 +202,20 @@ def test_a_live_stream_guards_each_long_swing_once_it_has_ended_and_warns(sprint
     assert messages and "found no stance for" in messages[0] and "marked" in messages[0]
     np.testing.assert_array_equal(live["stance"], batch.stance)
     np.testing.assert_allclose(live["pos"], batch.pos, rtol=0, atol=1e-9)
+
+
+def test_a_long_swing_without_a_still_instant_does_not_blame_the_detector():
+    """The guard names the detector only when the data show the stances it missed (a still instant in the swing)."""
+    t = np.arange(0.0, 10.0, 0.01)
+    stance = t < 1.0  # the detector found the still start, then nothing
+    for rate, blamed in ((3.0, False), (0.5, True)):  # the foot turns at 3 rad/s throughout, or lies still
+        gyr = np.tile([0.0, rate, 0.0], (t.size, 1))
+        gyr[t < 1.0] = 0.0
+        guard = StanceGuard()
+        _, report = guard.apply(t, gyr, stance)
+        with pytest.warns(GuardWarning) as caught:
+            guard.warn(report, "fsm", "walk")
+        message = str(caught[0].message)
+        assert ("the detector misses the stances" in message) == blamed
+        assert ("the detector is not shown to be at fault" in message) == (not blamed)
+        assert (report["stances_added"] > 0) == blamed

@@ -1,0 +1,469 @@
+"""Is it human gait? A run's strides against the ranges of human gait, and the declaration that explains them.
+
+A wrong sampling rate passes every check of the signals themselves when no time stamp
+contradicts it: a 60 Hz walk declared as 120 Hz reads at twice its rate, every duration
+halves, every rotation the gyroscope integrates halves and every distance shrinks by about
+four (a double integral of the same accelerations over half the time). What betrays it is
+the gait the run estimates: strides of 0.17 m at 163 steps/min with 6 mm of foot clearance
+are what a walk of 0.7 m strides at 81 steps/min gives when read at twice its rate.
+
+:class:`GaitScan` is fed a run's final estimates (batch: once; live: chunk by chunk, by
+:class:`~footzoo.core.sanity.EstimateScan`) and measures every stride between the middles of
+two consecutive stances of the detector: its duration ``T`` (s), length ``L`` (m, horizontal),
+the foot's clearance ``h`` (m, the highest point of the swing above the first stance), the
+foot's rotation in the swing ``θ = ∫|ω| dt`` (rad) and its peak rate (rad/s). A declared rate
+``F`` times the real one (``F = 2``: read at twice its rate) changes them as ``T/F``, ``L/F²``,
+``h/F²``, ``θ/F``, cadence ``×F``, speed ``/F``; the angular rate the gyroscope measures does not
+change. Each hypothesis ``F`` of :data:`FACTORS` (and ``F = 1``, the declaration) is scored by
+how far the strides, with ``F`` undone, fall outside the ranges of human gait:
+
+========================  ===============  ====================================================
+quantity (``F`` undone)   range            source
+========================  ===============  ====================================================
+cadence (steps/min)       35–300           slow walking of the elderly (Murakami & Otaka 2017,
+                                           J Phys Ther Sci 29:722) to sprinting at 4.5–5 steps/s
+                                           (Weyand et al. 2000, J Appl Physiol 89:1991)
+stride length (m)         0.1–6            shuffling steps to elite sprint strides of
+                                           2 × 2.5–2.7 m (Weyand et al. 2000)
+speed (m/s)               0.05–12          a stroll to Bolt's 12.3 m/s peak
+foot clearance (m)        0.01–1           minimum toe clearance 1.3 cm in walking (Winter
+                                           1992, Phys Ther 72:45); the heel at the buttocks in
+                                           a sprint swing
+cadence vs speed          ≤ 150 + 15 v     walkers step at 95–160 steps/min (pedestrians:
+                                           Sato et al. via Murakami & Otaka 2017); runners
+                                           raise their cadence with speed, to 3.0 ± 0.2 steps/s
+                                           at 65–70 % of their top speed and 4.5–5 at the top
+                                           (Ae et al., PMC8523042; Weyand et al. 2000)
+rolling ratio L/θ (m/rad) 0.24–0.45        footzoo's measurement: the stride length per radian
+                                           the foot turns in its swing is 0.26–0.40 m/rad on
+                                           every walk and run of the data folder, 0.21–0.40
+                                           (median 0.34) on all 42 real recordings, crawling
+                                           and shuffling included (``benchmarks/relabel.md``)
+========================  ===============  ====================================================
+
+The cost of a hypothesis is the sum, over these quantities, of the squared distance outside
+the range in units of :data:`TOLERANCE` (25 %), each capped at :data:`CAP` (a run that is no
+gait at all — crawling, a pipeline whose detector missed most stances — cannot outvote the
+rest; a gait that no hypothesis brings within :data:`GAIT_INFORMATIVE` is no evidence at all),
+plus the gyroscope–accelerometer evidence of the rate
+(:meth:`footzoo.filters.consistency.ConsistencyScan.time_scales`: the swings integrated with the
+time scaled by ``F``, whose residual is lowest where the rate is right — on real recordings
+1.0–1.1 times the right scale, so the lowest residual within :data:`SCALE_WINDOW` of ``F``
+counts; its excess over the lowest in units of :data:`CONSISTENCY_TOLERANCE`, 30 %), plus
+:data:`PRIOR` for any hypothesis but the declared one. When the best hypothesis costs
+:data:`MARGIN` less than the declared rate, one :class:`~footzoo.core.errors.SensorWarning`
+names it, with the strides as declared and as corrected, the likely rate (the declared one
+divided by ``F``, rounded to a common rate of :data:`COMMON_RATES` within 3 %) and the fix.
+The gait alone never names a rate: a detector that splits or merges strides changes cadence and
+length as a wrong rate does (a four-stride walk with a badly tuned detector gave 0.03 m at 240
+steps/min), so a rate is named only if the residuals prefer it by :data:`SUPPORT`, and the factor
+named is the one, on that side of 1, whose residual is lowest (the gait's ranges tell that the
+rate is wrong more than by how much; they name 3 of the 42 real walks relabelled at ×2 that the
+residuals alone leave below the margin).
+As recorded, none of the 42 real recordings of the data folder is named, and none of 162
+simulated walks, runs and stairs at 50–200 Hz; relabelled at ×2, ×½ or ×1.5, 37, 36 and 35 of
+the 42 real ones are named with the real rate (``recommended``; ``benchmarks/relabel.md``), and
+479 of 486 simulated ones (9 scenarios at 50, 100 and 200 Hz, with and without noise, by three
+configs; the other 7, short slow strides at 50 Hz read at 1.5 times their rate, are named 60 Hz).
+
+A gyroscope in rad/s declared as deg/s reads 57.3 times too slow: the accelerometer shows a
+foot that moves (|‖f‖ − g| above :data:`MOTION_ACC` for :data:`MOTION_TIME` s) while the
+gyroscope never turns it (fewer than :data:`TURN_FRACTION` of those samples above
+:data:`TURN_RATE`); a moving foot turns at 5–20 rad/s. That is named too (and the rate is then
+not judged). An accelerometer in g or mg declared as m/s², or the reverse, and a gyroscope in
+deg/s declared as rad/s are refused when the recording is built
+(:func:`footzoo.core.data.check_units`).
+
+Findings are kept in ``Result.diagnostics["sensor"]["plausibility"]`` (and ``Stream.sensor``):
+the strides' medians as declared, the hypotheses' costs, ``rate_factor``, ``likely_rate``.
+Decided on the first :data:`CHECKPOINTS` strides as soon as they are measured (live) and on
+every stride at the end of the data: batch and live give the same finding.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any, Protocol
+
+import numpy as np
+
+from .conventions import GRAVITY
+from .errors import SensorWarning
+from .norms import row_norms
+
+#: Hypotheses of a wrong rate: the declared rate is ``F`` times the real one (2: read at twice its rate).
+FACTORS = (2.0, 1.5, 1.25, 1.2, 1.0 / 1.2, 0.8, 2.0 / 3.0, 0.5)
+#: Ranges of human gait (walking to sprinting) with ``F`` undone: cadence (steps/min), stride length (m), speed
+#: (m/s), foot clearance (m), rolling ratio (m/rad); see the module docstring for the sources.
+CADENCE_RANGE = (35.0, 300.0)
+STRIDE_LENGTH_RANGE = (0.1, 6.0)
+SPEED_RANGE = (0.05, 12.0)
+CLEARANCE_RANGE = (0.01, 1.0)
+ROLLING_RANGE = (0.24, 0.45)
+#: Highest cadence at a speed v (m/s): ``CADENCE_AT_REST + CADENCE_PER_SPEED * v`` steps/min.
+CADENCE_AT_REST = 150.0
+CADENCE_PER_SPEED = 15.0
+#: One unit of cost: a quantity 25 % outside its range costs 1 (squared: 2 units cost 4).
+TOLERANCE = math.log(1.25)
+#: Largest cost of one quantity (three units): a run that is no gait cannot outvote the rest.
+CAP = 9.0
+#: One unit of cost of the gyroscope-accelerometer evidence: a residual 30 % above the lowest.
+CONSISTENCY_TOLERANCE = math.log(1.3)
+#: The residual counted for a time scale is the lowest between these multiples of it (real recordings: lowest at
+#: 1.0–1.1× the right scale, 1.09 in the median over the 42 real recordings as recorded; a simulation: at it).
+SCALE_WINDOW = (0.98, 1.12)
+#: With the gyroscope-accelerometer evidence, a rate is named only if it lowers that evidence's cost by this much
+#: (the gait alone does not overrule residuals that do not depend on the time scale).
+SUPPORT = 1.0
+#: Cost of any declaration but the one made, and the margin by which another must win to be named.
+PRIOR = 2.0
+MARGIN = 4.0
+#: The gait is evidence only when some hypothesis (the declared one included) costs at most this.
+GAIT_INFORMATIVE = 4.0
+#: A second hypothesis within this cost of the best is named as the alternative.
+AMBIGUOUS = 2.0
+#: Fewest strides and swings the rate is judged on.
+MIN_STRIDES = 6
+MIN_SWINGS = 4
+#: The strides after which the rate is judged live (then at the end of the data on every stride measured).
+CHECKPOINTS = (12, 24, 48)
+#: Most strides measured (the scan's memory is bounded; a rate does not change within a recording).
+MAX_STRIDES = 256
+#: Longest stride, stance and swing (s) measured: a longer one is a pause or a missed stance.
+MAX_STRIDE_TIME = 4.0
+MAX_STANCE_TIME = 3.0
+#: Longest stretch (s) kept while waiting for the first stance to end (the memory of the scan is bounded).
+MAX_PENDING = 10.0
+#: Sampling rates of common IMUs (Hz): the likely rate is rounded to one of them (:data:`SNAP`).
+COMMON_RATES = (10.0, 12.5, 20.0, 25.0, 30.0, 40.0, 50.0, 60.0, 64.0, 100.0, 102.4, 104.0, 120.0, 125.0, 128.0,
+                200.0, 204.8, 208.0, 240.0, 250.0, 256.0, 400.0, 416.0, 500.0, 512.0, 800.0, 833.0, 1000.0, 1024.0,
+                1600.0, 2000.0)
+#: Largest relative distance from the rate ``declared / F`` to the common rate it is rounded to.
+SNAP = 0.03
+#: Gyroscope unit: a moving sample has |‖f‖ − g| above MOTION_ACC (m/s²); after MOTION_TIME (s) of them, fewer
+#: than TURN_FRACTION above TURN_RATE (rad/s) is a foot that does not turn.
+MOTION_ACC = 3.0
+MOTION_TIME = 2.0
+TURN_RATE = 1.0
+TURN_FRACTION = 0.01
+DEG = math.pi / 180.0
+
+_WORDS = {2.0: "twice", 1.5: "1.5 times", 1.25: "1.25 times", 1.2: "1.2 times", 1.0 / 1.2: "five sixths of",
+          0.8: "0.8 times", 2.0 / 3.0: "two thirds of", 0.5: "half"}
+
+
+class RateEvidence(Protocol):
+    """The gyroscope–accelerometer evidence of the rate (:class:`footzoo.filters.consistency.ConsistencyScan`)."""
+
+    rate: float  # the declared rate (Hz)
+
+    def ready(self, until: int) -> bool: ...
+
+    def time_scales(self, until: int | None = None) -> dict[str, Any] | None: ...
+
+
+def stride_summary(strides: np.ndarray) -> dict[str, float]:
+    """Medians of the strides (rows of :attr:`GaitScan.strides`), as declared: cadence, length, speed, ...
+
+    Returns
+    -------
+    dict
+        ``strides``, ``cadence_steps_min``, ``stride_length_m``, ``speed_m_s``, ``clearance_m``,
+        ``swing_time_s`` (the detector's swing), ``rotation_rad`` (∫|ω| dt over the swing),
+        ``rolling_m_rad`` (length per radian of rotation) and ``peak_rate_rad_s``.
+    """
+    T, L, h, rot, peak, swing = (strides[:, j] for j in range(6))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return {"strides": int(len(strides)), "cadence_steps_min": float(120.0 / np.median(T)),
+                "stride_length_m": float(np.median(L)), "speed_m_s": float(np.median(L / T)),
+                "clearance_m": float(np.median(h)), "swing_time_s": float(np.median(swing)),
+                "rotation_rad": float(np.median(rot)), "rolling_m_rad": float(np.median(L / np.maximum(rot, 1e-9))),
+                "peak_rate_rad_s": float(np.median(peak))}
+
+
+def _outside(x: float, lo: float, hi: float) -> float:
+    """Squared distance of ``x`` outside ``[lo, hi]`` in units of :data:`TOLERANCE`, capped at :data:`CAP`."""
+    if not (x > 0 and math.isfinite(x)):
+        return CAP
+    d = max(0.0, math.log(lo / x), math.log(x / hi)) / TOLERANCE
+    return min(CAP, d * d)
+
+
+def gait_costs(gait: dict[str, float], factor: float) -> dict[str, float]:
+    """The cost of each quantity of the strides ``gait`` (:func:`stride_summary`) with the factor ``factor`` undone."""
+    f = factor
+    cadence, speed = gait["cadence_steps_min"] / f, gait["speed_m_s"] * f
+    return {"cadence": _outside(cadence, *CADENCE_RANGE),
+            "stride_length": _outside(gait["stride_length_m"] * f * f, *STRIDE_LENGTH_RANGE),
+            "speed": _outside(speed, *SPEED_RANGE),
+            "clearance": _outside(gait["clearance_m"] * f * f, *CLEARANCE_RANGE),
+            "cadence_for_speed": _outside(cadence, 1.0, CADENCE_AT_REST + CADENCE_PER_SPEED * max(speed, 0.0)),
+            "rolling": _outside(gait["rolling_m_rad"] * f, *ROLLING_RANGE)}
+
+
+def consistency_cost(evidence: dict[str, Any] | None, factor: float) -> float:
+    """Cost of the time scale ``factor`` by the gyroscope–accelerometer residuals (0 without evidence).
+
+    The lowest residual between ``factor`` times the ends of :data:`SCALE_WINDOW` counts: on real
+    recordings the residual is lowest a little above the right time scale (1.09× it, the median over
+    the 42 real recordings as recorded), on a simulation at it.
+    """
+    if evidence is None:
+        return 0.0
+    scales, residual = np.log(evidence["scales"]), np.log(np.maximum(evidence["residual"], 1e-12))
+    order = np.argsort(scales)
+    around = math.log(factor) + np.append(np.linspace(math.log(SCALE_WINDOW[0]), math.log(SCALE_WINDOW[1]), 9), 0.0)
+    at = float(np.min(np.interp(around, scales[order], residual[order])))
+    return ((at - float(residual.min())) / CONSISTENCY_TOLERANCE) ** 2
+
+
+def likely_rate(declared: float, factor: float) -> float:
+    """The rate (Hz) a recording declared at ``declared`` Hz has if the declaration is ``factor`` times too high,
+    rounded to the nearest common rate of :data:`COMMON_RATES` within :data:`SNAP`."""
+    rate = declared / factor
+    near = min(COMMON_RATES, key=lambda r: abs(math.log(r / rate)))
+    return near if abs(math.log(near / rate)) <= math.log(1.0 + SNAP) else float(f"{rate:.4g}")
+
+
+def judge_rate(gait: dict[str, float] | None, evidence: dict[str, Any] | None) -> dict[str, Any]:
+    """Score the declared rate and each hypothesis of :data:`FACTORS`; the verdict (module docstring).
+
+    Parameters
+    ----------
+    gait : dict or None
+        :func:`stride_summary` of at least :data:`MIN_STRIDES` strides, or None.
+    evidence : dict or None
+        :meth:`~footzoo.filters.consistency.ConsistencyScan.time_scales` of at least :data:`MIN_SWINGS` swings, or None.
+
+    Returns
+    -------
+    dict
+        ``costs`` ({factor: cost}, 1 the declared rate), ``gait_informative``, ``factor`` (the named
+        factor of :data:`FACTORS`, or None: named when the declared rate costs :data:`MARGIN` more
+        than the best and the gyroscope–accelerometer residuals prefer that one by :data:`SUPPORT`;
+        the factor on its side of 1 whose residual is lowest), ``alternative`` (a second one almost
+        as likely, or None).
+    """
+    informative = gait is not None and min(sum(gait_costs(gait, f).values()) for f in (1.0, *FACTORS)) \
+        <= GAIT_INFORMATIVE
+
+    def cost(f: float) -> float:
+        c = consistency_cost(evidence, f) + (sum(gait_costs(gait, f).values()) if informative else 0.0)
+        return c + (0.0 if f == 1.0 else PRIOR)
+
+    costs = {f: cost(f) for f in (1.0, *FACTORS)}
+    best, out = min(FACTORS, key=costs.get), {"costs": costs, "gait_informative": informative, "factor": None,
+                                              "alternative": None}
+    if costs[1.0] - costs[best] < MARGIN or evidence is None:
+        return out  # the gait alone never names a rate: a detector that splits strides mimics one read too fast
+    fit = {f: consistency_cost(evidence, f) for f in (1.0, *FACTORS)}
+    if fit[1.0] - fit[best] < SUPPORT:
+        return out  # the gyroscope and the accelerometer do not prefer it
+    # which factor: the residuals, which depend on it directly (the gait's ranges tell that the rate is wrong)
+    order = sorted((f for f in FACTORS if (f > 1.0) == (best > 1.0)), key=lambda f: (fit[f], costs[f]))
+    out["factor"] = order[0]
+    if len(order) > 1 and fit[order[1]] - fit[order[0]] < AMBIGUOUS:
+        out["alternative"] = order[1]
+    return out
+
+
+class GaitScan:
+    """The strides of a run and their plausibility, fed its final estimates chunk by chunk (module docstring).
+
+    Parameters
+    ----------
+    name : str
+        The recording's name, for the warnings.
+    gravity : float
+        g (m/s²).
+    evidence : RateEvidence, optional
+        The gyroscope–accelerometer scan of the same samples (:meth:`use_evidence`).
+    """
+
+    def __init__(self, name: str = "recording", gravity: float = GRAVITY, evidence: RateEvidence | None = None):
+        self.name, self.gravity, self.evidence = name, gravity, evidence
+        self.report: dict[str, Any] = {}
+        self._rows: list[list[float]] = []  # per stride: T, L, h, rot, peak, swing, last sample, samples spanned
+        self._buf: dict[str, np.ndarray] | None = None
+        self._pending: list[int] | None = list(CHECKPOINTS)  # None once judged at the end
+        self._motion = [0.0, 0, 0]  # moving time (s), moving samples, of them turning
+        self._t_last: float | None = None
+
+    @property
+    def strides(self) -> np.ndarray:
+        """(n, 6): per stride T (s), L (m), h (m), θ (rad), peak |ω| (rad/s), the detector's swing (s)."""
+        return np.asarray(self._rows, dtype=float).reshape(-1, 8)[:, :6]
+
+    def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+             pos: np.ndarray) -> None:
+        """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m, NED)."""
+        if not len(t):
+            return
+        w = row_norms(gyr)
+        if "gyro_unit" not in self.report:
+            self._gyro_unit(np.asarray(k), t, acc, w)
+        if len(self._rows) >= MAX_STRIDES:
+            return  # every stride the scan judges is measured: the rest of the data changes nothing
+        new = {"k": np.asarray(k), "t": np.asarray(t, dtype=float), "w": w, "stance": np.asarray(stance, dtype=bool),
+               "pos": np.asarray(pos, dtype=float)}
+        self._buf = new if self._buf is None else {n: np.concatenate([self._buf[n], v]) for n, v in new.items()}
+        self._strides()
+        self._decide(final=False)
+
+    def use_evidence(self, evidence: RateEvidence) -> None:
+        """Weigh the gyroscope–accelerometer evidence of the rate (a ConsistencyScan fed the same samples)."""
+        self.evidence = evidence
+        self._decide(final=False)
+
+    def finish(self) -> dict[str, Any]:
+        """End of the data: judge what is still pending, then every stride measured; the finding (empty: none)."""
+        if self._pending is not None:
+            self._decide(final=True)
+            self._pending = None  # judged once
+        return self.report
+
+    # ------------------------------------------------------------------ strides
+    def _strides(self) -> None:
+        """Measure every stride whose two stances have ended; keep the samples from the last ended stance on
+        (vectorised over the strides of the chunk)."""
+        b = self._buf
+        t, w, pos, k = b["t"], b["w"], b["pos"], b["k"]
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], b["stance"].astype(np.int8), [0]])))
+        starts, ends = edges[::2], edges[1::2]
+        closed = ends < len(t)  # a stance still going on at the chunk's end has no middle yet
+        starts, ends = starts[closed], ends[closed]
+        if len(starts) >= 2:
+            a0, b0, a1, b1 = starts[:-1], ends[:-1], starts[1:], ends[1:]
+            m0, m1 = (a0 + b0 - 1) // 2, (a1 + b1 - 1) // 2
+            T, stance = t[m1] - t[m0], t[b0 - 1] - t[a0]
+            ok = np.flatnonzero((T <= MAX_STRIDE_TIME) & (stance <= MAX_STANCE_TIME))  # else a pause, a missed stance
+            ok = ok[:MAX_STRIDES - len(self._rows)]
+            if len(ok):
+                a0, b0, a1, m0, m1, T = a0[ok], b0[ok], a1[ok], m0[ok], m1[ok], T[ok]
+                # the swing of each stride: samples b0 - 1 .. a1 (the last stance sample to the first of the next)
+                swing = np.column_stack([b0 - 1, a1 + 1]).ravel()  # a1 + 1 <= b1 < len(t): closed stances
+                turned = np.concatenate([[0.0], np.cumsum(w[:-1] * np.diff(t))])  # ∫|ω| dt from the buffer's start
+                rows = np.column_stack([
+                    T, np.hypot(*(pos[m1, :2] - pos[m0, :2]).T),
+                    pos[m0, 2] - np.minimum.reduceat(pos[:, 2], swing)[::2], turned[a1] - turned[b0 - 1],
+                    np.maximum.reduceat(w, swing)[::2], t[a1] - t[b0 - 1], k[m1], k[m1] - k[m0]])
+                self._rows.extend(rows.tolist())
+        if len(starts) and t[-1] - t[(starts[-1] + ends[-1] - 1) // 2] <= MAX_STRIDE_TIME:
+            keep = int(starts[-1])  # the next stride starts at the middle of the last stance that ended
+        else:  # no stride can end in what follows (or no stance has ended yet): keep the stance going on, if any
+            moving = np.flatnonzero(~b["stance"])
+            keep = int(moving[-1]) + 1 if len(moving) else 0
+            if not len(starts) and t[-1] - t[0] <= MAX_PENDING:
+                keep = 0  # the first stance is still to end
+            keep = min(keep, len(t) - 1)
+        self._buf = {n: v[keep:] for n, v in b.items()}
+
+    # ------------------------------------------------------------------ gyroscope unit
+    def _gyro_unit(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, w: np.ndarray) -> None:
+        """Count the moving samples and how many of them turn; decide once MOTION_TIME s of motion are seen."""
+        dt = np.diff(t, prepend=t[0] if self._t_last is None else self._t_last)
+        self._t_last = float(t[-1])
+        moving = np.abs(row_norms(acc) - self.gravity) > MOTION_ACC
+        if not moving.any():
+            return
+        time = self._motion[0] + np.cumsum(np.where(moving, dt, 0.0))
+        reached = np.flatnonzero(time >= MOTION_TIME)
+        upto = int(reached[0]) + 1 if len(reached) else len(t)
+        count = self._motion[1] + int(np.count_nonzero(moving[:upto]))
+        turning = self._motion[2] + int(np.count_nonzero(moving[:upto] & (w[:upto] > TURN_RATE)))
+        self._motion = [float(time[upto - 1]), count, turning]
+        if not len(reached) or turning >= TURN_FRACTION * count:
+            return
+        peak = float(np.max(w[:upto][moving[:upto]])) if turning == count else float(np.max(w[:upto]))
+        self.report["gyro_unit"] = {"sample": int(k[upto - 1]), "moving_s": self._motion[0], "moving_samples": count,
+                                    "turning_samples": turning, "peak_rate_rad_s": peak,
+                                    "peak_if_rad_s": peak / DEG}
+        warnings.warn(
+            f"{self.name}: the accelerometer shows {self._motion[0]:.1f} s of motion (|‖f‖ − g| above "
+            f"{MOTION_ACC:g} m/s², {count} samples) but the gyroscope turns faster than {TURN_RATE:g} rad/s in "
+            f"only {turning} of them, at most {peak:.3g} rad/s: a moving foot turns at 5–20 rad/s. The gyroscope's "
+            f"values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} rad/s): declare "
+            "gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line --option gyr_unit=rad/s, "
+            "a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. Details in "
+            "diagnostics['sensor']['plausibility']",
+            SensorWarning, stacklevel=5,
+        )
+
+    # ------------------------------------------------------------------ the rate
+    def _decide(self, final: bool) -> None:
+        """Judge the rate at each checkpoint whose evidence is complete (all of them at the end, then every stride)."""
+        if self._pending is None or "rate" in self.report or "gyro_unit" in self.report or not (self._pending or final):
+            return
+        rows = np.asarray(self._rows, dtype=float).reshape(-1, 8)
+        while self._pending and len(rows) >= self._pending[0]:
+            m = self._pending[0]
+            until = int(rows[m - 1, 6])
+            if not final and self.evidence is not None and not self.evidence.ready(until):
+                return  # the gyroscope-accelerometer scan has not measured these strides' swings yet
+            if not final and self.evidence is None:
+                return  # batch: the evidence comes with finish()
+            self._pending.pop(0)
+            if self._judge(rows[:m], until):
+                return
+        if final:  # every stride, or the gyroscope-accelerometer evidence alone when the detector found too few
+            self._judge(rows, int(rows[-1, 6]) if len(rows) >= MIN_STRIDES else None)
+
+    def _judge(self, rows: np.ndarray, until: int | None) -> bool:
+        """Judge the rate on the strides ``rows`` and the swings ending by sample ``until`` (None: every stride and
+        swing; the strides are then too few to count); warn if a rate is named."""
+        gait = stride_summary(rows[:, :6]) if until is not None else None
+        evidence = self.evidence.time_scales(until) if self.evidence is not None else None
+        if evidence is not None and evidence["swings"] < MIN_SWINGS:
+            evidence = None
+        if gait is None and evidence is None:
+            return False
+        verdict = judge_rate(gait, evidence)
+        factor = verdict["factor"]
+        if factor is None:
+            return False
+        # the declared rate: the gyroscope-accelerometer scan's (the run's), else samples per second over the strides
+        declared = float(getattr(self.evidence, "rate", 0.0)) or float(np.sum(rows[:, 7]) / np.sum(rows[:, 0]))
+        likely = likely_rate(declared, factor)
+        factor = declared / likely  # the factor to the rounded rate
+        finding = {"cause": f"the rate is declared {factor:.3g} times the real one", "rate_factor": factor,
+                   "declared_rate": declared, "likely_rate": likely, "strides": gait, "until_sample": until,
+                   "costs": {f"{f:.3g}": c for f, c in verdict["costs"].items()},
+                   "gait_informative": verdict["gait_informative"]}
+        if verdict["alternative"] is not None:
+            finding["alternative_rate"] = likely_rate(declared, verdict["alternative"])
+        if evidence is not None:
+            finding["time_scale_residual"] = {f"{s:.3g}": float(r) for s, r in zip(evidence["scales"],
+                                                                                   evidence["residual"], strict=True)}
+        self.report["rate"] = finding
+        warnings.warn(self._message(finding, evidence, verdict), SensorWarning, stacklevel=6)
+        return True
+
+    def _message(self, finding: dict[str, Any], evidence: dict[str, Any] | None, verdict: dict[str, Any]) -> str:
+        f, g = finding["rate_factor"], finding["strides"] or {}
+        likely, declared = finding["likely_rate"], finding["declared_rate"]
+        words = next((w for k, w in _WORDS.items() if abs(math.log(f / k)) < 0.02), f"{f:.3g} times")
+        kind = "run" if g and g["cadence_steps_min"] / f > 140.0 and g["speed_m_s"] * f > 2.0 else "walk"
+        parts = []
+        if g and verdict["gait_informative"]:
+            parts.append(
+                f"strides of {g['stride_length_m']:.2f} m at {g['cadence_steps_min']:.0f} steps/min, "
+                f"{g['clearance_m'] * 1e3:.0f} mm of foot clearance and {g['rolling_m_rad']:.2f} m per radian the "
+                f"foot turns are what a {kind} of {g['stride_length_m'] * f * f:.2f} m strides at "
+                f"{g['cadence_steps_min'] / f:.0f} steps/min gives when read at {words} its rate")
+        if evidence is not None:
+            residual = dict(zip(evidence["scales"].tolist(), evidence["residual"].tolist(), strict=True))
+            at = float(np.exp(np.interp(math.log(f), np.log(sorted(residual)),
+                                        np.log([residual[s] for s in sorted(residual)]))))
+            parts.append(
+                f"the gyroscope and the accelerometer agree best with the time scaled by about {f:.3g}: integrated "
+                f"over {evidence['swings']} swings, the gyroscope's attitude leaves a speed of {residual[1.0]:.2f} g "
+                f"× the swing's duration where the foot stops as declared, and {at:.2f} with the time × {f:.3g}")
+        also = (f" (or {finding['alternative_rate']:g} Hz)" if "alternative_rate" in finding else "")
+        return (
+            f"{self.name}: {'; '.join(parts)}. The recording is probably sampled at {likely:g} Hz{also}, not "
+            f"{declared:.4g} Hz: every duration is off by {f:.3g}× and every distance by about {f * f:.3g}×. Declare "
+            f"the real rate (a sidecar's time: {{rate: {likely:g}}}; --option rate={likely:g} or "
+            f"footzoo.load(path, rate={likely:g}) where the reader has a rate option), or, with a time column, fix "
+            f"its unit or scale (t × {f:.3g}); the run's other findings (swings without a stance, drift, the "
+            "mounting) may follow from it. Details in diagnostics['sensor']['plausibility']")

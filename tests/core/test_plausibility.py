@@ -1,0 +1,141 @@
+"""The gait against the ranges of human gait (footzoo.core.plausibility): a wrong rate or gyroscope unit named once,
+with its fix, batch and live."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from footzoo import Pipeline
+from footzoo.core.data import Recording
+from footzoo.core.errors import SensorWarning
+from footzoo.core.plausibility import MARGIN, judge_rate, likely_rate
+from footzoo.runtime.stream import Stream
+from footzoo.sim import NoiseModel, simulate
+
+BASE = {"name": "physics", "orientation": {"type": "madgwick", "use_magnetometer": False},
+        "detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
+#: The medians of a walk as footzoo measures it (PyShoe's 2017-11-22 walks: 1.0–1.4 m at 85–115 steps/min, about
+#: 0.1 m of clearance, 0.29–0.40 m per radian the foot turns).
+WALK = {"strides": 20, "cadence_steps_min": 105.0, "stride_length_m": 1.3, "speed_m_s": 1.14, "clearance_m": 0.11,
+        "swing_time_s": 0.8, "rotation_rad": 3.7, "rolling_m_rad": 0.35, "peak_rate_rad_s": 9.0}
+
+
+def relabelled(gait: dict[str, float], f: float) -> dict[str, float]:
+    """The walk read at ``f`` times its rate, by the laws of the module docstring: durations / f, rotations / f,
+    lengths / f² (a double integral), the measured angular rate unchanged."""
+    return {**gait, "cadence_steps_min": gait["cadence_steps_min"] * f,
+            "stride_length_m": gait["stride_length_m"] / f**2,
+            "speed_m_s": gait["speed_m_s"] / f, "clearance_m": gait["clearance_m"] / f**2,
+            "swing_time_s": gait["swing_time_s"] / f, "rotation_rad": gait["rotation_rad"] / f,
+            "rolling_m_rad": gait["rolling_m_rad"] / f}
+
+
+def evidence(lowest: float) -> dict[str, object]:
+    """Gyroscope-accelerometer residuals lowest at the time scale ``lowest``: 0.08 there, ×6 per doubling away (PyShoe's
+    walks: 0.06–0.13 at the right scale, 3–4 times that at 1.5 times it, 3–14 at twice or half of it)."""
+    scales = np.array([1.0, *(2.0 ** (k / 8.0) for k in range(-8, 9) if k)])
+    return {"scales": scales, "residual": 0.08 * 6.0 ** np.abs(np.log2(scales / lowest)), "swings": 20}
+
+
+def _sensor_warnings(fn):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = fn()
+    return out, [str(w.message) for w in caught if issubclass(w.category, SensorWarning)]
+
+
+# --------------------------------------------------------------------------- the verdict, from numbers
+def test_a_walk_as_declared_costs_nothing_and_is_not_named():
+    verdict = judge_rate(WALK, evidence(1.0))
+    assert verdict["factor"] is None and verdict["costs"][1.0] == 0.0
+
+
+#: The issue's walk: 0.7 m strides at 81 steps/min read at twice its rate (0.17 m at 163 steps/min, 6 mm of clearance).
+ISSUE = relabelled({**WALK, "cadence_steps_min": 81.5, "stride_length_m": 0.7, "speed_m_s": 0.48, "clearance_m": 0.025,
+                    "rolling_m_rad": 0.3}, 2.0)
+
+
+def test_the_gait_alone_names_no_rate():
+    # outside the ranges of human gait, but a detector that splits every stride in two looks the same
+    verdict = judge_rate(ISSUE, None)
+    assert verdict["factor"] is None and verdict["costs"][1.0] - verdict["costs"][2.0] >= MARGIN
+
+
+def test_the_gait_tips_residuals_too_shallow_to_name_a_rate_alone():
+    shallow = {**evidence(2.0), "residual": 0.08 * 1.5 ** np.abs(np.log2(evidence(2.0)["scales"] / 2.0))}
+    assert judge_rate(WALK, shallow)["factor"] is None  # a human gait as declared: the residuals are not enough
+    assert judge_rate(ISSUE, shallow)["factor"] == 2.0  # the issue's gait outside the human ranges: named
+
+
+def test_a_walk_within_the_ranges_of_human_gait_at_either_rate_is_named_by_its_residuals():
+    # 158 steps/min, 0.58 m strides: a quick short-stepped walk, humanly possible (and so is 105 at 1.3 m)
+    assert judge_rate(relabelled(WALK, 1.5), evidence(1.0))["factor"] is None
+    assert judge_rate(relabelled(WALK, 1.5), evidence(1.5))["factor"] == 1.5
+
+
+@pytest.mark.parametrize("f", [2.0, 0.5, 1.5, 2.0 / 3.0])
+def test_with_the_gyroscope_and_the_accelerometer_each_factor_is_named(f):
+    assert judge_rate(relabelled(WALK, f), evidence(f))["factor"] == f
+
+
+def test_residuals_that_prefer_the_declared_rate_overrule_the_gait():
+    assert judge_rate(ISSUE, evidence(1.0))["factor"] is None
+
+
+def test_a_gait_that_no_rate_makes_human_is_no_evidence():
+    crawl = {**WALK, "stride_length_m": 0.004, "speed_m_s": 0.004, "clearance_m": 0.0, "rolling_m_rad": 0.02}
+    verdict = judge_rate(crawl, None)
+    assert not verdict["gait_informative"] and verdict["factor"] is None
+
+
+def test_the_likely_rate_is_a_common_rate_when_one_is_near():
+    assert likely_rate(400.2, 2.0) == 200.0 and likely_rate(120.0, 2.0) == 60.0
+    assert likely_rate(409.6, 2.0) == 204.8 and likely_rate(240.0, 1.2) == 200.0
+    assert likely_rate(100.0, 1.5) == pytest.approx(66.67)  # 64 Hz is 4 % away: not rounded to it
+
+
+# --------------------------------------------------------------------------- simulated walks, batch and live
+@pytest.fixture(scope="module")
+def walk() -> Recording:
+    return simulate("rectangle", n_strides=24, rate=100.0, noise=NoiseModel(seed=4))
+
+
+@pytest.mark.parametrize("f, stamps", [(2.0, True), (1.5, True), (0.5, False)])
+def test_a_walk_read_at_the_wrong_rate_is_named_once_with_the_real_rate_batch_and_live(walk, f, stamps):
+    t = walk.t / f if stamps else np.arange(walk.n) / (100.0 * f)  # without time stamps: only the declared rate
+    rec = Recording(t=t, acc=walk.acc, gyr=walk.gyr, meta={"name": "relabelled"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["rate"]
+    assert finding["likely_rate"] == 100.0 and finding["rate_factor"] == pytest.approx(f, rel=0.01)
+    declared = f"{100.0 * f:.4g}"
+    assert len(found) == 1 and f"probably sampled at 100 Hz, not {declared} Hz" in found[0], found
+    assert "time: {rate: 100}" in found[0] and "--option rate=100" in found[0]
+    assert finding["strides"]["cadence_steps_min"] == pytest.approx(120.0 * f, rel=0.02)  # the simulator's 120
+    stream = Stream(Pipeline.from_dict(BASE), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([1, 23, 7, 64])))
+    online = stream.sensor["plausibility"]["rate"]
+    assert (online["likely_rate"], online["until_sample"]) == (finding["likely_rate"], finding["until_sample"])
+    assert len(live) == 1 and "probably sampled at 100 Hz" in live[0]
+
+
+def test_the_same_walk_at_its_real_rate_is_not_named(walk):
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(walk))
+    assert "plausibility" not in res.diagnostics["sensor"] and not found
+
+
+def test_a_gyroscope_in_rad_s_declared_as_deg_s_is_named_batch_and_live(walk):
+    rec = Recording(t=walk.t, acc=walk.acc, gyr=walk.gyr * math.pi / 180.0, meta={"name": "deg"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["gyro_unit"]
+    assert finding["turning_samples"] == 0 and finding["peak_if_rad_s"] == pytest.approx(
+        np.abs(walk.gyr).max() * math.sqrt(3), rel=0.8)  # read as rad/s, a walking foot's rate
+    assert len(found) == 1 and "look like rad/s declared as deg/s" in found[0] and "gyr_unit: rad/s" in found[0]
+    assert "acc_scale" not in res.diagnostics["sensor"]  # the quiet gyroscope says nothing of the accelerometer
+    stream = Stream(Pipeline.from_dict(BASE), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([5, 40])))
+    assert stream.sensor["plausibility"]["gyro_unit"]["sample"] == finding["sample"]
+    assert len(live) == 1
