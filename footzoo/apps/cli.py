@@ -117,6 +117,42 @@ def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
     return parse
 
 
+def _jobs(text: str) -> int:
+    """An argparse ``type`` for ``--jobs``: -1 (every core) or 1 up to a few per core of this machine."""
+    from ..studies.study import check_jobs
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    try:
+        return check_jobs(value, text)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _biases(text: str) -> tuple[str, ...]:
+    """An argparse ``type`` for ``--biases``: ``none`` or a comma-separated subset of acc, gyr, mag."""
+    if text.strip() in ("", "none"):
+        return ()
+    names = tuple(b.strip() for b in text.split(","))
+    unknown = [b for b in names if b not in ("acc", "gyr", "mag")]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"{', '.join(map(repr, unknown))}: unknown bias; give a comma-separated "
+                                         "list of acc, gyr, mag (e.g. acc,gyr), or none")
+    return names
+
+
+def _scheduler(text: str) -> str:
+    """An argparse ``type`` for ``--scheduler``: a Dask scheduler's address, checked before any work."""
+    from ..studies.runner import check_scheduler
+
+    try:
+        return check_scheduler(text)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
 def _writable_dir(path: str, option: str = "--out") -> Path:
     """Create ``path`` if needed and check it is a writable directory, before any work is done."""
     out = Path(path)
@@ -197,6 +233,13 @@ def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
     return files
 
 
+def _locked(folder: Path, owner: str):
+    """The output folder's lock for this command (another footzoo process writing into it is refused)."""
+    from ..core.atomic import folder_lock
+
+    return folder_lock(folder, "--out", owner)
+
+
 def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], option: str = "--out") -> None:
     """Refuse, before the run, an output folder whose files would replace an input."""
     from ..core.atomic import refuse_inputs
@@ -204,15 +247,22 @@ def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], opti
     refuse_inputs([folder / n for n in names], inputs, option)
 
 
-def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list[str]:
-    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) and optionally the figures."""
-    folder = result.save(out, backend="csv", inputs=inputs)
-    written = sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS)
-    if plot:
-        from ..evaluation.plots import plot_run
+def _figures(result, rec) -> dict[str, bytes]:
+    """The run's figures (``--plot``) as PNG files in memory: saved with the result, as one unit."""
+    from ..evaluation.plots import png_bytes, run_figures
 
-        written += [p.name for p in plot_run(result, out, rec)]
-    return written
+    return {name: png_bytes(fig) for name, fig in run_figures(result, rec).items()}
+
+
+def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list[str]:
+    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) with the figures (``--plot``).
+
+    One commit: the manifest is written last, and the figures of an earlier run into the folder
+    that this one does not draw are removed with it (they belong to the earlier result).
+    """
+    figures = _figures(result, rec) if plot else {}
+    folder = result.save(out, backend="csv", inputs=inputs, files=figures)
+    return sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS) + sorted(figures)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -224,6 +274,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.plot and out is None:
         print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
         return 2
+    if out is None:
+        return _run(args, pipeline, None)
+    data = Path(args.data).name if args.data else "the built-in sample"
+    with _locked(out, f"footzoo run {Path(args.config).name} on {data}"):
+        return _run(args, pipeline, out)
+
+
+def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
+    """:func:`cmd_run` once its output folder (if any) is locked."""
     if _two_feet(args):
         return _run_session(args, pipeline)
     with warnings.catch_warnings(record=True) as caught:
@@ -327,13 +386,10 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
     if args.out is not None:
         out = Path(args.out)
-        res.save(out, backend="csv", inputs=inputs)
+        figures = {foot: _figures(r, session.recordings[foot]) for foot, r in res.results.items()} if args.plot else {}
+        res.save(out, backend="csv", inputs=inputs, files=figures)
         written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
-        if args.plot:
-            from ..evaluation.plots import plot_run
-
-            for foot, r in res.results.items():
-                plot_run(r, out / foot, session.recordings[foot])
+        written += sorted(next(iter(figures.values()), {}))
         write_log(out, texts, inputs)
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "
               f"{out} (footzoo.SessionResult.load({str(out)!r}) reads it back)")
@@ -419,8 +475,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     )
 
     check_output(_writable_file(args.out))
-    biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
-    noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
+    noise = NoiseModel(scale=args.noise_scale, biases=args.biases, seed=args.seed)
     if args.scenario == "pendulum":
         rec = simulate_pendulum(rate=args.rate, noise=noise, sampling=args.sampling)
     elif args.scenario == "calibration":
@@ -652,8 +707,10 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
     sim.add_argument("--noise-scale", type=_number(0.0, 1000.0), default=1.0,
                      help="factor on Table II noise σ (default 1)")
-    sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
-    sim.add_argument("--seed", type=int, default=0)
+    sim.add_argument("--biases", type=_biases, default=("acc", "gyr", "mag"),
+                     help="Table II biases to include, comma-separated: acc,gyr,mag (default), or none")
+    sim.add_argument("--seed", type=_number(0, 2**63 - 1, integer=True), default=0,
+                     help="seed of the noise (a whole number >= 0; default 0)")
     sim.add_argument("--fpa", type=_number(-90.0, 90.0, "deg"), default=0.0,
                      help="foot progression angle in deg (toe-out +)")
     sim.add_argument("--mount-yaw", type=_number(-180.0, 180.0, "deg"), default=0.0,
@@ -681,12 +738,14 @@ def build_parser() -> argparse.ArgumentParser:
     abl = sub.add_parser("ablate", aliases=["study"],
                          help="run an ablation study (configs x recordings) and write tables and plots")
     abl.add_argument("study", type=_input_yaml, help="study YAML, e.g. study_quick")
-    abl.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores (default: the "
+    abl.add_argument("--jobs", type=_jobs, help="local worker processes (joblib); -1 = all cores (default: the "
                      "study's jobs, else 1)")
     abl.add_argument("--max-cells", type=_number(1, 1e15, integer=True), metavar="N",
                      help="allow a grid of up to N runs (default: the study's max_cells, else 10000)")
-    abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
+    abl.add_argument("--scheduler", type=_scheduler,
+                     help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    abl.add_argument("--out", type=_output,
+                     help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
     abl.add_argument("--prune-cache", action="store_true",
                      help="remove every cache entry this study did not use (other studies' runs in the same --out)")
@@ -700,8 +759,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "with a tune: block) and write it as a config")
     tun.add_argument("study", type=_input_yaml,
                      help="tune YAML: a study file with a tune: block (objective, search, group_by)")
-    tun.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores")
-    tun.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    tun.add_argument("--jobs", type=_jobs, help="local worker processes (joblib); -1 = all cores")
+    tun.add_argument("--scheduler", type=_scheduler,
+                     help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     tun.add_argument("--out", type=_output, help="output folder (default: tune_<file>): cache/, tune_folds.csv, "
                      "tune_scores.csv, best.yaml")
     tun.add_argument("--config", type=_output, help="write the chosen config here (default: the tune block's "
@@ -753,14 +813,36 @@ def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]
     return SubParser
 
 
+#: Extensions of YAML files (configs, studies) and of recordings, to recognise arguments given in the wrong place.
+YAML_SUFFIXES = (".yaml", ".yml")
+
+
+def _swap_hint(args: argparse.Namespace, extras: list[str]) -> str:
+    """The fix for arguments in the wrong place (``footzoo run walk.csv config.yaml``), or ``""``."""
+    from ..core.yamlsafe import RECORDING_SUFFIXES
+
+    yaml_extra = next((e for e in extras if Path(e).suffix.lower() in YAML_SUFFIXES), None)
+    given = getattr(args, "config", None) or getattr(args, "study", None)
+    if args.command == "run" and yaml_extra and given and Path(given).suffix.lower() in RECORDING_SUFFIXES:
+        return (f"; the config comes first and the recording after --data (swapped?): footzoo run {yaml_extra} "
+                f"--data {given}")
+    data = next((e for e in extras if Path(e).suffix.lower() in RECORDING_SUFFIXES), None)
+    if args.command == "run" and data:
+        return f"; a recording goes after --data: footzoo run {given or 'CONFIG'} --data {data}"
+    return ""
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     print(f"footzoo: warning: {message}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    parser = build_parser()
     try:
-        args = build_parser().parse_args(argv)
+        args, extras = parser.parse_known_args(argv)
+        if extras:
+            parser.error(f"unrecognized arguments: {' '.join(extras)}{_swap_hint(args, extras)}")
     except SystemExit as stop:  # --help (0) or a usage error (2, message already printed)
         return int(stop.code) if isinstance(stop.code, int) else EXIT_USAGE
     debug = bool(getattr(args, "debug", False))

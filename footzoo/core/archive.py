@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .atomic import FileGroup, dumps_json
+from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, previous_marker
 from .errors import FootzooWarning, FormatError, OutputError
 
 FORMAT = "footzoo-result"
@@ -300,14 +300,11 @@ class _Unpacker:
 # --------------------------------------------------------------------------- result archives
 
 def _earlier_files(folder: Path, kind: str) -> set[str] | None:
-    """The files an earlier footzoo archive in ``folder`` wrote (None when there is none)."""
-    manifest = folder / MANIFEST
-    if not manifest.is_file():
-        return None
-    try:
-        data = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
+    """The files an earlier footzoo archive in ``folder`` wrote (None when there is none).
+
+    Read from its manifest, or from the manifest an interrupted save set aside (:data:`INCOMPLETE`).
+    """
+    data = previous_marker(folder, MANIFEST)
     if not isinstance(data, dict) or data.get("format") not in (FORMAT, SESSION_FORMAT):
         return None
     return {str(f) for f in data.get("files", {})} | {MANIFEST}
@@ -445,7 +442,20 @@ FILE_SUFFIXES = (".csv", ".tsv", ".txt", ".json", ".parquet", ".pq", ".xlsx", ".
                  ".hdf5", ".zip", ".pkl", ".pickle")
 
 
-def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+def _extra_files(group: FileGroup, folder: Path, files: dict[str, bytes] | None) -> dict[str, Any]:
+    """Write the extra files of a save (figures: name -> content) into the group; their manifest entries."""
+    out: dict[str, Any] = {}
+    for name, content in (files or {}).items():
+        if not isinstance(name, str) or Path(name).name != name or name in (MANIFEST, INCOMPLETE):
+            raise OutputError(f"files: {name!r} is not a plain file name for the archive's folder")
+        with group.open(folder / name, "wb") as fh:
+            fh.write(content)
+        out[name] = {"holds": "written with the result (a figure of the run)", "kind": "file"}
+    return out
+
+
+def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+                files: dict[str, bytes] | None = None) -> Path:
     """Write ``result`` as a result archive folder (see the module doc); returns the folder.
 
     Parameters
@@ -459,6 +469,10 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     inputs : iterable of paths
         Files besides the recording's own (``result.recording["input_files"]``) that must not be
         replaced (the config file, for instance).
+    files : dict of str to bytes, optional
+        More files written with the archive, in the same commit, and listed in its manifest (the
+        figures of ``footzoo run --plot``): a later save without them removes them, so a folder
+        never keeps an earlier run's figures beside a newer result.
 
     Raises
     ------
@@ -474,12 +488,13 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
                           f"{str(Path(path).with_suffix(''))!r}). To export one table: result.samples.to_csv(...)")
     with _new_folder(path, what) as folder:
         earlier = _earlier_files(folder, FORMAT)
-        with FileGroup(inputs=_inputs(result, inputs), what=what) as group:
-            files = _result_files(result, folder, group, backend)
-            _refuse_foreign(folder, set(files) | {MANIFEST}, earlier, what)
+        with FileGroup(inputs=_inputs(result, inputs), what=what, marker=folder / MANIFEST) as group:
+            written = _result_files(result, folder, group, backend)
+            written.update(_extra_files(group, folder, files))
+            _refuse_foreign(folder, set(written) | {MANIFEST}, earlier, what)
             with group.open(folder / MANIFEST) as fh:
-                fh.write(_manifest(FORMAT, backend, files))
-            _commit(folder, group, files, earlier)
+                fh.write(_manifest(FORMAT, backend, written))
+            _commit(folder, group, written, earlier)
     return folder
 
 
@@ -488,8 +503,7 @@ def _read_manifest(folder: Path, kind: str) -> dict[str, Any]:
     if not folder.is_dir():
         raise FormatError(f"{str(folder)!r} is not a folder; {what} is loaded from the folder Result.save wrote")
     manifest = folder / MANIFEST
-    if not manifest.is_file():
-        raise FormatError(f"{str(folder)!r} holds no {MANIFEST}: it is not {what} saved by footzoo")
+    check_complete(folder, MANIFEST, what)
     try:
         data = json.loads(manifest.read_text(encoding="utf-8"))
     except (OSError, ValueError) as err:
@@ -558,19 +572,25 @@ def load_result(path: str | os.PathLike) -> Any:
                           f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
 
 
-def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+                 files: dict[str, dict[str, bytes]] | None = None) -> Path:
     """Write a :class:`~footzoo.runtime.session.SessionResult` as a folder: one result folder per foot
-    (``left/``, ``right/``), the combined stride table and the bilateral table (both recomputed on load)."""
+    (``left/``, ``right/``), the combined stride table and the bilateral table (both recomputed on load).
+
+    ``files``: per foot, more files written into its folder with the archive (as :func:`save_result`'s).
+    """
     backend = _backend(backend)
     what = "SessionResult.save"
     all_inputs = [i for r in session.results.values() for i in _inputs(r, ())] + [str(i) for i in inputs]
-    with _new_folder(path, what) as folder, FileGroup(inputs=all_inputs, what=what) as group:
+    with _new_folder(path, what) as folder, \
+            FileGroup(inputs=all_inputs, what=what, marker=Path(path) / MANIFEST) as group:
         earlier = _earlier_files(folder, SESSION_FORMAT)
-        files: dict[str, Any] = {}
+        files, extra = {}, files or {}
         for foot, result in session.results.items():
             sub = folder / foot
             sub.mkdir(exist_ok=True)
             own = _result_files(result, sub, group, backend)
+            own.update(_extra_files(group, sub, extra.get(foot)))
             with group.open(sub / MANIFEST) as fh:
                 fh.write(_manifest(FORMAT, backend, own, foot=foot))
             files.update({f"{foot}/{name}": info for name, info in own.items()})

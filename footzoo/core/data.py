@@ -365,7 +365,11 @@ def _floats(name: str, value: Any) -> np.ndarray:
 
 def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
     def get(cols: list[str]) -> np.ndarray | None:
-        return df[cols].to_numpy(dtype=float) if all(c in df.columns for c in cols) else None
+        found = [c for c in cols if c in df.columns]
+        if found and len(found) < len(cols):  # a reference that lost a column would be dropped without a word
+            raise RecordingError(f"reference columns incomplete: found {found}, need all of {cols}; add the missing "
+                                 "one(s) or drop these")
+        return df[cols].to_numpy(dtype=float) if found else None
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
     stance = None
@@ -674,12 +678,14 @@ class Result:
         t = self.samples["t"].to_numpy()
         return result_metrics_checked(t, self.pos, self.steps, self.reference)
 
-    def save(self, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+    def save(self, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+             files: dict[str, bytes] | None = None) -> Path:
         """Save as a folder: tables, metrics, config, versions, metadata, diagnostics and the reference.
 
-        Lossless and self-describing (a ``manifest.json`` says what each file holds); Parquet tables
-        when pyarrow is installed, CSV + JSON otherwise; written atomically, never over an input
-        (see :mod:`footzoo.core.archive`).
+        Lossless and self-describing (a ``manifest.json`` says what each file holds, written last:
+        a folder without it, or with ``.footzoo-incomplete``, is refused by :meth:`load` as
+        incomplete); Parquet tables when pyarrow is installed, CSV + JSON otherwise; written
+        atomically, never over an input (see :mod:`footzoo.core.archive`).
 
         Parameters
         ----------
@@ -689,6 +695,9 @@ class Result:
             Table format.
         inputs : iterable of paths
             Further files that must not be replaced (the recording's own are known).
+        files : dict of str to bytes, optional
+            More files saved with the result and listed in its manifest (figures: file name ->
+            content); a later save without them removes them.
 
         Returns
         -------
@@ -697,7 +706,7 @@ class Result:
         """
         from .archive import save_result
 
-        return save_result(self, path, backend=backend, inputs=inputs)
+        return save_result(self, path, backend=backend, inputs=inputs, files=files)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Result:

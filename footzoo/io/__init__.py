@@ -35,6 +35,7 @@ import numpy as np
 
 from ..core.data import Recording
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError
+from ..core.files import why_missing
 from .axes import parse_axes
 from .base import REQUIRED, Option, Reader
 from .metadata import read_facts
@@ -70,7 +71,9 @@ def check_input_file(path: str | Path, what: str = "recording") -> Path:
     p = Path(path)
     try:
         if not p.exists():
-            raise FormatError(f"{what} {str(p)!r}: no such file; check the path")
+            problem = why_missing(p)
+            raise FormatError(f"{what} {str(p)!r}: no such file; check the path" if problem == "does not exist"
+                              else f"{what} {str(p)!r} {problem}")
         if p.is_dir():
             raise FormatError(f"{what} {str(p)!r} is a directory; give the path of a recording file inside it")
         if not p.is_file():

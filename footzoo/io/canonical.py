@@ -23,8 +23,8 @@ import pandas as pd
 
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
-from ..core.data import Recording, Truth
-from ..core.errors import FootzooWarning, FormatError, OutputError
+from ..core.data import ACC_COLS, GYR_COLS, MAG_COLS, TRUTH_POS_COLS, TRUTH_QUAT_COLS, TRUTH_VEL_COLS, Recording, Truth
+from ..core.errors import FootzooWarning, FormatError, OutputError, did_you_mean
 from .axes import describe_axes, parse_axes, rotate_columns
 from .base import (
     RECORDING_OPTIONS,
@@ -76,9 +76,12 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
             df = pd.read_csv(text_source(path), comment="#", **EXACT_CSV)
     except UnicodeDecodeError as err:
         raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
+    except FormatError:
+        raise
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
     check_unique_columns(df, path)
+    _warn_unread(df.columns, path)
     if not np.array_equal(rows, np.eye(3)):
         rotate_columns(df, rows)
         _rotate_truth_attitude(df, rows)
@@ -94,9 +97,10 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
         rec.truth.closed_loop = bool(facts.closed_loop)
         if facts.steps is not None:
             try:
-                rec.truth.steps = pd.read_csv(facts.steps, **EXACT_CSV)
+                steps = pd.read_csv(facts.steps, **EXACT_CSV)
             except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
                 raise FormatError(f"{facts.steps}: cannot read the true steps: {err}; fix or delete the file") from None
+            rec.truth.steps = check_steps(steps, facts.steps, rec.t)
             rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
         if "stride_count" in facts.truth:  # the reference's own count (a hand count, or null: none)
             count = facts.truth["stride_count"]
@@ -115,6 +119,53 @@ def _rotate_truth_attitude(df: pd.DataFrame, rows: np.ndarray) -> None:
     if all(c in df.columns for c in TRUTH_QUAT_COLS):
         q = df[TRUTH_QUAT_COLS].to_numpy(dtype=float)
         df[TRUTH_QUAT_COLS] = quat_mul(q, np.broadcast_to(quat_from_matrix(rows.T), q.shape))
+
+
+#: Columns the canonical reader reads (besides ``dist_*`` and ``true_dist_*``).
+COLUMNS = ("t", *ACC_COLS, *GYR_COLS, *MAG_COLS, *TRUTH_POS_COLS, *TRUTH_VEL_COLS, *TRUTH_QUAT_COLS, "true_stance")
+
+
+def _warn_unread(columns: Any, path: Path) -> None:
+    """A warning naming the columns the canonical format does not read (a misspelt reference is not lost silently)."""
+    unread = [str(c) for c in columns if str(c) not in COLUMNS and not str(c).startswith(("dist_", "true_dist_"))]
+    if unread:
+        named = ", ".join(f"{c!r}{did_you_mean(c, list(COLUMNS))}" for c in unread[:8])
+        more = f" and {len(unread) - 8} more" if len(unread) > 8 else ""
+        warnings.warn(FootzooWarning(
+            f"{path.name}: column(s) {named}{more} are not read: the canonical format reads t, acc_x..z, gyr_x..z, "
+            "mag_x..z, dist_*, and as the reference true_pos_n..d, true_vel_n..d, true_qw..qz, true_stance, "
+            "true_dist_*; rename a column to use it (or drop it to silence this)"), stacklevel=4)
+
+
+#: Columns of a true-steps sidecar that hold the strides' times (s): footzoo's names and the simulator's older ones.
+STEP_TIME_COLUMNS = ("start_s", "to_s", "end_s", "ms_start_s", "ms_end_s", "swing_start", "swing_end", "start", "end")
+
+
+def check_steps(steps: pd.DataFrame, path: Path, t: Any) -> pd.DataFrame:
+    """A true-steps sidecar's table, or a FormatError when it is not one (no stride times, or times outside the
+    recording): its rows would otherwise count as the reference's strides."""
+    fix = f"a true-steps sidecar holds one row per stride with its times in s ({', '.join(STEP_TIME_COLUMNS[:3])}); " \
+          f"fix or delete {path.name}"
+    times = [c for c in STEP_TIME_COLUMNS if c in steps.columns]
+    if not times:
+        raise FormatError(f"{path}: not a stride table: its columns {list(steps.columns)[:8]} hold no stride times; "
+                          f"{fix}")
+    for col in times:
+        values = pd.to_numeric(steps[col], errors="coerce")
+        text = steps[col].notna() & values.isna()
+        if text.any():
+            raise FormatError(f"{path}: column {col!r} holds text ({steps[col][text].iloc[0]!r}), not times in s; "
+                              f"{fix}")
+        finite = values[np.isfinite(values)]
+        if not len(finite) or not len(t):
+            continue
+        lo, hi = float(finite.min()), float(finite.max())
+        within = lo >= t[0] - 1.0 and hi <= t[-1] + 1.0  # the recording's clock
+        relative = lo >= -1.0 and hi <= t[-1] - t[0] + 1.0  # or seconds from its start
+        if not (within or relative):
+            raise FormatError(f"{path}: column {col!r} runs from {lo:g} to {hi:g}, but the recording spans "
+                              f"{t[0]:g} to {t[-1]:g} s: sample numbers, or another recording's times? {fix}")
+    return steps
 
 
 class CanonicalReader(Reader):

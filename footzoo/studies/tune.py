@@ -453,7 +453,21 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     else:
         groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
     score = score or spec.score_function()
-    run = _Runner(study, spec, groups, dict(jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet))
+    if out is None:
+        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=None,
+                                                                progress=progress, quiet=quiet))
+    from ..core.atomic import folder_lock
+
+    with folder_lock(out, "tune output folder", f"tune {study.name!r}"):  # its studies run in it too
+        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=out,
+                                                                progress=progress, quiet=quiet))
+
+
+def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], bool] | None, groups: pd.Series,
+          options: dict[str, Any]) -> TuneResult:
+    """:func:`tune` once its output folder (if any) is locked."""
+    out = options["out"]
+    run = _Runner(study, spec, groups, options)
     if spec.search == "optuna":
         folds, held_out, best = optuna_search(run, spec, score, eligible)
         values, groups = run.values, run.groups
@@ -474,11 +488,12 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     if out is not None:
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
-        from ..core.atomic import write_text
+        from ..core.atomic import FileGroup
 
-        write_text(folder / "tune_folds.csv", folds.to_csv(index=False), what="tune folds")
-        write_text(folder / "tune_scores.csv", scores.rename("score").to_csv(index_label="setting"),
-                   what="tune scores")
+        with FileGroup(what="tune output folder") as written:  # both tables of this tune, or neither
+            written.path(folder / "tune_folds.csv").write_text(folds.to_csv(index=False), encoding="utf-8")
+            written.path(folder / "tune_scores.csv").write_text(
+                scores.rename("score").to_csv(index_label="setting"), encoding="utf-8")
     target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
     if target is not None:
         result.save_config(target, name=study.name)
