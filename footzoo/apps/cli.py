@@ -111,6 +111,8 @@ def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
             raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
         if not (lo <= value <= hi):  # also rejects nan
             u = f" {unit}" if unit else ""
+            if integer and hi >= 2**31:  # no real upper bound
+                raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must be a whole number >= {lo:g}{u}")
             raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must lie in [{lo:g}, {hi:g}]{u}")
         return value
 

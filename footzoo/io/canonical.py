@@ -36,7 +36,7 @@ from .base import (
     input_files,
     text_source,
 )
-from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
+from .metadata import facts_text, meta_path, plain_meta, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"
@@ -204,6 +204,10 @@ def check_output(path: str | Path) -> Path:
         if not parquet_available():
             raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
                               "or write .csv")
+    for side, holds in ((meta_path(p), "its metadata"), (steps_path(p), "its true strides")):
+        if side.is_dir():
+            raise OutputError(f"{str(p)!r}: its sidecar {side.name} ({holds}, written next to it) cannot be written: "
+                              f"{side.name} is a folder; move it away, or choose another name")
     return p
 
 
@@ -248,11 +252,11 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
             steps_sha = sha256(tmp_steps)
         else:
             group.remove(steps_path(p))
-        meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
+        meta, unwritten = plain_meta(rec.meta)
         closed = bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))
         group.path(meta_path(p)).write_text(facts_text(meta, closed, sha256(tmp), steps_sha, _truth_facts(rec)),
                                             encoding="utf-8")
-    _warn_unwritten(rec, p)
+    _warn_unwritten(rec, p, unwritten)
     return p
 
 
@@ -272,8 +276,12 @@ def _truth_facts(rec: Recording) -> dict[str, Any]:
     return out
 
 
-def _warn_unwritten(rec: Recording, path: Path) -> None:
-    """Warn about the parts of a reference the canonical files cannot hold (never dropped silently)."""
+def _warn_unwritten(rec: Recording, path: Path, meta: list[str] = ()) -> None:
+    """Warn about the metadata and the parts of a reference the canonical files cannot hold (never dropped silently)."""
+    if meta:
+        warnings.warn(FootzooWarning(
+            f"{path.name}: metadata {', '.join(meta[:8])} not written to {path.name}.meta.yaml (not plain text, "
+            "numbers, lists or mappings); convert it (e.g. to text) before writing, or keep it apart"), stacklevel=3)
     tr = rec.truth
     lost = [name for name in ("footprints", "stride_positions") if tr is not None and getattr(tr, name) is not None]
     if lost:

@@ -310,6 +310,12 @@ class Study:
     def from_dict(cls, d: dict[str, Any], root: str | Path = ".", max_cells: int | None = None) -> Study:
         """Build from a mapping (see :data:`STUDY_KEYS`); ``max_cells`` overrides the study's grid limit."""
         root = Path(root)
+        if "base" not in d and {"orientation", "detector"} & set(d):
+            raise ConfigError("this is a pipeline config (orientation, detector, ...), not a study: run it with "
+                              "footzoo run FILE, or write a study whose base: names it (see footzoo configs: "
+                              "study_quick)")
+        if "tune" in d:
+            raise ConfigError("this is a tune file (a study with a tune: block): run it with footzoo tune FILE")
         for key in d:
             if key not in STUDY_KEYS:
                 raise ConfigError(f"unknown study key {key!r}{did_you_mean(key, list(STUDY_KEYS))}; "
