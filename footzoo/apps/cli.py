@@ -223,6 +223,8 @@ def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | 
 RUN_OUTPUTS = ("samples.csv", "steps.csv", "metrics.json", "result.json", "arrays.npz", "manifest.json")
 #: The log of a command that writes a folder: every warning it gave (:func:`write_log`).
 LOG = "footzoo.log"
+#: The figures ``--plot`` may add (:func:`footzoo.evaluation.plots.run_figures`).
+RUN_FIGURES = ("trajectory.png", "states.png", "errors.png", "strides.png", "fpa.png")
 
 
 def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
@@ -243,10 +245,12 @@ def _locked(folder: Path, owner: str):
 
 
 def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], option: str = "--out") -> None:
-    """Refuse, before the run, an output folder whose files would replace an input."""
+    """Refuse, before the run, an output folder whose files would replace an input, or a file footzoo did not write."""
+    from ..core.archive import check_folder
     from ..core.atomic import refuse_inputs
 
     refuse_inputs([folder / n for n in names], inputs, option)
+    check_folder(folder, names, option)
 
 
 def _figures(result, rec) -> dict[str, bytes]:
@@ -294,7 +298,7 @@ def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
         for w in caught:
             print(f"note: {w.message}", file=sys.stderr)
     if out is not None:
-        _check_outputs(out, (*RUN_OUTPUTS, LOG), _inputs(args, rec))
+        _check_outputs(out, (*RUN_OUTPUTS, LOG, *(RUN_FIGURES if args.plot else ())), _inputs(args, rec))
     with kept_warnings(args) as later:
         result = pipeline.run(rec)
         metrics = result.metrics

@@ -347,6 +347,14 @@ def _refuse_foreign(folder: Path, names: set[str], earlier: set[str] | None, wha
                           "empty folder, or move those files away")
 
 
+def check_folder(path: str | os.PathLike, names: Any, what: str = "--out") -> None:
+    """Refuse, before any work, a result folder holding one of ``names`` that no earlier footzoo result there wrote
+    (the check :func:`save_result` makes when it writes)."""
+    folder = Path(path)
+    if folder.is_dir():
+        _refuse_foreign(folder, set(names), _earlier_files(folder, FORMAT), what)
+
+
 def _metrics_payload(result: Any) -> dict[str, Any]:
     notes: dict[str, str] = {}
     try:

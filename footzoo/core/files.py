@@ -65,20 +65,35 @@ def foreign_encoding(head: bytes) -> str | None:
     head = head[:SNIFF_BYTES]
     for bom, name in FOREIGN_BOMS:
         if head.startswith(bom):
-            return _convert(name)
+            return _convert(name) if _reads_as(head, name) else None
     if not head:
         return None
-    lead = len(head) - len(head.lstrip(b"\0"))
-    if lead >= 4 and lead * 2 > min(len(head), 64):
-        return (f"starts with {lead}{'+' if lead == len(head) else ''} NUL bytes (0x00), not text: the file was "
-                "damaged while it was written (a logger that pre-allocates its file, a power cut, a full card) or is "
-                "not a text file; recover the data from the logger or re-export it")
     sample = head[:512]
     if len(sample) >= 8:
         nuls = [sample[k::2].count(0) / len(sample[k::2]) for k in (0, 1)]
-        if max(nuls) > 0.4 and min(nuls) < 0.05:
+        if max(nuls) > 0.4 and min(nuls) < 0.05 and _reads_as(sample, "UTF-16"):
             return _convert("UTF-16")
+    lead = len(head) - len(head.lstrip(b"\0"))
+    if lead:
+        return (f"starts with {lead}{'+' if lead == len(head) else ''} NUL byte(s) (0x00), not text: the file was "
+                "damaged while it was written (a logger that pre-allocates its file, a power cut, a full card) or is "
+                "not a text file; recover the data from the logger or re-export it")
     return None
+
+
+def _reads_as(head: bytes, name: str) -> bool:
+    """Whether ``head`` decodes as mostly printable text in ``name`` (UTF-16/32; either byte order)."""
+    width = 4 if name == "UTF-32" else 2
+    body = head[: len(head) // width * width]
+    for codec in ((name.lower(),) if head[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+                  else (f"{name.lower()}-le", f"{name.lower()}-be")):
+        try:
+            text = body.decode(codec, errors="strict")
+        except UnicodeDecodeError:
+            continue
+        if text and sum(c.isprintable() or c in "\r\n\t" for c in text) >= 0.9 * len(text):
+            return True
+    return False
 
 
 def _convert(name: str) -> str:
@@ -114,6 +129,9 @@ def damaged_text(name: str, data: bytes) -> str | None:
         return None
     offset, length = runs[0]
     line = body.count(b"\n", 0, offset) + 1
+    if line == 1:  # in the header line: not a text table at all
+        return (f"{name}: not a text file (a NUL byte 0x00 at byte {offset}, in its first line): binary data, or a "
+                "file damaged from its start; give the recording's text (CSV) export, or the format that reads it")
     return (f"{name}: a run of {length} NUL bytes (0x00) at byte {offset} (line {line}): the file was damaged while "
             "it was written (a power cut, a full card, a logger's crash); the rows there are not data. Cut the damaged "
             f"part out (the rows around line {line}) or recover the file, then read it again")

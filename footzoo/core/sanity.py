@@ -130,25 +130,35 @@ FROZEN_MIN_DURATION = 0.1
 _SENSORS = {"acc": "accelerometer", "gyr": "gyroscope"}
 
 
-def find_frozen(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) -> list[dict[str, Any]]:
+def find_frozen(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0,
+                history: dict[str, tuple[int, int]] | None = None) -> list[dict[str, Any]]:
     """Dropouts: one sensor repeats its exact three-axis reading while the other one moves.
 
     A sensor's noise changes every reading (the real recordings in the data folder repeat one at
     most twice in a row); a run of at least :data:`FROZEN_MIN_SAMPLES` samples and
     :data:`FROZEN_MIN_DURATION` s of one exact reading, while the other sensor's readings change
     in most of it, is a channel that dropped out (a lost connection, a logger that repeats the
-    last value or fills zeros). Both sensors frozen together is a noise-free simulation at rest,
-    not reported. Returns one dict per run: ``sensor`` (``"acc"``/``"gyr"``), ``first``, ``last``
-    (sample numbers, plus ``offset``), ``t0``, ``t1`` (s), ``value`` (the repeated reading).
+    last value or fills zeros). Not reported: both sensors frozen together (a noise-free
+    simulation at rest), and a sensor that repeats its readings exactly elsewhere too (more than
+    :data:`PLATEAU_FRACTION` of its other consecutive samples: a noise-free signal with flat tops).
+    ``history``: per sensor, ``(repeats, pairs)`` of the samples before these (live). Returns one dict
+    per run: ``sensor`` (``"acc"``/``"gyr"``), ``first``, ``last`` (sample numbers, plus ``offset``),
+    ``t0``, ``t1`` (s), ``value`` (the repeated reading).
     """
     found: list[dict[str, Any]] = []
     if len(t) < FROZEN_MIN_SAMPLES:
         return found
     same = {"acc": np.all(acc[1:] == acc[:-1], axis=1), "gyr": np.all(gyr[1:] == gyr[:-1], axis=1)}
     for name, other in (("acc", "gyr"), ("gyr", "acc")):
+        before_repeats, before_pairs = (history or {}).get(name, (0, 0))
+        repeats = before_repeats + int(same[name].sum())
+        pairs = before_pairs + len(same[name])
         for s, e in _runs(same[name], FROZEN_MIN_SAMPLES - 1):  # pairs s..e-1: samples s..e
             if t[e] - t[s] < FROZEN_MIN_DURATION or np.mean(same[other][s:e]) > 0.5:
                 continue
+            away = pairs - (e - s)
+            if away > 0 and (repeats - (e - s)) / away > PLATEAU_FRACTION:
+                continue  # flat stretches are this signal's shape (noise-free), not a dropout
             found.append({"sensor": name, "first": s + offset, "last": e + offset, "t0": float(t[s]),
                           "t1": float(t[e]), "value": (acc if name == "acc" else gyr)[s].tolist()})
     return found
@@ -338,6 +348,8 @@ class SignalScan:
         self._frozen_x = np.zeros((0, 6))
         self._frozen_k0 = 0
         self._frozen_open: dict[str, int | None] = {}  # per sensor: the first sample of its reported, open dropout
+        self._vector_repeats = {"acc": 0, "gyr": 0}  # consecutive samples repeating a sensor's whole reading
+        self._vector_pairs = 0
 
     def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, Any]:
         """Scan the next samples; the new findings (also added to :attr:`report`)."""
@@ -361,10 +373,19 @@ class SignalScan:
         keep = GLITCH_MAX_LEN + 1
         self._k0 += max(len(joined_t) - keep, 0)
         self._t, self._x = joined_t[-keep:], joined[-keep:]
+        pairs = np.vstack([self._frozen_x[-1:], x]) if len(self._frozen_x) else x
+        if len(pairs) > 1:
+            self._vector_pairs += len(pairs) - 1
+            self._vector_repeats["acc"] += self._tail_repeats(pairs, slice(0, 3))
+            self._vector_repeats["gyr"] += self._tail_repeats(pairs, slice(3, 6))
         frozen = self._frozen(t, x, k0)
         if frozen:
             new["frozen"] = frozen
         return new
+
+    @staticmethod
+    def _tail_repeats(x: np.ndarray, cols: slice) -> int:
+        return int(np.all(x[1:, cols] == x[:-1, cols], axis=1).sum()) if len(x) > 1 else 0
 
     def _frozen(self, t: np.ndarray, x: np.ndarray, k0: int) -> list[dict[str, Any]]:
         """Dropouts (:func:`find_frozen`) live, each reported once while it lasts.
@@ -374,7 +395,10 @@ class SignalScan:
         """
         tail_t, tail_x = np.concatenate([self._frozen_tail, t]), np.vstack([self._frozen_x, x])
         base = self._frozen_k0 if len(self._frozen_tail) else k0
-        found = [f for f in find_frozen(tail_t, tail_x[:, :3], tail_x[:, 3:], base)
+        history = {name: (self._vector_repeats[name] - self._tail_repeats(tail_x, cols),
+                          self._vector_pairs - max(len(tail_t) - 1, 0))
+                   for name, cols in (("acc", slice(0, 3)), ("gyr", slice(3, 6)))}
+        found = [f for f in find_frozen(tail_t, tail_x[:, :3], tail_x[:, 3:], base, history)
                  if self._frozen_open.get(f["sensor"]) is None]
         for f in found:
             self._frozen_open[f["sensor"]] = f["first"]

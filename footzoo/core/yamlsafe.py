@@ -284,7 +284,9 @@ class StrictDumper(yaml.SafeDumper):
 def _represent_str(dumper: StrictDumper, value: str) -> yaml.ScalarNode:
     tag = StrictLoader.resolve(StrictLoader, ScalarNode, value, (True, False))  # type: ignore[arg-type]
     node = dumper.represent_scalar("tag:yaml.org,2002:str", value)
-    if tag != "tag:yaml.org,2002:str" and node.style is None:
+    if any(c in value for c in "\x85\u2028\u2029") or not all(c.isprintable() or c in "\n\t" for c in value):
+        node.style = '"'  # line breaks YAML folds (NEL, LS, PS) and control characters: escaped, so they read back
+    elif tag != "tag:yaml.org,2002:str" and node.style is None:
         node.style = "'"
     return node
 

@@ -550,7 +550,7 @@ def _seeds(r: dict[str, Any], i: int) -> list[int]:
     repeats = r.get("repeats", 1)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
-    return [s + 1000 * k for k in range(repeats) for s in seeds]
+    return [s + 1000 * k for k in range(repeats if seeds else 0) for s in seeds]
 
 
 def _count_recording(r: Any, i: int) -> int:
