@@ -272,9 +272,15 @@ class TuneResult:
 
     def save_config(self, path: str | Path, name: str | None = None) -> Path:
         """Write the chosen setting as a pipeline config YAML (atomically), the procedure in its header."""
+        from ..core.atomic import write_text
+
+        return write_text(path, self.config_text(name), what="tuned config")
+
+    def config_text(self, name: str | None = None) -> str:
+        """The YAML text :meth:`save_config` writes."""
         import yaml
 
-        from ..core.atomic import json_safe, write_text
+        from ..core.atomic import json_safe
 
         cfg = copy.deepcopy(self.best_config_)
         cfg["name"] = name or str(cfg.get("name", "tuned"))
@@ -284,7 +290,7 @@ class TuneResult:
                     f"test score {r.test_score:.4g}" for r in self.folds_.itertuples()),
                   *(f"# at the edge: {e}" for e in self.edges_)]
         body = yaml.safe_dump(json_safe(cfg), sort_keys=False, default_flow_style=None, width=120)
-        return write_text(path, "\n".join(header) + "\n" + body, what="tuned config")
+        return "\n".join(header) + "\n" + body
 
 
 def candidate_study(study: Study, spec: TuneSpec) -> tuple[Study, dict[str, dict[str, Any]]]:
@@ -485,18 +491,18 @@ def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], 
     result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective, edges)
     for edge in edges:
         warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=2)
-    if out is not None:
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
-        from ..core.atomic import FileGroup
+    target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
+    from ..core.atomic import FileGroup
 
-        with FileGroup(what="tune output folder") as written:  # both tables of this tune, or neither
+    with FileGroup(what="tune output") as written:  # the tables and the chosen config of this tune, or none of them
+        if out is not None:
+            folder = Path(out)
+            folder.mkdir(parents=True, exist_ok=True)
             written.path(folder / "tune_folds.csv").write_text(folds.to_csv(index=False), encoding="utf-8")
             written.path(folder / "tune_scores.csv").write_text(
                 scores.rename("score").to_csv(index_label="setting"), encoding="utf-8")
-    target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
-    if target is not None:
-        result.save_config(target, name=study.name)
+        if target is not None:
+            written.path(target).write_text(result.config_text(name=study.name), encoding="utf-8")
     return result
 
 

@@ -391,7 +391,7 @@ CASES = [
          "path must be a file path or glob"),
     Case("stream-acc-in-g", lambda d, w: _push(w, *[(w.t[k], w.acc[k] / 9.80665, w.gyr[k]) for k in range(w.n)]),
          RecordingError, "this looks like g, not m/s²"),
-    # ---------------------------------------------------------------- plug-ins (more: test_bad_input_plugins.py)
+    # ---------------------------------------------------------------- plug-ins (more: test_plugins.py)
     Case("plugin-raises", lambda d, w: _faulty_plugin(d, w, "test_case_raises", "return 1 / 0"), PluginError,
          "detector 'test_case_raises' (footzoo_plugin_"),
     Case("plugin-exits", lambda d, w: _faulty_plugin(d, w, "test_case_exits", "raise SystemExit(3)"), PluginError,

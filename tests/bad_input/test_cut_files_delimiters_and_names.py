@@ -1,4 +1,4 @@
-"""Bad input, round 2: files cut short, foreign delimiters, damaged MATLAB files, YAML and CLI oddities.
+"""Bad input: files cut short, foreign delimiters, damaged MATLAB files, YAML and CLI oddities, study names.
 
 Each case is a clear error naming the file, the problem and the fix (never a raw traceback, never a silently
 wrong recording).

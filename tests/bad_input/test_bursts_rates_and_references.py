@@ -1,4 +1,4 @@
-"""Bad input, third round: long glitch bursts, time stamps at half or twice the rate, references without per-sample
+"""Bad input: long glitch bursts, time stamps at half or twice the rate, references without per-sample
 columns written and read back (docs/bad-input.md)."""
 
 from __future__ import annotations
