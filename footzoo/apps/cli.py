@@ -158,6 +158,10 @@ def _scheduler(text: str) -> str:
 def _writable_dir(path: str, option: str = "--out") -> Path:
     """Create ``path`` if needed and check it is a writable directory, before any work is done."""
     out = Path(path)
+    if out.is_symlink() and not out.exists():
+        from ..core.files import why_missing
+
+        raise OutputError(f"{option} {path!r} {why_missing(out)}")
     if out.exists() and not out.is_dir():
         raise OutputError(f"{option} {path!r} exists and is not a directory; choose a directory")
     try:

@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, previous_marker
+from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, json_safe, previous_marker
 from .errors import FootzooWarning, FormatError, OutputError
 
 FORMAT = "footzoo-result"
@@ -364,7 +364,7 @@ def _metrics_payload(result: Any) -> dict[str, Any]:
         warnings.warn(FootzooWarning(f"Result.save: the metrics could not be computed ({type(err).__name__}: {err}); "
                                      "saved without them"), stacklevel=4)
         metrics = {"error": f"{type(err).__name__}: {err}"}
-    recording = {k: v for k, v in result.recording.items() if isinstance(v, (str, int, float, bool))}
+    recording = json_safe(result.recording)  # nested metadata as plain JSON; objects as their text, never dropped
     return {"metrics": metrics, "metric_notes": notes, "config": result.config, "versions": result.versions,
             "recording": recording}
 

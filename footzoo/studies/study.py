@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import collections
 import copy
 import functools
 import glob
@@ -351,7 +352,8 @@ class Study:
                 raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
                                   "or remove it")
             keys = [json.dumps(level, sort_keys=True, default=str) for level in v]
-            twice = next((level for level, key in zip(v, keys, strict=True) if keys.count(key) > 1), None)
+            counts = collections.Counter(keys)
+            twice = next((level for level, key in zip(v, keys, strict=True) if counts[key] > 1), None)
             if twice is not None:  # it would run every cell of that level twice under one name
                 raise ConfigError(f"factor {k!r} lists the level {twice!r} more than once; list each level once")
         recordings = []

@@ -231,6 +231,19 @@ def test_one_device_of_a_multi_device_export_is_read_as_asked(tmp_path, walk):
     assert two.meta["device"] == "dev-2"
 
 
+def test_a_gaitmap_file_with_a_sensor_besides_the_feet_says_it_is_not_read(tmp_path, walk):
+    cols = ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]
+    sensors = ["left_sensor", "right_sensor", "hip_sensor"]
+    rows = ["sensor," + ",".join(s for s in sensors for _ in cols), "axis," + ",".join(cols * len(sensors))]
+    values = np.hstack([walk.acc, np.degrees(walk.gyr)])
+    rows += [f"{k}," + ",".join(repr(float(v)) for v in np.tile(values[k], len(sensors))) for k in range(walk.n)]
+    p = tmp_path / "imu_sample.csv"
+    p.write_text("\n".join(rows) + "\n")
+    with pytest.warns(FootzooWarning, match=r"sensor\(s\) \['hip_sensor'\] are not read: footzoo reads the feet"):
+        rec = load(p, foot="left")
+    assert rec.n == walk.n
+
+
 @pytest.mark.skipif(not KOROGLU.exists(), reason="the real recordings (../shared/data) are not here")
 def test_the_real_sensorconnect_export_reads_as_before(tmp_path):
     rec = load(KOROGLU)
@@ -259,6 +272,18 @@ def test_non_scalar_metadata_is_written_and_what_cannot_be_is_named(tmp_path, wa
     assert back.meta["subject"] == {"age": 30, "height_m": 1.8} and back.meta["tags"] == ["a", "b"]
     assert back.meta["arr"] == [0.0, 1.0, 2.0] and back.meta["when"] == "2024-01-02"
     assert back.meta["pair"] == [1, 2] and back.meta["f32"] == 1.5 and "obj" not in back.meta
+
+
+def test_a_results_metrics_json_keeps_nested_metadata():
+    """metrics.json (a run's summary for other tools) holds the recording's metadata as plain JSON, nested too."""
+    from types import SimpleNamespace
+
+    from footzoo.core.archive import _metrics_payload
+
+    result = SimpleNamespace(metrics={"strides": 3.0}, metric_notes={}, config={}, versions={}, recording={
+        "name": "m", "subject": {"age": 30}, "tags": ["a"], "arr": np.arange(2.0), "t0": float("nan")})
+    assert _metrics_payload(result)["recording"] == {"name": "m", "subject": {"age": 30}, "tags": ["a"],
+                                                     "arr": [0.0, 1.0], "t0": None}
 
 
 def test_why_a_named_path_is_missing():

@@ -52,6 +52,14 @@ def _mag(pipeline, walk, first: int, stop: bool):
     return action
 
 
+def _gyr_missing(pipeline, walk, first: int):
+    def action():
+        stream = Stream(pipeline, rate=walk.rate)
+        for k in range(first + 1):
+            stream.push(walk.t[k], walk.acc[k], walk.gyr[k] if k < first else None)
+    return action
+
+
 USES = [
     ("run-twice", lambda p, w: _run_then(p, w, lambda s: s.run(w)),
      "Stream.run(): this stream has run (or was closed) already; a stream takes one recording: make a new Stream"),
@@ -67,6 +75,9 @@ USES = [
      "sample or with none"),
     ("mag-starts", lambda p, w: _mag(p, w, 120, stop=False),
      "mag started at t = 1.2 s (sample 120), after 120 sample(s) without it"),
+    ("gyr-missing", lambda p, w: _gyr_missing(p, w, 150),
+     "gyr is missing (None) at t = 1.5: every sample needs gyr (rad/s, 3 numbers); a sensor that dropped out cannot "
+     "be bridged"),
 ]
 
 
