@@ -20,10 +20,14 @@ their dtype through the manifest: floats with 17 significant digits (bit-identic
 booleans, integers, and text as JSON strings (text that looks like a number stays text; an empty
 text and a missing one differ). Everything is written into the folder as one
 :class:`~footzoo.core.atomic.FileGroup`: a crash or Ctrl-C leaves the earlier result complete; files
-of the earlier result that the new one does not have are removed. The folder may hold other files
-(they are left alone), but a file with one of the archive's names that an earlier footzoo result
-did not write is never replaced: the save is refused. A session (both feet) is saved the same way,
-with one result folder per foot (:func:`save_session`).
+of the earlier result that the new one does not have are removed. ``manifest.json`` is the folder's
+completion marker: the earlier one is set aside (``.footzoo-incomplete``) before any file is replaced
+and the new one is written last, so that even a process killed between two renames leaves a folder
+that :func:`load_result` refuses as incomplete, never one that mixes two results. Files saved with a
+result (``files=``: the figures of ``footzoo run --plot``) are listed in its manifest and go with it.
+The folder may hold other files (they are left alone), but a file with one of the archive's names
+that an earlier footzoo result did not write is never replaced: the save is refused. A session (both
+feet) is saved the same way, with one result folder per foot (:func:`save_session`).
 """
 
 from __future__ import annotations

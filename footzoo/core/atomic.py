@@ -402,17 +402,20 @@ _HELD_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
-def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "") -> Iterator[Path]:
-    """Hold an exclusive lock on ``folder`` (the file ``.footzoo.lock`` in it) for the block.
+def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "",
+                identity: str | None = None) -> Iterator[Path]:
+    """Hold a lock on ``folder`` (the file ``.footzoo.lock`` in it) for the block.
 
     The lock file says who holds it: ``owner`` (e.g. ``"study 'quick'"``), the process id, the host
-    and the start time. A second footzoo process that asks for the same folder gets an
-    :class:`OutputError` at once (it does not wait) naming the holder and how to proceed. The lock
-    is released (and its file removed) when the block ends; a process that dies holding it
-    releases it too (the operating system drops an ``flock`` with its process), so a lock left by
-    a killed process is stale and taken over. Where the file system has no locks (some network
-    file systems), the lock file's process id decides: a holder on this host that no longer runs is
-    stale. The same thread may enter the lock again (a tune runs its studies in its own folder).
+    and the start time. Another footzoo process that asks for the same folder gets an
+    :class:`OutputError` at once (it does not wait) naming the holder and how to proceed, unless
+    both give the same ``identity`` (the same study started twice: they share its cache, resume
+    each other's runs and write the same report). The lock is released when the block ends (its
+    file removed by the last holder); a process that dies holding it releases it too (the operating
+    system drops an ``flock`` with its process), so a lock left by a killed process is stale and
+    taken over. Where the file system has no locks (some network file systems), the lock file's
+    process id decides: a holder on this host that no longer runs is stale. The same thread may
+    enter the lock again (a tune runs its studies in its own folder).
 
     Parameters
     ----------
@@ -422,6 +425,8 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "") 
         How the folder was named (``"--out"``), for messages.
     owner : str
         What writes into it, for the message another process gets.
+    identity : str, optional
+        What the holder writes: processes with the same identity share the folder; None: exclusive.
     """
     p = Path(folder)
     try:
@@ -430,11 +435,9 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "") 
         raise OutputError(f"{what} {str(p)!r} cannot be created: {err.strerror or err}") from None
     key = (os.path.realpath(p), threading.get_ident())
     with _HELD_LOCK:
-        if key in _HELD:
+        nested = key in _HELD
+        if nested:
             _HELD[key] += 1
-            nested = True
-        else:
-            nested = False
     if nested:
         try:
             yield p
@@ -442,7 +445,7 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "") 
             with _HELD_LOCK:
                 _HELD[key] -= 1
         return
-    fh = _acquire(p, what, owner)
+    fh = _acquire(p, what, owner, identity)
     with _HELD_LOCK:
         _HELD[key] = 1
     try:
@@ -450,8 +453,9 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "") 
     finally:
         with _HELD_LOCK:
             _HELD.pop(key, None)
-        with contextlib.suppress(OSError):
-            os.unlink(p / LOCK_NAME)  # still held: no other process can have taken this file
+        if identity is None or _try_lock(fh) is True:  # the last holder: no other process holds this file
+            with contextlib.suppress(OSError):
+                os.unlink(p / LOCK_NAME)
         fh.close()  # closing releases the lock
 
 
@@ -468,10 +472,10 @@ def lock_holder(folder: PathLike) -> dict[str, Any] | None:
     return info if isinstance(info, dict) else None
 
 
-def _acquire(folder: Path, what: str, owner: str) -> IO[Any]:
-    """The open, locked lock file of ``folder`` with this process's description in it (see :func:`folder_lock`)."""
+def _acquire(folder: Path, what: str, owner: str, identity: str | None) -> IO[Any]:
+    """The open, locked lock file of ``folder`` (see :func:`folder_lock`)."""
     lock = folder / LOCK_NAME
-    for _ in range(5):  # another process may remove the file between our open and our lock: open it again
+    for _ in range(40):  # another process may replace the file, or convert its lock, meanwhile: look again
         try:
             fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as err:
@@ -479,25 +483,43 @@ def _acquire(folder: Path, what: str, owner: str) -> IO[Any]:
                               f"({err.strerror or err}); choose a writable folder") from None
         fh = os.fdopen(fd, "r+", encoding="utf-8")
         state = _try_lock(fh)
-        if state is False or (state is None and _holder_alive(lock_holder(folder))):
-            holder = lock_holder(folder)
+        holder = lock_holder(folder)
+        shared = identity is not None and (holder or {}).get("identity") == identity
+        if state is None and _holder_alive(holder) and not shared:  # no file locks here: the pid decides
             fh.close()
-            raise OutputError(_in_use(folder, what, holder, flock=state is False))
-        try:
-            same = os.path.samestat(os.fstat(fh.fileno()), os.stat(lock))
-        except OSError:
-            same = False
-        if not same:
+            raise OutputError(_in_use(folder, what, holder, flock=False))
+        if state is False:
+            if not shared:
+                fh.close()
+                raise OutputError(_in_use(folder, what, holder, flock=True))
+            if _try_lock(fh, exclusive=False) is not True:  # the same study, still converting its lock: again
+                fh.close()
+                time.sleep(0.05)
+                continue
+        if not _same_file(fh, lock) or (state is False and (lock_holder(folder) or {}).get("identity") != identity):
             fh.close()
             continue
+        if state is False:  # sharing the folder with the same study: its description stays
+            return fh
         fh.seek(0)
         fh.truncate()
         fh.write(json.dumps({"owner": owner or "footzoo", "pid": os.getpid(), "host": _host(),
-                             "started": time.strftime("%Y-%m-%d %H:%M:%S"), "footzoo": _version()}) + "\n")
+                             "started": time.strftime("%Y-%m-%d %H:%M:%S"), "footzoo": _version(),
+                             "identity": identity}) + "\n")
         fh.flush()
+        if identity is not None and state is True:
+            _try_lock(fh, exclusive=False, wait=True)  # the same study may join
         return fh
     raise OutputError(f"{what} {str(folder)!r}: its lock file {LOCK_NAME} keeps changing; another process is "
                       "starting in it: try again")
+
+
+def _same_file(fh: IO[Any], path: Path) -> bool:
+    """Whether the open lock file is still the one at ``path`` (another holder may have removed it meanwhile)."""
+    try:
+        return os.path.samestat(os.fstat(fh.fileno()), os.stat(path))
+    except OSError:
+        return False
 
 
 def _in_use(folder: Path, what: str, holder: dict[str, Any] | None, flock: bool) -> str:
@@ -539,8 +561,12 @@ def _version() -> str:
     return __version__
 
 
-def _try_lock(fh: IO[Any]) -> bool | None:
-    """True: locked; False: another process holds the lock; None: the file system has no locks."""
+def _try_lock(fh: IO[Any], exclusive: bool = True, wait: bool = False) -> bool | None:
+    """True: locked; False: another process holds a conflicting lock; None: the file system has no locks.
+
+    ``exclusive=False``: a shared lock (compatible with other shared ones; Windows has none: exclusive).
+    ``wait``: block until it is granted (converting a lock this process holds).
+    """
     try:
         import fcntl
     except ImportError:  # Windows
@@ -551,8 +577,9 @@ def _try_lock(fh: IO[Any]) -> bool | None:
             return True
         except OSError:
             return False
+    flags = (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | (0 if wait else fcntl.LOCK_NB)
     try:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(fh.fileno(), flags)
         return True
     except OSError as err:
         if err.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
@@ -597,12 +624,19 @@ def previous_marker(folder: PathLike, marker: str) -> Any:
     return None
 
 
-def end_folder(folder: PathLike, marker: str, text: str) -> Path:
-    """Write the completion marker ``marker`` (last, atomically) and clear the mark of :func:`begin_folder`."""
+def end_folder(folder: PathLike, marker: str, text: str | None = None) -> Path:
+    """Write the completion marker ``marker`` (last, atomically) and clear the mark of :func:`begin_folder`.
+
+    ``text`` None: put the earlier marker back as it was (nothing changed), when it is still set aside.
+    """
     f = Path(folder)
-    write_text(f / marker, text, what=str(f))
-    with contextlib.suppress(FileNotFoundError):
-        os.unlink(f / INCOMPLETE)
+    if text is None:
+        with contextlib.suppress(FileNotFoundError):  # another run of the same study may have put it back
+            os.replace(f / INCOMPLETE, f / marker)
+    else:
+        write_text(f / marker, text, what=str(f))
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(f / INCOMPLETE)
     _fsync_folder(f)
     return f / marker
 

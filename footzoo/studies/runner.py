@@ -24,6 +24,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import threading
 import time
 import traceback
@@ -475,7 +476,7 @@ def run_study(
     study.check(max_cells)
     bar = _Progress(progress, "study")
     lock = contextlib.nullcontext() if out is None else folder_lock(out, "study output folder",
-                                                                     f"study {study.name!r}")
+                                                                     f"study {study.name!r}", study_identity(study))
     try:
         with lock:
             if scheduler is None:
@@ -491,6 +492,13 @@ def run_study(
     if not quiet:
         _replay_warnings(table.attrs["warnings"], table.attrs["refused"])
     return table
+
+
+def study_identity(study: Study) -> str:
+    """What makes two studies the same (their definition): the same study started twice shares its folder."""
+    spec = [study.name, study.bases, study.factors, study.metrics, study.sweep_points, study.plugins,
+            [[r.label, r.path, r.format, r.options, r.simulate, r.seed] for r in study.recordings]]
+    return hashlib.sha256(json.dumps(spec, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
@@ -603,7 +611,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         digest = _outputs_digest(table, runs, list(study.factors), figures)
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
-            end_folder(out, MANIFEST, json.dumps(previous_marker(out, MANIFEST), indent=1))
+            end_folder(out, MANIFEST)  # the earlier marker back, as it was
         else:
             # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             written = write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
@@ -818,9 +826,11 @@ def check_scheduler(address: Any) -> Any:
     if scheme not in SCHEDULER_SCHEMES:
         raise ConfigError(f"scheduler {address!r}: unknown protocol {scheme!r} (Dask speaks "
                           f"{', '.join(SCHEDULER_SCHEMES)}); {fix}")
-    if scheme == "inproc":
-        raise ConfigError(f"scheduler {address!r}: an in-process address cannot be reached from footzoo; pass the "
-                          f"Client itself (run_study(scheduler=client)), or {fix}")
+    if scheme == "inproc":  # a LocalCluster(processes=False) of this process: inproc://HOST/PID/N
+        if not re.fullmatch(r"[^/\s]+/\d+/\d+", rest):
+            raise ConfigError(f"scheduler {address!r} is not an in-process address (inproc://HOST/PID/N, as "
+                              f"LocalCluster(processes=False) gives); {fix}")
+        return f"inproc://{rest}"
     host, colon, port = rest.rstrip("/").rpartition(":")
     if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
         raise ConfigError(f"scheduler {address!r} is not HOST:PORT with a port in 1-65535; {fix}")

@@ -65,7 +65,7 @@ CASES = [
       for i, (a, fragment) in enumerate([
           ("garbage", "is not HOST:PORT with a port in 1-65535"), ("tcp://", "is not HOST:PORT"),
           ("tcp://host:99999", "is not HOST:PORT with a port in 1-65535"),
-          ("http://host:8786", "unknown protocol 'http'"), ("inproc://x", "an in-process address"),
+          ("http://host:8786", "unknown protocol 'http'"), ("inproc://x", "is not an in-process address (inproc://HOST/PID/N"),
           ("", "is not HOST:PORT"), ("tcp://[::1:8786", "the IPv6 host must be in brackets")])],
     # arguments in the wrong place
     ("run-swapped", lambda d, w: ["run", str(w), str(YUN)], EXIT_USAGE,

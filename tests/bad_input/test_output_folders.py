@@ -107,6 +107,15 @@ def _interrupt(proc: subprocess.Popen) -> tuple[int, str]:
     return proc.returncode, err
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _unregistered():
+    """The slow detector, loaded here by the studies run in this process, leaves the registry with the module."""
+    from footzoo.plugins import registry
+
+    yield
+    registry._REGISTRY["detector"].pop("test_slow_fsm", None)
+
+
 @pytest.fixture(scope="module")
 def walk_file(tmp_path_factory) -> Path:
     return write(simulate(n_strides=3, rate=100.0, noise=NoiseModel(seed=1)), tmp_path_factory.mktemp("w") / "w.csv")

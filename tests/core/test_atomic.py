@@ -202,6 +202,36 @@ def test_a_locked_folder_refuses_a_second_writer_naming_the_first(tmp_path):
         pass
 
 
+def test_the_same_study_twice_shares_the_folder_and_another_is_refused(tmp_path):
+    """Holders that give the same identity (one study started twice) share; the last one out removes the file."""
+    import threading
+
+    folder = tmp_path / "study"
+    entered, leave, errors = threading.Event(), threading.Event(), []
+
+    def hold(identity, owner):
+        try:
+            with folder_lock(folder, owner=owner, identity=identity):
+                entered.set()
+                leave.wait(30)
+        except OutputError as err:
+            errors.append(str(err))
+
+    first = threading.Thread(target=hold, args=("study-A", "study 'a'"))
+    first.start()
+    assert entered.wait(30)
+    second = threading.Thread(target=hold, args=("study-A", "study 'a'"))
+    other = threading.Thread(target=hold, args=("study-B", "study 'b'"))
+    second.start()
+    other.start()
+    other.join(30)
+    assert len(errors) == 1 and "is in use: study 'a'" in errors[0]  # the other study, refused
+    leave.set()
+    first.join(30)
+    second.join(30)
+    assert len(errors) == 1 and not (folder / LOCK_NAME).exists()  # the same one joined; the last removed the file
+
+
 def test_a_lock_held_by_another_process_is_refused_and_released_when_it_dies(tmp_path):
     folder = tmp_path / "out"
     code = ("import sys, time\nfrom footzoo.core.atomic import folder_lock\n"
