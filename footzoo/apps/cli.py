@@ -265,14 +265,16 @@ def _figures(result, rec) -> dict[str, bytes]:
 
 
 def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list[str]:
-    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) with the figures (``--plot``).
+    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) with the figures (``--plot``)
+    and the command's log.
 
     One commit: the manifest is written last, and the figures of an earlier run into the folder
     that this one does not draw are removed with it (they belong to the earlier result).
     """
     figures = _figures(result, rec) if plot else {}
-    folder = result.save(out, backend="csv", inputs=inputs, files=figures)
-    return sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS) + sorted(figures)
+    files = {**figures, LOG: log_text(result.diagnostics["warnings"])}
+    folder = result.save(out, backend="csv", inputs=inputs, files=files)
+    return sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS) + sorted(files)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -314,7 +316,6 @@ def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
                    result.metric_notes)
     if out is not None:
         written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
-        written.append(write_log(out, result.diagnostics["warnings"], _inputs(args, rec)).name)
         print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
     else:
         tell_unshown(args, result.diagnostics["warnings"])
@@ -351,14 +352,18 @@ class kept_warnings:
                     warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
+def log_text(texts: list[str]) -> bytes:
+    """The content of ``footzoo.log``: every warning of the command, one per line (or that there was none)."""
+    return (("\n".join(texts) if texts else "no warnings") + "\n").encode("utf-8")
+
+
 def write_log(folder: Path, texts: list[str], inputs: list[str] | None = None) -> Path:
-    """``folder/footzoo.log``: every warning of the command, one per line (or that there was none), atomically."""
-    from ..core.atomic import refuse_inputs, write_text
+    """``folder/footzoo.log`` (:func:`log_text`), atomically (a run's is saved with its result instead)."""
+    from ..core.atomic import refuse_inputs, write_bytes
 
     target = folder / LOG
     refuse_inputs([target], inputs or [], "--out")
-    body = "\n".join(texts) if texts else "no warnings"
-    return write_text(target, body + "\n", what="the command's log")
+    return write_bytes(target, log_text(texts), what="the command's log")
 
 
 def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
@@ -397,10 +402,9 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     if args.out is not None:
         out = Path(args.out)
         figures = {foot: _figures(r, session.recordings[foot]) for foot, r in res.results.items()} if args.plot else {}
-        res.save(out, backend="csv", inputs=inputs, files=figures)
+        res.save(out, backend="csv", inputs=inputs, files={**figures, ".": {LOG: log_text(texts)}})
         written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
         written += sorted(next(iter(figures.values()), {}))
-        write_log(out, texts, inputs)
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "
               f"{out} (footzoo.SessionResult.load({str(out)!r}) reads it back)")
     else:

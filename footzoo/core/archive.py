@@ -462,7 +462,7 @@ def _extra_files(group: FileGroup, folder: Path, files: dict[str, bytes] | None)
             raise OutputError(f"files: {name!r} is not a plain file name for the archive's folder")
         with group.open(folder / name, "wb") as fh:
             fh.write(content)
-        out[name] = {"holds": "written with the result (a figure of the run)", "kind": "file"}
+        out[name] = {"holds": "written with the result (a figure of the run, the command's log)", "kind": "file"}
     return out
 
 
@@ -589,7 +589,8 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
     """Write a :class:`~footzoo.runtime.session.SessionResult` as a folder: one result folder per foot
     (``left/``, ``right/``), the combined stride table and the bilateral table (both recomputed on load).
 
-    ``files``: per foot, more files written into its folder with the archive (as :func:`save_result`'s).
+    ``files``: per foot, more files written into its folder with the archive (as :func:`save_result`'s); under
+    ``"."``, into the session's folder (the command's log).
     """
     backend = _backend(backend)
     what = "SessionResult.save"
@@ -612,6 +613,7 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
                             ("bilateral", "medians per foot and symmetry index (SessionResult.bilateral; derived)")):
             name, info = _write_table(getattr(session, attr), group, folder, attr, backend)
             files[name] = {"holds": holds, **info}
+        files.update(_extra_files(group, folder, extra.get(".")))
         _refuse_foreign(folder, set(files) | {MANIFEST}, earlier, what)
         with group.open(folder / MANIFEST) as fh:
             fh.write(_manifest(SESSION_FORMAT, backend, files, name=session.name, feet=list(session.results)))

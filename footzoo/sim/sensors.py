@@ -127,10 +127,16 @@ class NoiseModel:
             raise ConfigError(f"noise seed must be a whole number >= 0 (it seeds numpy's generator), got {self.seed!r}")
         for name in ("acc_bias", "acc_sigma", "gyr_bias", "gyr_sigma", "mag_bias", "mag_sigma", "scale"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not np.isfinite(value) \
-                    or (name.endswith(("sigma", "scale")) and value < 0):
-                bound = " >= 0" if name.endswith(("sigma", "scale")) else ""
-                raise ConfigError(f"noise {name} must be a finite number{bound}, got {value!r}")
+            try:
+                arr = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                arr = np.asarray(np.nan)
+            per_axis = name != "scale" and arr.shape == (3,)  # a bias or σ may differ per axis (x, y, z)
+            bound = " >= 0" if name.endswith(("sigma", "scale")) else ""
+            if isinstance(value, bool) or (arr.shape != () and not per_axis) or not np.isfinite(arr).all() \
+                    or (bound and (arr < 0).any()):
+                raise ConfigError(f"noise {name} must be a finite number{bound}"
+                                  f"{'' if name == 'scale' else ' (or one per axis: [x, y, z])'}, got {value!r}")
         if self.paired_rate is not None and not (isinstance(self.paired_rate, (int, float, np.number))
                                                  and np.isfinite(self.paired_rate) and self.paired_rate > 0):
             raise ConfigError(f"paired_rate must be a rate in Hz > 0, got {self.paired_rate!r}")
@@ -138,7 +144,7 @@ class NoiseModel:
     @property
     def random(self) -> bool:
         """Whether the seed changes the noise (some σ is above zero): with none, every seed gives one recording."""
-        return self.scale > 0 and max(self.acc_sigma, self.gyr_sigma, self.mag_sigma) > 0
+        return self.scale > 0 and max(float(np.max(s)) for s in (self.acc_sigma, self.gyr_sigma, self.mag_sigma)) > 0
 
     def apply(self, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None, t: np.ndarray | None = None):
         """Noisy copies of the signals (eq. 18); ``t`` (s), the sample times, is needed with ``paired_rate``."""
