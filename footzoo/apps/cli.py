@@ -37,10 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.atomic import atomic_path, check_target, refuse_inputs, write_text
+from ..core.atomic import atomic_path, check_target, folder_lock, refuse_inputs, write_bytes
 from ..core.context import RunContext
 from ..core.conventions import ACC_UNITS, GYR_UNITS
 from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
+from ..core.files import why_missing
 from ..core.params import describe as describe_parameters
 from ..plugins.base import BASES
 from ..plugins.registry import describe
@@ -119,15 +120,57 @@ def _number(lo: float, hi: float, unit: str = "", integer: bool = False):
             raise argparse.ArgumentTypeError(f"{text!r} is not {kind}") from None
         if not (lo <= value <= hi):  # also rejects nan
             u = f" {unit}" if unit else ""
+            if integer and hi >= 2**31:  # no real upper bound
+                raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must be a whole number >= {lo:g}{u}")
             raise argparse.ArgumentTypeError(f"{text}{u} is out of range: it must lie in [{lo:g}, {hi:g}]{u}")
         return value
 
     return parse
 
 
+def _jobs(text: str) -> int:
+    """An argparse ``type`` for ``--jobs``: -1 (every core) or 1 up to a few per core of this machine."""
+    # deferred: pandas and the study runner, loaded only for --jobs
+    from ..studies.study import check_jobs
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    try:
+        return check_jobs(value, text)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _biases(text: str) -> tuple[str, ...]:
+    """An argparse ``type`` for ``--biases``: ``none`` or a comma-separated subset of acc, gyr, mag."""
+    if text.strip() in ("", "none"):
+        return ()
+    names = tuple(b.strip() for b in text.split(","))
+    unknown = [b for b in names if b not in ("acc", "gyr", "mag")]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"{', '.join(map(repr, unknown))}: unknown bias; give a comma-separated "
+                                         "list of acc, gyr, mag (e.g. acc,gyr), or none")
+    return names
+
+
+def _scheduler(text: str) -> str:
+    """An argparse ``type`` for ``--scheduler``: a Dask scheduler's address, checked before any work."""
+    # deferred: pandas and the study runner, loaded only for --scheduler
+    from ..studies.runner import check_scheduler
+
+    try:
+        return check_scheduler(text)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
 def _writable_dir(path: str, option: str = "--out") -> Path:
     """Create ``path`` if needed and check it is a writable directory, before any work is done."""
     out = Path(path)
+    if out.is_symlink() and not out.exists():
+        raise OutputError(f"{option} {path!r} {why_missing(out)}")
     if out.exists() and not out.is_dir():
         raise OutputError(f"{option} {path!r} exists and is not a directory; choose a directory")
     try:
@@ -194,6 +237,8 @@ def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | 
 RUN_OUTPUTS = ("samples.csv", "steps.csv", "metrics.json", "result.json", "arrays.npz", "manifest.json")
 #: The log of a command that writes a folder: every warning it gave (:func:`write_log`).
 LOG = "footzoo.log"
+#: The figures ``--plot`` may add (:func:`footzoo.evaluation.plots.run_figures`).
+RUN_FIGURES = ("trajectory.png", "states.png", "errors.png", "strides.png", "fpa.png")
 
 
 def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
@@ -206,22 +251,39 @@ def _inputs(args: argparse.Namespace, rec=None) -> list[str]:
     return files
 
 
+def _locked(folder: Path, owner: str):
+    """The output folder's lock for this command (another footzoo process writing into it is refused)."""
+    return folder_lock(folder, "--out", owner)
+
+
 def _check_outputs(folder: Path, names: tuple[str, ...], inputs: list[str], option: str = "--out") -> None:
-    """Refuse, before the run, an output folder whose files would replace an input."""
+    """Refuse, before the run, an output folder whose files would replace an input, or a file footzoo did not write."""
+    # deferred: pandas (the result archive): the command line starts without it
+    from ..core.archive import check_folder
 
     refuse_inputs([folder / n for n in names], inputs, option)
+    check_folder(folder, names, option)
+
+
+def _figures(result, rec) -> dict[str, bytes]:
+    """The run's figures (``--plot``) as PNG files in memory: saved with the result, as one unit."""
+    # deferred: matplotlib's figures, drawn only with --plot
+    from ..evaluation.plots import png_bytes, run_figures
+
+    return {name: png_bytes(fig) for name, fig in run_figures(result, rec).items()}
 
 
 def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list[str]:
-    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) and optionally the figures."""
-    folder = result.save(out, backend="csv", inputs=inputs)
-    written = sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS)
-    if plot:
-        # deferred: matplotlib's figures, drawn only with --plot
-        from ..evaluation.plots import plot_run
+    """The result archive (samples.csv, steps.csv, metrics.json, result.json, ...) with the figures (``--plot``)
+    and the command's log.
 
-        written += [p.name for p in plot_run(result, out, rec)]
-    return written
+    One commit: the manifest is written last, and the figures of an earlier run into the folder
+    that this one does not draw are removed with it (they belong to the earlier result).
+    """
+    figures = _figures(result, rec) if plot else {}
+    files = {**figures, LOG: log_text(result.diagnostics["warnings"])}
+    folder = result.save(out, backend="csv", inputs=inputs, files=files)
+    return sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS) + sorted(files)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -234,6 +296,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.plot and out is None:
         print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
         return 2
+    if out is None:
+        return _run(args, pipeline, None)
+    data = Path(args.data).name if args.data else "the built-in sample"
+    with _locked(out, f"footzoo run {Path(args.config).name} on {data}"):
+        return _run(args, pipeline, out)
+
+
+def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
+    """:func:`cmd_run` once its output folder (if any) is locked."""
     if _two_feet(args):
         return _run_session(args, pipeline)
     with warnings.catch_warnings(record=True) as caught:
@@ -243,7 +314,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         for w in caught:
             print(f"note: {w.message}", file=sys.stderr)
     if out is not None:
-        _check_outputs(out, (*RUN_OUTPUTS, LOG), _inputs(args, rec))
+        _check_outputs(out, (*RUN_OUTPUTS, LOG, *(RUN_FIGURES if args.plot else ())), _inputs(args, rec))
     with kept_warnings(args) as later:
         result = pipeline.run(rec)
         metrics = result.metrics
@@ -255,7 +326,6 @@ def cmd_run(args: argparse.Namespace) -> int:
                    result.metric_notes)
     if out is not None:
         written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
-        written.append(write_log(out, result.diagnostics["warnings"], _inputs(args, rec)).name)
         print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
     else:
         tell_unshown(args, result.diagnostics["warnings"])
@@ -292,13 +362,17 @@ class kept_warnings:
                     warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
+def log_text(texts: list[str]) -> bytes:
+    """The content of ``footzoo.log``: every warning of the command, one per line (or that there was none)."""
+    return (("\n".join(texts) if texts else "no warnings") + "\n").encode("utf-8")
+
+
 def write_log(folder: Path, texts: list[str], inputs: list[str] | None = None) -> Path:
-    """``folder/footzoo.log``: every warning of the command, one per line (or that there was none), atomically."""
+    """``folder/footzoo.log`` (:func:`log_text`), atomically (a run's is saved with its result instead)."""
 
     target = folder / LOG
     refuse_inputs([target], inputs or [], "--out")
-    body = "\n".join(texts) if texts else "no warnings"
-    return write_text(target, body + "\n", what="the command's log")
+    return write_bytes(target, log_text(texts), what="the command's log")
 
 
 def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
@@ -337,15 +411,10 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     print(res.bilateral.to_string(float_format=lambda v: f"{v:.4f}"))
     if args.out is not None:
         out = Path(args.out)
-        res.save(out, backend="csv", inputs=inputs)
+        figures = {foot: _figures(r, session.recordings[foot]) for foot, r in res.results.items()} if args.plot else {}
+        res.save(out, backend="csv", inputs=inputs, files={**figures, ".": {LOG: log_text(texts)}})
         written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
-        if args.plot:
-            # deferred: matplotlib's figures, drawn only with --plot
-            from ..evaluation.plots import plot_run
-
-            for foot, r in res.results.items():
-                plot_run(r, out / foot, session.recordings[foot])
-        write_log(out, texts, inputs)
+        written += sorted(next(iter(figures.values()), {}))
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "
               f"{out} (footzoo.SessionResult.load({str(out)!r}) reads it back)")
     else:
@@ -430,8 +499,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     )
 
     check_output(_writable_file(args.out))
-    biases = () if args.biases in ("", "none") else tuple(b.strip() for b in args.biases.split(","))
-    noise = NoiseModel(scale=args.noise_scale, biases=biases, seed=args.seed)
+    noise = NoiseModel(scale=args.noise_scale, biases=args.biases, seed=args.seed)
     if args.scenario == "pendulum":
         rec = simulate_pendulum(rate=args.rate, noise=noise, sampling=args.sampling)
     elif args.scenario == "calibration":
@@ -668,8 +736,10 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--sampling", choices=["interval", "instantaneous"], default="interval")
     sim.add_argument("--noise-scale", type=_number(0.0, 1000.0), default=1.0,
                      help="factor on Table II noise σ (default 1)")
-    sim.add_argument("--biases", default="acc,gyr,mag", help="Table II biases to include, or 'none'")
-    sim.add_argument("--seed", type=int, default=0)
+    sim.add_argument("--biases", type=_biases, default=("acc", "gyr", "mag"),
+                     help="Table II biases to include, comma-separated: acc,gyr,mag (default), or none")
+    sim.add_argument("--seed", type=_number(0, 2**63 - 1, integer=True), default=0,
+                     help="seed of the noise (a whole number >= 0; default 0)")
     sim.add_argument("--fpa", type=_number(-90.0, 90.0, "deg"), default=0.0,
                      help="foot progression angle in deg (toe-out +)")
     sim.add_argument("--mount-yaw", type=_number(-180.0, 180.0, "deg"), default=0.0,
@@ -697,12 +767,14 @@ def build_parser() -> argparse.ArgumentParser:
     abl = sub.add_parser("ablate", aliases=["study"],
                          help="run an ablation study (configs x recordings) and write tables and plots")
     abl.add_argument("study", type=_input_yaml, help="study YAML, e.g. study_quick")
-    abl.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores (default: the "
+    abl.add_argument("--jobs", type=_jobs, help="local worker processes (joblib); -1 = all cores (default: the "
                      "study's jobs, else 1)")
     abl.add_argument("--max-cells", type=_number(1, 1e15, integer=True), metavar="N",
                      help="allow a grid of up to N runs (default: the study's max_cells, else 10000)")
-    abl.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    abl.add_argument("--out", help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
+    abl.add_argument("--scheduler", type=_scheduler,
+                     help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    abl.add_argument("--out", type=_output,
+                     help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
     abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
     abl.add_argument("--prune-cache", action="store_true",
                      help="remove every cache entry this study did not use (other studies' runs in the same --out)")
@@ -716,8 +788,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "with a tune: block) and write it as a config")
     tun.add_argument("study", type=_input_yaml,
                      help="tune YAML: a study file with a tune: block (objective, search, group_by)")
-    tun.add_argument("--jobs", type=int, help="local worker processes (joblib); -1 = all cores")
-    tun.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    tun.add_argument("--jobs", type=_jobs, help="local worker processes (joblib); -1 = all cores")
+    tun.add_argument("--scheduler", type=_scheduler,
+                     help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     tun.add_argument("--out", type=_output, help="output folder (default: tune_<file>): cache/, tune_folds.csv, "
                      "tune_scores.csv, best.yaml")
     tun.add_argument("--config", type=_output, help="write the chosen config here (default: the tune block's "
@@ -768,14 +841,37 @@ def _subparser(common: argparse.ArgumentParser) -> type[argparse.ArgumentParser]
     return SubParser
 
 
+#: Extensions of YAML files (configs, studies) and of recordings, to recognise arguments given in the wrong place.
+YAML_SUFFIXES = (".yaml", ".yml")
+
+
+def _swap_hint(args: argparse.Namespace, extras: list[str]) -> str:
+    """The fix for arguments in the wrong place (``footzoo run walk.csv config.yaml``), or ``""``."""
+    # deferred: yaml, read only for a usage error
+    from ..core.yamlsafe import RECORDING_SUFFIXES
+
+    yaml_extra = next((e for e in extras if Path(e).suffix.lower() in YAML_SUFFIXES), None)
+    given = getattr(args, "config", None) or getattr(args, "study", None)
+    if args.command == "run" and yaml_extra and given and Path(given).suffix.lower() in RECORDING_SUFFIXES:
+        return (f"; the config comes first and the recording after --data (swapped?): footzoo run {yaml_extra} "
+                f"--data {given}")
+    data = next((e for e in extras if Path(e).suffix.lower() in RECORDING_SUFFIXES), None)
+    if args.command == "run" and data:
+        return f"; a recording goes after --data: footzoo run {given or 'CONFIG'} --data {data}"
+    return ""
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     print(f"footzoo: warning: {message}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    parser = build_parser()
     try:
-        args = build_parser().parse_args(argv)
+        args, extras = parser.parse_known_args(argv)
+        if extras:
+            parser.error(f"unrecognized arguments: {' '.join(extras)}{_swap_hint(args, extras)}")
     except SystemExit as stop:  # --help (0) or a usage error (2, message already printed)
         return int(stop.code) if isinstance(stop.code, int) else EXIT_USAGE
     debug = bool(getattr(args, "debug", False))

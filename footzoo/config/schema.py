@@ -105,6 +105,11 @@ def top_level_errors(d: dict[str, Any]) -> list[str]:
     """Every problem with the top-level keys of a config (unknown, missing, badly typed), as messages."""
     if not isinstance(d, dict):
         return [f"a config must be a mapping, got {type(d).__name__}"]
+    if {"base", "recordings"} <= set(d) and not {"orientation", "detector"} & set(d):
+        kind = "tune" if "tune" in d else "study"
+        verb = "footzoo tune" if kind == "tune" else "footzoo ablate"
+        return [f"this is a {kind} file (base, recordings), not a pipeline config: run it with {verb} FILE; "
+                "footzoo run takes a pipeline config (orientation, detector, ...)"]
     errors = []
     valid = list(TOP_LEVEL_KEYS)
     for key in d:

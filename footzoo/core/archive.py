@@ -20,10 +20,14 @@ their dtype through the manifest: floats with 17 significant digits (bit-identic
 booleans, integers, and text as JSON strings (text that looks like a number stays text; an empty
 text and a missing one differ). Everything is written into the folder as one
 :class:`~footzoo.core.atomic.FileGroup`: a crash or Ctrl-C leaves the earlier result complete; files
-of the earlier result that the new one does not have are removed. The folder may hold other files
-(they are left alone), but a file with one of the archive's names that an earlier footzoo result
-did not write is never replaced: the save is refused. A session (both feet) is saved the same way,
-with one result folder per foot (:func:`save_session`).
+of the earlier result that the new one does not have are removed. ``manifest.json`` is the folder's
+completion marker: the earlier one is set aside (``.footzoo-incomplete``) before any file is replaced
+and the new one is written last, so that even a process killed between two renames leaves a folder
+that :func:`read_result` refuses as incomplete, never one that mixes two results. Files saved with a
+result (``files=``: the figures of ``footzoo run --plot``) are listed in its manifest and go with it.
+The folder may hold other files (they are left alone), but a file with one of the archive's names
+that an earlier footzoo result did not write is never replaced: the save is refused. A session (both
+feet) is saved the same way, with one result folder per foot (:func:`save_session`).
 """
 
 from __future__ import annotations
@@ -45,7 +49,7 @@ import numpy as np
 import pandas as pd
 
 from .._version import __version__
-from .atomic import FileGroup, dumps_json
+from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, json_safe, previous_marker
 from .data import Truth
 from .errors import FootzooWarning, FormatError, OutputError
 
@@ -302,14 +306,11 @@ class _Unpacker:
 # --------------------------------------------------------------------------- result archives
 
 def _earlier_files(folder: Path, kind: str) -> set[str] | None:
-    """The files an earlier footzoo archive in ``folder`` wrote (None when there is none)."""
-    manifest = folder / MANIFEST
-    if not manifest.is_file():
-        return None
-    try:
-        data = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
+    """The files an earlier footzoo archive in ``folder`` wrote (None when there is none).
+
+    Read from its manifest, or from the manifest an interrupted save set aside (:data:`INCOMPLETE`).
+    """
+    data = previous_marker(folder, MANIFEST)
     if not isinstance(data, dict) or data.get("format") not in (FORMAT, SESSION_FORMAT):
         return None
     return {str(f) for f in data.get("files", {})} | {MANIFEST}
@@ -352,6 +353,14 @@ def _refuse_foreign(folder: Path, names: set[str], earlier: set[str] | None, wha
                           "empty folder, or move those files away")
 
 
+def check_folder(path: str | os.PathLike, names: Any, what: str = "--out") -> None:
+    """Refuse, before any work, a result folder holding one of ``names`` that no earlier footzoo result there wrote
+    (the check :func:`save_result` makes when it writes)."""
+    folder = Path(path)
+    if folder.is_dir():
+        _refuse_foreign(folder, set(names), _earlier_files(folder, FORMAT), what)
+
+
 def _metrics_payload(result: Any) -> dict[str, Any]:
     notes: dict[str, str] = {}
     try:
@@ -361,7 +370,7 @@ def _metrics_payload(result: Any) -> dict[str, Any]:
         warnings.warn(FootzooWarning(f"Result.save: the metrics could not be computed ({type(err).__name__}: {err}); "
                                      "saved without them"), stacklevel=4)
         metrics = {"error": f"{type(err).__name__}: {err}"}
-    recording = {k: v for k, v in result.recording.items() if isinstance(v, (str, int, float, bool))}
+    recording = json_safe(result.recording)  # nested metadata as plain JSON; objects as their text, never dropped
     return {"metrics": metrics, "metric_notes": notes, "config": result.config, "versions": result.versions,
             "recording": recording}
 
@@ -445,7 +454,20 @@ FILE_SUFFIXES = (".csv", ".tsv", ".txt", ".json", ".parquet", ".pq", ".xlsx", ".
                  ".hdf5", ".zip", ".pkl", ".pickle")
 
 
-def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+def _extra_files(group: FileGroup, folder: Path, files: dict[str, bytes] | None) -> dict[str, Any]:
+    """Write the extra files of a save (figures: name -> content) into the group; their manifest entries."""
+    out: dict[str, Any] = {}
+    for name, content in (files or {}).items():
+        if not isinstance(name, str) or Path(name).name != name or name in (MANIFEST, INCOMPLETE):
+            raise OutputError(f"files: {name!r} is not a plain file name for the archive's folder")
+        with group.open(folder / name, "wb") as fh:
+            fh.write(content)
+        out[name] = {"holds": "written with the result (a figure of the run, the command's log)", "kind": "file"}
+    return out
+
+
+def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+                files: dict[str, bytes] | None = None) -> Path:
     """Write ``result`` as a result archive folder (see the module doc); returns the folder.
 
     Parameters
@@ -459,6 +481,10 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     inputs : iterable of paths
         Files besides the recording's own (``result.recording["input_files"]``) that must not be
         replaced (the config file, for instance).
+    files : dict of str to bytes, optional
+        More files written with the archive, in the same commit, and listed in its manifest (the
+        figures of ``footzoo run --plot``): a later save without them removes them, so a folder
+        never keeps an earlier run's figures beside a newer result.
 
     Raises
     ------
@@ -474,12 +500,13 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
                           f"{str(Path(path).with_suffix(''))!r}). To export one table: result.samples.to_csv(...)")
     with _new_folder(path, what) as folder:
         earlier = _earlier_files(folder, FORMAT)
-        with FileGroup(inputs=_inputs(result, inputs), what=what) as group:
-            files = _result_files(result, folder, group, backend)
-            _refuse_foreign(folder, set(files) | {MANIFEST}, earlier, what)
+        with FileGroup(inputs=_inputs(result, inputs), what=what, marker=folder / MANIFEST) as group:
+            written = _result_files(result, folder, group, backend)
+            written.update(_extra_files(group, folder, files))
+            _refuse_foreign(folder, set(written) | {MANIFEST}, earlier, what)
             with group.open(folder / MANIFEST) as fh:
-                fh.write(_manifest(FORMAT, backend, files))
-            _commit(folder, group, files, earlier)
+                fh.write(_manifest(FORMAT, backend, written))
+            _commit(folder, group, written, earlier)
     return folder
 
 
@@ -488,8 +515,7 @@ def _read_manifest(folder: Path, kind: str) -> dict[str, Any]:
     if not folder.is_dir():
         raise FormatError(f"{str(folder)!r} is not a folder; {what} is loaded from the folder Result.save wrote")
     manifest = folder / MANIFEST
-    if not manifest.is_file():
-        raise FormatError(f"{str(folder)!r} holds no {MANIFEST}: it is not {what} saved by footzoo")
+    check_complete(folder, MANIFEST, what)
     try:
         data = json.loads(manifest.read_text(encoding="utf-8"))
     except (OSError, ValueError) as err:
@@ -559,19 +585,26 @@ def read_result(path: str | os.PathLike) -> dict[str, Any]:
                           f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
 
 
-def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+                 files: dict[str, dict[str, bytes]] | None = None) -> Path:
     """Write a :class:`~footzoo.runtime.session.SessionResult` as a folder: one result folder per foot
-    (``left/``, ``right/``), the combined stride table and the bilateral table (both recomputed on load)."""
+    (``left/``, ``right/``), the combined stride table and the bilateral table (both recomputed on load).
+
+    ``files``: per foot, more files written into its folder with the archive (as :func:`save_result`'s); under
+    ``"."``, into the session's folder (the command's log).
+    """
     backend = _backend(backend)
     what = "SessionResult.save"
     all_inputs = [i for r in session.results.values() for i in _inputs(r, ())] + [str(i) for i in inputs]
-    with _new_folder(path, what) as folder, FileGroup(inputs=all_inputs, what=what) as group:
+    with _new_folder(path, what) as folder, \
+            FileGroup(inputs=all_inputs, what=what, marker=Path(path) / MANIFEST) as group:
         earlier = _earlier_files(folder, SESSION_FORMAT)
-        files: dict[str, Any] = {}
+        files, extra = {}, files or {}
         for foot, result in session.results.items():
             sub = folder / foot
             sub.mkdir(exist_ok=True)
             own = _result_files(result, sub, group, backend)
+            own.update(_extra_files(group, sub, extra.get(foot)))
             with group.open(sub / MANIFEST) as fh:
                 fh.write(_manifest(FORMAT, backend, own, foot=foot))
             files.update({f"{foot}/{name}": info for name, info in own.items()})
@@ -581,6 +614,7 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
                             ("bilateral", "medians per foot and symmetry index (SessionResult.bilateral; derived)")):
             name, info = _write_table(getattr(session, attr), group, folder, attr, backend)
             files[name] = {"holds": holds, **info}
+        files.update(_extra_files(group, folder, extra.get(".")))
         _refuse_foreign(folder, set(files) | {MANIFEST}, earlier, what)
         with group.open(folder / MANIFEST) as fh:
             fh.write(_manifest(SESSION_FORMAT, backend, files, name=session.name, feet=list(session.results)))

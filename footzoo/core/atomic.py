@@ -41,12 +41,15 @@ import math
 import os
 import secrets
 import signal
+import socket
 import threading
+import time
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from .errors import OutputError
+from .._version import __version__
+from .errors import FormatError, OutputError
 
 #: Infix of the temporary files (a leftover one, from a killed process, can be deleted).
 TMP_INFIX = ".footzoo-tmp-"
@@ -110,11 +113,14 @@ def refuse_inputs(targets: Iterable[PathLike], inputs: Iterable[PathLike], what:
                 )
 
 
+_DEFERRING = threading.local()
+
+
 @contextlib.contextmanager
 def _interrupts_deferred() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) until the block has finished; re-raise it afterwards (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
+    if threading.current_thread() is not threading.main_thread() or getattr(_DEFERRING, "on", False):
+        yield  # not the main thread (no signals here), or already held by an enclosing block
         return
     caught: list[Any] = []
     try:
@@ -122,9 +128,11 @@ def _interrupts_deferred() -> Iterator[None]:
     except (ValueError, OSError):  # no signal handling here (embedded interpreter)
         yield
         return
+    _DEFERRING.on = True
     try:
         yield
     finally:
+        _DEFERRING.on = False
         signal.signal(signal.SIGINT, previous)
         if caught:
             raise KeyboardInterrupt
@@ -169,6 +177,11 @@ class FileGroup:
     fsync : bool
         Flush every file (and the folders' entries) to disk before returning. ``False`` is faster where
         durability against a power cut does not matter (a cache that is recomputed when damaged).
+    marker : path, optional
+        The member that is the folder's completion marker (a manifest): the earlier one is set aside
+        before the other members are renamed, and the new one is renamed last
+        (:func:`begin_folder`), so that even a process killed half-way through the renames leaves a
+        folder its readers refuse as incomplete, never one that mixes two versions and looks whole.
 
     Notes
     -----
@@ -177,10 +190,12 @@ class FileGroup:
     deleted and nothing under a final name changes.
     """
 
-    def __init__(self, inputs: Iterable[PathLike] = (), what: str = "output", fsync: bool = True):
+    def __init__(self, inputs: Iterable[PathLike] = (), what: str = "output", fsync: bool = True,
+                 marker: PathLike | None = None):
         self.inputs = [Path(i) for i in inputs]
         self.what = what
         self.fsync = fsync
+        self.marker = Path(os.path.abspath(marker)) if marker is not None else None
         self._members: dict[Path, Path] = {}
         self._stale: list[Path] = []
         self._done = False
@@ -238,12 +253,20 @@ class FileGroup:
                 if self.fsync:
                     for tmp in self._members.values():
                         _fsync_file(tmp)
+                marked = self.marker is not None and self.marker in self._members
+                if marked:
+                    begin_folder(self.marker.parent, self.marker.name)
                 for final, tmp in self._members.items():
-                    os.replace(tmp, final)
-                    done.append(final)
+                    if final != self.marker or not marked:
+                        os.replace(tmp, final)
+                        done.append(final)
                 for stale in self._stale:
                     if Path(os.path.abspath(stale)) not in self._members:
                         _remove_quietly(stale)
+                if marked:
+                    os.replace(self._members[self.marker], self.marker)
+                    done.append(self.marker)
+                    _remove_quietly(self.marker.parent / INCOMPLETE)
             except OSError as err:
                 self._discard()
                 written = f" ({', '.join(p.name for p in done)} already replaced)" if done else ""
@@ -373,33 +396,175 @@ def write_json(path: PathLike, value: Any, inputs: Iterable[PathLike] = (), what
     return write_text(path, dumps_json(value, indent), inputs=inputs, what=what)
 
 
-@contextlib.contextmanager
-def folder_lock(folder: PathLike, what: str = "output folder") -> Iterator[Path]:
-    """Hold an exclusive lock on ``folder`` (a ``.footzoo.lock`` file in it) for the block.
+#: Lock file an output folder holds while one footzoo process writes into it (:func:`folder_lock`).
+LOCK_NAME = ".footzoo.lock"
 
-    A second footzoo process that asks for the same folder gets an :class:`OutputError` at once
-    (it does not wait). The lock is released when the block ends or the process dies.
+_HELD: dict[tuple[str, int], int] = {}  # (folder, thread) -> depth: the locks this process holds
+_HELD_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "",
+                identity: str | None = None) -> Iterator[Path]:
+    """Hold a lock on ``folder`` (the file ``.footzoo.lock`` in it) for the block.
+
+    The lock file says who holds it: ``owner`` (e.g. ``"study 'quick'"``), the process id, the host
+    and the start time. Another footzoo process that asks for the same folder gets an
+    :class:`OutputError` at once (it does not wait) naming the holder and how to proceed, unless
+    both give the same ``identity`` (the same study started twice: they share its cache, resume
+    each other's runs and write the same report). The lock is released when the block ends (its
+    file removed by the last holder); a process that dies holding it releases it too (the operating
+    system drops an ``flock`` with its process), so a lock left by a killed process is stale and
+    taken over. Where the file system has no locks (some network file systems), the lock file's
+    process id decides: a holder on this host that no longer runs is stale. The same thread may
+    enter the lock again (a tune runs its studies in its own folder).
+
+    Parameters
+    ----------
+    folder : path
+        The output folder (created when missing).
+    what : str
+        How the folder was named (``"--out"``), for messages.
+    owner : str
+        What writes into it, for the message another process gets.
+    identity : str, optional
+        What the holder writes: processes with the same identity share the folder; None: exclusive.
     """
     p = Path(folder)
-    p.mkdir(parents=True, exist_ok=True)
-    lock = p / ".footzoo.lock"
-    fh = open(lock, "a+")
     try:
-        if not _try_lock(fh):
-            fh.seek(0)
-            holder = fh.read().strip() or "another process"
-            raise OutputError(f"{what} {str(p)!r} is being written by {holder}; wait until it has finished, "
-                              "or choose another output folder")
-        fh.seek(0)
-        fh.truncate()
-        fh.write(f"footzoo process {os.getpid()}\n")
-        fh.flush()
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise OutputError(f"{what} {str(p)!r} cannot be created: {err.strerror or err}") from None
+    key = (os.path.realpath(p), threading.get_ident())
+    with _HELD_LOCK:
+        nested = key in _HELD
+        if nested:
+            _HELD[key] += 1
+    if nested:
+        try:
+            yield p
+        finally:
+            with _HELD_LOCK:
+                _HELD[key] -= 1
+        return
+    fh = _acquire(p, what, owner, identity)
+    with _HELD_LOCK:
+        _HELD[key] = 1
+    try:
         yield p
     finally:
+        with _HELD_LOCK:
+            _HELD.pop(key, None)
+        if identity is None or _try_lock(fh) is True:  # the last holder: no other process holds this file
+            with contextlib.suppress(OSError):
+                os.unlink(p / LOCK_NAME)
         fh.close()  # closing releases the lock
 
 
-def _try_lock(fh: IO[Any]) -> bool:
+def lock_holder(folder: PathLike) -> dict[str, Any] | None:
+    """What the lock file of ``folder`` says about its holder (``pid``, ``host``, ``started``, ``owner``), or None."""
+    try:
+        text = (Path(folder) / LOCK_NAME).read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    try:
+        info = json.loads(text)
+    except ValueError:
+        return {"owner": text.strip()[:200]} if text.strip() else None
+    return info if isinstance(info, dict) else None
+
+
+def _acquire(folder: Path, what: str, owner: str, identity: str | None) -> IO[Any]:
+    """The open, locked lock file of ``folder`` (see :func:`folder_lock`)."""
+    lock = folder / LOCK_NAME
+    for _ in range(40):  # another process may replace the file, or convert its lock, meanwhile: look again
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise OutputError(f"{what} {str(folder)!r}: its lock file {LOCK_NAME} cannot be created "
+                              f"({err.strerror or err}); choose a writable folder") from None
+        fh = os.fdopen(fd, "r+", encoding="utf-8")
+        state = _try_lock(fh)
+        holder = lock_holder(folder)
+        shared = identity is not None and (holder or {}).get("identity") == identity
+        if state is None and _holder_alive(holder) and not shared:  # no file locks here: the pid decides
+            fh.close()
+            raise OutputError(_in_use(folder, what, holder, flock=False))
+        if state is False:
+            if not shared:
+                fh.close()
+                raise OutputError(_in_use(folder, what, holder, flock=True))
+            if _try_lock(fh, exclusive=False) is not True:  # the same study, still converting its lock: again
+                fh.close()
+                time.sleep(0.05)
+                continue
+        if not _same_file(fh, lock) or (state is False and (lock_holder(folder) or {}).get("identity") != identity):
+            fh.close()
+            continue
+        if state is False:  # sharing the folder with the same study: its description stays
+            return fh
+        fh.seek(0)
+        fh.truncate()
+        fh.write(json.dumps({"owner": owner or "footzoo", "pid": os.getpid(), "host": _host(),
+                             "started": time.strftime("%Y-%m-%d %H:%M:%S"), "footzoo": _version(),
+                             "identity": identity}) + "\n")
+        fh.flush()
+        if identity is not None and state is True:
+            _try_lock(fh, exclusive=False, wait=True)  # the same study may join
+        return fh
+    raise OutputError(f"{what} {str(folder)!r}: its lock file {LOCK_NAME} keeps changing; another process is "
+                      "starting in it: try again")
+
+
+def _same_file(fh: IO[Any], path: Path) -> bool:
+    """Whether the open lock file is still the one at ``path`` (another holder may have removed it meanwhile)."""
+    try:
+        return os.path.samestat(os.fstat(fh.fileno()), os.stat(path))
+    except OSError:
+        return False
+
+
+def _in_use(folder: Path, what: str, holder: dict[str, Any] | None, flock: bool) -> str:
+    holder = holder or {}
+    who = holder.get("owner") or "another footzoo process"
+    where = " ".join(x for x in (f"process {holder['pid']}" if holder.get("pid") else "",
+                                 f"on {holder['host']}" if holder.get("host") else "",
+                                 f"since {holder['started']}" if holder.get("started") else "") if x)
+    stale = "" if flock else (f". If that process no longer runs (on another machine footzoo cannot tell), delete "
+                              f"{str(folder / LOCK_NAME)!r} and start again")
+    return (f"{what} {str(folder)!r} is in use: {who}{f' ({where})' if where else ''} is writing into it. Wait until "
+            f"it has finished, or give this one another output folder{stale}")
+
+
+def _holder_alive(holder: dict[str, Any] | None) -> bool:
+    """Whether the process a lock file names may still run (without file locks: its pid, on this host)."""
+    if not holder or not isinstance(holder.get("pid"), int):
+        return False
+    if holder.get("host") != _host():
+        return True  # another machine: footzoo cannot tell, so the lock stands
+    try:
+        os.kill(holder["pid"], 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # it exists (owned by another user)
+        return True
+    return True
+
+
+def _host() -> str:
+    return socket.gethostname()
+
+
+def _version() -> str:
+    return __version__
+
+
+def _try_lock(fh: IO[Any], exclusive: bool = True, wait: bool = False) -> bool | None:
+    """True: locked; False: another process holds a conflicting lock; None: the file system has no locks.
+
+    ``exclusive=False``: a shared lock (compatible with other shared ones; Windows has none: exclusive).
+    ``wait``: block until it is granted (converting a lock this process holds).
+    """
     try:
         # deferred: the platform's own locking module (fcntl on POSIX, msvcrt on Windows)
         import fcntl
@@ -411,12 +576,89 @@ def _try_lock(fh: IO[Any]) -> bool:
             return True
         except OSError:
             return False
+    flags = (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | (0 if wait else fcntl.LOCK_NB)
     try:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        fcntl.flock(fh.fileno(), flags)
         return True
-    except OSError:
-        return False
+    except OSError as err:
+        if err.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            return False
+        return None  # ENOLCK, EOPNOTSUPP...: no locks here; the lock file's pid decides
 
 
-__all__ = ["TMP_INFIX", "FileGroup", "OutputError", "atomic_path", "atomic_write", "check_target", "dumps_json",
-           "folder_lock", "json_safe", "refuse_inputs", "same_file", "write_bytes", "write_json", "write_text"]
+# --------------------------------------------------------------------------- folder outputs
+
+#: Present in a folder output while footzoo (re)writes it; holds the completion marker of the earlier
+#: version (the marker is absent meanwhile). A folder with it was interrupted: it is incomplete.
+INCOMPLETE = ".footzoo-incomplete"
+
+
+def begin_folder(folder: PathLike, marker: str) -> Any:
+    """Mark the folder output ``folder`` as being written: its completion marker ``marker`` is set aside.
+
+    The marker (a JSON file written last, e.g. a result's ``manifest.json``) is renamed to
+    :data:`INCOMPLETE`, so that until :func:`end_folder` writes the new one, readers refuse the
+    folder as incomplete (:func:`check_complete`). Returns the earlier marker's content (parsed
+    JSON; from :data:`INCOMPLETE` when an earlier write was interrupted), or None.
+    """
+    f = Path(folder)
+    earlier = f / marker
+    journal = f / INCOMPLETE
+    if earlier.is_file():
+        os.replace(earlier, journal)
+    elif not journal.exists():
+        journal.write_text("{}\n", encoding="utf-8")  # its presence is the mark; the content is the earlier marker
+    return previous_marker(f, marker)
+
+
+def previous_marker(folder: PathLike, marker: str) -> Any:
+    """The content of ``folder``'s completion marker, or of the one an interrupted write set aside; None."""
+    for name in (marker, INCOMPLETE):
+        try:
+            data = json.loads((Path(folder) / name).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if data:
+            return data
+    return None
+
+
+def end_folder(folder: PathLike, marker: str, text: str | None = None) -> Path:
+    """Write the completion marker ``marker`` (last, atomically) and clear the mark of :func:`begin_folder`.
+
+    ``text`` None: put the earlier marker back as it was (nothing changed), when it is still set aside.
+    """
+    f = Path(folder)
+    if text is None:
+        with contextlib.suppress(FileNotFoundError):  # another run of the same study may have put it back
+            os.replace(f / INCOMPLETE, f / marker)
+    else:
+        write_text(f / marker, text, what=str(f))
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(f / INCOMPLETE)
+    _fsync_folder(f)
+    return f / marker
+
+
+def incomplete(folder: PathLike) -> bool:
+    """True when a write of the folder output ``folder`` was interrupted (:data:`INCOMPLETE` is there)."""
+    return (Path(folder) / INCOMPLETE).exists()
+
+
+def check_complete(folder: PathLike, marker: str, what: str) -> Path:
+    """``folder`` when its completion marker is there and no write was interrupted; else a FormatError."""
+    f = Path(folder)
+    if incomplete(f):
+        raise FormatError(f"{str(f)!r} is incomplete: footzoo was interrupted while writing {what} there "
+                          f"({INCOMPLETE} is there, {marker} is not written yet); its files are not all of one "
+                          "run: run the command again to complete it")
+    if not (f / marker).is_file():
+        raise FormatError(f"{str(f)!r} holds no {marker}: it is not {what} written by footzoo, or its writing "
+                          f"stopped before the end ({marker} is written last); write it again")
+    return f
+
+
+__all__ = ["INCOMPLETE", "LOCK_NAME", "TMP_INFIX", "FileGroup", "OutputError", "atomic_path", "atomic_write",
+           "begin_folder", "check_complete", "check_target", "dumps_json", "end_folder", "folder_lock", "incomplete",
+           "json_safe", "lock_holder", "previous_marker", "refuse_inputs", "same_file", "write_bytes", "write_json",
+           "write_text"]

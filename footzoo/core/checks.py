@@ -84,6 +84,9 @@ def check_vector(name: str, value: Any, size: int = 3, nonzero: bool = False, un
 
 
 def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: str) -> np.ndarray:
+    if value is None:  # a channel that dropped out: said so, not as a shape
+        raise RecordingError(f"{name} is missing (None) at t = {t!r}: every sample needs {name} ({unit}, 3 numbers); "
+                             "a sensor that dropped out cannot be bridged: repair the gap or end the stream there")
     raw = value if isinstance(value, np.ndarray) else None
     if raw is None and isinstance(value, (list, tuple)):
         raw = np.asarray(value, dtype=object)

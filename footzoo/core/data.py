@@ -363,7 +363,11 @@ def _floats(name: str, value: Any) -> np.ndarray:
 
 def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
     def get(cols: list[str]) -> np.ndarray | None:
-        return df[cols].to_numpy(dtype=float) if all(c in df.columns for c in cols) else None
+        found = [c for c in cols if c in df.columns]
+        if found and len(found) < len(cols):  # a reference that lost a column would be dropped without a word
+            raise RecordingError(f"reference columns incomplete: found {found}, need all of {cols}; add the missing "
+                                 "one(s) or drop these")
+        return df[cols].to_numpy(dtype=float) if found else None
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
     stance = None

@@ -125,6 +125,60 @@ def find_saturation(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> list[dic
     return found
 
 
+#: Fewest samples, and shortest time (s), of one sensor repeating its exact reading that are called a dropout.
+FROZEN_MIN_SAMPLES = 10
+FROZEN_MIN_DURATION = 0.1
+_SENSORS = {"acc": "accelerometer", "gyr": "gyroscope"}
+
+
+def find_frozen(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0,
+                history: dict[str, tuple[int, int]] | None = None) -> list[dict[str, Any]]:
+    """Dropouts: one sensor repeats its exact three-axis reading while the other one moves.
+
+    A sensor's noise changes every reading (the real recordings in the data folder repeat one at
+    most twice in a row); a run of at least :data:`FROZEN_MIN_SAMPLES` samples and
+    :data:`FROZEN_MIN_DURATION` s of one exact reading, while the other sensor's readings change
+    in most of it, is a channel that dropped out (a lost connection, a logger that repeats the
+    last value or fills zeros). Not reported: both sensors frozen together (a noise-free
+    simulation at rest), and a sensor that repeats its readings exactly elsewhere too (more than
+    :data:`PLATEAU_FRACTION` of its other consecutive samples: a noise-free signal with flat tops).
+    ``history``: per sensor, ``(repeats, pairs)`` of the samples before these (live). Returns one dict
+    per run: ``sensor`` (``"acc"``/``"gyr"``), ``first``, ``last`` (sample numbers, plus ``offset``),
+    ``t0``, ``t1`` (s), ``value`` (the repeated reading).
+    """
+    found: list[dict[str, Any]] = []
+    if len(t) < FROZEN_MIN_SAMPLES:
+        return found
+    same = {"acc": np.all(acc[1:] == acc[:-1], axis=1), "gyr": np.all(gyr[1:] == gyr[:-1], axis=1)}
+    for name, other in (("acc", "gyr"), ("gyr", "acc")):
+        before_repeats, before_pairs = (history or {}).get(name, (0, 0))
+        repeats = before_repeats + int(same[name].sum())
+        pairs = before_pairs + len(same[name])
+        for s, e in _runs(same[name], FROZEN_MIN_SAMPLES - 1):  # pairs s..e-1: samples s..e
+            if t[e] - t[s] < FROZEN_MIN_DURATION or np.mean(same[other][s:e]) > 0.5:
+                continue
+            away = pairs - (e - s)
+            if away > 0 and (repeats - (e - s)) / away > PLATEAU_FRACTION:
+                continue  # flat stretches are this signal's shape (noise-free), not a dropout
+            found.append({"sensor": name, "first": s + offset, "last": e + offset, "t0": float(t[s]),
+                          "t1": float(t[e]), "value": (acc if name == "acc" else gyr)[s].tolist()})
+    return found
+
+
+def warn_frozen(found: list[dict[str, Any]], name: str, stacklevel: int = 4) -> None:
+    """The warning of the dropouts :func:`find_frozen` found."""
+    if not found:
+        return
+    parts = [f"the {_SENSORS[f['sensor']]} repeats one reading {np.round(f['value'], 4).tolist()} exactly from "
+             f"t = {f['t0']:.3f} s to {f['t1']:.3f} s (samples {f['first']}–{f['last']}) while the "
+             f"{_SENSORS['gyr' if f['sensor'] == 'acc' else 'acc']} moves" for f in found[:3]]
+    more = f" and {len(found) - 3} more" if len(found) > 3 else ""
+    warnings.warn(
+        f"{name}: {'; '.join(parts)}{more}: that channel dropped out (a lost connection, or a logger that repeats its "
+        "last value); every estimate from there is wrong. Cut the recording before the dropout, or repair it. "
+        "Details in meta['sanity']['frozen']", SensorWarning, stacklevel=stacklevel)
+
+
 def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np.ndarray:
     """Samples of bursts of 1 to ``max_len`` samples that stand out from the samples around them by more than ``jump``.
 
@@ -210,6 +264,10 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
             SensorWarning, stacklevel=4,
         )
     report.update(warn_glitches(t, acc, gyr, name, stacklevel=5))
+    frozen = find_frozen(t, acc, gyr)
+    if frozen:
+        report["frozen"] = frozen
+        warn_frozen(frozen, name, stacklevel=5)
     return report
 
 
@@ -292,6 +350,12 @@ class SignalScan:
         self._repeats = [0] * 6
         self._saturated = [[False] * 6, [False] * 6]
         self._floor = [SATURATION_FLOOR["acc"]] * 3 + [SATURATION_FLOOR["gyr"]] * 3
+        self._frozen_tail = np.zeros(0)  # time of the samples since the last change of either sensor's reading
+        self._frozen_x = np.zeros((0, 6))
+        self._frozen_k0 = 0
+        self._frozen_open: dict[str, int | None] = {}  # per sensor: the first sample of its reported, open dropout
+        self._vector_repeats = {"acc": 0, "gyr": 0}  # consecutive samples repeating a sensor's whole reading
+        self._vector_pairs = 0
 
     def push(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> dict[str, Any]:
         """Scan the next samples; the new findings (also added to :attr:`report`)."""
@@ -315,7 +379,50 @@ class SignalScan:
         keep = GLITCH_MAX_LEN + 1
         self._k0 += max(len(joined_t) - keep, 0)
         self._t, self._x = joined_t[-keep:], joined[-keep:]
+        pairs = np.vstack([self._frozen_x[-1:], x]) if len(self._frozen_x) else x
+        if len(pairs) > 1:
+            self._vector_pairs += len(pairs) - 1
+            self._vector_repeats["acc"] += self._tail_repeats(pairs, slice(0, 3))
+            self._vector_repeats["gyr"] += self._tail_repeats(pairs, slice(3, 6))
+        frozen = self._frozen(t, x, k0)
+        if frozen:
+            new["frozen"] = frozen
         return new
+
+    @staticmethod
+    def _tail_repeats(x: np.ndarray, cols: slice) -> int:
+        return int(np.all(x[1:, cols] == x[:-1, cols], axis=1).sum()) if len(x) > 1 else 0
+
+    def _frozen(self, t: np.ndarray, x: np.ndarray, k0: int) -> list[dict[str, Any]]:
+        """Dropouts (:func:`find_frozen`) live, each reported once while it lasts.
+
+        The samples since the start of each sensor's current streak of one exact reading are kept
+        (until the streak is reported or ends: bounded), so a dropout spread over many pushes is found.
+        """
+        tail_t, tail_x = np.concatenate([self._frozen_tail, t]), np.vstack([self._frozen_x, x])
+        base = self._frozen_k0 if len(self._frozen_tail) else k0
+        history = {name: (self._vector_repeats[name] - self._tail_repeats(tail_x, cols),
+                          self._vector_pairs - max(len(tail_t) - 1, 0))
+                   for name, cols in (("acc", slice(0, 3)), ("gyr", slice(3, 6)))}
+        found = [f for f in find_frozen(tail_t, tail_x[:, :3], tail_x[:, 3:], base, history)
+                 if self._frozen_open.get(f["sensor"]) is None]
+        for f in found:
+            self._frozen_open[f["sensor"]] = f["first"]
+        keep = len(tail_t) - 1
+        for name, cols in (("acc", slice(0, 3)), ("gyr", slice(3, 6))):
+            flags = np.all(tail_x[1:, cols] == tail_x[:-1, cols], axis=1)
+            streak = len(flags)
+            while streak > 0 and flags[streak - 1]:
+                streak -= 1
+            if streak == len(flags):  # its reading changed at the last sample: any dropout of it is over
+                self._frozen_open[name] = None
+            elif self._frozen_open.get(name) is None:
+                keep = min(keep, streak)  # an open streak not reported yet: keep its samples
+        self._frozen_tail, self._frozen_x, self._frozen_k0 = tail_t[keep:], tail_x[keep:], base + keep
+        if found:
+            self.report.setdefault("frozen", []).extend(found)
+            warn_frozen(found, self.name, stacklevel=5)
+        return found
 
     def _saturation(self, t: np.ndarray, x: np.ndarray, k0: int, step: np.ndarray) -> dict[str, Any]:
         """Runs at each axis's rails so far (vectorised over the chunk and the axes; one sample: scalar)."""
@@ -500,7 +607,7 @@ class EstimateScan:
         if first >= 0 and self._first is None:
             self._first = (float(t[first]), pos[first].copy())
         self._last = (float(t[-1]), pos[-1].copy())
-        self._scale(k, t, acc, off_g)
+        self._scale(k, t, acc, gyr, off_g)
         starts, ends = still
         if self._run is not None and not (len(starts) and starts[0] == 0):  # the open run ended at the chunk's start
             self._close(self._run)
@@ -522,11 +629,13 @@ class EstimateScan:
                 if s == 0:
                     self._run = None
 
-    def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, runs: np.ndarray) -> None:
+    def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, runs: np.ndarray) -> None:
         """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s.
 
         ``runs``: (2, K) the chunk's runs ``[s, e)`` of quiet samples (|ω| < STILL_GYR) with ‖f‖
-        outside [0.5 g, 1.5 g] (:func:`_quiet_runs`); ``acc`` the chunk's specific force (m/s²).
+        outside [0.5 g, 1.5 g] (:func:`_quiet_runs`); ``acc`` the chunk's specific force (m/s²). A
+        gyroscope that repeats one exact reading there is not quiet but dropped out (:func:`find_frozen`
+        names it): not a scale fault.
         """
         if "acc_scale" in self.report:
             return
@@ -538,6 +647,8 @@ class EstimateScan:
             start = carried if (s == 0 and carried is not None) else (int(k[s]), float(t[s]))
             if slow is not None and slow <= start[0]:
                 return  # its quiet says nothing of the foot: the gait scan named the gyroscope's unit
+            if e - s > 1 and np.all(gyr[s + 1:e] == gyr[s:e - 1]):  # a frozen gyroscope, not a quiet one
+                continue
             if t[e - 1] - start[1] >= SCALE_MIN_DURATION:
                 norms = row_norms(acc[s:e])
                 level = float(np.median(norms - self.gravity)) + self.gravity  # ‖f‖ there

@@ -34,6 +34,7 @@ from yaml.constructor import ConstructorError
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from .errors import ConfigError
+from .files import damaged_text, foreign_encoding, nul_padding, why_missing
 
 #: Largest YAML file read (bytes).
 MAX_BYTES = 1 << 20
@@ -216,7 +217,7 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
 
 
 #: Extensions of recordings, named when one is given where a YAML file is expected.
-RECORDING_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq", ".mat", ".gz", ".zip")
+RECORDING_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq", ".mat", ".gz", ".zip", ".npz", ".h5")
 
 
 def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str = "YAML file") -> Any:
@@ -234,9 +235,13 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
     if isinstance(path, str) and not path.strip():
         raise error(f"{what} is an empty path ('' would read the current folder); give the path of a YAML file")
     p = Path(path)
+    if p.suffix.lower() in RECORDING_SUFFIXES and p.suffix.lower() != ".txt":
+        raise error(f"{str(p)!r} is a recording ({p.suffix} file), not a {what} (YAML): a recording goes to --data, "
+                    f"e.g. footzoo run CONFIG --data {p}")
     try:
         if not p.exists():
-            raise error(f"{what} {str(p)!r} does not exist; check the path")
+            problem = why_missing(p)
+            raise error(f"{what} {str(p)!r} {problem}; check the path")
         if p.is_dir():
             raise error(f"{what} {str(p)!r} is a directory; give the path of a YAML file")
         if not p.is_file():
@@ -251,6 +256,12 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
         hint = (f" ({p.suffix} is a recording's extension: a recording goes to --data, the {what} is YAML)"
                 if p.suffix.lower() in RECORDING_SUFFIXES else "")
         raise error(f"{p}: larger than {MAX_BYTES} bytes; a {what} this large is not accepted{hint}")
+    encoding = foreign_encoding(raw)
+    if encoding:
+        raise error(f"{p}: {encoding}")
+    if b"\0" in raw:
+        raise error(damaged_text(str(p), raw) or f"{p}: ends with {nul_padding(raw)} NUL bytes (0x00) after its text: "
+                    "the file was damaged while it was written; delete them (or write the file again)")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
@@ -273,7 +284,9 @@ class StrictDumper(yaml.SafeDumper):
 def _represent_str(dumper: StrictDumper, value: str) -> yaml.ScalarNode:
     tag = StrictLoader.resolve(StrictLoader, ScalarNode, value, (True, False))  # type: ignore[arg-type]
     node = dumper.represent_scalar("tag:yaml.org,2002:str", value)
-    if tag != "tag:yaml.org,2002:str" and node.style is None:
+    if any(c in value for c in "\x85\u2028\u2029") or not all(c.isprintable() or c in "\n\t" for c in value):
+        node.style = '"'  # line breaks YAML folds (NEL, LS, PS) and control characters: escaped, so they read back
+    elif tag != "tag:yaml.org,2002:str" and node.style is None:
         node.style = "'"
     return node
 

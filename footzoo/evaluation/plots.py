@@ -575,10 +575,20 @@ def plot_run(result: Result, out: str | Path, recording: Recording | None = None
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    written = [save(trajectory_figure(result, recording), out / "trajectory.png"),
-               save(states_figure(result, recording, window), out / "states.png")]
+    return [save(fig, out / name) for name, fig in run_figures(result, recording, window).items()]
+
+
+def run_figures(result: Result, recording: Recording | None = None,
+                window: tuple[float, float] | None = None) -> dict[str, Figure]:
+    """The figures of :func:`plot_run` by file name (``trajectory.png``, ...), not saved.
+
+    ``footzoo run --plot --out`` saves them with the result archive, as one unit
+    (:meth:`footzoo.Result.save` ``files=``, each as :func:`png_bytes`).
+    """
+    figures = {"trajectory.png": trajectory_figure(result, recording),
+               "states.png": states_figure(result, recording, window)}
     for name, fig in (("errors", errors_figure(result, recording) if recording is not None else None),
                       ("strides", strides_figure(result, recording)), ("fpa", fpa_figure(result, recording))):
         if fig is not None:
-            written.append(save(fig, out / f"{name}.png"))
-    return written
+            figures[f"{name}.png"] = fig
+    return figures

@@ -99,12 +99,14 @@ class Result:
         t = self.samples["t"].to_numpy()
         return result_metrics_checked(t, self.pos, self.steps, self.reference)
 
-    def save(self, path: str | os.PathLike, backend: str = "auto", inputs: Any = ()) -> Path:
+    def save(self, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
+             files: dict[str, bytes] | None = None) -> Path:
         """Save as a folder: tables, metrics, config, versions, metadata, diagnostics and the reference.
 
-        Lossless and self-describing (a ``manifest.json`` says what each file holds); Parquet tables
-        when pyarrow is installed, CSV + JSON otherwise; written atomically, never over an input
-        (see :mod:`footzoo.core.archive`).
+        Lossless and self-describing (a ``manifest.json`` says what each file holds, written last:
+        a folder without it, or with ``.footzoo-incomplete``, is refused by :meth:`load` as
+        incomplete); Parquet tables when pyarrow is installed, CSV + JSON otherwise; written
+        atomically, never over an input (see :mod:`footzoo.core.archive`).
 
         Parameters
         ----------
@@ -114,13 +116,16 @@ class Result:
             Table format.
         inputs : iterable of paths
             Further files that must not be replaced (the recording's own are known).
+        files : dict of str to bytes, optional
+            More files saved with the result and listed in its manifest (figures: file name ->
+            content); a later save without them removes them.
 
         Returns
         -------
         Path
             The folder.
         """
-        return save_result(self, path, backend=backend, inputs=inputs)
+        return save_result(self, path, backend=backend, inputs=inputs, files=files)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Result:

@@ -38,6 +38,7 @@ import numpy as np
 from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
+from ..core.files import why_missing
 from . import xio
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import REQUIRED, Option, Reader
@@ -74,7 +75,9 @@ def check_input_file(path: str | Path, what: str = "recording") -> Path:
     p = Path(path)
     try:
         if not p.exists():
-            raise FormatError(f"{what} {str(p)!r}: no such file; check the path")
+            problem = why_missing(p)
+            raise FormatError(f"{what} {str(p)!r}: no such file; check the path" if problem == "does not exist"
+                              else f"{what} {str(p)!r} {problem}")
         if p.is_dir():
             raise FormatError(f"{what} {str(p)!r} is a directory; give the path of a recording file inside it")
         if not p.is_file():

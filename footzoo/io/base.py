@@ -31,6 +31,7 @@ from typing import Any, ClassVar
 
 from ..core.data import Recording
 from ..core.errors import FootzooWarning, FormatError
+from ..core.files import SNIFF_BYTES, damaged_text, foreign_encoding, nul_padding
 
 #: Longest line read when looking at a file's header (characters).
 HEADER_MAX_CHARS = 64 * 1024
@@ -188,35 +189,64 @@ def has_extension(path: str | Path, *suffixes: str) -> bool:
 
 
 def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
-    """``path``, or its content without a last line that was cut short, for ``pandas.read_csv``.
+    """``path``, or its content without a last line that was cut short or NUL padding, for ``pandas.read_csv``.
 
     A text table ends with a line break. When the file does not, its last row may have been cut
     in the middle of a number (a logger stopped mid-write, a copy interrupted) and would be read
     as a valid but wrong number: that row is dropped with a :class:`FootzooWarning` quoting it.
-    A file of one line only is returned as it is (its header alone), and so is a compressed file
-    (``.gz``, ``.bz2``, ``.xz``, ``.zip``, ``.zst``: pandas decompresses it and its format checks its end).
+    NUL bytes after the last line (a logger that pre-allocates its file) are dropped the same way,
+    with a warning; NUL bytes anywhere else, and UTF-16 or UTF-32 text, are a :class:`FormatError`
+    that names the place and the fix (:mod:`footzoo.core.files`). A file of one line only is
+    returned as it is (its header alone), and so is a compressed file (``.gz``, ``.bz2``, ``.xz``,
+    ``.zip``, ``.zst``: pandas decompresses it and its format checks its end).
     """
     if Path(path).suffix.lower() in COMPRESSED:
         return path
+    name = what or str(path)
     with open(path, "rb") as fh:
+        problem = foreign_encoding(fh.read(SNIFF_BYTES))
+        if problem:
+            raise FormatError(f"{name}: {problem}")
         fh.seek(0, 2)
         size = fh.tell()
         if size == 0:
             return path
         fh.seek(size - 1)
-        if fh.read(1) in (b"\n", b"\r"):
+        last_byte = fh.read(1)
+        fh.seek(0)
+        has_nul = _has_nul(fh)
+        if last_byte in (b"\n", b"\r") and not has_nul:
             return path
         fh.seek(0)
         data = fh.read()
+    if has_nul:
+        damage = damaged_text(name, data)
+        if damage:
+            raise FormatError(damage)
+        padding = nul_padding(data)
+        data = data[:len(data) - padding]
+        warnings.warn(FootzooWarning(
+            f"{name}: the file ends with {padding} NUL bytes (0x00) after its last line (a logger that pre-allocates "
+            "its file, or a copy cut short); they were ignored"), stacklevel=3)
+        if data.endswith((b"\n", b"\r")) or not data.strip():
+            return io.BytesIO(data)
     cut = data.rfind(b"\n")
     if cut < 0 or not data[:cut].strip():
-        return path
+        return io.BytesIO(data) if has_nul else path
     last = data[cut + 1:].decode("utf-8", errors="replace")
     warnings.warn(FootzooWarning(
-        f"{what or path}: the file does not end with a line break, so its last row may have been cut short "
+        f"{name}: the file does not end with a line break, so its last row may have been cut short "
         f"(a logger stopped or a copy interrupted mid-write); dropped that row: {last[:80]!r}. If the file is "
         "complete, end it with a line break"), stacklevel=3)
     return io.BytesIO(data[:cut + 1])
+
+
+def _has_nul(fh: Any, block: int = 1 << 22) -> bool:
+    """Whether the open binary file holds a NUL byte (read in blocks: bounded memory)."""
+    for chunk in iter(lambda: fh.read(block), b""):
+        if b"\0" in chunk:
+            return True
+    return False
 
 
 def check_unique_columns(df: Any, path: str | Path) -> None:

@@ -25,8 +25,8 @@ from ..core.archive import parquet_available
 from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.conventions import quat_from_matrix, quat_mul
-from ..core.data import TRUTH_QUAT_COLS, Recording, Truth
-from ..core.errors import FootzooWarning, FormatError, OutputError
+from ..core.data import ACC_COLS, GYR_COLS, MAG_COLS, TRUTH_POS_COLS, TRUTH_QUAT_COLS, TRUTH_VEL_COLS, Recording, Truth
+from ..core.errors import FootzooWarning, FormatError, OutputError, did_you_mean
 from .axes import describe_axes, parse_axes, rotate_columns
 from .base import (
     RECORDING_OPTIONS,
@@ -38,7 +38,7 @@ from .base import (
     input_files,
     text_source,
 )
-from .metadata import facts_text, meta_path, read_facts, sha256, steps_path
+from .metadata import facts_text, meta_path, plain_meta, read_facts, sha256, steps_path
 
 #: Float format of every CSV footzoo writes: 17 significant digits reload to the same double.
 FLOAT_FORMAT = "%.17g"
@@ -78,9 +78,12 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
             df = pd.read_csv(text_source(path), comment="#", **EXACT_CSV)
     except UnicodeDecodeError as err:
         raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
+    except FormatError:
+        raise
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
     check_unique_columns(df, path)
+    _warn_unread(df.columns, path)
     if not np.array_equal(rows, np.eye(3)):
         rotate_columns(df, rows)
         _rotate_truth_attitude(df, rows)
@@ -96,9 +99,10 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
         rec.truth.closed_loop = bool(facts.closed_loop)
         if facts.steps is not None:
             try:
-                rec.truth.steps = pd.read_csv(facts.steps, **EXACT_CSV)
+                steps = pd.read_csv(facts.steps, **EXACT_CSV)
             except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
                 raise FormatError(f"{facts.steps}: cannot read the true steps: {err}; fix or delete the file") from None
+            rec.truth.steps = check_steps(steps, facts.steps, rec.t)
             rec.truth.stride_count = len(rec.truth.steps)  # the sidecar lists every true stride
         if "stride_count" in facts.truth:  # the reference's own count (a hand count, or null: none)
             count = facts.truth["stride_count"]
@@ -115,6 +119,53 @@ def _rotate_truth_attitude(df: pd.DataFrame, rows: np.ndarray) -> None:
     if all(c in df.columns for c in TRUTH_QUAT_COLS):
         q = df[TRUTH_QUAT_COLS].to_numpy(dtype=float)
         df[TRUTH_QUAT_COLS] = quat_mul(q, np.broadcast_to(quat_from_matrix(rows.T), q.shape))
+
+
+#: Columns the canonical reader reads (besides ``dist_*`` and ``true_dist_*``).
+COLUMNS = ("t", *ACC_COLS, *GYR_COLS, *MAG_COLS, *TRUTH_POS_COLS, *TRUTH_VEL_COLS, *TRUTH_QUAT_COLS, "true_stance")
+
+
+def _warn_unread(columns: Any, path: Path) -> None:
+    """A warning naming the columns the canonical format does not read (a misspelt reference is not lost silently)."""
+    unread = [str(c) for c in columns if str(c) not in COLUMNS and not str(c).startswith(("dist_", "true_dist_"))]
+    if unread:
+        named = ", ".join(f"{c!r}{did_you_mean(c, list(COLUMNS))}" for c in unread[:8])
+        more = f" and {len(unread) - 8} more" if len(unread) > 8 else ""
+        warnings.warn(FootzooWarning(
+            f"{path.name}: column(s) {named}{more} are not read: the canonical format reads t, acc_x..z, gyr_x..z, "
+            "mag_x..z, dist_*, and as the reference true_pos_n..d, true_vel_n..d, true_qw..qz, true_stance, "
+            "true_dist_*; rename a column to use it (or drop it to silence this)"), stacklevel=4)
+
+
+#: Columns of a true-steps sidecar that hold the strides' times (s): footzoo's names and the simulator's older ones.
+STEP_TIME_COLUMNS = ("start_s", "to_s", "end_s", "ms_start_s", "ms_end_s", "swing_start", "swing_end", "start", "end")
+
+
+def check_steps(steps: pd.DataFrame, path: Path, t: Any) -> pd.DataFrame:
+    """A true-steps sidecar's table, or a FormatError when it is not one (no stride times, or times outside the
+    recording): its rows would otherwise count as the reference's strides."""
+    fix = f"a true-steps sidecar holds one row per stride with its times in s ({', '.join(STEP_TIME_COLUMNS[:3])}); " \
+          f"fix or delete {path.name}"
+    times = [c for c in STEP_TIME_COLUMNS if c in steps.columns]
+    if not times:
+        raise FormatError(f"{path}: not a stride table: its columns {list(steps.columns)[:8]} hold no stride times; "
+                          f"{fix}")
+    for col in times:
+        values = pd.to_numeric(steps[col], errors="coerce")
+        text = steps[col].notna() & values.isna()
+        if text.any():
+            raise FormatError(f"{path}: column {col!r} holds text ({steps[col][text].iloc[0]!r}), not times in s; "
+                              f"{fix}")
+        finite = values[np.isfinite(values)]
+        if not len(finite) or not len(t):
+            continue
+        lo, hi = float(finite.min()), float(finite.max())
+        within = lo >= t[0] - 1.0 and hi <= t[-1] + 1.0  # the recording's clock
+        relative = lo >= -1.0 and hi <= t[-1] - t[0] + 1.0  # or seconds from its start
+        if not (within or relative):
+            raise FormatError(f"{path}: column {col!r} runs from {lo:g} to {hi:g}, but the recording spans "
+                              f"{t[0]:g} to {t[-1]:g} s: sample numbers, or another recording's times? {fix}")
+    return steps
 
 
 class CanonicalReader(Reader):
@@ -151,6 +202,10 @@ def check_output(path: str | Path) -> Path:
         if not parquet_available():
             raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
                               "or write .csv")
+    for side, holds in ((meta_path(p), "its metadata"), (steps_path(p), "its true strides")):
+        if side.is_dir():
+            raise OutputError(f"{str(p)!r}: its sidecar {side.name} ({holds}, written next to it) cannot be written: "
+                              f"{side.name} is a folder; move it away, or choose another name")
     return p
 
 
@@ -195,11 +250,11 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
             steps_sha = sha256(tmp_steps)
         else:
             group.remove(steps_path(p))
-        meta = {k: v for k, v in rec.meta.items() if isinstance(v, (str, int, float, bool))}
+        meta, unwritten = plain_meta(rec.meta)
         closed = bool(closed_loop or (rec.truth is not None and rec.truth.closed_loop))
         group.path(meta_path(p)).write_text(facts_text(meta, closed, sha256(tmp), steps_sha, _truth_facts(rec)),
                                             encoding="utf-8")
-    _warn_unwritten(rec, p)
+    _warn_unwritten(rec, p, unwritten)
     return p
 
 
@@ -219,8 +274,12 @@ def _truth_facts(rec: Recording) -> dict[str, Any]:
     return out
 
 
-def _warn_unwritten(rec: Recording, path: Path) -> None:
-    """Warn about the parts of a reference the canonical files cannot hold (never dropped silently)."""
+def _warn_unwritten(rec: Recording, path: Path, meta: list[str] = ()) -> None:
+    """Warn about the metadata and the parts of a reference the canonical files cannot hold (never dropped silently)."""
+    if meta:
+        warnings.warn(FootzooWarning(
+            f"{path.name}: metadata {', '.join(meta[:8])} not written to {path.name}.meta.yaml (not plain text, "
+            "numbers, lists or mappings); convert it (e.g. to text) before writing, or keep it apart"), stacklevel=3)
     tr = rec.truth
     lost = [name for name in ("footprints", "stride_positions") if tr is not None and getattr(tr, name) is not None]
     if lost:

@@ -20,6 +20,7 @@ makes the right foot turn the other way). So both feet use the same map.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +29,7 @@ import pandas as pd
 
 from ..core.checks import check_positive, check_range
 from ..core.data import Recording, Truth, gap_limit
-from ..core.errors import FormatError
+from ..core.errors import FootzooWarning, FormatError
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import RECORDING_OPTIONS, Option, Reader, first_line, frame_options, text_source
 from .gaitmap_reference import REFERENCE_FILES, has_reference, reference_stride_positions, reference_strides
@@ -122,6 +123,12 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, axes: Any =
     sensor = f"{foot}_sensor"
     if sensor not in df.columns.get_level_values(0):
         raise FormatError(f"{path}: no {sensor!r} columns; found {sorted(set(df.columns.get_level_values(0)))}")
+    others = sorted({str(c) for c in df.columns.get_level_values(0)} - {f"{f}_sensor" for f in FEET})
+    if others:  # a multi-sensor export: footzoo reads the feet, and says what it leaves
+        warnings.warn(FootzooWarning(
+            f"{path.name}: sensor(s) {others} are not read: footzoo reads the feet (left_sensor, right_sensor) of a "
+            "gaitmap file; export another sensor as a file of its own (canonical or generic) to read it"),
+            stacklevel=4)
     block = df[sensor]
     missing = [c for c in COLUMNS if c not in block.columns]
     if missing:

@@ -192,8 +192,9 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         raise FormatError(f"{path}: no description {side.name} next to it; write one (see footzoo.io.generic) or "
                           "pass sidecar= (the path of a description shared by several files)")
     spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit)
+    source = text_source(path)
     try:
-        df = pd.read_csv(text_source(path), sep=spec.delimiter, decimal=spec.decimal, skiprows=spec.skip_rows,
+        df = pd.read_csv(source, sep=spec.delimiter, decimal=spec.decimal, skiprows=spec.skip_rows,
                          header=0 if spec.header else None, comment=spec.comment,
                          engine="python" if spec.delimiter == r"\s+" and spec.comment else "c")
     except (ValueError, pd.errors.ParserError) as err:

@@ -24,11 +24,15 @@ reader builds its :class:`~footzoo.core.data.Truth` from the sidecars alone.
 
 from __future__ import annotations
 
+import datetime
 import hashlib
+import os
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..core.errors import FootzooWarning, FormatError
 from ..core.yamlsafe import dump_text, load_file
@@ -149,6 +153,64 @@ def _truth_facts(raw: Any, side: Path, fix: str) -> dict[str, Any]:
                           f"{count!r:.80}; {fix}")
     # stride_count: null says "no count" (the steps file's rows are then not taken for one)
     return {k: v for k, v in raw.items() if v is not None or k == "stride_count"}
+
+
+#: Metadata footzoo derives when it reads a recording: not written to a sidecar (recomputed on reading).
+DERIVED_META = ("input_files", "sanity", "diagnostics")
+#: Largest array (values) written into a sidecar as a list; a larger one is named as not written.
+MAX_META_ARRAY = 1000
+
+
+def plain_meta(meta: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
+    """The metadata a sidecar can hold as plain YAML, and the keys it cannot (named, never dropped silently).
+
+    Text, numbers, booleans and None are kept; mappings with text keys and lists (tuples) are kept
+    with their plain values; numpy numbers become numbers, small numpy arrays lists, paths text,
+    dates ISO text. Anything else (an object, a large array) is listed in the second value.
+    The keys footzoo derives on reading (:data:`DERIVED_META`) are left out.
+    """
+    kept: dict[str, Any] = {}
+    dropped: list[str] = []
+    for key, value in meta.items():
+        if key in DERIVED_META:
+            continue
+        ok, plain = _plain(value)
+        if ok and isinstance(key, str):
+            kept[key] = plain
+        else:
+            dropped.append(f"{key!s} ({type(value).__name__})")
+    return kept, dropped
+
+
+def _plain(value: Any) -> tuple[bool, Any]:
+    if value is None or isinstance(value, (str, bool)):
+        return True, value
+    if isinstance(value, (int, np.integer)) and not isinstance(value, np.bool_):
+        return True, int(value)
+    if isinstance(value, np.bool_):
+        return True, bool(value)
+    if isinstance(value, (float, np.floating)):
+        return True, float(value)  # YAML's .nan and .inf read back as floats
+    if isinstance(value, (datetime.date, datetime.time)):
+        return True, value.isoformat()
+    if isinstance(value, os.PathLike):
+        return True, os.fspath(value)
+    if isinstance(value, np.ndarray):
+        if value.size > MAX_META_ARRAY or value.dtype.kind not in "biufU":
+            return False, None
+        value = value.tolist()
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            ok, plain = _plain(v)
+            if not ok or not isinstance(k, (str, int)):
+                return False, None
+            out[k] = plain
+        return True, out
+    if isinstance(value, (list, tuple)):
+        items = [_plain(v) for v in value]
+        return (True, [v for _, v in items]) if all(ok for ok, _ in items) else (False, None)
+    return False, None
 
 
 def facts_text(meta: dict[str, Any], closed_loop: bool, data_sha256: str, steps_sha256: str | None,

@@ -26,7 +26,7 @@ import pandas as pd
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import describe_axes, parse_axes, rotate_columns
-from .base import RECORDING_OPTIONS, Reader, frame_options
+from .base import RECORDING_OPTIONS, Reader, frame_options, text_source
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
@@ -59,9 +59,13 @@ def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str =
                           f"got shape {imu.shape}")
     truth = None
     if "gt" in d:
-        stance = np.asarray(d["zv_vicon_opt"]).ravel().astype(bool) if "zv_vicon_opt" in d else None
+        stance = _flags(d["zv_vicon_opt"], len(t), path, "zv_vicon_opt") if "zv_vicon_opt" in d else None
         mirror = np.array([1.0, 1.0, -1.0])  # VICON z up and mirrored: negate z only
-        truth = Truth(pos=np.asarray(d["gt"], dtype=float) * mirror, stance=stance)
+        gt = _numbers(d["gt"], path, "gt", "the VICON position, N x 3 in m")
+        if gt.ndim != 2 or gt.shape != (len(t), 3):
+            raise FormatError(f"{path}: 'gt' (the VICON position) has shape {gt.shape}, expected ({len(t)}, 3): one "
+                              "row per IMU sample; fix the file or delete 'gt' to read it without the reference")
+        truth = Truth(pos=gt * mirror, stance=stance)
     meta: dict[str, Any] = {"name": path.stem, "source": str(path), "format": "pyshoe", "foot": "right",
                             "placement": "right shoe instep (LORD MicroStrain)", "axes": describe_axes(rows)}
     meta["input_files"] = [str(path)]
@@ -74,7 +78,11 @@ def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str =
     if truth is not None:
         truth.source = "VICON (PyShoe)"
     if "trial_error" in d:
-        errors = np.ravel(d["trial_error"]).astype(float)
+        errors = _numbers(d["trial_error"], path, "trial_error", "PyShoe's error per detector, 1 x 5 in m").ravel()
+        if errors.size != len(TRIAL_ERROR_DETECTORS):
+            raise FormatError(f"{path}: 'trial_error' holds {errors.size} value(s), expected "
+                              f"{len(TRIAL_ERROR_DETECTORS)} (PyShoe's error with {', '.join(TRIAL_ERROR_DETECTORS)}); "
+                              "fix the file or delete the variable")
         meta["pyshoe_trial_error"] = {k: float(e) for k, e in zip(TRIAL_ERROR_DETECTORS, errors, strict=True)}
     frame = pd.DataFrame(imu[:, :6], columns=["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"])
     frame.insert(0, "t", t)
@@ -112,15 +120,59 @@ class PyShoeReader(Reader):
         return read(path, **options)
 
 
+#: Columns of the dataset's ``trials.csv`` the reader uses.
+TRIAL_COLUMNS = ("trial", "n_strides_manual_koroglu", "bipedal_tag_koroglu")
+
+
 def _trial_row(path: Path) -> dict[str, Any] | None:
-    """The trial's row of the dataset's ``trials.csv`` (next to the ``.mat``), if any."""
+    """The trial's row of the dataset's ``trials.csv`` (next to the ``.mat``), if any; checked.
+
+    A ``trials.csv`` that cannot be read, lacks the columns, lists the trial twice or holds
+    something other than whole numbers there is a :class:`FormatError` naming the file and the fix
+    (its counts would otherwise be taken for the reference's).
+    """
     table = path.with_name("trials.csv")
     if not table.exists():
         return None
 
-    df = pd.read_csv(table, dtype={"trial": str})
-    rows = df[df["trial"] == path.stem]
-    needed = {"n_strides_manual_koroglu", "bipedal_tag_koroglu"}
-    if rows.empty or not needed <= set(df.columns):
+    fix = (f"fix {table} (one row per trial: {', '.join(TRIAL_COLUMNS)}), or move it away to read the trial "
+           "without the hand counts")
+    try:
+        df = pd.read_csv(text_source(table), dtype={"trial": str})
+    except FormatError:
+        raise
+    except (UnicodeDecodeError, ValueError, pd.errors.ParserError) as err:
+        raise FormatError(f"{table}: cannot be read as a table ({type(err).__name__}: {err}); {fix}") from None
+    missing = [c for c in TRIAL_COLUMNS if c not in df.columns]
+    if missing:
+        raise FormatError(f"{table}: lacks the column(s) {missing}; {fix}")
+    rows = df[df["trial"].astype(str).str.strip() == path.stem]
+    if rows.empty:
         return None
-    return rows.iloc[0].to_dict()
+    if len(rows) > 1:
+        raise FormatError(f"{table}: lists the trial {path.stem!r} {len(rows)} times; {fix}")
+    row = rows.iloc[0].to_dict()
+    for col in TRIAL_COLUMNS[1:]:
+        value = pd.to_numeric(pd.Series([row[col]]), errors="coerce").iloc[0]
+        if not np.isfinite(value) or value != int(value) or (col.startswith("n_") and value < 0):
+            raise FormatError(f"{table}: {col} of trial {path.stem!r} is {row[col]!r}, not a whole number; {fix}")
+        row[col] = int(value)
+    return row
+
+
+def _numbers(value: Any, path: Path, name: str, what: str) -> np.ndarray:
+    """A MATLAB variable as a float array, or a FormatError naming it."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise FormatError(f"{path}: {name!r} must hold numbers ({what}); fix the file") from None
+
+
+def _flags(value: Any, n: int, path: Path, name: str) -> np.ndarray:
+    """A 0/1 MATLAB variable with one value per sample as a bool array, or a FormatError naming it."""
+    flags = _numbers(value, path, name, "1 = still, 0 = moving, one per sample").ravel()
+    if flags.size != n or not np.isin(flags, (0.0, 1.0)).all():
+        raise FormatError(f"{path}: {name!r} must hold 0 or 1 for each of the {n} samples, got {flags.size} value(s)"
+                          f"{'' if np.isin(flags, (0.0, 1.0)).all() else ' with others than 0 and 1'}; fix the file "
+                          "or delete the variable")
+    return flags.astype(bool)

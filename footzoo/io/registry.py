@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import FootzooWarning, FormatError, did_you_mean
+from ..core.files import SNIFF_BYTES, foreign_encoding
 from .base import first_line
 
 #: The entry-point group readers register under.
@@ -172,9 +173,16 @@ class Readers(Mapping[str, Any]):
                               f"one to use: format={accepted[0]!r} or format={accepted[1]!r} "
                               "(command line: --format NAME)")
 
+        if p.suffix.lower() in (".yaml", ".yml"):
+            raise FormatError(f"{p}: a YAML file (a config or study?), not a recording; a config is the first "
+                              f"argument (footzoo run {p.name} --data RECORDING), a recording goes to --data")
         head = ""
         try:
-            if p.suffix.lower() not in (".mat", ".parquet", ".pq"):
+            if p.suffix.lower() not in (".mat", ".parquet", ".pq", ".npz", ".h5"):
+                with open(p, "rb") as fh:
+                    problem = foreign_encoding(fh.read(SNIFF_BYTES))
+                if problem:
+                    raise FormatError(f"{p}: {problem}")
                 head = first_line(p).strip()
         except OSError:
             pass

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import copy
 import dataclasses
 import functools
 import inspect
@@ -46,9 +47,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from ..core.errors import FootzooError, PluginError, RecordingError
 from ..core.norms import unit_error
+from ..filters.measurement import MeasurementModel
 
 #: The action methods whose array inputs :func:`checked` checks (finite, numeric) before the plug-in sees them.
 ACTIONS = ("calibrate", "estimate", "detect", "apply", "apply_acceleration", "analyze")
@@ -179,6 +182,7 @@ def checked(method: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
     names = list(_argument_names(function))
     if name in ACTIONS:
         check_inputs(plugin, name, names, args, kwargs)
+    originals = (args, kwargs)
     args = tuple(read_only(a) for a in args)
     kwargs = {k: read_only(v) for k, v in kwargs.items()}
     try:
@@ -187,11 +191,18 @@ def checked(method: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
         raise
     except BaseException as err:  # noqa: BLE001 - SystemExit in a plug-in is its fault too
         raise fault(plugin, name, err) from err
-    return returned(plugin, name, names, args, kwargs, result)
+    changed_inputs(plugin, name, names, originals, (args, kwargs))
+    return returned(plugin, name, names, args, kwargs, result, originals)
 
 
 def read_only(value: Any) -> Any:
-    """A ``writeable=False`` view of an array (of each array of a dataclass such as ``Samples``); others as they are."""
+    """A ``writeable=False`` view of an array (of each array of a dataclass such as ``Samples``), a copy of a
+    mapping (the recording's metadata: a change is found by :func:`changed_inputs`) or of a table; others as
+    they are."""
+    if isinstance(value, dict):
+        return copy.deepcopy(value)
+    if isinstance(value, pd.DataFrame):
+        return value.copy()
     if isinstance(value, np.ndarray):
         if not value.flags.writeable:
             return value
@@ -237,8 +248,111 @@ def broken(plugin: Any, method: str, problem: str) -> PluginError:
     return PluginError(f"{who(plugin)} ({_where(plugin)}): {method}() {problem}", plugin=who(plugin), method=method)
 
 
-def returned(plugin: Any, method: str, names: list[str], args: tuple, kwargs: dict[str, Any], result: Any) -> Any:
+def changed_inputs(plugin: Any, method: str, names: list[str], originals: tuple[tuple, dict[str, Any]],
+                   given: tuple[tuple, dict[str, Any]]) -> None:
+    """A :class:`PluginError` when the plug-in changed a mapping it was given (the recording's ``meta``).
+
+    It got a copy (:func:`read_only`), so the caller's stays as it was; the change is the plug-in's
+    fault all the same: in a study the same recording goes to the next config, which must see it
+    unchanged, and a plug-in that relies on its change works by accident.
+    """
+    (args0, kwargs0), (args1, kwargs1) = originals, given
+    pairs = [*zip(names, args0, args1, strict=False), *((k, kwargs0[k], kwargs1[k]) for k in kwargs0)]
+    for label, before, after in pairs:
+        if isinstance(before, dict) and not same_value(before, after):
+            keys = sorted({str(k) for k in {*before, *after}
+                           if k not in before or k not in after or not same_value(before[k], after[k])})
+            raise broken(plugin, method, f"changed its input {label} (keys {keys[:5]}); footzoo passes inputs "
+                                         f"read-only (a study gives the same recording to the next config): copy "
+                                         f"it first ({label} = dict({label}))")
+
+
+def same_value(a: Any, b: Any) -> bool:
+    """Whether two plain values (mappings, lists, arrays, numbers, text) are equal; NaN equals NaN."""
+    if isinstance(a, dict) or isinstance(b, dict):
+        return isinstance(a, dict) and isinstance(b, dict) and a.keys() == b.keys() and all(
+            same_value(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) or isinstance(b, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        try:
+            return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=np.asarray(a).dtype.kind in "fc")
+        except (TypeError, ValueError):
+            return False
+    if isinstance(a, (pd.DataFrame, pd.Series)) or isinstance(b, (pd.DataFrame, pd.Series)):
+        return type(a) is type(b) and a.equals(b)
+    try:
+        if a == b:
+            return True
+    except (TypeError, ValueError):
+        return a is b
+    return isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
+
+
+#: Most rows a Kalman correction's measurement model may declare at one sample (``max_rows``).
+MAX_MODEL_ROWS = 1000
+
+
+def check_model(plugin: Any, model: Any, n: int | None) -> None:
+    """A Kalman correction's :class:`~footzoo.filters.measurement.MeasurementModel`, checked before the engine
+    sizes its buffers with it (a wrong ``max_rows`` would crash or allocate without bound)."""
+    if not isinstance(model, MeasurementModel):
+        raise broken(plugin, "model", f"returned {type(model).__name__}; it must return a "
+                                      "footzoo.filters.measurement.MeasurementModel")
+    rows = model.max_rows
+    if isinstance(rows, (bool, np.bool_)) or not isinstance(rows, (int, np.integer)) \
+            or not 0 <= rows <= MAX_MODEL_ROWS:
+        raise broken(plugin, "model", f"declares max_rows={rows!r}; it must be the whole number of rows its measure "
+                                      f"function writes at most at one sample, 0 to {MAX_MODEL_ROWS}")
+    for fn in ("measure", "feedback", "after"):
+        if not callable(getattr(model, fn)):
+            raise broken(plugin, "model", f"gives a {fn} that is not a function ({getattr(model, fn)!r:.60})")
+    for name in ("par", "mem"):
+        try:
+            np.asarray(getattr(model, name), dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise broken(plugin, "model", f"gives {name} that is not an array of numbers") from None
+    data = model.data
+    if data is not None:
+        arr = np.asarray(data)
+        if arr.ndim != 2 or (n is not None and arr.shape[0] != n) or arr.dtype.kind not in "biuf":
+            raise broken(plugin, "model", f"gives data of shape {arr.shape} and dtype {arr.dtype}; it must be "
+                                          f"({'N' if n is None else n}, d) numbers: one row per sample")
+
+
+def check_annotated(plugin: Any, steps: Any, result: Any) -> None:
+    """What an analysis' ``annotate`` returned: every stride it was given, the given columns unchanged."""
+    if not isinstance(result, pd.DataFrame):
+        raise broken(plugin, "annotate", f"returned {type(result).__name__}; it must return the steps table with "
+                                         "its columns added (a pandas DataFrame)")
+    if not isinstance(steps, pd.DataFrame):
+        return
+    if len(result) != len(steps) or not result.index.equals(steps.index):
+        lost = len(steps) - len(result)
+        what = (f"{lost} of the {len(steps)} strides it was given" if lost > 0 else
+                f"{-lost} stride(s) to the {len(steps)} it was given" if lost < 0 else "the order of the strides")
+        raise broken(plugin, "annotate", f"{'dropped' if lost > 0 else 'added' if lost < 0 else 'changed'} {what}; an "
+                                         "analysis adds columns to every stride and drops none (a stride it cannot "
+                                         "analyse gets NaN), or the stride table and its metrics would be wrong")
+    for col in steps.columns:
+        if col not in result.columns:
+            raise broken(plugin, "annotate", f"dropped the column {col!r} of the steps table; an analysis adds "
+                                             "columns and keeps the others")
+        if not result[col].equals(steps[col]):
+            raise broken(plugin, "annotate", f"changed the column {col!r} it was given; an analysis adds its own "
+                                             "columns (give yours another name) and keeps the others as they are")
+
+
+def returned(plugin: Any, method: str, names: list[str], args: tuple, kwargs: dict[str, Any], result: Any,
+             originals: tuple[tuple, dict[str, Any]] | None = None) -> Any:
     """Check what ``plugin.method(*args, **kwargs)`` returned (see the module docstring); return it."""
+    if method == "model":
+        samples = args[0] if args else next(iter(kwargs.values()), None)
+        t = getattr(samples, "t", None)
+        check_model(plugin, result, len(t) if isinstance(t, np.ndarray) else None)
+    elif method == "annotate":
+        given = (originals or (args, kwargs))[0]
+        check_annotated(plugin, given[0] if given else kwargs.get("steps"), result)
     if method in RETURNS_SELF:
         if result is None:
             raise broken(plugin, method, f"returned None: end {method}() with 'return self'")
@@ -333,3 +447,22 @@ def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, 
             raise broken(plugin, method, f"set {label} with non-unit quaternions (|q| = {np.linalg.norm(arr[k]):.9g} "
                                          f"at sample {k}, tolerance {QUAT_NORM_TOL:g}): normalise each attitude "
                                          "(q / |q|)")
+
+
+def detector_diagnostics(detector: Any, n: int) -> dict[str, Any]:
+    """A fitted detector's outputs for ``Result.diagnostics``: ``detector_stance``, ``detector_statistic`` and,
+    when the detector sets no statistic (an optional output), NaN in its place and ``detector_statistic_note``
+    saying so (never silently: a study then draws no threshold sweep for it)."""
+    statistic = getattr(detector, "statistic_", None)
+    out = {"detector_statistic": np.full(n, np.nan) if statistic is None else statistic,
+           "detector_stance": detector.stance_}
+    arr = np.asarray(out["detector_statistic"])
+    if arr.dtype.kind == "f" and not np.isfinite(arr).any():
+        out["detector_statistic_note"] = no_statistic_note(detector)
+    return out
+
+
+def no_statistic_note(detector: Any) -> str:
+    """Why a detector's statistic is NaN: it sets none (``statistic_`` is an optional output)."""
+    return (f"{who(detector)} sets no statistic_ (its test statistic is an optional output): detector_statistic is "
+            "NaN, and a study draws no threshold sweep (ROC curve) for it; its stance_ is used as it is")

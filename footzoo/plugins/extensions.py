@@ -7,7 +7,8 @@ objects defined in it pickle by reference and every worker process that loads th
 same module name. Loading is idempotent: a file or module already loaded with the same source is not
 executed again; an edited file is executed again and its plug-ins replace the old ones.
 
-This module sits at the bottom of the layers: it imports only :mod:`footzoo.core.errors` at module level.
+This module sits at the bottom of the layers: it imports only :mod:`footzoo.core.errors` and
+:mod:`footzoo.core.files` at module level.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import ConfigError, PluginImportError
+from ..core.files import why_missing
 
 ENTRY_POINT_GROUP = "footzoo.plugins"
 
@@ -107,7 +109,7 @@ def load_plugins(specs: list[str] | None, base_dir: str | Path | None = None,
             if is_path_spec(spec):
                 out.append(_load_file(Path(spec), label))
             else:
-                out.append(_load_module(spec, label))
+                out.append(_load_module(spec, label, base_dir))
     return out
 
 
@@ -189,10 +191,13 @@ def _source_files(spec: str, label: str) -> list[Path]:
 
 def _check_file(p: Path, label: str) -> None:
     if not p.exists():
-        raise ConfigError(f"{label}: plug-in file {str(p)!r} does not exist; paths are relative to the "
+        raise ConfigError(f"{label}: plug-in file {str(p)!r} {why_missing(p)}; paths are relative to the "
                           f"YAML file's folder")
     if not p.is_file():
         raise ConfigError(f"{label}: plug-in path {str(p)!r} is not a file; give the path to a .py file")
+    if p.suffix != ".py":
+        raise ConfigError(f"{label}: plug-in file {str(p)!r} is not a Python file (.py); a plug-in is a .py file "
+                          "that registers its classes (footzoo.register), or an installed module's name")
 
 
 def _load_file(path: Path, label: str) -> dict[str, Any]:
@@ -206,11 +211,16 @@ def _load_file(path: Path, label: str) -> dict[str, Any]:
     info = {"spec": str(path), "module": name, "path": str(path), "sha256": digest}
     if _LOADED.get(name) == digest and name in sys.modules:
         return info
+    if b"\0" in source:
+        raise ConfigError(f"{label}: plug-in file {str(path)!r} is not Python source (it holds NUL bytes: a binary or "
+                          "damaged file); give the path to the plug-in's .py file")
     try:
         code = compile(source, str(path), "exec")
-    except SyntaxError as err:
-        raise ConfigError(f"{label}: syntax error in plug-in file {err.filename or path}, line {err.lineno}: "
-                          f"{err.msg}; fix the file") from None
+    except (SyntaxError, ValueError) as err:  # ValueError: source Python cannot decode (before 3.12)
+        line = f", line {err.lineno}" if getattr(err, "lineno", None) else ""
+        raise ConfigError(f"{label}: syntax error in plug-in file {getattr(err, 'filename', None) or path}{line}: "
+                          f"{getattr(err, 'msg', None) or err}; fix the file (footzoo reads plug-ins as UTF-8 "
+                          "Python source)") from None
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     previous = sys.modules.get(name)
@@ -228,7 +238,14 @@ def _load_file(path: Path, label: str) -> dict[str, Any]:
     return info
 
 
-def _load_module(name: str, label: str) -> dict[str, Any]:
+def _load_module(name: str, label: str, base_dir: str | Path | None = None) -> dict[str, Any]:
+    here = Path(base_dir if base_dir is not None else ".") / name
+    if here.is_file() and not _importable(name.partition(".")[0]):
+        raise ConfigError(f"{label}: plug-in file {str(here)!r} is not a Python file (.py); a plug-in is a .py file "
+                          "that registers its classes (footzoo.register), or an installed module's name")
+    if not all(part.isidentifier() for part in name.split(".")):
+        raise ConfigError(f"{label}: {name!r} is neither a module name (words joined by dots, e.g. mylab.detectors) "
+                          f"nor a .py file; give the path to the plug-in's .py file")
     try:
         module = importlib.import_module(name)
     except ModuleNotFoundError as err:
@@ -250,6 +267,13 @@ def _load_module(name: str, label: str) -> dict[str, Any]:
     for f in files:
         h.update(f.read_bytes())
     return {"spec": name, "module": module.__name__, "path": path, "sha256": h.hexdigest()}
+
+
+def _importable(name: str) -> bool:
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
 
 
 def _restore(name: str, previous: Any) -> None:

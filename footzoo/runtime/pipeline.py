@@ -51,6 +51,7 @@ from ..plugins.base import (
     checked,
     inputs_checked_once,
 )
+from ..plugins.contract import detector_diagnostics
 from ..plugins.extensions import load_plugins
 from ..plugins.incremental import WHOLE_RECORDING, Latency, total
 from ..plugins.registry import build
@@ -310,10 +311,7 @@ class Pipeline:
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():
             sensor["consistency"] = axes.report
-        statistic = getattr(detector, "statistic_", None)  # optional output: NaN when a detector has none
-        if statistic is None:
-            statistic = np.full(rec.n, np.nan)
-        diagnostics = {"detector_statistic": statistic, "detector_stance": detector.stance_,
+        diagnostics = {**detector_diagnostics(detector, rec.n),  # a missing statistic is NaN, with a note
                        "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
         if self.calibration:
             diagnostics["calibration"] = calibration

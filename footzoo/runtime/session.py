@@ -122,13 +122,15 @@ class SessionResult:
     results: dict[str, Result]
     name: str = "session"
 
-    def save(self, path: str | Path, backend: str = "auto", inputs: Any = ()) -> Path:
+    def save(self, path: str | Path, backend: str = "auto", inputs: Any = (),
+             files: dict[str, dict[str, bytes]] | None = None) -> Path:
         """Save as a folder: one :meth:`Result.save` folder per foot, and the stride and bilateral tables.
 
-        Atomic as one unit and never over an input (see :mod:`footzoo.core.archive`).
+        Atomic as one unit and never over an input (see :mod:`footzoo.core.archive`); ``files``: per
+        foot, more files (figures) saved into its folder with it.
         """
 
-        return save_session(self, path, backend=backend, inputs=inputs)
+        return save_session(self, path, backend=backend, inputs=inputs, files=files)
 
     @classmethod
     def load(cls, path: str | Path) -> SessionResult:

@@ -51,6 +51,7 @@ from .stages import (
     OrientationStage,
     Queue,
 )
+from .stream_state import check_channel, check_open, check_unused
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
 SCAN_BLOCK = 128
@@ -158,14 +159,12 @@ class Stream:
         estimate is already the final one) for the newest sample: provisional when the pipeline
         looks ahead (with ``guess``; else the newest final estimate).
         """
-        if self._closed:
-            raise RecordingError("the stream is closed: start a new Stream for new data")
+        check_open(self, "push")
         t, acc, gyr, mag, dist = validate_sample(t, acc, gyr, mag, dist, self._t_prev, self.max_gap)
         row = {"k": np.array([self._k]), "t": np.array([t]), "acc": acc[None, :], "gyr": gyr[None, :]}
+        check_channel(self, "mag", mag is not None, t)
         if self._has_mag is None:
             self._has_mag = mag is not None
-        elif self._has_mag != (mag is not None):
-            raise RecordingError("mag must be pushed with every sample or with none (the first sample decides)")
         if mag is not None:
             row["mag"] = mag[None, :]
         d = self._distance_row(dist)
@@ -182,15 +181,13 @@ class Stream:
         The same final estimates as pushing the samples one by one (the blocks run chunk by chunk
         to the same numbers); cheaper per sample.
         """
-        if self._closed:
-            raise RecordingError("the stream is closed: start a new Stream for new data")
+        check_open(self, "extend")
         t, acc, gyr, mag, dist = validate_block(t, acc, gyr, mag, dist, self._t_prev, self.max_gap)
         n = t.shape[0]
         rows = {"k": np.arange(self._k, self._k + n), "t": t, "acc": acc, "gyr": gyr}
+        check_channel(self, "mag", mag is not None, t[0])
         if self._has_mag is None:
             self._has_mag = mag is not None
-        elif self._has_mag != (mag is not None):
-            raise RecordingError("mag must be pushed with every sample or with none (the first sample decides)")
         if mag is not None:
             rows["mag"] = mag
         if dist is not None or self._dist_width is not None:
@@ -287,6 +284,7 @@ class Stream:
         (:attr:`Recording.rate`) when the stream was made without one, as the batch run does. With
         ``log`` set to a list, each call's returned estimate is appended.
         """
+        check_unused(self)
         if self.rate is None and self.ctx is None:
             self.rate = rec.rate
         sizes = np.asarray(chunk, dtype=int).reshape(-1)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from dataclasses import asdict
+from dataclasses import asdict, fields
 from typing import Any
 
 import numpy as np
@@ -69,6 +69,41 @@ def check_arguments(**kw: Any) -> None:
         if name in kw and (isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v)
                            or not ok(float(v))):
             raise ConfigError(f"simulate: {name} must be a number in {bounds}, got {v!r}")
+    seed = kw.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ConfigError(f"simulate: seed must be a whole number >= 0, got {seed!r}")
+    noise = kw.get("noise")
+    if isinstance(noise, dict):
+        noise_model(noise)
+    elif noise is not None and not isinstance(noise, NoiseModel):
+        raise ConfigError(f"simulate: noise must be a mapping of NoiseModel's options (e.g. {{scale: 1}}) or "
+                          f"nothing, got {noise!r:.80}")
+
+
+def noise_model(options: dict[str, Any]) -> NoiseModel:
+    """A :class:`NoiseModel` from a mapping (a study's ``noise:``), its unknown options named (ConfigError)."""
+    known = [f.name for f in fields(NoiseModel)]
+    for key in options:
+        if key not in known:
+            raise ConfigError(f"simulate: noise: unknown option {key!r}{did_you_mean(str(key), known)}; "
+                              f"options: {known}")
+    return NoiseModel(**{k: (tuple(v) if k == "biases" and isinstance(v, list) else v) for k, v in options.items()})
+
+
+def seed_matters(spec: dict[str, Any]) -> bool:
+    """Whether the seed changes a ``simulate(**spec)`` recording: its noise or its distance sensors are random.
+
+    Without either, every seed gives the same recording (a study would average identical runs).
+    """
+    noise = spec.get("noise")
+    if isinstance(noise, dict):
+        noise = noise_model(noise)
+    if isinstance(noise, NoiseModel) and noise.random:
+        return True
+    sensors = spec.get("distance_sensors")
+    if sensors:
+        return (sensors if isinstance(sensors, DistanceSensors) else DistanceSensors()).noise_var > 0
+    return False
 
 
 #: The path-shape options ``simulate`` takes besides its named arguments (see its ``**path_options``).
@@ -187,7 +222,7 @@ def simulate(
     """
     check_arguments(path=path, n_strides=n_strides, stride_length=stride_length, cycle=cycle,
                     stance_fraction=stance_fraction, clearance=clearance, rate=rate, stand_start=stand_start,
-                    stand_end=stand_end, foot=foot)
+                    stand_end=stand_end, foot=foot, seed=seed, noise=noise)
     rec_name = f"sim_{path}"
     if path == "run":
         path, speeds = "mixed_speed", [("run", n_strides)]
@@ -220,7 +255,7 @@ def simulate(
             field = field + disturbance.at(state["p"])
         mag = quat_rotate(quat_conj(state["q"]), field)
     if noise is not None:
-        noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
+        noise = noise_model(noise) if isinstance(noise, dict) else noise
         acc, gyr, mag = noise.apply(acc, gyr, mag, t)
     dist = true_dist = None
     if distance_sensors:
@@ -267,7 +302,7 @@ def simulate_calibration(
     acc, gyr = sample_imu(state, t, gravity, "interval")
     mag = quat_rotate(quat_conj(state["q"]), magnetic_field_ned(location)) if magnetometer else None
     if noise is not None:
-        noise = NoiseModel(**noise) if isinstance(noise, dict) else noise
+        noise = noise_model(noise) if isinstance(noise, dict) else noise
         acc, gyr, mag = noise.apply(acc, gyr, mag, t)
     truth = Truth(pos=state["p"], vel=state["v"], quat=state["q"], stance=state["still"])
     meta = {"name": "sim_calibration", "source": "footzoo.sim", "format": "simulated", "foot": foot,

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.conventions import GRAVITY, gravity_ned, quat_conj, quat_mul, quat_normalize, quat_rotate
+from ..core.errors import ConfigError
 
 #: Named magnetic field locations: total intensity (Gauss) and inclination (deg, down positive).
 MAGNETIC_FIELDS = {
@@ -116,11 +117,34 @@ class NoiseModel:
     paired_rate: float | None = None
 
     def __post_init__(self) -> None:
-        unknown = set(self.biases) - {"acc", "gyr", "mag"}
+        if isinstance(self.biases, str) or not isinstance(self.biases, (tuple, list)):
+            raise ConfigError(f"noise biases must be a list of names from 'acc', 'gyr', 'mag' (e.g. [acc, gyr]; [] for "
+                              f"none), got {self.biases!r}")
+        unknown = [b for b in self.biases if b not in ("acc", "gyr", "mag")]
         if unknown:
-            raise ValueError(f"unknown bias name(s) {sorted(unknown)}; use 'acc', 'gyr', 'mag'")
-        if self.paired_rate is not None and not (np.isfinite(self.paired_rate) and self.paired_rate > 0):
-            raise ValueError(f"paired_rate must be a rate in Hz > 0, got {self.paired_rate!r}")
+            raise ConfigError(f"unknown bias name(s) {unknown}; use 'acc', 'gyr', 'mag'")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise ConfigError(f"noise seed must be a whole number >= 0 (it seeds numpy's generator), got {self.seed!r}")
+        for name in ("acc_bias", "acc_sigma", "gyr_bias", "gyr_sigma", "mag_bias", "mag_sigma", "scale"):
+            value = getattr(self, name)
+            try:
+                arr = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                arr = np.asarray(np.nan)
+            per_axis = name != "scale" and arr.shape == (3,)  # a bias or σ may differ per axis (x, y, z)
+            bound = " >= 0" if name.endswith(("sigma", "scale")) else ""
+            if isinstance(value, bool) or (arr.shape != () and not per_axis) or not np.isfinite(arr).all() \
+                    or (bound and (arr < 0).any()):
+                raise ConfigError(f"noise {name} must be a finite number{bound}"
+                                  f"{'' if name == 'scale' else ' (or one per axis: [x, y, z])'}, got {value!r}")
+        if self.paired_rate is not None and not (isinstance(self.paired_rate, (int, float, np.number))
+                                                 and np.isfinite(self.paired_rate) and self.paired_rate > 0):
+            raise ConfigError(f"paired_rate must be a rate in Hz > 0, got {self.paired_rate!r}")
+
+    @property
+    def random(self) -> bool:
+        """Whether the seed changes the noise (some σ is above zero): with none, every seed gives one recording."""
+        return self.scale > 0 and max(float(np.max(s)) for s in (self.acc_sigma, self.gyr_sigma, self.mag_sigma)) > 0
 
     def apply(self, acc: np.ndarray, gyr: np.ndarray, mag: np.ndarray | None, t: np.ndarray | None = None):
         """Noisy copies of the signals (eq. 18); ``t`` (s), the sample times, is needed with ``paired_rate``."""

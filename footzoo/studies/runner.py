@@ -24,6 +24,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import threading
 import time
 import traceback
@@ -37,10 +38,11 @@ import numpy as np
 import pandas as pd
 
 from ..core import errors
-from ..core.errors import ConfigError
+from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker
+from ..core.errors import ConfigError, FootzooWarning
 from ..evaluation.metrics import reference_steps, run_metrics
 from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
-from ..plugins.contract import checked
+from ..plugins.contract import checked, no_statistic_note
 from ..plugins.extensions import load_plugins
 from ..plugins.registry import build
 from ..runtime.pipeline import Pipeline
@@ -54,7 +56,7 @@ from .cache import (
     write_entry,
 )
 from .report import write_outputs
-from .study import Cell, Study, code_fingerprint
+from .study import Cell, Study, check_jobs, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
 RECORDINGS_PER_PROCESS = 2  # recordings a worker process keeps in memory for the next chunk
@@ -108,7 +110,8 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     checked(det.detect, rec.t, rec.acc, rec.gyr)
     stat, truth = np.asarray(getattr(det, "statistic_", None) if getattr(det, "statistic_", None) is not None
                              else np.full(rec.n, np.nan), float), rec.truth.stance
-    if not np.isfinite(stat).any():  # the detector has no statistic (an optional output): no ROC curve
+    if not np.isfinite(stat).any():  # the detector has no statistic (an optional output): no ROC curve, said so
+        warnings.warn(FootzooWarning(no_statistic_note(det)), stacklevel=2)
         return []
     out = []
     for th in np.quantile(stat, np.linspace(0.0, 1.0, points)):
@@ -187,7 +190,10 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
             out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4)
         if sweep_points:
-            out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
+            with warnings.catch_warnings(record=True) as swept:
+                warnings.simplefilter("always")
+                out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
+            caught += swept
     except Exception as err:  # one failing run is reported, not fatal
         _fail(out, err)
     out["warnings"] = list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught))[:5]
@@ -323,24 +329,35 @@ def run_study(
         study = Study.from_yaml(study, max_cells=max_cells)
     if jobs is None:
         jobs = study.jobs or 1
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0:
-        raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
+    check_jobs(jobs)
+    if scheduler is not None:
+        scheduler = check_scheduler(scheduler)
     study.check(max_cells)
     bar = _Progress(progress, "study")
+    lock = contextlib.nullcontext() if out is None else folder_lock(out, "study output folder",
+                                                                     f"study {study.name!r}", study_identity(study))
     try:
-        if scheduler is None:
-            table = _run_study(study, jobs, None, out, max_runs, bar, report, prune)
-        else:
-            cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, made when needed
-            try:
-                table = _run_study(study, jobs, cluster, out, max_runs, bar, report, prune)
-            finally:
-                cluster.close()
+        with lock:
+            if scheduler is None:
+                table = _run_study(study, jobs, None, out, max_runs, bar, report, prune)
+            else:
+                cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, when needed
+                try:
+                    table = _run_study(study, jobs, cluster, out, max_runs, bar, report, prune)
+                finally:
+                    cluster.close()
     finally:
         bar.close()
     if not quiet:
         _replay_warnings(table.attrs["warnings"], table.attrs["refused"])
     return table
+
+
+def study_identity(study: Study) -> str:
+    """What makes two studies the same (their definition): the same study started twice shares its folder."""
+    spec = [study.name, study.bases, study.factors, study.metrics, study.sweep_points, study.plugins,
+            [[r.label, r.path, r.format, r.options, r.simulate, r.seed] for r in study.recordings]]
+    return hashlib.sha256(json.dumps(spec, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
@@ -386,6 +403,8 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         cache = Path(out) / "cache"
         cache.mkdir(parents=True, exist_ok=True)
         cache_dir = str(cache)
+        if report:  # until the new report is complete, the folder's report is marked incomplete
+            begin_folder(out, MANIFEST)
 
     bar.phase("reading cache")
     results: dict[int, dict[str, Any]] = {}
@@ -445,6 +464,7 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
         digest = _outputs_digest(table, runs, list(study.factors), figures)
         if _outputs_current(Path(out), digest):
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
+            end_folder(out, MANIFEST)  # the earlier marker back, as it was
         else:
             # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             written = write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
@@ -471,7 +491,7 @@ def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: li
 def _outputs_current(out: Path, digest: str) -> bool:
     """True when ``out`` holds every output of a report with this digest, each with its recorded content."""
     try:
-        manifest = json.loads((out / MANIFEST).read_text())
+        manifest = previous_marker(out, MANIFEST)  # set aside while this study runs (begin_folder)
         return manifest["digest"] == digest and all(
             _file_sha256(out / name) == sha for name, sha in manifest["files"].items())
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
@@ -479,10 +499,11 @@ def _outputs_current(out: Path, digest: str) -> bool:
 
 
 def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
-    """Record the report's files (``written``) with their content; remove the files the previous report
-    wrote and this one did not (a figure of a metric no longer drawn), so none is taken for current."""
+    """Record the report's files (``written``) with their content, last (the folder's completion marker);
+    remove the files the previous report wrote and this one did not (a figure of a metric no longer
+    drawn), so none is taken for current."""
     try:
-        old = json.loads((out / MANIFEST).read_text())
+        old = previous_marker(out, MANIFEST)
         # only a manifest of report files: older ones listed every file of the folder, the user's too
         before = set(old["files"]) if old.get("lists") == "report files" else set()
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
@@ -491,9 +512,7 @@ def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
         if Path(name).name == name:  # a file of this folder, as every report writes
             (out / name).unlink(missing_ok=True)
     files = {name: _file_sha256(out / name) for name in sorted(written)}
-    tmp = out / f".{MANIFEST}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
-    tmp.replace(out / MANIFEST)
+    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
 
 
 def _file_sha256(path: Path) -> str:
@@ -564,24 +583,37 @@ class _Cluster:
     @property
     def client(self) -> Any:
         if self._client is None:
-            # deferred: dask, an optional extra (footzoo[distributed])
-            from dask.distributed import Client
-
-            self._client = Client(self.address)
+            self._client = _connect(self.address)
         return self._client
 
     def close(self) -> None:
-        if self._client is not None:
+        if self._client is not None and isinstance(self.address, str):  # a client passed in stays open
             self._client.close()
-            self._client = None
+        self._client = None
 
 
 def _connected(scheduler: Any) -> Any:
     """A context giving a Dask client: the study's (left open) for a :class:`_Cluster`, else a new one."""
+    if isinstance(scheduler, _Cluster):
+        return contextlib.nullcontext(scheduler.client)
+    client = _connect(scheduler)
+    return client if isinstance(scheduler, str) else contextlib.nullcontext(client)  # the caller's client stays open
+
+
+def _connect(address: Any) -> Any:
+    """A Dask client of the scheduler at ``address`` (a client as it is); a ConfigError when none answers."""
     # deferred: dask, an optional extra (footzoo[distributed])
     from dask.distributed import Client
 
-    return contextlib.nullcontext(scheduler.client) if isinstance(scheduler, _Cluster) else Client(scheduler)
+    address = check_scheduler(address)
+    if not isinstance(address, str):  # a connected Client
+        return address
+    try:
+        return Client(address)
+    except (OSError, TimeoutError) as err:
+        raise ConfigError(f"scheduler {address}: no Dask scheduler answers there ({err}); start one (dask scheduler, "
+                          "then dask worker ADDRESS on each machine), check the address and the firewall, or leave "
+                          "the scheduler out to run on this machine") from None
 
 
 def _indexed(k: int, *args: Any) -> tuple[int, list[dict[str, Any]]]:
@@ -615,8 +647,52 @@ def tidy(runs: list[dict[str, Any]], factors: list[str]) -> pd.DataFrame:
 
 
 def read_trajectories(out: str | Path) -> pd.DataFrame:
-    """The stored trajectories of a study's runs (``out/trajectories.parquet``): one row per stored point."""
+    """The stored trajectories of a study's runs (``out/trajectories.parquet``): one row per stored point.
+
+    Raises
+    ------
+    FormatError
+        When the study's report in ``out`` is incomplete (a study was interrupted while writing it,
+        or is writing it now: ``outputs.json``, written last, is missing).
+    """
+    check_complete(out, MANIFEST, "a study's report")
     return pd.read_parquet(Path(out) / "trajectories.parquet")
+
+
+def check_scheduler(address: Any) -> Any:
+    """A Dask scheduler's address (``tcp://HOST:PORT``) or a client as it is; a ConfigError for a malformed one.
+
+    Checked before any work (Dask's own parser fails late, with a bare ValueError).
+    """
+    if not isinstance(address, str):
+        if hasattr(address, "submit") and hasattr(address, "scheduler_info"):  # a connected Client
+            return address
+        raise ConfigError(f"scheduler must be a Dask scheduler's address such as tcp://10.0.0.5:8786, got "
+                          f"{type(address).__name__} {address!r:.80}")
+    text = address.strip()
+    fix = ("give the address the scheduler printed when it started, e.g. tcp://10.0.0.5:8786 (or leave the "
+           "scheduler out to run on this machine)")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme not in SCHEDULER_SCHEMES:
+        raise ConfigError(f"scheduler {address!r}: unknown protocol {scheme!r} (Dask speaks "
+                          f"{', '.join(SCHEDULER_SCHEMES)}); {fix}")
+    if scheme == "inproc":  # a LocalCluster(processes=False) of this process: inproc://HOST/PID/N
+        if not re.fullmatch(r"[^/\s]+/\d+/\d+", rest):
+            raise ConfigError(f"scheduler {address!r} is not an in-process address (inproc://HOST/PID/N, as "
+                              f"LocalCluster(processes=False) gives); {fix}")
+        return f"inproc://{rest}"
+    host, colon, port = rest.rstrip("/").rpartition(":")
+    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise ConfigError(f"scheduler {address!r} is not HOST:PORT with a port in 1-65535; {fix}")
+    if host.startswith("[") != host.endswith("]"):
+        raise ConfigError(f"scheduler {address!r}: the IPv6 host must be in brackets, e.g. tcp://[::1]:8786")
+    return f"{scheme}://{host}:{int(port)}"
+
+
+#: Protocols of a Dask scheduler's address footzoo can connect to.
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 
 
 def _cell_value(v: Any) -> Any:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import collections
 import copy
 import functools
 import glob
@@ -9,6 +10,7 @@ import hashlib
 import inspect
 import itertools
 import json
+import math
 import os
 import stat
 import sys
@@ -33,7 +35,7 @@ from ..plugins.registry import KINDS, available
 from ..runtime.pipeline import Pipeline
 from ..runtime.validate import config_errors
 from ..sim import NoiseModel, simulate
-from ..sim.scenarios import check_spec
+from ..sim.scenarios import check_spec, seed_matters
 
 #: Largest grid (bases × factor levels × recordings) a study runs unless its ``max_cells`` says more.
 MAX_CELLS = 10_000
@@ -304,6 +306,12 @@ class Study:
     def from_dict(cls, d: dict[str, Any], root: str | Path = ".", max_cells: int | None = None) -> Study:
         """Build from a mapping (see :data:`STUDY_KEYS`); ``max_cells`` overrides the study's grid limit."""
         root = Path(root)
+        if "base" not in d and {"orientation", "detector"} & set(d):
+            raise ConfigError("this is a pipeline config (orientation, detector, ...), not a study: run it with "
+                              "footzoo run FILE, or write a study whose base: names it (see footzoo configs: "
+                              "study_quick)")
+        if "tune" in d:
+            raise ConfigError("this is a tune file (a study with a tune: block): run it with footzoo tune FILE")
         for key in d:
             if key not in STUDY_KEYS:
                 raise ConfigError(f"unknown study key {key!r}{did_you_mean(key, list(STUDY_KEYS))}; "
@@ -339,12 +347,18 @@ class Study:
                 raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
                                   "or remove it")
             keys = [json.dumps(level, sort_keys=True, default=str) for level in v]
-            twice = next((level for level, key in zip(v, keys, strict=True) if keys.count(key) > 1), None)
+            counts = collections.Counter(keys)
+            twice = next((level for level, key in zip(v, keys, strict=True) if counts[key] > 1), None)
             if twice is not None:  # it would run every cell of that level twice under one name
                 raise ConfigError(f"factor {k!r} lists the level {twice!r} more than once; list each level once")
         recordings = []
         if not isinstance(d["recordings"] or [], list):
             raise ConfigError("recordings must be a list, e.g. [{path: data/*.csv}, {simulate: {path: straight}}]")
+        max_cells = d.get("max_cells", MAX_CELLS) if max_cells is None else max_cells
+        if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
+            raise ConfigError(f"max_cells must be a whole number >= 1, got {max_cells!r}")
+        _refuse_large(len(bases), factors, [_count_recording(r, i) for i, r in enumerate(d["recordings"] or [])],
+                      max_cells)  # before any list is expanded: a pasted repeats: 10000000 must not fill the memory
         for i, r in enumerate(d["recordings"] or []):
             recordings += _expand_recording(r, root, i)
         if not recordings:
@@ -371,11 +385,8 @@ class Study:
         if isinstance(points, bool) or not isinstance(points, int) or points < 0:
             raise ConfigError(f"sweep.points must be a whole number >= 0, got {points!r}")
         jobs = d.get("jobs")
-        if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs == 0):
-            raise ConfigError(f"jobs must be a number of worker processes (1 = serial, -1 = every core), got {jobs!r}")
-        max_cells = d.get("max_cells", MAX_CELLS) if max_cells is None else max_cells
-        if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
-            raise ConfigError(f"max_cells must be a whole number >= 1, got {max_cells!r}")
+        if jobs is not None:
+            check_jobs(jobs)
         study = cls(str(d.get("name", "study")), bases, factors, recordings, metrics, points, plugins, jobs,
                     max_cells, figures)
         study.check_size()
@@ -391,14 +402,8 @@ class Study:
 
     def check_size(self, max_cells: int | None = None) -> None:
         """A ConfigError when the grid has more runs than ``max_cells`` (default: the study's own limit)."""
-        limit = self.max_cells if max_cells is None else max_cells
-        if self.size > limit:
-            levels = " x ".join(f"{len(v)} {k}" for k, v in self.factors.items()) or "no factors"
-            raise ConfigError(
-                f"the study has {self.size:,} runs ({len(self.bases)} base(s) x {levels} x "
-                f"{len(self.recordings)} recording(s)), more than the limit of {limit:,}: shorten the factors' "
-                "level lists, or raise the limit (max_cells: N in the study file, --max-cells N on the command "
-                "line) if you mean it")
+        _refuse_large(len(self.bases), self.factors, [len(self.recordings)],
+                      self.max_cells if max_cells is None else max_cells)
 
     def configs(self) -> list[tuple[dict[str, Any], dict[str, Any]]]:
         """Every distinct ``(config, levels)`` of the grid, without the recordings.
@@ -501,6 +506,56 @@ def _resolve(root: Path, path: str) -> str:
     return str(root / p)
 
 
+#: Most local worker processes per core a study starts (more only share the cores and multiply the memory).
+JOBS_PER_CORE = 4
+
+
+def max_jobs() -> int:
+    """The most local worker processes a study may start on this machine: :data:`JOBS_PER_CORE` per core."""
+    return JOBS_PER_CORE * (os.cpu_count() or 1)
+
+
+def check_jobs(jobs: Any, what: str = "jobs") -> int:
+    """``jobs`` when it is -1 (every core) or 1 to :func:`max_jobs`; a ConfigError naming the range otherwise."""
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or not (jobs == -1 or 1 <= jobs <= max_jobs()):
+        raise ConfigError(f"{what} must be a number of worker processes on this machine: 1 (serial) to {max_jobs()} "
+                          f"({JOBS_PER_CORE} per core of this machine's {os.cpu_count() or 1}; more only share the "
+                          f"cores), or -1 for one per core; got {jobs!r}")
+    return jobs
+
+
+def _refuse_large(bases: int, factors: dict[str, list[Any]], recordings: list[int], limit: int) -> None:
+    """A ConfigError naming the count when bases x factor levels x recordings exceeds ``limit`` (nothing expanded)."""
+    size = bases * math.prod(len(v) for v in factors.values()) * sum(recordings)
+    if size > limit:
+        levels = " x ".join(f"{len(v)} {k}" for k, v in factors.items()) or "no factors"
+        raise ConfigError(
+            f"the study has {size:,} runs ({bases} base(s) x {levels} x {sum(recordings):,} recording(s)), more "
+            f"than the limit of {limit:,}: shorten the factors' level lists or the recordings' seeds and repeats, or "
+            "raise the limit (max_cells: N in the study file, --max-cells N on the command line) if you mean it")
+
+
+def _seeds(r: dict[str, Any], i: int) -> list[int]:
+    """The seeds of a ``simulate:`` entry, repeats included (``seeds`` and ``repeats`` checked)."""
+    seeds = r.get("seeds", [0])
+    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0
+                                              for s in seeds):
+        raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers >= 0, got {seeds!r:.120}")
+    repeats = r.get("repeats", 1)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
+    return [s + 1000 * k for k in range(repeats if seeds else 0) for s in seeds]
+
+
+def _count_recording(r: Any, i: int) -> int:
+    """How many recordings an entry of ``recordings:`` gives, without expanding it (a glob counts as 1 here)."""
+    if isinstance(r, dict) and "simulate" in r and "path" not in r:
+        seeds, repeats = r.get("seeds", [0]), r.get("repeats", 1)
+        if isinstance(seeds, list) and isinstance(repeats, int) and not isinstance(repeats, bool) and repeats >= 1:
+            return len(seeds) * repeats
+    return 1
+
+
 def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
     if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
         raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
@@ -534,13 +589,13 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         check_spec(sim)
     except ConfigError as err:
         raise ConfigError(f"recordings[{i}].{err}") from None
-    seeds = r.get("seeds", [0])
-    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) for s in seeds):
-        raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers, got {seeds!r}")
-    repeats = r.get("repeats", 1)
-    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
-        raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
-    seeds = [s + 1000 * k for k in range(repeats) for s in seeds]
+    seeds = _seeds(r, i)
+    if len(set(seeds)) > 1 and not seed_matters(sim):
+        raise ConfigError(
+            f"recordings[{i}]: its {len(set(seeds))} seeds give {len(set(seeds))} identical recordings: the simulation "
+            "has no random part (no noise, or noise: {scale: 0}), so the study would average identical runs as if "
+            "they were independent; add the sensor noise (noise: {scale: 1}, Yun et al. 2012 Table II) or keep one "
+            "seed (seeds: [0])")
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
     return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
 

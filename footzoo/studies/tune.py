@@ -54,7 +54,7 @@ import pandas as pd
 import yaml
 
 from ..config.library import resolve
-from ..core.atomic import json_safe, write_text
+from ..core.atomic import FileGroup, folder_lock, json_safe, write_text
 from ..core.errors import ConfigError, FootzooWarning, did_you_mean
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import METRICS
@@ -276,7 +276,10 @@ class TuneResult:
 
     def save_config(self, path: str | Path, name: str | None = None) -> Path:
         """Write the chosen setting as a pipeline config YAML (atomically), the procedure in its header."""
+        return write_text(path, self.config_text(name), what="tuned config")
 
+    def config_text(self, name: str | None = None) -> str:
+        """The YAML text :meth:`save_config` writes."""
         cfg = copy.deepcopy(self.best_config_)
         cfg["name"] = name or str(cfg.get("name", "tuned"))
         header = [f"# chosen by footzoo tune: {self.best_} ({self.objective}); leave-one-group-out over "
@@ -285,7 +288,7 @@ class TuneResult:
                     f"test score {r.test_score:.4g}" for r in self.folds_.itertuples()),
                   *(f"# at the edge: {e}" for e in self.edges_)]
         body = yaml.safe_dump(json_safe(cfg), sort_keys=False, default_flow_style=None, width=120)
-        return write_text(path, "\n".join(header) + "\n" + body, what="tuned config")
+        return "\n".join(header) + "\n" + body
 
 
 def candidate_study(study: Study, spec: TuneSpec) -> tuple[Study, dict[str, dict[str, Any]]]:
@@ -454,7 +457,19 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     else:
         groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
     score = score or spec.score_function()
-    run = _Runner(study, spec, groups, dict(jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet))
+    if out is None:
+        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=None,
+                                                                progress=progress, quiet=quiet))
+    with folder_lock(out, "tune output folder", f"tune {study.name!r}"):  # its studies run in it too
+        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=out,
+                                                                progress=progress, quiet=quiet))
+
+
+def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], bool] | None, groups: pd.Series,
+          options: dict[str, Any]) -> TuneResult:
+    """:func:`tune` once its output folder (if any) is locked."""
+    out = options["out"]
+    run = _Runner(study, spec, groups, options)
     if spec.search == "optuna":
         folds, held_out, best = optuna_search(run, spec, score, eligible)
         values, groups = run.values, run.groups
@@ -472,16 +487,16 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective, edges)
     for edge in edges:
         warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=2)
-    if out is not None:
-        folder = Path(out)
-        folder.mkdir(parents=True, exist_ok=True)
-
-        write_text(folder / "tune_folds.csv", folds.to_csv(index=False), what="tune folds")
-        write_text(folder / "tune_scores.csv", scores.rename("score").to_csv(index_label="setting"),
-                   what="tune scores")
     target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
-    if target is not None:
-        result.save_config(target, name=study.name)
+    with FileGroup(what="tune output") as written:  # the tables and the chosen config of this tune, or none of them
+        if out is not None:
+            folder = Path(out)
+            folder.mkdir(parents=True, exist_ok=True)
+            written.path(folder / "tune_folds.csv").write_text(folds.to_csv(index=False), encoding="utf-8")
+            written.path(folder / "tune_scores.csv").write_text(
+                scores.rename("score").to_csv(index_label="setting"), encoding="utf-8")
+        if target is not None:
+            written.path(target).write_text(result.config_text(name=study.name), encoding="utf-8")
     return result
 
 

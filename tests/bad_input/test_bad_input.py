@@ -188,15 +188,17 @@ class Case:
 CASES = [
     # ---------------------------------------------------------------- readers
     Case("xio-random-bytes", lambda d, w: (lambda: load(_text(d, "r.csv", bytes(range(256)) * 40), format="xio")),
-         FormatError, "cannot read as xio"),
+         FormatError, "r.csv: starts with 1 NUL byte(s) (0x00), not text"),
     Case("xio-header-then-latin1", lambda d, w: (lambda: load(_text(
         d, "r.csv", b"Time (s),Gyroscope X (deg/s)\n1.0,caf\xe9\n"), format="xio")), FormatError, "not UTF-8 text"),
     Case("detect-random-bytes", lambda d, w: (lambda: load(_text(d, "r.csv", b"\xff\xfe\x00" * 500))),
          FormatError, "cannot tell the format"),
     Case("canonical-random-bytes", lambda d, w: (lambda: load(_text(d, "r.csv", b"t,acc_x,gyr_x\n\xff\x00\x81\n"))),
-         FormatError, "r.csv: not UTF-8"),
+         FormatError, "r.csv: a run of 1 NUL bytes (0x00) at byte 15 (line 2): the file was damaged"),
     Case("canonical-random-bytes-cut", lambda d, w: (lambda: load(_text(d, "r.csv", b"t,acc_x,gyr_x\n\xff\x00\x81"))),
-         RecordingError, "r.csv: the recording is empty", warns="r.csv: the file does not end with a line break"),
+         FormatError, "r.csv: a run of 1 NUL bytes (0x00) at byte 15 (line 2)"),
+    Case("canonical-latin1", lambda d, w: (lambda: load(_text(d, "r.csv", b"t,acc_x,gyr_x\n\xff\x81\n"))),
+         FormatError, "r.csv: not UTF-8"),
     Case("parquet-garbage", lambda d, w: (lambda: load(_text(d, "r.parquet", b"PAR1 not really"))),
          FormatError, "cannot read"),
     Case("mat-garbage", lambda d, w: (lambda: load(_text(d, "r.mat", b"MATLAB 5.0 garbage" * 20))),
@@ -226,8 +228,8 @@ CASES = [
     Case("meta-yaml-latin1", lambda d, w: _with_meta(d, w, "meta: {name: caf\xe9}\n".encode("latin-1")),
          FormatError, "not UTF-8"),
     Case("meta-yaml-alias-bomb", lambda d, w: _with_meta(d, w, _bomb()), FormatError, "alias"),
-    Case("truth-shorter-than-imu", lambda d, w: (lambda: load(_pyshoe(d, w, gt_rows=w.n // 2))), RecordingError,
-         "ground truth pos has"),
+    Case("truth-shorter-than-imu", lambda d, w: (lambda: load(_pyshoe(d, w, gt_rows=w.n // 2))), FormatError,
+         "'gt' (the VICON position) has shape (350, 3), expected (700, 3): one row per IMU sample"),
     Case("truth-shorter-direct", lambda d, w: (lambda: Recording(t=w.t, acc=w.acc, gyr=w.gyr,
                                                                   truth=Truth(pos=w.truth.pos[:-10]))),
          RecordingError, "truth must have one row per IMU sample"),
@@ -251,7 +253,7 @@ CASES = [
          "footzoo needs t in seconds"),
     Case("decimal-comma", lambda d, w: (lambda: load(_text(d, "c.csv", "t;acc_x;acc_y;acc_z;gyr_x;gyr_y;gyr_z\n"
                                                             "0;0,1;0;-9,8;0;0;0\n"), format="canonical")),
-         RecordingError, "missing column(s)"),
+         RecordingError, "missing column(s)", warns=r"c\.csv: column\(s\) 't;acc_x;.*' are not read"),
     Case("text-column", lambda d, w: (lambda: load(_text(d, "c.csv", _TEXT_COLUMN))), RecordingError,
          "column 'acc_x' holds no numbers (first value '0,1')"),
     Case("truth-stance-text", lambda d, w: (lambda: load(_stance_text(d, w))), RecordingError,
@@ -393,7 +395,7 @@ CASES = [
          "path must be a file path or glob"),
     Case("stream-acc-in-g", lambda d, w: _push(w, *[(w.t[k], w.acc[k] / 9.80665, w.gyr[k]) for k in range(w.n)]),
          RecordingError, "this looks like g, not m/s²"),
-    # ---------------------------------------------------------------- plug-ins (more: test_bad_input_plugins.py)
+    # ---------------------------------------------------------------- plug-ins (more: test_plugins.py)
     Case("plugin-raises", lambda d, w: _faulty_plugin(d, w, "test_case_raises", "return 1 / 0"), PluginError,
          "detector 'test_case_raises' (footzoo_plugin_"),
     Case("plugin-exits", lambda d, w: _faulty_plugin(d, w, "test_case_exits", "raise SystemExit(3)"), PluginError,

@@ -208,6 +208,23 @@ def readers_on_csvish_text(header: str, rows: list[str], encoding: str) -> None:
         _load_every_way(p)
 
 
+def readers_on_damaged_text(text: str, encoding: str, at: float, nuls: int) -> None:
+    """A recording in a foreign encoding, or with a run of NUL bytes (a damaged or padded file): a footzoo error,
+    or (a UTF-8 byte-order mark, NUL padding after the last line) the same recording as the clean file."""
+    data = text.encode(encoding)
+    k = int(at * len(data))
+    damaged = data[:k] + b"\0" * nuls + data[k:]
+    with tempfile.TemporaryDirectory() as d:
+        clean, p = Path(d) / "clean.csv", Path(d) / "r.csv"
+        clean.write_text(text)
+        p.write_bytes(damaged)
+        ref = _only_footzoo_errors(lambda: load(clean))
+        rec = _only_footzoo_errors(lambda: load(p))
+        _load_every_way(p)
+    if rec is not None:  # read: then it is the clean recording, never a shifted or partial one
+        assert ref is not None and np.array_equal(rec.t, ref.t) and np.array_equal(rec.acc, ref.acc)
+
+
 def reader_on_near_valid_recording(text: str) -> None:
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "r.csv"
@@ -409,6 +426,9 @@ PROPERTIES = {
                                                           st.sampled_from([".csv", ".txt", ".mat", ".parquet"]))),
     "readers_on_csvish_text": (readers_on_csvish_text, (HEADER, ROWS, st.sampled_from(["utf-8", "latin-1"]))),
     "reader_on_near_valid_recording": (reader_on_near_valid_recording, (near_valid_recordings(),)),
+    "readers_on_damaged_text": (readers_on_damaged_text, (
+        near_valid_recordings(), st.sampled_from(["utf-8", "utf-8-sig", "utf-16", "utf-16-le", "utf-32"]),
+        st.floats(0.0, 1.0), st.sampled_from([0, 1, 7, 300]))),
     "yaml_text": (yaml_text, (st.one_of(YAMLISH, st.text(max_size=200)),)),
     "generic_descriptions": (generic_descriptions, (
         st.fixed_dictionaries({}, optional={k: VALUE for k in ("time", "acc", "gyr", "mag", "axes", "delimiter",

@@ -14,17 +14,25 @@ import pytest
 
 from footzoo.core import atomic
 from footzoo.core.atomic import (
+    INCOMPLETE,
+    LOCK_NAME,
     TMP_INFIX,
     FileGroup,
     atomic_path,
     atomic_write,
+    begin_folder,
+    check_complete,
     check_target,
+    end_folder,
     folder_lock,
+    incomplete,
+    lock_holder,
+    previous_marker,
     refuse_inputs,
     write_json,
     write_text,
 )
-from footzoo.core.errors import OutputError
+from footzoo.core.errors import FormatError, OutputError
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -165,10 +173,148 @@ def test_strict_json_has_no_bare_nan(tmp_path):
     assert back == {"a": None, "b": [None, 3, True], "c": [0.0, 1.0], "d": [1, 2], "e": str(tmp_path), "f": "1e3"}
 
 
-def test_a_locked_folder_refuses_a_second_writer(tmp_path):
-    with folder_lock(tmp_path / "study") as folder:
-        with pytest.raises(OutputError, match=r"is being written by footzoo process \d+"), \
-                folder_lock(folder):
+def test_a_locked_folder_refuses_a_second_writer_naming_the_first(tmp_path):
+    """Another thread (or process) asking for a held folder is refused at once with the holder's description."""
+    import threading
+
+    errors = []
+    with folder_lock(tmp_path / "study", owner="study 'quick'") as folder:
+        holder = lock_holder(folder)
+        assert holder["owner"] == "study 'quick'" and holder["pid"] == os.getpid() and holder["host"]
+
+        def second():
+            try:
+                with folder_lock(folder, owner="study 'other'"):
+                    pass
+            except OutputError as err:
+                errors.append(str(err))
+
+        thread = threading.Thread(target=second)
+        thread.start()
+        thread.join()
+        with folder_lock(folder):  # the same thread may enter again (a tune runs its studies in its folder)
             pass
-    with folder_lock(tmp_path / "study"):  # released
+        assert (folder / LOCK_NAME).exists()
+    assert len(errors) == 1 and "is in use: study 'quick' (process" in errors[0]
+    assert "another output folder" in errors[0]
+    assert not (tmp_path / "study" / LOCK_NAME).exists()  # released and removed
+    with folder_lock(tmp_path / "study"):
         pass
+
+
+def test_the_same_study_twice_shares_the_folder_and_another_is_refused(tmp_path):
+    """Holders that give the same identity (one study started twice) share; the last one out removes the file."""
+    import threading
+
+    folder = tmp_path / "study"
+    entered, leave, errors = threading.Event(), threading.Event(), []
+
+    def hold(identity, owner):
+        try:
+            with folder_lock(folder, owner=owner, identity=identity):
+                entered.set()
+                leave.wait(30)
+        except OutputError as err:
+            errors.append(str(err))
+
+    first = threading.Thread(target=hold, args=("study-A", "study 'a'"))
+    first.start()
+    assert entered.wait(30)
+    second = threading.Thread(target=hold, args=("study-A", "study 'a'"))
+    other = threading.Thread(target=hold, args=("study-B", "study 'b'"))
+    second.start()
+    other.start()
+    other.join(30)
+    assert len(errors) == 1 and "is in use: study 'a'" in errors[0]  # the other study, refused
+    leave.set()
+    first.join(30)
+    second.join(30)
+    assert len(errors) == 1 and not (folder / LOCK_NAME).exists()  # the same one joined; the last removed the file
+
+
+def test_a_lock_held_by_another_process_is_refused_and_released_when_it_dies(tmp_path):
+    folder = tmp_path / "out"
+    code = ("import sys, time\nfrom footzoo.core.atomic import folder_lock\n"
+            f"with folder_lock({str(folder)!r}, owner='study \\'first\\''):\n"
+            "    print('locked', flush=True)\n    time.sleep(60)\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "locked"
+        with pytest.raises(OutputError, match=rf"is in use: study 'first' \(process {proc.pid} on .* since .*\)"):
+            with folder_lock(folder, owner="study 'second'"):
+                pass
+    finally:
+        proc.kill()  # dies holding the lock: no clean-up runs
+        proc.wait()
+    assert (folder / LOCK_NAME).exists() and lock_holder(folder)["pid"] == proc.pid  # left behind by the dead process
+    with folder_lock(folder, owner="study 'second'"):  # stale: taken over
+        assert lock_holder(folder)["owner"] == "study 'second'"
+
+
+def test_without_file_locks_a_dead_holder_is_stale_and_a_live_one_is_not(tmp_path, monkeypatch):
+    """On a file system without locks (some network file systems) the lock file's process id decides."""
+    monkeypatch.setattr(atomic, "_try_lock", lambda fh: None)
+    folder = tmp_path / "out"
+    folder.mkdir()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    (folder / LOCK_NAME).write_text(json.dumps({"owner": "study 'gone'", "pid": int(dead.stdout),
+                                                "host": atomic._host(), "started": "2024-01-01 10:00:00"}))
+    with folder_lock(folder, owner="study 'new'"):
+        assert lock_holder(folder)["owner"] == "study 'new'"
+    (folder / LOCK_NAME).write_text(json.dumps({"owner": "study 'alive'", "pid": os.getppid(), "host": atomic._host()}))
+    with pytest.raises(OutputError, match="study 'alive'.*If that process no longer runs.*delete"):
+        with folder_lock(folder):
+            pass
+    (folder / LOCK_NAME).write_text(json.dumps({"owner": "study 'far'", "pid": 1, "host": "another-machine"}))
+    with pytest.raises(OutputError, match="study 'far' \\(process 1 on another-machine\\)"):
+        with folder_lock(folder):
+            pass
+
+
+def test_a_marked_group_sets_the_old_marker_aside_first_and_writes_the_new_one_last(tmp_path, monkeypatch):
+    """The manifest of a folder output is its completion marker: a process killed between the renames leaves the
+    folder without one (refused as incomplete), never the old manifest beside new files."""
+    folder = tmp_path / "result"
+    folder.mkdir()
+    with FileGroup(marker=folder / "manifest.json") as group:
+        group.path(folder / "a.csv").write_text("1")
+        group.path(folder / "manifest.json").write_text('{"files": ["a.csv"]}')
+    assert check_complete(folder, "manifest.json", "a result") == folder
+    seen = []
+    real = os.replace
+
+    def replace(src, dst):
+        seen.append((Path(dst).name, (folder / "manifest.json").exists(), (folder / INCOMPLETE).exists()))
+        if Path(dst).name == "b.csv":
+            raise KeyboardInterrupt  # the process "dies" here (a kill is not deferred)
+        real(src, dst)
+
+    monkeypatch.setattr(atomic.os, "replace", replace)
+    with pytest.raises(KeyboardInterrupt), FileGroup(marker=folder / "manifest.json") as group:
+        group.path(folder / "a.csv").write_text("2")
+        group.path(folder / "b.csv").write_text("2")
+        group.path(folder / "manifest.json").write_text('{"files": ["a.csv", "b.csv"]}')
+    monkeypatch.undo()
+    assert seen[0][0] == INCOMPLETE  # the old manifest set aside first...
+    assert ("a.csv", False, True) in seen  # ...before any member replaced an old file
+    assert not (folder / "manifest.json").exists() and incomplete(folder)
+    with pytest.raises(FormatError, match=r"is incomplete: footzoo was interrupted while writing a result there"):
+        check_complete(folder, "manifest.json", "a result")
+    assert previous_marker(folder, "manifest.json") == {"files": ["a.csv"]}  # what the next write needs to know
+    with FileGroup(marker=folder / "manifest.json") as group:  # written again: complete
+        group.path(folder / "manifest.json").write_text('{"files": []}')
+    assert not incomplete(folder) and check_complete(folder, "manifest.json", "a result")
+
+
+def test_a_folder_output_is_incomplete_from_its_start_until_its_marker_is_written(tmp_path):
+    folder = tmp_path / "study"
+    folder.mkdir()
+    with pytest.raises(FormatError, match="holds no outputs.json: it is not a report written by footzoo"):
+        check_complete(folder, "outputs.json", "a report")
+    end_folder(folder, "outputs.json", '{"digest": "one"}')
+    assert begin_folder(folder, "outputs.json") == {"digest": "one"}
+    assert incomplete(folder) and not (folder / "outputs.json").exists()
+    assert begin_folder(folder, "outputs.json") == {"digest": "one"}  # an interrupted run's marker is kept
+    end_folder(folder, "outputs.json", '{"digest": "two"}')
+    assert not incomplete(folder) and previous_marker(folder, "outputs.json") == {"digest": "two"}
