@@ -164,6 +164,8 @@ def test_stride_errors_against_a_hand_made_reference():
     assert e["matched_strides"] == 3
     assert e["ic_error_median_abs_s"] == pytest.approx(0.01)
     assert e["to_error_median_abs_s"] == pytest.approx(0.01)
+    # signed: IC +0.01, 0, +0.02 s and TO +0.01, −0.02, 0 s: medians +0.01 and 0
+    assert e["ic_error_median_s"] == pytest.approx(0.01) and e["to_error_median_s"] == pytest.approx(0.0)
     # every matched stride: errors 0, 0.1 and 0 m; the straight ones (turn left out): 0 and 0.1 m
     assert e["stride_length_rms_error_m"] == pytest.approx(np.sqrt(0.1**2 / 3))
     assert e["stride_length_mean_error_m"] == pytest.approx(0.1 / 3)
