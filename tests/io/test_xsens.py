@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from footzoo import FormatError
-from footzoo.core.errors import FootzooWarning
+from footzoo.core.errors import FootzooWarning, RecordingError
 from footzoo.io import detect_format, load
 from footzoo.io.axes import parse_axes
 from footzoo.io.xsens import COUNTER_WRAP, packet_times, reference_events
@@ -57,6 +57,15 @@ def test_an_xsens_export_comes_back_in_frd_at_its_packet_times(walk, tmp_path):
     np.testing.assert_allclose(rec.gyr, walk.gyr[keep], atol=1e-8)
     np.testing.assert_allclose(rec.mag, walk.mag[keep], atol=1e-8)
     assert rec.meta["foot"] == "left" and rec.meta["axes"] == "(-x, y, -z)" and rec.truth is None
+
+
+def test_a_gap_longer_than_max_gap_is_refused_or_bridged_when_allowed(walk, tmp_path):
+    path = tmp_path / "gap.txt"
+    path.write_text(xsens_text(walk, drop=list(range(200, 230))))  # 30 packets lost: a 0.31 s interval
+    with pytest.raises(RecordingError, match="longer than 250.0 ms"):
+        load(path)
+    with pytest.warns(FootzooWarning, match="bridged 1 gap"):
+        assert load(path, max_gap=0.5).n == walk.n - 30
 
 
 def test_the_axis_map_is_an_option_and_must_be_right_handed(walk, tmp_path):
