@@ -33,7 +33,7 @@ def walk():
 
 def xsens_text(rec, first: int = 0, drop=(), rate_line: str = "Acquisition frequency: 100 Hz", counter=None) -> str:
     """The walk as an IPOL-style Xsens export: sensor x to the heel and z up (180° about y), rows ``drop`` left out."""
-    to_sensor = parse_axes("-x, y, -z").T  # FRD -> sensor (the map is a rotation: its inverse is its transpose)
+    to_sensor = parse_axes("[-x, y, -z]").T  # FRD -> sensor (the map is a rotation: its inverse is its transpose)
     acc, gyr, mag = rec.acc @ to_sensor.T, rec.gyr @ to_sensor.T, rec.mag @ to_sensor.T
     pc = np.arange(rec.n) + first if counter is None else np.asarray(counter)
     keep = np.setdiff1d(np.arange(rec.n), drop)
@@ -56,7 +56,7 @@ def test_an_xsens_export_comes_back_in_frd_at_its_packet_times(walk, tmp_path):
     np.testing.assert_allclose(rec.acc, walk.acc[keep], atol=1e-8)
     np.testing.assert_allclose(rec.gyr, walk.gyr[keep], atol=1e-8)
     np.testing.assert_allclose(rec.mag, walk.mag[keep], atol=1e-8)
-    assert rec.meta["foot"] == "left" and rec.meta["axes"] == "(-x, y, -z)" and rec.truth is None
+    assert rec.meta["foot"] == "left" and rec.meta["axes"] == "[-x, y, -z]" and rec.truth is None
 
 
 def test_a_gap_longer_than_max_gap_is_refused_or_bridged_when_allowed(walk, tmp_path):
@@ -71,10 +71,10 @@ def test_a_gap_longer_than_max_gap_is_refused_or_bridged_when_allowed(walk, tmp_
 def test_the_axis_map_is_an_option_and_must_be_right_handed(walk, tmp_path):
     path = tmp_path / "walk.txt"
     path.write_text(xsens_text(walk))
-    sensor = load(path, axes="x, y, z")  # the sensor's own axes
-    np.testing.assert_allclose(sensor.acc, walk.acc @ parse_axes("-x, y, -z"), atol=1e-8)
+    sensor = load(path, axes="[x, y, z]")  # the sensor's own axes
+    np.testing.assert_allclose(sensor.acc, walk.acc @ parse_axes("[-x, y, -z]"), atol=1e-8)
     with pytest.raises(FormatError, match="left-handed"):
-        load(path, axes="x, y, -z")
+        load(path, axes="[x, y, -z]")
 
 
 def test_the_rate_comes_from_the_file_or_the_option(walk, tmp_path):
