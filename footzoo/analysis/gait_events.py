@@ -1,23 +1,41 @@
 """Gait events per stride from the foot's sagittal angular rate: toe-off (TO) and initial contact (IC).
 
-Method (Rampp et al. 2015, "Inertial sensor-based stride parameter calculation from
-gait sequences in geriatric patients", IEEE TBME 62(4), 1089-1097, the gait event
-detection of its Methods section, which states the rules in prose, without numbered
-equations; implemented in gaitmap as ``RamppEventDetection``; the same landmarks as
-Sabatini et al. 2005, "Assessment of walking features from foot inertial sensing",
-IEEE TBME 52(3), 486-494, Sec. II-B): the events of one stride are features of the
-foot's sagittal (medio-lateral) angular rate ``ω_ml`` between two stances, positive
-when the toe lifts. Between two stances the rate has three landmarks:
+The events of one stride are features of the foot's sagittal (medio-lateral) angular rate
+``ω_ml`` between two stances, positive when the toe lifts (Sabatini et al. 2005, "Assessment of
+walking features from foot inertial sensing", IEEE TBME 52(3), 486-494, Sec. II-B; Rampp et al.
+2015, "Inertial sensor-based stride parameter calculation from gait sequences in geriatric
+patients", IEEE TBME 62(4), 1089-1097, the gait event detection of its Methods section, which
+states the rules in prose, without numbered equations). Between two stances the rate has three
+landmarks:
 
-* the push-off: the foot plantar-flexes ever faster until the toe leaves the
-  floor, a negative peak of ``ω_ml`` — **TO** is this minimum (Rampp's "terminal
-  contact" is the zero crossing that follows it within a few samples);
-* the mid-swing: the foot dorsi-flexes, a positive peak ``p``;
-* the heel strike: the dorsi-flexion stops when the heel lands, ``ω_ml`` goes
-  through zero and then negative while the foot rolls flat — **IC** is that first
-  downward zero crossing after ``p`` (Rampp's IC is the ``ω_ml`` minimum right after
-  it, refined by the acceleration peak of the impact; Sabatini's is the same
-  zero crossing).
+* the push-off: the foot rolls over its toe, plantar-flexing ever faster; the toe leaves the
+  floor about when the rotation is fastest, and in the air the rate turns, through zero, into
+  the swing's dorsi-flexion;
+* the mid-swing: the dorsi-flexion's positive peak ``p``;
+* the heel strike: the dorsi-flexion stops when the heel lands, ``ω_ml`` goes through zero and
+  then negative while the foot rolls flat.
+
+**Definitions.**
+
+* **TO** is the instant the rate, recovering from its push-off peak ``ω_min`` (the fastest
+  plantar-flexion, a negative minimum), passes :data:`TO_LEVEL` = half of it, on the rising flank
+  between the peak and ``p``. The toe leaves on that flank: after the fastest plantar-flexion
+  (the terminal contact of gaitmap's ``HerzerEventDetection``, "roughly at the point of the most
+  rapid plantar flexion", after Figueiredo et al. 2018, IEEE TNSRE 26(10), 1945-1956) and before
+  the zero crossing (Rampp et al.'s toe-off, gaitmap's ``RamppEventDetection`` terminal contact:
+  the change from plantar flexion to dorsal extension). The half-amplitude point times that edge
+  independently of the sampling rate and of the peak's size.
+* **IC** is the first downward zero crossing of ``ω_ml`` after ``p`` (Sabatini et al. 2005's
+  landmark; Rampp et al. take the ``ω_ml`` minimum right after it, refined by the acceleration
+  peak of the impact).
+
+Checked against three references (docs/gait-events.md, ``benchmarks/accuracy.py --parts
+events``): the simulator's truth (the toe leaving the floor, the heel touching it;
+:mod:`footzoo.sim.gait`), gaitmap's motion-capture events (``stride_events_sample.csv``) and the
+hand-checked IMU events of Voisard et al.'s data set (:mod:`footzoo.io.xsens`). For TO they agree
+(the half point lies 5 to 9 ms after each one's toe-off); for IC the motion capture puts the
+contact at the zero crossing and the hand-checked events put it a median 23 ms later, at the
+impact, so IC follows the motion capture.
 
 **Independent of the mounting** (footzoo's choice, :func:`sagittal_rate`): ``ω_ml`` is
 not a sensor axis but the angular rate rotated into the navigation frame with the
@@ -29,26 +47,16 @@ so it gives the same events. With a sensor aligned to the foot (x toe, y right, 
 down) and a level foot, ``ω_ml`` equals ``gyr_y``; :func:`detect_gait_events` still takes
 that body-frame signal when no attitude is given.
 
-footzoo's other choices (not fixed by the paper): the stances come from the pipeline's
-stance detector instead of Rampp's DTW stride segmentation; TO is searched from
-the middle of the stance before the swing to ``p``, IC from ``p`` to the middle of
-the next stance; the TO minimum is refined to sub-sample time with a parabola
-through its three samples, the IC crossing by linear interpolation; a sample
-stands for the middle of its interval ``(t[k-1], t[k]]`` (footzoo's
-interval-average convention), so event times are half a period before the
-sample times. On the simulator's physical profile the rate's zero crossing is
-the true IC and its minimum lies half the pre-swing before the true toe-off
-(the simulated toe leaves the floor when the rotation about it ends, a real
-toe while the foot still rotates fast, see below). Checked on
-gaitmap's example (motion-capture events, ``stride_events_sample.csv``): TO lies
-1–2 samples after the ``ω_ml`` minimum and IC at the zero crossing, 2–3 samples
-before the impact peak of the accelerometer; the zero crossing that follows the
-TO minimum is 4–5 samples (20–25 ms at 204.8 Hz) late, which is why the minimum
-is used.
-
-Where a swing lacks the pattern (no positive ``ω_ml`` after the push-off, e.g. a
-shuffle), the events fall back to the detector's stance edges and ``events_from``
-says so.
+footzoo's other choices (not fixed by the papers): the stances come from the pipeline's
+stance detector instead of Rampp's DTW stride segmentation; the push-off peak is searched from
+the middle of the stance before the swing to ``p``, IC from ``p`` to the middle of the next
+stance; the push-off peak's value is refined with a parabola through its three samples (so the
+half level does not depend on where the samples fall), both crossings are interpolated linearly
+between two samples; a sample stands for the middle of its interval ``(t[k-1], t[k]]``
+(footzoo's interval-average convention), so event times are half a period before the sample
+times. Where a swing lacks the pattern (no positive ``ω_ml`` after the push-off, e.g. a
+shuffle), the events fall back to the detector's stance edges and ``from_rate`` (the steps
+table's ``events_from_rate``) says so.
 """
 
 from __future__ import annotations
@@ -58,6 +66,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kernels.jit import njit
+
+#: Toe-off: the fraction of the push-off peak of ``ω_ml`` to which the rate has recovered (half).
+TO_LEVEL = 0.5
 
 
 @dataclass
@@ -124,6 +135,19 @@ def _first_down_crossing(w: np.ndarray, after: np.ndarray, until: np.ndarray, ou
         out[i] = -1
         for c in range(after[i] + 1, min(until[i], n - 1) + 1):
             if w[c - 1] > 0.0 and w[c] <= 0.0:
+                out[i] = c
+                break
+
+
+@njit
+def _first_up_crossing(w: np.ndarray, after: np.ndarray, until: np.ndarray, level: np.ndarray,
+                       out: np.ndarray) -> None:
+    """``out[i]``: the first ``c`` in ``[after_i + 1, until_i]`` with ``w[c-1] < level_i <= w[c]``, or −1."""
+    n = w.shape[0]
+    for i in range(after.shape[0]):
+        out[i] = -1
+        for c in range(after[i] + 1, min(until[i], n - 1) + 1):
+            if w[c - 1] < level[i] and w[c] >= level[i]:
                 out[i] = c
                 break
 
@@ -216,7 +240,7 @@ def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: n
 
 
 def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> GaitEvents:
-    """TO and IC of each swing between consecutive stances (Rampp et al. 2015, Sec. II-C).
+    """TO and IC of each swing between consecutive stances (see the module docstring for the definitions).
 
     Parameters
     ----------
@@ -248,27 +272,35 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     mid = (a + b - 1) // 2
     sw0, sw1 = b[:-1], a[1:]  # swing samples [sw0, sw1)
     # mid-swing peak p of the dorsi-flexion
-    p = segment_argext(w, np.minimum(sw0, n - 1), np.maximum(sw1, sw0 + 1), largest=True)
-    # TO: push-off minimum between the previous mid-stance and p
+    p = segment_argext(w, np.minimum(sw0, n - 1), np.maximum(sw1, sw0 + 1), largest=True).astype(np.int64)
+    # push-off peak j: the fastest plantar-flexion between the previous mid-stance and p
     to_lo = np.minimum(mid[:-1], p)
     j = segment_argext(w, to_lo, np.maximum(p, to_lo + 1), largest=False)
-    # IC: first downward zero crossing after p, before the next mid-stance
-    c = np.empty(k, dtype=np.int64)
-    _first_down_crossing(w, p.astype(np.int64), mid[1:].astype(np.int64), c)
-    ok = (c >= 0) & (w[p] > 0.0) & (w[j] < 0.0)
-    c = np.where(ok, c, 1)
-    # sub-sample refinement: linear crossing for IC, parabola through the minimum for TO
-    den_c = w[c - 1] - w[c]
-    frac = np.where(ok, w[c - 1] / np.where(ok, den_c, 1.0), 0.0)
-    t_c0, t_c = _mid_times(ts, c - 1, ok), _mid_times(ts, c, ok)
-    ic = t_c0 + frac * (t_c - t_c0)
+    # its value at sub-sample resolution: the vertex of the parabola through the three samples around j
     jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
     den = w[jl] - 2.0 * w[j] + w[jr]
-    shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
-    shift = np.clip(shift, -0.5, 0.5)  # at a segment's edge j need not be a local minimum: stay by the sample
-    t_j, t_jl, t_jr = _mid_times(ts, j, ok), _mid_times(ts, jl, ok), _mid_times(ts, jr, ok)
-    dt = np.where(shift >= 0, t_jr - t_j, t_j - t_jl)
-    to = t_j + shift * dt
+    inner = (den > 0) & (jl < j) & (j < jr)
+    peak = np.where(inner, w[j] - (w[jl] - w[jr]) ** 2 / (8.0 * np.where(inner, den, 1.0)), w[j])
+    # TO: the rate recovers to TO_LEVEL of the push-off peak, on the flank between j and p
+    level = TO_LEVEL * np.minimum(peak, w[j])
+    r = np.empty(k, dtype=np.int64)
+    _first_up_crossing(w, j.astype(np.int64), p, level, r)
+    # IC: first downward zero crossing after p, before the next mid-stance
+    c = np.empty(k, dtype=np.int64)
+    _first_down_crossing(w, p, mid[1:].astype(np.int64), c)
+    ok = (c >= 0) & (r >= 0) & (w[p] > 0.0) & (w[j] < 0.0)
+    c, r = np.where(ok, c, 1), np.where(ok, r, 1)
+    # sub-sample times: linear interpolation between the middles of the two samples around each crossing
+    ic = _crossing_times(ts, w, c, np.zeros(k), ok)
+    to = _crossing_times(ts, w, r, level, ok)
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
     ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
     return GaitEvents(to=to, ic=ic, from_rate=ok)
+
+
+def _crossing_times(ts: np.ndarray, w: np.ndarray, c: np.ndarray, level: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """When ``w`` passes ``level`` between samples ``c − 1`` and ``c`` (s): linear between their interval middles."""
+    den = w[c] - w[c - 1]
+    frac = np.where(ok, (level - w[c - 1]) / np.where(ok & (den != 0), den, 1.0), 0.0)
+    t0, t1 = _mid_times(ts, c - 1, ok), _mid_times(ts, c, ok)
+    return t0 + np.clip(frac, 0.0, 1.0) * (t1 - t0)

@@ -319,7 +319,8 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         The count of reference and matched strides, and where both sides have
         the column: median absolute error of the initial contact
         (``ic_error_median_abs_s``, on ``end_s``) and toe-off
-        (``to_error_median_abs_s``), mean signed errors, stride-time error;
+        (``to_error_median_abs_s``), mean and median signed errors (``ic_error_mean_s``,
+        ``ic_error_median_s``, ``to_error_mean_s``, ``to_error_median_s``), stride-time error;
         stride-length RMS and mean error (m) over every matched stride
         (``stride_length_rms_error_m``, ``stride_length_mean_error_m``) and over
         the straight ones only (``stride_length_rms_error_straight_m``,
@@ -348,6 +349,7 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         if d is not None:
             put(f"{name}_error_median_abs_s", d, lambda v: np.median(np.abs(v)))
             put(f"{name}_error_mean_s", d, np.mean)
+            put(f"{name}_error_median_s", d, np.median)
     if "end_s" in m.columns and "start_s" in m.columns:
         ref_time = m["end_s"].to_numpy(float) - m["start_s"].to_numpy(float)
         d = m["est_stride_time_s"].to_numpy(float) - ref_time
@@ -493,8 +495,10 @@ METRICS: dict[str, str] = {
     "matched_strides": "reference strides paired with an estimated stride",
     "ic_error_median_abs_s": "median absolute initial-contact timing error (s)",
     "ic_error_mean_s": "mean initial-contact timing error, estimate minus reference (s)",
+    "ic_error_median_s": "median initial-contact timing error, estimate minus reference (s)",
     "to_error_median_abs_s": "median absolute toe-off timing error (s)",
     "to_error_mean_s": "mean toe-off timing error, estimate minus reference (s)",
+    "to_error_median_s": "median toe-off timing error, estimate minus reference (s)",
     "stride_time_error_median_abs_s": "median absolute stride-time error (s)",
     "stride_length_rms_error_m": "stride-length RMS error over the matched strides (m)",
     "stride_length_mean_error_m": "stride-length mean error over the matched strides (m)",

@@ -59,9 +59,9 @@ STEP_METRICS = ("gait_phase_error_rate", "step_count_error", "stance_onset_error
 SAMPLE_METRICS = ("stance_precision", "stance_recall", "stance_f1", "stance_accuracy")
 #: Reference event column -> the stride comparisons that need it.
 NEEDS: dict[str, tuple[str, ...]] = {
-    "end_s": ("ic_error_median_abs_s", "ic_error_mean_s", "stride_time_error_median_abs_s"),
+    "end_s": ("ic_error_median_abs_s", "ic_error_mean_s", "ic_error_median_s", "stride_time_error_median_abs_s"),
     "start_s": ("stride_time_error_median_abs_s",),
-    "to_s": ("to_error_median_abs_s", "to_error_mean_s"),
+    "to_s": ("to_error_median_abs_s", "to_error_mean_s", "to_error_median_s"),
     "stride_length_m": ("stride_length_rms_error_m", "stride_length_mean_error_m",
                         "stride_length_rms_error_straight_m", "stride_length_mean_error_straight_m"),
     "fpa_rad": ("fpa_mean_error_deg", "fpa_rms_error_deg"),

@@ -20,6 +20,7 @@ gaitmap        m/s², deg/s                    ``[x, -y, -z]``: foot frame x toe
                                               for both feet (see gaitmap.py)
 sensorconnect  g, rad/s, Gauss                ``[x, y, z]``: MicroStrain x fwd, y right, z down
 openshoe       header's: g or m/s², rad/s     ``[x, -y, -z]``: z up in the heel
+xsens          m/s², rad/s, normalised (a.u.) ``[-x, y, -z]``: IPOL's MTw, x to the heel, z up
 generic        the description's              the description's ``axes:``
 ============== ============================== ============================================
 """

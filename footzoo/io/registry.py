@@ -47,6 +47,7 @@ BUILTIN: dict[str, str] = {
     "gaitmap": "footzoo.io.gaitmap:GaitmapReader",
     "sensorconnect": "footzoo.io.sensorconnect:SensorConnectReader",
     "openshoe": "footzoo.io.openshoe:OpenShoeReader",
+    "xsens": "footzoo.io.xsens:XsensReader",
     "generic": "footzoo.io.generic:GenericReader",
 }
 

@@ -14,16 +14,26 @@ Two profiles:
   not move while the foot rolls over heel and toe (linear acceleration zero in
   stance). The truth's stance is the whole 60 %.
 * ``"physical"`` — the foot rotates about its heel (initial contact) and toe
-  (pre-swing) contact points, so the instep sensor moves; rates follow a
-  raised cosine with the same angles, so velocities have no jumps; the swing's
-  pitch rate is a half sine, so it passes through zero at toe-off and heel
-  strike without dwelling there. Only foot flat (and standing) is stance.
+  (pre-swing) contact points, so the instep sensor moves; the heel rotation's
+  rate follows a raised cosine with Table I's angle, so velocities have no
+  jumps. The toe leaves the floor the way a real one does, while the foot
+  still plantar-flexes fast (:class:`~footzoo.sim.profiles.FootPitch`): the
+  push-off's rate rises to about 9.4 rad/s and holds it until toe-off, then
+  turns in the air into the swing's dorsi-flexion (through zero 12.5 ms after
+  toe-off at a 1 s cycle), which falls back to zero at heel strike; so the
+  rate passes through zero at heel strike, and the sensor leaves the toe with
+  its velocity and acceleration, which fade over the swing (velocity and
+  acceleration continuous at toe-off and heel strike). Only foot flat (and
+  standing) is stance.
 
 In both, the swing carries the sensor along the straight horizontal line
 between its positions at toe-off and heel strike with the corrected Gaussian
 velocity profile (eq. 14) and lifts it by the clearance with the corrected
-Gaussian of eq. 15 (see :mod:`footzoo.sim.profiles`); the foot's yaw turns
-from one stance's yaw to the next with the same progress profile.
+Gaussian of eq. 15 (see :mod:`footzoo.sim.profiles`; in the physical profile
+plus the fading toe-off motion); the foot's yaw turns from one stance's yaw to
+the next with the same progress profile. The truth's toe-off (``swing_start``)
+is the instant the toe leaves the floor, its initial contact (``swing_end``)
+the instant the heel touches it.
 """
 
 from __future__ import annotations
@@ -33,11 +43,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.conventions import quat_from_euler, quat_mul, quat_to_matrix
-from .profiles import GaussianSwing, rotation_progress
+from .profiles import FootPitch, GaussianSwing, rotation_progress
 
 #: Table I angles (rad): initial contact −6.5 rad/s × 0.1 s, pre-swing −7.5 rad/s × 0.1 s.
 IC_ANGLE = 0.65
 PS_ANGLE = 0.75
+#: Physical profile (:class:`~footzoo.sim.profiles.FootPitch`): the push-off's plantar-flexion rate reaches its
+#: peak over this share of the pre-swing and holds it until toe-off (Table I's pre-swing: 0.1 s of a 1 s cycle,
+#: 0.75 rad); in the air it turns into the swing's dorsi-flexion over this share of the pre-swing (its zero
+#: crossing then falls 12.5 % of the pre-swing after toe-off); it falls to zero at heel strike over this share of
+#: the swing. On gaitmap's example walk (motion capture, 57 strides) the rate's minimum (about −9.5 rad/s) lies a
+#: median 7 ms before the toe-off (1.5 samples at 204.8 Hz; the reference's own resolution is 10 ms), its zero
+#: crossing 15 ms after it, and it falls from about 6 rad/s over the last 0.1 s before the initial contact.
+PUSH_RISE = 0.4
+PUSH_TURN = 0.2
+SWING_DECLINE = 0.25
 
 
 @dataclass
@@ -134,9 +154,12 @@ class Segment:
     a: np.ndarray | None = None  # swing start / still position
     b: np.ndarray | None = None  # swing end
     clearance: float = 0.0
-    smooth: bool | str = False
+    smooth: bool = False
     swing: GaussianSwing | None = None
     cycles: int = 0  # flex: number of dorsi-/plantar-flexion cycles (theta[0] is the amplitude)
+    foot_pitch: FootPitch | None = None  # physical ps and swing: the pitch from heel-off to heel strike
+    v0: np.ndarray | None = None  # physical swing: the sensor's velocity at toe-off (NED, m/s)
+    a0: np.ndarray | None = None  # physical swing: the sensor's acceleration at toe-off (NED, m/s²)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Position, velocity, acceleration (NED), yaw ψ, pitch θ and their rates at absolute times ``t``."""
@@ -156,6 +179,8 @@ class Segment:
             dpsi, dth = self.psi[1] - self.psi[0], self.theta[1] - self.theta[0]
             out["psi"], out["psi_dot"] = self.psi[0] + dpsi * s, dpsi * s1
             out["theta"], out["theta_dot"] = self.theta[0] + dth * u, dth * u1
+            if self.foot_pitch is not None:
+                self._push_through_toe_off(tl, T, out)
             return out
         if self.kind == "still":
             out["p"] = np.tile(self.a, (n, 1))
@@ -165,6 +190,8 @@ class Segment:
         # rotation about a contact point (ic, ps) or the ankle (flex)
         if self.kind == "flex":
             th, thd, thdd = flexion_angle(tl, T, self.theta[0], self.cycles)
+        elif self.foot_pitch is not None:  # pre-swing: the push-off, rotating fast when the toe leaves
+            th, thd, thdd = self.foot_pitch.pitch(tl)
         else:
             u, u1, u2 = rotation_progress(tl, T, self.smooth)
             dth = self.theta[1] - self.theta[0]
@@ -182,6 +209,25 @@ class Segment:
                      + np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thdd[:, None])
         return out
 
+
+    def _push_through_toe_off(self, tl: np.ndarray, T: float, out: dict[str, np.ndarray]) -> None:
+        """Physical swing: the push-off's rotation and the sensor's motion go on through toe-off.
+
+        Pitch: :class:`~footzoo.sim.profiles.FootPitch` from toe-off to heel strike. Position: the
+        sensor leaves with its velocity ``v0`` and acceleration ``a0`` at toe-off, which fade over
+        the swing: ``v0 T f(x) + a0 T² g(x)`` (``x = τ/T``) is added to the path, with the quintic
+        Hermite functions ``f`` (slope 1 at 0) and ``g`` (curvature 1 at 0) that vanish with their
+        first two derivatives at heel strike, so position, velocity and acceleration are
+        continuous at both ends.
+        """
+        out["theta"], out["theta_dot"], _ = self.foot_pitch.pitch(self.foot_pitch.ps + tl)
+        x = (tl / T)[:, None]
+        f = (x - 6 * x**3 + 8 * x**4 - 3 * x**5, 1 - 18 * x**2 + 32 * x**3 - 15 * x**4, -36 * x + 96 * x**2 - 60 * x**3)
+        g = (x**2 / 2 - 1.5 * x**3 + 1.5 * x**4 - x**5 / 2, x - 4.5 * x**2 + 6 * x**3 - 2.5 * x**4,
+             1 - 9 * x + 18 * x**2 - 10 * x**3)
+        out["p"] = out["p"] + T * f[0] * self.v0 + T**2 * g[0] * self.a0
+        out["v"] = out["v"] + f[1] * self.v0 + T * g[1] * self.a0
+        out["a"] = out["a"] + f[2] / T * self.v0 + g[2] * self.a0
 
 def flexion_angle(t: np.ndarray, duration: float, amplitude: float, cycles: int):
     """Slow dorsi-/plantar-flexions: ``θ = A sin³(2π n t/T)`` with rate and acceleration, zero at both ends."""
@@ -286,19 +332,24 @@ class GaitTimeline:
             toe_a = pa + rz_a @ geo.toe
             heel_b = pb + rz_b @ geo.heel
             start = t
-            # pre-swing: rotate about the toe, 0 -> -θ_ps
+            # pre-swing: rotate about the toe, 0 -> -θ_ps (physical: still rotating fast at toe-off)
+            pitch = FootPitch(ph["ps"], ph["swing"], PS_ANGLE, IC_ANGLE, PUSH_RISE * ph["ps"], PUSH_TURN * ph["ps"],
+                              SWING_DECLINE * ph["swing"]) if physical else None
             ps = Segment(t, t + ph["ps"], "ps", not physical, (psi_a, psi_a), (0.0, -PS_ANGLE),
-                         contact=toe_a if physical else None, r_contact=geo.toe, a=pa, smooth=physical)
+                         contact=toe_a if physical else None, r_contact=geo.toe, a=pa, smooth=physical,
+                         foot_pitch=pitch)
             t += ph["ps"]
             # initial contact of the next stance: rotate about the heel, θ_ic -> 0
             ic_t0 = t + ph["swing"]
             ic = Segment(ic_t0, ic_t0 + ph["ic"], "ic", not physical, (psi_b, psi_b), (IC_ANGLE, 0.0),
                          contact=heel_b if physical else None, r_contact=geo.heel, a=pb, smooth=physical)
-            a_sw = ps.evaluate(np.array([ps.t1]))["p"][0]
+            at_to = ps.evaluate(np.array([ps.t1]))
+            a_sw = at_to["p"][0]
             b_sw = ic.evaluate(np.array([ic.t0]))["p"][0]
             sw = Segment(t, t + ph["swing"], "swing", False, (psi_a, psi_b), (-PS_ANGLE, IC_ANGLE), a=a_sw, b=b_sw,
-                         clearance=spec.clearance, smooth="sine" if physical else False,
-                         swing=GaussianSwing(ph["swing"]))
+                         clearance=spec.clearance, smooth=False,
+                         swing=GaussianSwing(ph["swing"]), foot_pitch=pitch,
+                         v0=at_to["v"][0] if physical else None, a0=at_to["a"][0] if physical else None)
             t = ic.t1
             ff = Segment(t, t + ph["ff"], "still", True, (psi_b, psi_b), (0.0, 0.0), a=pb)
             t += ph["ff"]

@@ -67,28 +67,88 @@ class GaussianSwing:
         return b / self.peak, b1 / self.peak, b2 / self.peak
 
 
-def rotation_progress(
-    t: np.ndarray, duration: float, smooth: bool | str
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rotation_progress(t: np.ndarray, duration: float, smooth: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fraction ``u`` of a rotation done at time ``t`` of a phase, with ``du/dt``, ``d²u/dt²``.
 
     ``smooth=False``: constant rate (Yun's Table I), ``u = t/T``.
     ``smooth=True``: raised-cosine rate, ``u = τ − sin(2πτ)/(2π)``, zero rate and
     zero angular acceleration at both ends (no velocity jumps at phase changes;
-    used for rotations about a contact point, which move the sensor).
-    ``smooth="sine"``: half-sine rate, ``u = (1 − cos πτ)/2``: zero rate at the ends
-    but leaving zero quickly (used for the swing, whose rotation does not move
-    the sensor in this model: the pitch rate passes through zero at toe-off and
-    heel strike without dwelling near it, as a real foot's does).
+    used for rotations about a contact point, which move the sensor). The
+    physical profile's push-off and swing follow :class:`FootPitch` instead.
     """
     T = float(duration)
     tau = np.asarray(t, dtype=float) / T
-    if smooth == "sine":
-        u = (1 - np.cos(np.pi * tau)) / 2
-        return u, np.pi * np.sin(np.pi * tau) / (2 * T), np.pi**2 * np.cos(np.pi * tau) / (2 * T**2)
     if not smooth:
         return tau, np.full_like(tau, 1.0 / T), np.zeros_like(tau)
     u = tau - np.sin(2 * np.pi * tau) / (2 * np.pi)
     u1 = (1 - np.cos(2 * np.pi * tau)) / T
     u2 = 2 * np.pi * np.sin(2 * np.pi * tau) / T**2
     return u, u1, u2
+
+
+class FootPitch:
+    """The foot's pitch from heel-off to heel strike: push-off, toe-off while rotating fast, swing.
+
+    Times ``τ`` (s) from heel-off; the pitch ``θ`` (rad) is 0 at heel-off, positive when the toe
+    lifts. A real toe leaves the floor while the foot still plantar-flexes fast, and the rate then
+    turns quickly into the swing's dorsi-flexion. The rate ``θ̇``:
+
+    1. rises (in magnitude) as a half raised cosine over ``rise`` to ``−W``;
+    2. holds ``−W`` until toe-off (``τ = pre_swing``): the foot rolls over its toe, and the toe
+       leaves at the fastest plantar-flexion (no angular acceleration while the toe is pinned);
+    3. turns from ``−W`` to the swing's ``P`` as a raised cosine over ``turn``, in the air,
+       crossing zero (the end of the plantar-flexion) with a steep slope;
+    4. holds ``P``;
+    5. falls to zero at heel strike as a quarter cosine over ``decline``.
+
+    ``W = ps_angle / (pre_swing − rise/2)`` makes the angle at toe-off ``−ps_angle``, and ``P``
+    makes it ``ic_angle`` at heel strike.
+
+    Parameters
+    ----------
+    pre_swing, swing : float
+        Heel-off to toe-off and toe-off to heel strike (s).
+    ps_angle, ic_angle : float
+        Plantar-flexion at toe-off and dorsi-flexion at heel strike (rad, positive).
+    rise, turn, decline : float
+        Durations (s) of pieces 1, 3 and 5 (``rise ≤ pre_swing``, ``turn + decline ≤ swing``).
+    """
+
+    def __init__(self, pre_swing: float, swing: float, ps_angle: float, ic_angle: float, rise: float, turn: float,
+                 decline: float):
+        self.ps, self.sw = float(pre_swing), float(swing)
+        self.rise, self.turn, self.decline = float(rise), float(turn), float(decline)
+        if not (0 < self.rise <= self.ps and self.turn > 0 and self.decline > 0
+                and self.turn + self.decline <= self.sw):
+            raise ValueError(f"FootPitch: rise {self.rise:g} s, turn {self.turn:g} s and decline {self.decline:g} s "
+                             f"do not fit a pre-swing of {self.ps:g} s and a swing of {self.sw:g} s")
+        #: Plantar-flexion rate held from ``rise`` to toe-off (rad/s, positive).
+        self.w = float(ps_angle) / (self.ps - self.rise / 2.0)
+        hold = self.sw - self.turn - self.decline
+        #: Dorsi-flexion rate held through the swing (rad/s).
+        self.p = (float(ps_angle) + float(ic_angle) + self.w * self.turn / 2.0) / (
+            self.turn / 2.0 + hold + 2.0 * self.decline / np.pi)
+        self.end = self.ps + self.sw
+
+    def pitch(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``θ`` (rad), ``θ̇`` (rad/s) and ``θ̈`` (rad/s²) at ``t`` (s from heel-off; held outside ``[0, end]``)."""
+        t = np.clip(np.asarray(t, dtype=float), 0.0, self.end)
+        w, p, r, d, q = self.w, self.p, self.rise, self.turn, self.decline
+        b = self.ps + d  # end of the turn
+        c = self.end - q  # start of the decline
+        x1 = np.pi * np.clip(t, 0.0, r) / r
+        x3 = np.pi * np.clip(t - self.ps, 0.0, d) / d
+        x5 = np.pi * np.clip(t - c, 0.0, q) / (2 * q)
+        theta = (-w * (np.clip(t, 0.0, r) / 2 - r * np.sin(x1) / (2 * np.pi))
+                 - w * (np.clip(t, r, self.ps) - r)
+                 - w * np.clip(t - self.ps, 0.0, d)
+                 + (w + p) / 2 * (np.clip(t - self.ps, 0.0, d) - d * np.sin(x3) / np.pi)
+                 + p * (np.clip(t, b, c) - b)
+                 + p * 2 * q * np.sin(x5) / np.pi)
+        piece = np.select([t < r, t <= self.ps, t < b, t <= c], [1, 2, 3, 4], 5)
+        rate = np.select([piece == 1, piece == 2, piece == 3, piece == 4],
+                         [-w * (1 - np.cos(x1)) / 2, -w, -w + (w + p) * (1 - np.cos(x3)) / 2, p], p * np.cos(x5))
+        accel = np.select([piece == 1, piece == 3, piece == 5],
+                          [-w * np.pi * np.sin(x1) / (2 * r), (w + p) * np.pi * np.sin(x3) / (2 * d),
+                           -p * np.pi * np.sin(x5) / (2 * q)], 0.0)
+        return theta, rate, accel

@@ -41,9 +41,9 @@ def test_heel_and_toe_roll_are_not_stance_on_a_noise_free_physical_walk():
 def test_no_stance_sample_while_the_simulated_foot_moves(rate):
     """The stance's edge samples are tested over their interval: no stance sample while the foot moves fast.
 
-    At 100 Hz the last sample before toe-off has |ω| = 0.48 rad/s (below Ω_th) and rises to 3.2
-    at the next one, while the simulated foot already rises at 0.19 m/s: tested at its instant
-    only, it was stance once per stride, and each swing's dedrift started from a wrong zero.
+    At 100 Hz the first sample of the heel rise has |ω| = 0.47 rad/s (below Ω_th) and 2.9 at the
+    next one, while the simulated sensor already moves at 0.18 m/s: tested at its instant only, it
+    was stance once per stride, and each swing's dedrift started from a wrong zero.
     With the interval test the fastest stance sample moves at 0.00, 0.00, 0.05 and 0.07 m/s at
     50, 100, 200 and 1000 Hz (|ω| below Ω_th as the toe roll starts).
     """

@@ -174,8 +174,13 @@ def test_koroglu_strides_exact_and_no_stance_in_mid_swing(experiment):
 
 @pytest.mark.parametrize("rate", [250.0, 400.0])
 def test_a_stop_in_the_air_before_a_stair_is_no_stance_without_the_provisional_closing(rate):
-    """Simulated stairs: the foot stops in the air about 0.14 s before it lands and moves again. Closing that
-    short provisional swing hid its motion from the speed test (stances 0.14 s early at 250 Hz and above)."""
+    """Simulated stairs at 250 and 400 Hz: every stance found, its edges within two samples and 20 ms.
+
+    A foot that stops in the air before it lands on a step and moves again makes a short provisional
+    swing; closing it hid its motion from the speed test (stances 0.14 s early at 250 Hz and above on a
+    simulated foot that hovered with its pitch rate near zero). The physical simulator's foot keeps
+    turning until the heel comes down (measured onset error of the closing setting now +5 ms), so only
+    the setting's own stances are checked here."""
     from footzoo.evaluation.metrics import step_detection
     from footzoo.sim import simulate
 
@@ -183,9 +188,7 @@ def test_a_stop_in_the_air_before_a_stair_is_no_stance_without_the_provisional_c
                    profile="physical", noise={"scale": 1.0, "seed": 0}, magnetometer=False)
     before = SpeedAdaptiveSHOE().detect(rec.t, rec.acc, rec.gyr)
     after = SpeedAdaptiveSHOE(provisional_min_swing=0.0).detect(rec.t, rec.acc, rec.gyr)
-    early = step_detection(before.stance_, rec.truth.stance, rec.t)
     right = step_detection(after.stance_, rec.truth.stance, rec.t)
-    assert early["onset_error_mean_s"] < -0.1  # measured −0.13 s at 250 Hz
     assert right["error_rate"] == 0.0
     assert abs(right["onset_error_mean_s"]) < 2.0 / rate and abs(right["offset_error_mean_s"]) < 0.02
     # the default (None) is min_swing: the detector as before

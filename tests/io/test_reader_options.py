@@ -94,8 +94,18 @@ def write_generic(rec, path):
     return path, {"acc_unit": "mg", "gyr_unit": "rad/s"}  # the options replace the description's axes and units
 
 
+def write_xsens(rec, path):
+    path = path.with_suffix(".txt")
+    rows = np.column_stack([np.arange(rec.n), sensor(rec.acc) / GRAVITY, np.degrees(sensor(rec.gyr)), sensor(rec.mag)])
+    head = "PacketCounter\tAcc_X\tAcc_Y\tAcc_Z\tGyr_X\tGyr_Y\tGyr_Z\tMag_X\tMag_Y\tMag_Z\n"
+    path.write_text("Acquisition frequency: 200 Hz\n" + head
+                    + "\n".join("\t".join(repr(float(v)) for v in row) for row in rows) + "\n")
+    return path, {"acc_unit": "g", "gyr_unit": "deg/s"}
+
+
 WRITERS = {"canonical": write_canonical, "xio": write_xio, "pyshoe": write_pyshoe, "gaitmap": write_gaitmap,
-           "sensorconnect": write_sensorconnect, "openshoe": write_openshoe, "generic": write_generic}
+           "sensorconnect": write_sensorconnect, "openshoe": write_openshoe, "xsens": write_xsens,
+           "generic": write_generic}
 
 
 def test_every_builtin_reader_declares_axes_and_the_unit_options():

@@ -203,7 +203,9 @@ def test_complementary_filter_equals_the_two_pass_loop(walk, use_mag):
     n = 1500
     t, acc, gyr, mag = walk.t[:n], walk.acc[:n], walk.gyr[:n], walk.mag[:n]
     stance = walk.truth.stance[:n]
-    f = FQAComplementary(static_gain=1.05, dynamic_gain=0.3, use_magnetometer=use_mag)
+    # the two-pass loop has no disturbance rejection: compared without it (the simulated push-off turns the foot
+    # fast while |f| passes g, where the dip test takes a few samples for disturbed)
+    f = FQAComplementary(static_gain=1.05, dynamic_gain=0.3, use_magnetometer=use_mag, mag_rejection=False)
     got = f.estimate(t, acc, gyr, mag, stance, walk.truth.quat[0]).quat_
     ref = _reference_complementary(walk.truth.quat[0], acc, gyr, mag if use_mag else None, sample_intervals(t),
                                    f.gain_)

@@ -151,15 +151,33 @@ def _reference_gait_events(t, gyr, stances):
     den_c = w[c - 1] - w[c]
     frac = np.where(ok, w[c - 1] / np.where(ok, den_c, 1.0), 0.0)
     ic = t[c - 1] + frac * (t[c] - t[c - 1])
+    # TO: the first sample in (j, p] at or above half the push-off peak (the parabola's vertex), after one below
     jl, jr = np.maximum(j - 1, 0), np.minimum(j + 1, n - 1)
     den = w[jl] - 2.0 * w[j] + w[jr]
-    shift = np.where((den > 0) & (jl < j) & (j < jr), 0.5 * (w[jl] - w[jr]) / np.where(den > 0, den, 1.0), 0.0)
-    shift = np.clip(shift, -0.5, 0.5)
-    dt = np.where(shift >= 0, t[jr] - t[j], t[j] - t[jl])
-    to = t[j] + shift * dt
+    inner = (den > 0) & (jl < j) & (j < jr)
+    level = 0.5 * np.minimum(np.where(inner, w[j] - (w[jl] - w[jr]) ** 2 / (8.0 * np.where(inner, den, 1.0)), w[j]),
+                             w[j])
+    idx, offsets = _ranges(j + 1, np.maximum(p + 1, j + 1))
+    seg = np.repeat(np.arange(k), np.maximum(p - j, 0))
+    up = np.flatnonzero((w[idx - 1] < level[seg]) & (w[idx] >= level[seg]))
+    first = np.searchsorted(up, offsets)
+    found = (first < len(up)) & (seg[up[np.minimum(first, max(len(up) - 1, 0))]] == np.arange(k)) if len(up) else \
+        np.zeros(k, bool)
+    r = np.where(found, idx[up[np.minimum(first, max(len(up) - 1, 0))]] if len(up) else 1, 1)
+    ok &= found
+    den_r = w[r] - w[r - 1]
+    frac_r = np.clip((level - w[r - 1]) / np.where(den_r != 0, den_r, 1.0), 0.0, 1.0)
+    to = t[r - 1] + frac_r * (t[r] - t[r - 1])
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])
     ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
     return to, ic, ok
+
+
+def _ranges(lo, hi):
+    """Indices of the ranges [lo_i, hi_i) concatenated, and each range's offset."""
+    lengths = hi - lo
+    offsets = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+    return np.arange(int(lengths.sum()), dtype=np.int64) - np.repeat(offsets - lo, lengths), offsets
 
 
 def test_segment_argext_equals_the_reduceat_code():
@@ -182,7 +200,7 @@ def test_segment_argext_equals_the_reduceat_code():
     {"path": "mixed_speed", "rate": 100.0}, {"path": "stairs", "rate": 200.0}, {"path": "rectangle", "rate": 50.0}])
 @pytest.mark.parametrize("flip", [False, True])
 def test_gait_events_equal_the_vectorised_code(scenario, flip):
-    """The compiled searches and the mid-interval times of the event samples give the previous events to the bit."""
+    """The compiled searches and the mid-interval times of the event samples give the vectorised events to the bit."""
     from footzoo.analysis.gait_events import detect_gait_events
     from footzoo.analysis.strides import real_stances
     from footzoo.plugins.registry import build

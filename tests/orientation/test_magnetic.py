@@ -71,11 +71,18 @@ def test_rejection_keeps_the_heading_through_a_disturbance(corner_walks, orienta
     assert closure_off > closure_on + 0.5
 
 
-def test_rejection_changes_nothing_without_a_disturbance(corner_walks):
+def test_rejection_barely_changes_an_undisturbed_walk(corner_walks):
+    """Without a disturbance the rejection leaves the heading within 0.1° and the loop within 5 mm.
+
+    It is not silent: the dip is tested where | |f| − g | < 0.1 g, and while the simulated push-off turns the
+    foot at 9.4 rad/s |f| passes g, so a few samples are taken for disturbed (measured: heading 0.00° apart for
+    fqa_complementary, 0.06° for madgwick; closure 1 mm apart).
+    """
     _, clean, _ = corner_walks
     base = {"detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
     for orientation in ("fqa_complementary", "madgwick"):
         spec = {"type": orientation}
         on = footzoo.Pipeline.from_dict({**base, "orientation": spec}).run(clean)
         off = footzoo.Pipeline.from_dict({**base, "orientation": {**spec, "mag_rejection": False}}).run(clean)
-        np.testing.assert_allclose(on.quat, off.quat, atol=1e-12)
+        assert np.degrees(np.abs(np.angle(np.exp(1j * (yaw(on.quat) - yaw(off.quat)))))).max() < 0.1
+        assert abs(loop_closure(on.pos)["loop_closure_xy_m"] - loop_closure(off.pos)["loop_closure_xy_m"]) < 0.005

@@ -1,0 +1,46 @@
+"""benchmarks/accuracy_events.py: its landmarks agree with footzoo's events; the heel marker on gaitmap's walk."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from footzoo.evaluation.metrics import match_strides, reference_steps
+from footzoo.runtime.pipeline import Pipeline
+from footzoo.sim import NoiseModel, simulate
+
+from ..conftest import data_file, load_benchmark
+
+
+@pytest.fixture(scope="module")
+def events():
+    return load_benchmark("accuracy_events")
+
+
+def test_the_landmark_loop_finds_footzoos_events(events):
+    """The benchmark's per-swing loop and the library's compiled searches: the same IC to the rounding, the same TO
+    to well under a millisecond (the loop takes half the peak sample, the library half the parabola's vertex)."""
+    rec = simulate(path="rectangle", length=10.0, width=5.0, rate=100.0, profile="physical", noise=NoiseModel(seed=0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = Pipeline.from_yaml("recommended").run(rec)
+    marks = events.landmarks(rec, res)
+    assert len(marks) == len(res.steps) == 24
+    np.testing.assert_allclose(marks["zero crossing (IC)"], res.steps["end_s"], atol=1e-9)
+    np.testing.assert_allclose(marks["half-way back (TO)"], res.steps["to_s"], atol=5e-4)
+    # against the truth: the landmarks' offsets are the events' errors with the sign turned
+    offsets = events._offsets(marks, reference_steps(rec.truth.steps))
+    m = match_strides(res.steps, reference_steps(rec.truth.steps))
+    assert np.median(offsets["zero crossing (IC)"]) == pytest.approx(-np.median(m["est_end_s"] - m["end_s"]), abs=1e-9)
+    # the simulated toe leaves before the rate's zero crossing, the heel lands at it
+    assert np.median(offsets["zero crossing after it"]) < -0.005
+    assert abs(np.median(offsets["zero crossing (IC)"])) < 0.002
+
+
+def test_gaitmaps_heel_marker_still_goes_down_after_the_motion_capture_ic(events):
+    folder = data_file("gaitmap_example", "mocap_sample.csv").parent
+    heel = events.heel_marker(folder.parent)
+    assert len(heel) == 57  # every stride's IC of both feet
+    # measured: fastest descent 12 ms after the IC at 0.29 m/s, stopped 22 ms after it
+    assert 5 <= heel["fastest descent (ms)"].median() <= 20 and heel["speed (m/s)"].median() > 0.2
+    assert 15 <= heel["stopped (ms)"].median() <= 30
