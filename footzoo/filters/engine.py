@@ -184,7 +184,7 @@ class KalmanEngine:
     engine : {"auto", "fast", "reference"}
         Which implementation (module docstring).
     names : list of str, optional
-        The models' names in messages (``correction 'zupt'``).
+        The models' names in messages (``correction '<its name>'``).
 
     Attributes
     ----------
