@@ -47,7 +47,7 @@ from ..kernels.jit import njit
 from .forward import forward_span
 from .recorders import record, views
 from .smoother import smooth_free_span, smooth_span
-from .structures import Checkpoints, CheckpointRecord, Pieces, Record
+from .structures import CheckpointRecord, Checkpoints, Pieces, Record
 
 #: Most samples per piece, and most rows of one batch's record: the record (about 1 kB per sample at
 #: 9 states, 4 MB) stays in the processor's cache.

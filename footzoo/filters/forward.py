@@ -41,10 +41,10 @@ from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .measurement import BA, BG, P, Q, V
 from .process_noise import Noise, add_process_noise
-from .recorders import begin, before, end, row, transition, updated, views
+from .recorders import before, begin, end, row, transition, updated, views
 from .smoother import feed_back_attitude, unowned_trajectory
 from .strapdown import mid_rotation, quat_product, rotvec_quat
-from .structures import FilterState, Fault, ModelArrays, Outputs, Workspace
+from .structures import Fault, FilterState, ModelArrays, Outputs, Workspace
 
 
 @njit

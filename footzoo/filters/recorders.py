@@ -38,8 +38,8 @@ from ..kernels.views import unowned
 from .smoother import unowned_record, unowned_trajectory
 from .stepwise import close_segment
 from .structures import (
-    Checkpoints,
     CheckpointRecord,
+    Checkpoints,
     Fault,
     Record,
     SegmentRecord,

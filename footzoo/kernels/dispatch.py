@@ -4,9 +4,9 @@
 runs ``implementations[type(first argument)]``. Called from a kernel, numba picks the
 implementation when it compiles the kernel (``numba.extending.overload``, numba's public API for
 this) and inlines it: a kernel compiled for one type of that argument contains that
-implementation's code only, no branch (inlined, unless asked otherwise). Called from Python (or without numba), it looks the
-implementation up at each call. The key of an argument that is ``None`` is ``type(None)``, of a
-``NamedTuple`` its class.
+implementation's code only, no branch (inlined, unless asked otherwise). Called from Python (or
+without numba), it looks the implementation up at each call. The key of an argument that is
+``None`` is ``type(None)``, of a ``NamedTuple`` its class.
 
 Every implementation must take the prototype's parameters under the same names (numba checks it).
 """

@@ -12,7 +12,8 @@ What footzoo takes from numba's internals, and why:
     (:data:`SHIPPED`) and to key a kernel by the content of every footzoo module it may inline
     (numba keys it by its own file's time stamp only: an edited helper in another module would
     leave stale machine code).
-``numba.core.cgutils``, ``numba.np.arrayobj.make_array``, ``numba.core.ir_utils.alias_func_extensions`` (:data:`unowned`)
+``numba.core.cgutils``, ``numba.np.arrayobj.make_array``,
+``numba.core.ir_utils.alias_func_extensions`` (:data:`unowned`)
     An array view whose owner is null: passing it to a function costs no reference counting; numba's
     alias analysis is told that the view aliases its array (else its dead-code elimination may drop
     writes through the view, as it does after inlining an overload).

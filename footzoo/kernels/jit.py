@@ -76,7 +76,9 @@ def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
 
 
 def njit_signature(fn: Callable[..., Any], signature: Any, identity: str | None = None, **options: Any) -> Any:
-    """``numba.njit(signature, cache=True, **options)(fn)``, with footzoo's kernel cache (:mod:`footzoo.kernels.internals`).
+    """``numba.njit(signature, cache=True, **options)(fn)`` with footzoo's kernel cache.
+
+    The cache is :class:`footzoo.kernels.internals.KernelCache`.
 
     Compiles now, for that signature only; numba's errors propagate. Needs numba (:func:`load_numba`).
     ``identity``: of the function a closure ``fn`` wraps (:class:`~footzoo.kernels.internals.KernelCache`).
