@@ -4,7 +4,7 @@ Everything else is in setup.cfg. After the usual build, ``footzoo compile --ship
 pipeline config in ``configs/`` once on a short simulated walk (in two processes side by
 side where there are two cores: see GROUPS) and writes the machine code numba produces into
 ``footzoo/_compiled`` of the build: an installed footzoo then loads it at its first
-run instead of compiling (see footzoo/kernels/cache.py for when the code is valid). This needs the
+run instead of compiling (see footzoo/kernels/internals.py for when the code is valid). This needs the
 build requirements of pyproject.toml. If it fails, or FOOTZOO_NO_PRECOMPILE=1 is set, the wheel is
 built without them and kernels are compiled at first use, as in an editable install.
 """

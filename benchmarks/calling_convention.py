@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 
 import numpy as np
 from numba import njit
@@ -27,8 +26,7 @@ from numba import types as nt
 from footzoo.corrections.ekf_zupt import zero_velocity_measure
 from footzoo.filters.measurement import VEL, Context, Rows, V, convention
 from footzoo.kernels.functions import fixed_address, model_signature
-
-warnings.filterwarnings("ignore", message=".*First-class function type feature is experimental")
+from footzoo.kernels.internals import compile_options, quiet
 
 
 def positional(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
@@ -76,23 +74,26 @@ def main() -> None:
     f1 = nt.float64[::1]
     fields = [nt.int64, nt.float64, f1, f1, f1, nt.boolean, nt.int64[::1], f1, f1, f1]
     named_sig = nt.int64(nt.NamedTuple(fields, Context), nt.NamedTuple([f1, nt.float64[:, ::1], f1, nt.int64], Rows))
-    fn_positional = fixed_address(njit(sig, _nrt=False)(positional))
+    no_refcount = compile_options(refcounting=False)
+    fn_positional = fixed_address(njit(sig, **no_refcount)(positional))
     with_context = zero_velocity_measure.py_func  # footzoo's own, (ctx, rows)
-    fn_named = fixed_address(njit(named_sig, _nrt=False)(with_context))
-    fn_convention = fixed_address(njit(sig, _nrt=False)(convention(njit(inline="always")(with_context), "measure")))
+    fn_named = fixed_address(njit(named_sig, **no_refcount)(with_context))
+    fn_convention = fixed_address(njit(sig, **no_refcount)(convention(njit(inline="always")(with_context), "measure")))
     # par: ekf_zupt's (σ_v, no zero rate, σ_ω, no bias bounds); idx: a 9-state filter
     arrays = (np.zeros(16), np.zeros(3), np.zeros(3), np.array([0, -1, 3, 6, -1], np.int64),
               np.array([1.0, 0.0, 0.05, 0.0, 0.0]), np.zeros(1),
               np.zeros((n, 1)), np.zeros(3), np.zeros((3, 9)), np.zeros(3))
     runs = {"positional": (loop_positional, fn_positional), "named tuples": (loop_named, fn_named),
             "convention": (loop_positional, fn_convention)}
-    for loop, fn in runs.values():  # compile
-        loop((fn,), 10, *arrays)
+    with quiet():  # numba warns that tuples of functions are experimental when it types them
+        for loop, fn in runs.values():  # compile
+            loop((fn,), 10, *arrays)
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
         for name, (loop, fn) in runs.items():
             t0 = time.perf_counter()
-            loop((fn,), n, *arrays)
+            with quiet():
+                loop((fn,), n, *arrays)
             best[name] = min(best[name], (time.perf_counter() - t0) / n * 1e9)
     for name, ns in best.items():
         print(f"{name:14s} {ns:6.1f} ns per call")

@@ -6,7 +6,7 @@ machine code on disk. :func:`compile_kernels` runs each config once on two short
 config uses: run it once on a new machine, or before a study starts its workers
 (``footzoo compile configs/*.yaml``; a study file stands for every config of its grid). With
 ``ship`` it writes the code into a folder instead: ``setup.py`` does so when it builds a wheel,
-which then carries the compiled kernels of the shipped configs (see :mod:`footzoo.kernels.cache`).
+which then carries the compiled kernels of the shipped configs (see :class:`footzoo.kernels.internals.KernelCache`).
 """
 
 from __future__ import annotations
@@ -73,9 +73,9 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
         raise RuntimeError("footzoo compile needs numba (pip install numba): without it the kernels run as Python")
     if ship is not None:
         # deferred: numba, loaded only when kernels are shipped
-        from ..kernels import cache as _kernel_cache
+        from ..kernels import internals
 
-        _kernel_cache.ship(ship)
+        internals.ship(ship)
     # 8 strides at 100 Hz, with every sensor a config may read (magnetometer, distance sensors) and
     # with none (most recordings: the kernels that take an optional channel get None); the kernels'
     # argument types depend on neither the length nor the rate

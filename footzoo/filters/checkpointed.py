@@ -7,16 +7,16 @@ in reverse-mode differentiation) keeps instead the filter's state (nominal state
 and the models' memory, about 0.8 kB) at the first sample of every *piece*, and a piece needs
 its record only where the filter was updated:
 
-1. the forward pass: the compiled loop over the whole recording with a record in the mode
-   :data:`~footzoo.filters.smoother.CHECKPOINTS` (:func:`checkpoint_record`): no row per
-   sample; the state where a piece starts (:func:`~footzoo.filters.smoother.take_checkpoint`:
+1. the forward pass: the compiled loop over the whole recording with a
+   :class:`~footzoo.filters.structures.CheckpointRecord` (:func:`checkpoint_record`): no row per
+   sample; the state where a piece starts (:func:`~footzoo.filters.recorders.take_checkpoint`:
    sample 0, each stance's start at least :data:`MIN_GAP` samples after the last piece's, and
    at least every :data:`BLOCK` samples) and the piece's last sample with an update;
 2. :func:`backward`, the pieces from the last to the first, a batch at a time:
 
-   - the loop run again over each piece of the batch from its checkpoint up to its last update,
-     with a row per sample (in one record the batches share: :func:`replay_record`, mode
-     :data:`~footzoo.filters.smoother.REPLAY`);
+   - :func:`replay`: the loop run again over each piece of the batch from its checkpoint up to its
+     last update, with a row per sample (in one :class:`~footzoo.filters.structures.Record` the
+     batches share) and no output written;
    - :func:`smooth_pieces`: for each piece, last first, the samples after its last update (a
      swing: no update, so ``P⁺`` follows from the one before by the prediction alone) in closed
      form (:func:`~footzoo.filters.smoother.smooth_free_span`), then the closed-loop RTS
@@ -44,7 +44,10 @@ from collections.abc import Callable
 import numpy as np
 
 from ..kernels.jit import njit
-from .smoother import CHECKPOINTS, REPLAY, record_arrays, smooth_free_span, smooth_span
+from .forward import forward_span
+from .recorders import record, views
+from .smoother import smooth_free_span, smooth_span
+from .structures import CheckpointRecord, Checkpoints, Pieces, Record
 
 #: Most samples per piece, and most rows of one batch's record: the record (about 1 kB per sample at
 #: 9 states, 4 MB) stays in the processor's cache.
@@ -56,14 +59,11 @@ BLOCK = 4096
 MIN_GAP = 32
 
 
-def checkpoint_record(stance: np.ndarray, n_state: int, n_mem: int, block: int, min_gap: int) -> tuple:
-    """The forward pass's record over the samples of ``stance`` (N,) bool: no rows; the state where each piece starts.
+def checkpoint_record(stance: np.ndarray, n_state: int, n_mem: int, block: int, min_gap: int) -> CheckpointRecord:
+    """The forward pass's recorder over the samples of ``stance`` (N,) bool: the state where each piece starts.
 
-    In the form of :func:`~footzoo.filters.smoother.record_arrays` (mode
-    :data:`~footzoo.filters.smoother.CHECKPOINTS`, ``segment`` = (mode, pieces taken, ``block``,
-    ``min_gap``)), its checkpoints ``(nav (J, 16), P (J, n, n), mems (J, s), spans (J, 2) int)``
-    with room for every piece the rule of :func:`~footzoo.filters.smoother.take_checkpoint` can
-    start: sample 0, one per stance start, one per ``block`` samples, and at most one per
+    Room for every piece the rule of :func:`~footzoo.filters.recorders.take_checkpoint` can start:
+    sample 0, one per stance start, one per ``block`` samples, and at most one per
     ``min(min_gap, block)`` samples (a stance that flickers costs no more room).
     """
     n = len(stance)
@@ -73,40 +73,24 @@ def checkpoint_record(stance: np.ndarray, n_state: int, n_mem: int, block: int, 
     # and at least min(min_gap, block) samples after it
     spacing = max(1, min(min_gap, block))
     j = min(1 + starts + max(n - 1, 0) // max(block, 1), 1 + max(n - 1, 0) // spacing) if n > 0 else 0
-    empty = record_arrays(0, n_state, 1)
-    checkpoints = (np.empty((j, 16)), np.empty((j, n_state, n_state)), np.empty((j, n_mem)),
-                   np.zeros((j, 2), np.int64))
-    return (*empty[:5], np.array([CHECKPOINTS, 0, block, min_gap], np.int64), empty[6], checkpoints)
+    checkpoints = Checkpoints(np.empty((j, 16)), np.empty((j, n_state, n_state)), np.empty((j, n_mem)),
+                              np.zeros(j, np.int64), np.zeros(j, np.int64))
+    return CheckpointRecord(checkpoints, np.zeros(1, np.int64), int(block), int(min_gap))
 
 
-def replay_record(forward: tuple, n_state: int, m_max: int, rows: int) -> tuple:
-    """The record the pieces are run again into: ``rows`` rows, the checkpoints of the forward pass's ``forward``.
-
-    Mode :data:`~footzoo.filters.smoother.REPLAY`; :func:`backward` sets its ``segment`` to each
-    batch's pieces (``(REPLAY, offset, j0, j1, next free row)``). The same types as ``forward``: the
-    loop is compiled once for both.
-    """
-    record = record_arrays(rows, n_state, m_max)
-    return (*record[:5], np.array([REPLAY, 0, 0, 0, 0], np.int64), record[6], forward[7])
-
-
-def pieces(record: tuple, n: int) -> np.ndarray:
-    """The pieces the forward pass started (its record from :func:`checkpoint_record`), (J, 3) int.
-
-    Each row: the first sample ``a_j``, the last sample with an update ``u_j`` (``a_j`` if none), the
-    last sample ``b_j`` (the next piece's first; ``n − 1`` for the last).
-    """
-    spans = record[7][3][: int(record[5][1])]
-    out = np.empty((len(spans), 3), np.int64)
-    out[:, :2] = spans
-    out[:-1, 2] = spans[1:, 0]
-    out[-1:, 2] = n - 1
-    return out
+def pieces(recorder: CheckpointRecord, n: int) -> Pieces:
+    """The pieces the forward pass started over ``n`` samples: each piece's first sample ``a_j``, its last sample
+    with an update ``u_j`` (``a_j`` if none), its last sample ``b_j`` (the next piece's first; ``n − 1`` for the
+    last)."""
+    j = int(recorder.taken[0])
+    cp = recorder.checkpoints
+    first = cp.first[:j].copy()
+    return Pieces(first, cp.last_update[:j].copy(), np.append(first[1:], n - 1).astype(np.int64))
 
 
-def batches(spans: np.ndarray, rows: int) -> list[tuple[int, int]]:
+def batches(spans: Pieces, rows: int) -> list[tuple[int, int]]:
     """Consecutive pieces ``[j0, j1)`` whose rows (``u_j − a_j + 1`` each) fit in a record of ``rows`` rows together."""
-    need = spans[:, 1] - spans[:, 0] + 1
+    need = spans.last_update - spans.first + 1
     out, j0, used = [], 0, 0
     for j, m in enumerate(need.tolist()):
         if m > rows:
@@ -120,39 +104,55 @@ def batches(spans: np.ndarray, rows: int) -> list[tuple[int, int]]:
     return out
 
 
-@njit
-def smooth_pieces(record, spans, j0, j1, lam, forward, noise, idx, use_ext, smoothed, buffers):
-    """The backward pass over pieces ``j1 − 1 … j0`` (their rows in ``record``, run again); ``λ`` in place.
+def replay_record(n_state: int, m_max: int, rows: int) -> Record:
+    """The :class:`~footzoo.filters.structures.Record` the pieces of a batch are run again into (``rows`` rows)."""
+    return record(rows, n_state, m_max)
 
-    ``spans``: :func:`pieces`; ``forward``, ``noise``: as :func:`~footzoo.filters.smoother.smooth_free_span`
-    takes them; ``smoothed``: (quat, vel, pos, gyro_bias, acc_bias) of the whole recording, corrected in
-    place; ``buffers``: (μ's (BLOCK, n), Φ's (BLOCK, 19), μ, e (n,), C (3, 3)).
+
+@njit
+def replay(signals, core, state, models, k0, work, rec, checkpoints, spans, j0, j1):
+    """Run pieces ``j0 … j1 − 1`` again, each from its checkpoint to its last update, their rows one after the
+    other in ``rec`` (from row 0); no output written. ``state`` is overwritten (a scratch state)."""
+    r = 0
+    for j in range(j0, j1):
+        a, u = spans.first[j], spans.last_update[j]
+        state.nav[:] = checkpoints.nav[j]
+        state.P[:, :] = checkpoints.P[j]
+        state.mems[:] = checkpoints.mems[j]
+        rec.first[r] = rec.first[r - 1] + rec.count[r - 1] if r > 0 else 0
+        rec.count[r] = 0
+        rec.offset[0] = a - r
+        forward_span(signals, core, state, models, None, k0, work, views(rec), a, u)
+        r += u - a + 1
+
+
+@njit
+def smooth_pieces(rec, spans, j0, j1, lam, fwd, noise, gravity, offs, use_ext, smoothed, work):
+    """The backward pass over pieces ``j1 − 1 … j0`` (their rows in ``rec``, run again); ``λ`` in place.
+
+    ``spans``: :func:`pieces`; ``fwd``, ``noise``, ``gravity``, ``work``: as
+    :func:`~footzoo.filters.smoother.smooth_free_span` takes them; ``smoothed``: the whole
+    recording's :class:`~footzoo.filters.structures.Trajectory`, corrected in place.
     """
-    quat, vel, pos, gyro_bias, acc_bias = smoothed
-    mus, phis, mu, e, c = buffers
-    cov = record[0]
+    cov = rec.cov
     r_end = 0
     for j in range(j0, j1):
-        r_end += spans[j, 1] - spans[j, 0] + 1
+        r_end += spans.last_update[j] - spans.first[j] + 1
     for j in range(j1 - 1, j0 - 1, -1):
-        a, u, b = spans[j, 0], spans[j, 1], spans[j, 2]
+        a, u, b = spans.first[j], spans.last_update[j], spans.last[j]
         r = r_end - (u - a + 1)  # the piece's first row
-        smooth_free_span(u, b, cov, r + u - a, lam, forward, noise, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias,
-                         mus, phis, e, (mu, c))
-        smooth_span(record, a, u, a - r, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias, lam, mu, e)
+        smooth_free_span(u, b, cov, r + u - a, lam, fwd, noise, gravity, offs, use_ext, smoothed, work)
+        smooth_span(rec, a, u, a - r, offs, use_ext, smoothed, lam, work.mu, work.e)
         r_end = r
 
 
-def backward(run: Callable[[], None], record: tuple, spans: np.ndarray, smooth: Callable[[int, int], None],
-             block: int) -> None:
+def backward(run: Callable[[int, int], None], spans: Pieces, smooth: Callable[[int, int], None],
+             rows: int) -> None:
     """The RTS backward pass over every piece, last first, a batch at a time (module docstring).
 
-    ``run()``: the loop over the pieces that ``record`` (:func:`replay_record`, ``block + 1`` rows at
-    least) names, writing their rows into it; ``smooth(j0, j1)``: :func:`smooth_pieces` of them;
-    ``spans``: :func:`pieces`.
+    ``run(j0, j1)``: :func:`replay` of pieces ``j0 … j1 − 1`` into a record of ``rows`` rows;
+    ``smooth(j0, j1)``: :func:`smooth_pieces` of them; ``spans``: :func:`pieces`.
     """
-    segment = record[5]
-    for j0, j1 in reversed(batches(spans, min(len(record[0]), block + 1))):
-        segment[:] = (REPLAY, 0, j0, j1, 0)
-        run()
+    for j0, j1 in reversed(batches(spans, rows)):
+        run(j0, j1)
         smooth(j0, j1)

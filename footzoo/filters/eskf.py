@@ -24,6 +24,7 @@ The covariance update is filterpy's Joseph form (eq. 45).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -85,37 +86,33 @@ class ErrorStateFilter:
         State blocks.
     p0 : (n,) array
         Initial variances.
-    q : (n,) array
-        Process-noise variance growth per second of each state (Q = diag(q) dt).
-    impact : float
-        Velocity variance growth per squared motion acceleration (s): the velocity rows of Q
-        grow by ``impact·|a|²·dt`` (see :class:`footzoo.filters.engine.NavigationNoise`).
-    integration : float
-        κ (1): the velocity rows of Q grow by ``(κ·|Δf|·dt)²``, ``Δf`` the change of the sampled
-        specific force over the interval (:mod:`footzoo.filters.velocity_noise`).
+    noise : Noise
+        The process noise (:mod:`footzoo.filters.process_noise`): ``Q = diag(q) dt`` plus the
+        velocity variance the caller computes for the sample (:meth:`predict`).
+
+    Attributes
+    ----------
+    y, S, K : ndarray
+        filterpy's innovation (m,), its covariance (m, m) and the gain (n, m) of the last update.
+    nis : float
+        The last update's normalised innovation squared ``yᵀ S⁻¹ y``.
     """
 
-    def __init__(self, layout: Layout, p0: np.ndarray, q: np.ndarray, impact: float = 0.0,
-                 integration: float = 0.0):
+    def __init__(self, layout: Layout, p0: np.ndarray, noise: Any):
         from filterpy.kalman import KalmanFilter  # imported here: the compiled engine does not need it
 
         self.layout = layout
         self.kf = KalmanFilter(dim_x=layout.n, dim_z=1)
         self.kf.P = np.diag(np.asarray(p0, dtype=float))
-        self.q = np.asarray(q, dtype=float)
-        self.impact = float(impact)
-        self.integration = float(integration)
+        self.noise = noise
         self.nis = 0.0
 
-    def predict(self, F: np.ndarray, dt: float, acc_sq: float = 0.0, change_sq: float = 0.0) -> None:
-        """``P ← Φ P Φᵀ + Q`` (eq. 44); the error state stays zero between updates.
-
-        ``acc_sq``: the squared motion acceleration |a|² ((m/s²)²) of the sample, for ``impact``;
-        ``change_sq``: the squared change |f_k − f_{k−1}|² ((m/s²)²) of the sampled specific force,
-        for ``integration``.
-        """
-        q = self.q * dt
-        q[self.layout["vel"]] += self.impact * acc_sq * dt + (self.integration * dt) ** 2 * change_sq
+    def predict(self, F: np.ndarray, dt: float, velocity_variance: float = 0.0) -> None:
+        """``P ← Φ P Φᵀ + Q`` (eq. 44), ``Q = diag(q) dt`` plus ``velocity_variance`` ((m/s)²) on each velocity
+        axis (:func:`footzoo.filters.process_noise.velocity_variance`); the error state stays zero between
+        updates."""
+        q = np.asarray(self.noise.q, dtype=float) * dt
+        q[self.layout["vel"]] += velocity_variance
         self.kf.predict(F=F, Q=np.diag(q))
 
     def update(self, z: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:
@@ -132,3 +129,18 @@ class ErrorStateFilter:
     def P(self) -> np.ndarray:
         """Current covariance."""
         return self.kf.P
+
+    @property
+    def y(self) -> np.ndarray:
+        """The last update's innovation (m,)."""
+        return self.kf.y[:, 0]
+
+    @property
+    def S(self) -> np.ndarray:
+        """The last update's innovation covariance (m, m)."""
+        return self.kf.S
+
+    @property
+    def K(self) -> np.ndarray:
+        """The last update's gain (n, m)."""
+        return self.kf.K

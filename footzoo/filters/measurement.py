@@ -66,10 +66,8 @@ heading at the end of a stance).
 The compiled loop calls the functions through a calling convention of plain
 positional arguments, the fields of ``ctx`` and then those of ``rows`` (or
 ``dx``), into which numba compiles each function (:mod:`footzoo.kernels.functions`);
-:func:`convention` gives it in Python. Functions written for footzoo 0.x took
-those positional arguments themselves (``measure(k, t, nav, w, f, stance, idx,
-par, mem, data, z, H, R, m)``, ``feedback(dx, idx, par, mem)``, ``after(k,
-nav, stance, idx, par, mem)``): they still run, with a ``FutureWarning``.
+:func:`convention` gives it in Python. A function that takes anything but this
+contract's parameters is refused with a :class:`~footzoo.core.errors.PluginError`.
 """
 
 from __future__ import annotations
@@ -78,7 +76,6 @@ import contextlib
 import functools
 import inspect
 import math
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -121,62 +118,46 @@ class Rows(NamedTuple):
     m: int
 
 
-#: Parameters of each function: with the context (this contract), and positional (footzoo 0.x).
-PARAMETERS = {"measure": (("ctx", "rows"), 14), "feedback": (("ctx", "dx"), 4), "after": (("ctx",), 6)}
+#: The parameters of each function of a measurement model.
+PARAMETERS = {"measure": ("ctx", "rows"), "feedback": ("ctx", "dx"), "after": ("ctx",)}
 
 
-def convention(fn: Callable[..., Any], role: str, positional: bool = False) -> Callable[..., Any]:
+def convention(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
     """The engine's calling convention for ``fn``: a function of the positional arguments that calls ``fn``.
 
     The arguments are the fields of :class:`Context`, then those of :class:`Rows` (``measure``) or
-    ``dx`` (``feedback``). ``positional``: ``fn`` takes footzoo 0.x's positional arguments instead.
-    Plain Python; :mod:`footzoo.kernels.functions` compiles ``fn`` into it.
+    ``dx`` (``feedback``). Plain Python; :mod:`footzoo.kernels.functions` compiles ``fn`` into it.
     """
     if role == "measure":
-        if positional:
-            return fn
-
         def measure(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
             return fn(Context(k, t, nav, w, f, stance, idx, par, mem, data), Rows(z, H, R, m))
 
         return measure
     if role == "feedback":
-        if positional:
-            def feedback(k, t, nav, w, f, stance, idx, par, mem, data, dx):  # noqa: ARG001
-                fn(dx, idx, par, mem)
-        else:
-            def feedback(k, t, nav, w, f, stance, idx, par, mem, data, dx):
-                fn(Context(k, t, nav, w, f, stance, idx, par, mem, data), dx)
+        def feedback(k, t, nav, w, f, stance, idx, par, mem, data, dx):
+            fn(Context(k, t, nav, w, f, stance, idx, par, mem, data), dx)
+
         return feedback
-    if positional:
-        def after(k, t, nav, w, f, stance, idx, par, mem, data):  # noqa: ARG001
-            fn(k, nav, stance, idx, par, mem)
-    else:
-        def after(k, t, nav, w, f, stance, idx, par, mem, data):
-            fn(Context(k, t, nav, w, f, stance, idx, par, mem, data))
+
+    def after(k, t, nav, w, f, stance, idx, par, mem, data):
+        fn(Context(k, t, nav, w, f, stance, idx, par, mem, data))
+
     return after
 
 
-def is_positional(fn: Callable[..., Any], role: str) -> bool:
-    """Whether ``fn`` takes footzoo 0.x's positional arguments (warned about); raises
-    :class:`~footzoo.core.errors.PluginError` when it takes neither those nor this contract's."""
+def check_parameters(fn: Callable[..., Any], role: str) -> None:
+    """Raise :class:`~footzoo.core.errors.PluginError` unless ``fn`` takes this contract's parameters for ``role``."""
     py = getattr(fn, "py_func", fn)
-    names, old = PARAMETERS[role]
+    names = PARAMETERS[role]
     try:
         params = [p for p in inspect.signature(py).parameters.values()
                   if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    except (TypeError, ValueError):  # no signature to read: take it as this contract's
-        return False
-    if len(params) == len(names):
-        return False
-    where = f"{getattr(py, '__module__', '?')}.{getattr(py, '__qualname__', py)}"
-    if len(params) == old:
-        warnings.warn(f"{role} function {where} takes footzoo 0.x's {old} positional arguments; write it as "
-                      f"{role}({', '.join(names)}) (footzoo.filters.measurement explains the fields): the old form "
-                      "will be refused in a future release", FutureWarning, stacklevel=4)
-        return True
-    raise PluginError(f"{role} function {where} takes {len(params)} argument(s); a {role} function takes "
-                      f"({', '.join(names)}): see footzoo.filters.measurement for what they hold")
+    except (TypeError, ValueError):  # no signature to read: taken as this contract's
+        return
+    if len(params) != len(names):
+        where = f"{getattr(py, '__module__', '?')}.{getattr(py, '__qualname__', py)}"
+        raise PluginError(f"{role} function {where} takes {len(params)} argument(s); a {role} function takes "
+                          f"({', '.join(names)}): see footzoo.filters.measurement for what they hold")
 
 
 def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
@@ -185,13 +166,13 @@ def _compile(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
         return fn.compiled()
     if getattr(fn, "footzoo_convention", None) == role:  # already compiled to it
         return fn
-    return _compiled_convention(fn, role, is_positional(fn, role))
+    check_parameters(fn, role)
+    return _compiled_convention(fn, role)
 
 
-def _compiled_convention(fn: Callable[..., Any], role: str, positional: bool) -> Callable[..., Any]:
-    """``fn`` compiled into :func:`convention` (a positional 0.x ``measure`` takes it as it is)."""
-    wrap = None if positional and role == "measure" else (lambda g: convention(g, role, positional))
-    compiled = compile_model_function(fn, role, wrap)
+def _compiled_convention(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
+    """``fn`` compiled into :func:`convention`."""
+    compiled = compile_model_function(fn, role, lambda g: convention(g, role))
     with contextlib.suppress(AttributeError, TypeError):  # a plain function without numba: marked as well
         compiled.footzoo_convention = role
     return compiled
@@ -208,9 +189,9 @@ class ModelFunction:
 
     def __init__(self, fn: Callable[..., Any], role: str):
         functools.update_wrapper(self, fn)
+        check_parameters(fn, role)
         self.py_func = fn
         self.role = role
-        self.positional = is_positional(fn, role)
         self._dispatcher: Any = None
         self._error: str | None = None
 
@@ -221,7 +202,7 @@ class ModelFunction:
             if self._error is not None:
                 raise NotCompilable(self._error)
             try:
-                self._dispatcher = _compiled_convention(self.py_func, self.role, self.positional)
+                self._dispatcher = _compiled_convention(self.py_func, self.role)
             except NotCompilable as err:
                 self._error = str(err)
                 raise
@@ -232,13 +213,13 @@ class ModelFunction:
         try:
             return self.compiled()
         except NotCompilable:
-            return convention(self.py_func, self.role, self.positional)
+            return convention(self.py_func, self.role)
 
     def __call__(self, *args: Any) -> Any:
         return self.py_func(*args)
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__") or name in ("py_func", "role", "positional", "_dispatcher", "_error"):
+        if name.startswith("__") or name in ("py_func", "role", "_dispatcher", "_error"):
             raise AttributeError(name)
         return getattr(self.compiled(), name)
 
@@ -256,7 +237,8 @@ def calling(fn: Callable[..., Any], role: str) -> Callable[..., Any]:
         return fn.conventional()
     if getattr(fn, "footzoo_convention", None) == role:
         return fn
-    return convention(fn, role, is_positional(fn, role))
+    check_parameters(fn, role)
+    return convention(fn, role)
 
 
 def _lazy(fn: Callable[..., Any], role: str) -> Callable[..., Any]:

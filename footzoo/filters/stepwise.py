@@ -29,11 +29,12 @@ The backward pass of a segment ``(s₀, s]``
     whole-recording smoother, over a stride instead of the whole recording.
 
 What is kept
-    The record of :func:`footzoo.filters.smoother.record_arrays` (``P⁺_k``, Φ_k's blocks and the
-    update rows), per sample of the open segment only, dropped once the segment has been smoothed:
-    about 1 kB per sample at 9 states, one stride. Live, the Kalman stage holds them; on a whole
-    recording the loop itself smooths each segment as soon as it has closed
-    (:func:`close_segment`), while the record is in the cache.
+    A :class:`~footzoo.filters.structures.Record` (``P⁺_k``, Φ_k's blocks and the update rows), per
+    sample of the open segment only, dropped once the segment has been smoothed: about 1 kB per
+    sample at 9 states, one stride. Live, the Kalman stage holds them; on a whole recording the loop
+    itself smooths each segment as soon as it has closed (a
+    :class:`~footzoo.filters.structures.SegmentRecord`, :func:`close_segment`), while the record is
+    in the cache.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import njit
-from .smoother import IN_LOOP, smooth_segment
+from .smoother import smooth_segment
 
 #: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
 WAITS_FOR = "the end of the next stance"
@@ -49,6 +50,7 @@ WAITS_FOR = "the end of the next stance"
 #: Longest segment (s) before a stance sample closes it although the stance goes on (standing still);
 #: a walking stride with its stance lasts about 1–1.5 s.
 MAX_SEGMENT = 3.0
+
 
 @njit(inline=True)
 def ends_segment(stance, t, k, lo):
@@ -74,33 +76,32 @@ def _segment_ends(stance, t, closed):
 
 
 @njit(inline=True)
-def close_segment(record, k, stance, t, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
+def close_segment(rec, smoothed, k, stance, t, offs, use_ext, forward):
     """In the loop over a whole recording, before sample k: smooth the segment that sample k − 1 ended.
 
-    The rule of :func:`segment_ends` (:func:`ends_segment`); the record then starts afresh at
-    sample k. Nothing unless the record was made ``in_loop``.
+    The rule of :func:`segment_ends` (:func:`ends_segment`); ``rec`` (its ``offset``: the open
+    segment's first sample) then starts afresh at sample k. ``forward``: the loop's outputs
+    (a :class:`~footzoo.filters.structures.Trajectory`), copied into ``smoothed`` and smoothed there.
     """
-    segment = record[5]
-    if segment[0] == IN_LOOP and ends_segment(stance, t, k - 1, segment[1]):
-        lo = segment[1]
-        smooth_copy(record, lo, k - 1, lo, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias)
-        segment[1] = k
+    lo = rec.offset[0]
+    if ends_segment(stance, t, k - 1, lo):
+        smooth_copy(rec, smoothed, lo, k - 1, lo, offs, use_ext, forward)
+        rec.offset[0] = k
 
 
 @njit
-def smooth_copy(record, lo, hi, off, idx, use_ext, quat, vel, pos, gyro_bias, acc_bias):
-    """Samples ``lo … hi`` of the forward trajectories into the record's smoothed ones, smoothed there."""
-    sq, sv, sp, sg, sa = record[6]
+def smooth_copy(rec, smoothed, lo, hi, off, offs, use_ext, forward):
+    """Samples ``lo … hi`` of the ``forward`` trajectory into ``smoothed``, smoothed there (record rows ``k − off``)."""
     for k in range(lo, hi + 1):
         for i in range(4):
-            sq[k, i] = quat[k, i]
+            smoothed.quat[k, i] = forward.quat[k, i]
         for i in range(3):
-            sv[k, i] = vel[k, i]
-            sp[k, i] = pos[k, i]
-            sg[k, i] = gyro_bias[k, i]
-            sa[k, i] = acc_bias[k, i]
-    n = (record[2].shape[1] - 1) // 2
-    smooth_segment(record, lo, hi, off, idx, use_ext, sq, sv, sp, sg, sa, np.empty(n), np.empty(n), np.empty(n))
+            smoothed.vel[k, i] = forward.vel[k, i]
+            smoothed.pos[k, i] = forward.pos[k, i]
+            smoothed.gyro_bias[k, i] = forward.gyro_bias[k, i]
+            smoothed.acc_bias[k, i] = forward.acc_bias[k, i]
+    n = rec.rows.h.shape[1]
+    smooth_segment(rec, lo, hi, off, offs, use_ext, smoothed, np.empty(n), np.empty(n), np.empty(n))
 
 
 def segment_ends(stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:

@@ -3,7 +3,8 @@
 A checkout's footzoo (``python -m pytest`` or ``mkdocs build`` in the source tree imports it) has no
 ``_compiled`` folder, so numba would compile every kernel afresh (about a minute of CPU on a new
 machine). A kernel's shipped code is used only where its source file has the same content
-(:mod:`footzoo.kernels.cache` checks a SHA-256 of the file), so after ``pip install .`` of the
+(:class:`footzoo.kernels.internals.KernelCache` checks a SHA-256 of the file and of the footzoo
+modules it imports), so after ``pip install .`` of the
 checkout its code can load what the wheel compiled, and compiles whatever differs.
 """
 

@@ -11,7 +11,10 @@ and each kernel is compiled at its first call, only for the argument types it
 gets (so a pipeline compiles only the kernels it uses). The machine code is
 cached on disk next to the module (or in ``NUMBA_CACHE_DIR``), so a new process
 loads it instead of compiling again; a wheel also ships the kernels its configs
-use, compiled when it was built (:mod:`footzoo.kernels.cache`).
+use, compiled when it was built (:class:`footzoo.kernels.internals.KernelCache`).
+
+This module uses numba's public API only; what footzoo takes from numba's internals is in
+:mod:`footzoo.kernels.internals`, imported once numba is.
 """
 
 from __future__ import annotations
@@ -67,20 +70,22 @@ def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
     options = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
     if inline:  # numba copies its typed body into each caller: no compilation and no cache entry of its own
         options["inline"] = "always"
-    from . import cache as _kernel_cache
+    from . import internals
 
-    return _kernel_cache.attach(_numba.njit(**options)(fn))
+    return internals.attach(_numba.njit(**options)(fn))
 
 
 def njit_signature(fn: Callable[..., Any], signature: Any, identity: str | None = None, **options: Any) -> Any:
-    """``numba.njit(signature, cache=True, **options)(fn)``, with footzoo's kernel cache (:mod:`footzoo.kernels.cache`).
+    """``numba.njit(signature, cache=True, **options)(fn)`` with footzoo's kernel cache.
+
+    The cache is :class:`footzoo.kernels.internals.KernelCache`.
 
     Compiles now, for that signature only; numba's errors propagate. Needs numba (:func:`load_numba`).
-    ``identity``: of the function a closure ``fn`` wraps (:class:`~footzoo.kernels.cache.KernelCache`).
+    ``identity``: of the function a closure ``fn`` wraps (:class:`~footzoo.kernels.internals.KernelCache`).
     """
-    from . import cache as _kernel_cache
+    from . import internals
 
-    return _kernel_cache.compile_with(load_numba().njit(cache=True, **options)(fn), signature, identity)
+    return internals.compile_with(load_numba().njit(cache=True, **options)(fn), signature, identity)
 
 
 def _materialise() -> None:

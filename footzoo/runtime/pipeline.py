@@ -390,9 +390,9 @@ class Pipeline:
             out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
             if covariance:
                 out["diagnostics"]["P_diag"] = out["P_diag"]
-                out["diagnostics"]["nis"] = out["nis"][:, 0]
-                out["diagnostics"]["nis_rows"] = out["nis"][:, 1].astype(int)
-                out["diagnostics"]["consistency"] = nis_summary(out["nis"][:, 0], out["nis"][:, 1])
+                out["diagnostics"]["nis"] = out["nis"]
+                out["diagnostics"]["nis_rows"] = out["nis_rows"]
+                out["diagnostics"]["consistency"] = nis_summary(out["nis"], out["nis_rows"])
                 if eng.layout.has("pos"):  # the forward filter's position standard deviation (m), N, E, D
                     out["diagnostics"]["pos_std"] = np.sqrt(out["P_diag"][:, eng.layout["pos"]])
             out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})

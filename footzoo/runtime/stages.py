@@ -22,8 +22,8 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.errors import GuardWarning
-from ..filters.smoother import RECORD_KEYS, ROWS_KEY
-from ..filters.stepwise import segment_ends
+from ..filters.recorders import ROW_KEYS, SAMPLE_KEYS
+from ..filters.smoothing import smoothing as smoother_named
 from ..filters.strapdown import Integrator, motion_acceleration
 from ..plugins.base import (
     AccelerationCorrection,
@@ -258,8 +258,8 @@ class KalmanStage:
     With ``smoother="stepwise"`` (:mod:`footzoo.filters.stepwise`) the engine also records each
     sample for the backward pass; the samples wait in the open segment until the segment closes
     (the first sample after a stance has been seen, or the end of the data), are smoothed as
-    the batch run smooths them (:meth:`KalmanEngine.smooth_stepwise`, the same rule and kernel)
-    and become final. Their provisional estimates are the forward filter's.
+    the batch run smooths them (the segments of :class:`footzoo.filters.smoothing.Stepwise`, the
+    same kernel) and become final. Their provisional estimates are the forward filter's.
     """
 
     def __init__(self, engine: Any, corrections: list[KalmanCorrection], q0: np.ndarray, external_attitude: bool,
@@ -268,10 +268,11 @@ class KalmanStage:
         self.corrections = corrections
         nav0 = np.zeros(16)
         nav0[:4] = q0
-        self.state = engine.live(engine.start(nav0))
+        self.state = engine.start(nav0)
         self.external = external_attitude
         self.prev: Chunk | None = None  # the last sample the engine has processed (its row 0 of a chunk)
-        self.stepwise = smoother == "stepwise"
+        self.smoothing = smoother_named(smoother)
+        self.stepwise = bool(self.smoothing)
         self.open = Columns()  # step-wise smoother: the open segment's samples, forward estimates and record
         self.open_rows = Columns()  # ... and its update rows (record_first: absolute row numbers)
         self.rows_before = 0  # rows of the samples released (the absolute number of open_rows' first row)
@@ -286,10 +287,13 @@ class KalmanStage:
                                   rows["quat"] if self.external else None, data, int(rows["k"][0]), covariance=False,
                                   record=record)
         skip = 0 if prev is None else 1
-        keys = ("quat", "vel", "pos", "acc_nav", *(("gyro_bias", "acc_bias", *RECORD_KEYS) if record else ()))
+        keys = ("quat", "vel", "pos", "acc_nav", *(("gyro_bias", "acc_bias", *SAMPLE_KEYS) if record else ()))
         done = {k: out[k][skip:] for k in keys}
         if record:
-            done[ROWS_KEY] = out[ROWS_KEY][:int(out["record_first"][-1] + out["record_count"][-1])]
+            used = int(out["record_first"][-1] + out["record_count"][-1])
+            rows_kept = int(out["record_first"][skip]) if skip < len(out["record_first"]) else used
+            done.update({k: out[k][rows_kept:used] for k in ROW_KEYS})
+            done["record_first"] = done["record_first"] - rows_kept
         return done
 
     def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
@@ -298,10 +302,10 @@ class KalmanStage:
             self.prev = take(chunk, length(chunk) - 1)
             if not self.stepwise:
                 return {**chunk, **out}
-            rows = out.pop(ROWS_KEY)
+            rows = {k: out.pop(k) for k in ROW_KEYS}
             out["record_first"] = out["record_first"] + (self.rows_before + len(self.open_rows))
             self.open.append({**chunk, **out})
-            self.open_rows.append({"row": rows})
+            self.open_rows.append(rows)
         return self._close_segments(finish) if self.stepwise else {}
 
     def _close_segments(self, closed: bool) -> Chunk:
@@ -309,20 +313,26 @@ class KalmanStage:
         if not len(self.open):
             return {}
         rows = self.open.view()
-        if not segment_ends(rows["stance"], rows["t"], closed).size:  # most packets end no stance: nothing to do
+        ends = self.smoothing.ends(rows["stance"].astype(bool), rows["t"], closed)
+        if not ends.size:  # most packets end no stance: nothing to do
             return {}
-        no_rows = np.zeros((0, 1 + 2 * self.engine.layout.n))
-        held = {**rows, "record_first": rows["record_first"] - self.rows_before,
-                ROWS_KEY: self.open_rows.view()["row"] if len(self.open_rows) else no_rows}
-        n_final = self.engine.smooth_stepwise(held, rows["stance"].astype(bool), rows["t"], closed)
-        if not n_final:
-            return {}
+        held = {**rows, "record_first": rows["record_first"] - self.rows_before, **self._open_rows()}
+        self.engine.smooth(held, ends)
+        n_final = int(ends[-1]) + 1
         done = take(_public(rows), 0, n_final)
         released = int(held["record_first"][n_final - 1] + held["record_count"][n_final - 1])
         self.open.drop(n_final)
         self.open_rows.drop(released)
         self.rows_before += released
         return done
+
+    def _open_rows(self) -> dict[str, np.ndarray]:
+        """The open segment's update rows (empty columns when there are none)."""
+        if len(self.open_rows):
+            return self.open_rows.view()
+        n = self.engine.layout.n
+        return {"row_h": np.zeros((0, n)), "row_gain": np.zeros((0, n)), "row_scaled": np.zeros(0),
+                "row_nu": np.zeros(0), "row_s": np.zeros(0)}
 
     def finish(self) -> Chunk:
         return self._close_segments(True) if self.stepwise else {}
@@ -344,7 +354,7 @@ class KalmanStage:
 
 def _public(rows: Chunk) -> Chunk:
     """The columns of a sample (without the step-wise smoother's record and the bias estimates)."""
-    return {k: v for k, v in rows.items() if k not in RECORD_KEYS and k not in ("gyro_bias", "acc_bias")}
+    return {k: v for k, v in rows.items() if k not in SAMPLE_KEYS and k not in ("gyro_bias", "acc_bias")}
 
 
 class BatchNavigationStage:

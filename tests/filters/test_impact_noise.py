@@ -8,6 +8,7 @@ import pytest
 from footzoo import ConfigError, Pipeline
 from footzoo.filters.engine import NavigationNoise
 from footzoo.filters.eskf import ErrorStateFilter, Layout, transition
+from footzoo.filters.process_noise import Noise, velocity_variance
 from footzoo.sim import NoiseModel, simulate
 
 BASE = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}]}
@@ -21,10 +22,11 @@ def walk():
 def test_one_prediction_by_hand():
     layout = Layout([("pos", 3), ("vel", 3)])
     q = np.array([0.0, 0.0, 0.0, 0.01, 0.01, 0.01])
-    kf = ErrorStateFilter(layout, np.zeros(6), q, impact=2e-5)
+    noise = Noise(q, impact=2e-5, integration=0.0)
+    kf = ErrorStateFilter(layout, np.zeros(6), noise)
     a = np.array([30.0, -10.0, 40.0])  # a heel strike's motion acceleration (m/s²)
     dt = 0.005
-    kf.predict(transition(layout, np.eye(3), a, dt), dt, float(a @ a))
+    kf.predict(transition(layout, np.eye(3), a, dt), dt, velocity_variance(noise, a, np.zeros((2, 3)), 1, dt))
     # from P = 0: P_vel = (q_v + impact |a|²) dt on each axis, P_pos still 0 (Φ moves it at the next step)
     np.testing.assert_allclose(np.diag(kf.P)[3:], (0.01 + 2e-5 * 2600.0) * dt, rtol=1e-15)
     np.testing.assert_array_equal(np.diag(kf.P)[:3], 0.0)

@@ -12,7 +12,7 @@ import pytest
 from footzoo import ConfigError, Pipeline, Stream
 from footzoo.filters.engine import NavigationNoise
 from footzoo.filters.eskf import ErrorStateFilter, Layout, transition
-from footzoo.filters.velocity_noise import UNIFORM_TIMING
+from footzoo.filters.process_noise import UNIFORM_TIMING, Noise, velocity_variance
 from footzoo.sim import NoiseModel, simulate
 
 BASE = {"orientation": {"type": "ins"}, "detector": {"type": "shoe"}, "corrections": [{"type": "zupt"}],
@@ -48,10 +48,12 @@ def test_uniform_timing_is_the_sigma_of_a_uniform_instant():
 def test_one_prediction_by_hand():
     layout = Layout([("pos", 3), ("vel", 3)])
     q = np.array([0.0, 0.0, 0.0, 0.01, 0.01, 0.01])
-    kf = ErrorStateFilter(layout, np.zeros(6), q, integration=0.3)
-    change = np.array([120.0, -40.0, 90.0])  # a heel strike between two samples (m/s²)
+    noise = Noise(q, impact=0.0, integration=0.3)
+    kf = ErrorStateFilter(layout, np.zeros(6), noise)
     dt = 0.005
-    kf.predict(transition(layout, np.eye(3), np.zeros(3), dt), dt, 0.0, float(change @ change))
+    # a heel strike between two samples: f_k − f_{k−1} = (120, −40, 90) m/s²
+    acc = np.array([[1.0, 2.0, -9.8], [1.0 + 120.0, 2.0 - 40.0, -9.8 + 90.0]])
+    kf.predict(transition(layout, np.eye(3), np.zeros(3), dt), dt, velocity_variance(noise, np.zeros(3), acc, 1, dt))
     # from P = 0: P_vel = q_v dt + (κ |Δf| dt)² on each axis (|Δf|² = 24100), P_pos still 0
     np.testing.assert_allclose(np.diag(kf.P)[3:], 0.01 * dt + (0.3 * dt) ** 2 * 24100.0, rtol=1e-15)
     np.testing.assert_array_equal(np.diag(kf.P)[:3], 0.0)

@@ -1,8 +1,8 @@
 """The measurement functions' contract: ``measure(ctx, rows)``, ``feedback(ctx, dx)``, ``after(ctx)``.
 
-Checked against hand-made cases and against footzoo 0.x's positional form of the same functions (which
-must still run, with a FutureWarning), on both engines; and that the compiled calling convention of a
-plug-in's function is cached across processes like footzoo's own.
+Checked against hand-made cases on both engines; a function written with the engine's positional
+arguments instead is refused, naming the contract; and the compiled calling convention of a plug-in's
+function is cached across processes like footzoo's own.
 """
 
 from __future__ import annotations
@@ -63,26 +63,17 @@ def _last_speed(ctx):
     ctx.mem[5] = ctx.t
 
 
-def _velocity_rows_0x(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
-    """The same as :func:`_velocity_rows`, written with footzoo 0.x's positional arguments."""
-    if not stance:
-        return m
-    mem[0] += 1.0
-    for i in range(3):
-        H[m, idx[VEL] + i] = 1.0
-        z[m] = nav[V + i]
-        R[m] = par[0] * par[0]
-        m += 1
+def _velocity_rows_positional(k, t, nav, w, f, stance, idx, par, mem, data, z, H, R, m):
+    """The same as :func:`_velocity_rows`, written with the engine's positional arguments (refused)."""
     return m
 
 
-def _bias_feedback_0x(dx, idx, par, mem):
-    for i in range(3):
-        mem[1 + i] += dx[idx[5] + i]
+def _bias_feedback_positional(dx, idx, par, mem):
+    return None
 
 
-def _last_speed_0x(k, nav, stance, idx, par, mem):
-    mem[4] = np.sqrt(nav[V] ** 2 + nav[V + 1] ** 2 + nav[V + 2] ** 2)
+def _last_speed_positional(k, nav, stance, idx, par, mem):
+    return None
 
 
 def _engine(measure, feedback, after, engine):
@@ -142,21 +133,16 @@ def test_a_model_in_the_context_form_runs_and_its_functions_see_the_sample(walk,
     assert np.abs(out["vel"][stance]).max() < 0.05  # the rows pulled the stance velocity to zero
 
 
-@pytest.mark.parametrize("engine", ["fast", "reference"])
-def test_footzoo_0x_positional_functions_still_run_to_the_same_numbers_with_a_future_warning(walk, engine):
-    if engine == "fast" and not _jit.HAVE_NUMBA:
-        pytest.skip("numba not installed")
-    with pytest.warns(FutureWarning, match=r"measure function .*_velocity_rows_0x.*write it as measure\(ctx, rows\)"):
-        old_measure = measurement_function(_velocity_rows_0x)
-    with pytest.warns(FutureWarning, match=r"feedback\(ctx, dx\)"):
-        old_feedback = feedback_function(_bias_feedback_0x)
-    with pytest.warns(FutureWarning, match=r"after\(ctx\)"):
-        old_after = after_function(_last_speed_0x)
-    new, _ = _run(walk, measurement_function(_velocity_rows), feedback_function(_bias_feedback),
-                  after_function(_last_speed), engine)
-    old, _ = _run(walk, old_measure, old_feedback, old_after, engine)
-    for key in ("quat", "vel", "pos", "P_diag"):
-        assert np.array_equal(new[key], old[key]), key
+@pytest.mark.parametrize(("fn", "role", "contract"), [
+    (_velocity_rows_positional, "measure", r"\(ctx, rows\)"), (_bias_feedback_positional, "feedback", r"\(ctx, dx\)"),
+    (_last_speed_positional, "after", r"\(ctx\)")])
+def test_a_function_with_positional_arguments_is_refused_naming_the_contract(fn, role, contract):
+    mark = {"measure": measurement_function, "feedback": feedback_function, "after": after_function}[role]
+    with pytest.raises(PluginError, match=rf"{role} function .*{fn.__name__} takes \d+ argument\(s\); a {role} "
+                                          rf"function takes {contract}"):
+        mark(fn)
+    with pytest.raises(PluginError, match=contract):
+        calling(fn, role)
 
 
 def test_a_function_with_another_number_of_arguments_is_the_plugins_error_naming_the_contract():

@@ -56,7 +56,7 @@ def _linear_system(measured_every: int = 40):
     every other ``measured_every`` samples, as in stance), and filterpy's standard RTS smoother on it."""
     from filterpy.kalman import KalmanFilter
 
-    from footzoo.filters.smoother import packed, record_arrays
+    from footzoo.filters.recorders import packed, record
 
     rng = np.random.default_rng(0)
     dt, n_steps = 0.01, 300
@@ -88,13 +88,13 @@ def _linear_system(measured_every: int = 40):
     P = p0.copy()
     # the step-wise smoother's record, filled as the compiled loop fills it: P⁺, Φ's blocks (here only
     # Δ[pos, vel] = I dt), the scalar update rows one at a time (h, k, ν / s)
-    record = record_arrays(n_steps, 6, 3)
-    cov, phi, rows, first, count = record[:5]
+    rec = record(n_steps, 6, 3)
+    cov, rows, first, count = rec.cov, rec.rows, rec.first, rec.count
     cov[0] = packed(P)
     for k in range(1, n_steps):
         nominal[k] = F @ nominal[k - 1]
         P = F @ P @ F.T + Q
-        phi[k, 0] = dt
+        rec.transitions.dt[k] = dt
         first[k] = first[k - 1] + count[k - 1]
         if measured[k]:
             S = H @ P @ H.T + R
@@ -105,7 +105,8 @@ def _linear_system(measured_every: int = 40):
                 u = Pa @ H[a]
                 s_ = H[a] @ u + R[a, a]
                 nu = (H[a] @ nominal[k] - zs[k][a]) - H[a] @ seq
-                rows[first[k] + a] = np.concatenate([H[a], u / s_, [nu / s_]])
+                r = first[k] + a
+                rows.h[r], rows.gain[r], rows.scaled[r], rows.nu[r], rows.s[r] = H[a], u / s_, nu / s_, nu, s_
                 seq += u / s_ * nu
                 Pa = Pa - np.outer(u, u) / s_
             count[k] = 3
@@ -114,16 +115,22 @@ def _linear_system(measured_every: int = 40):
             P = (np.eye(6) - K @ H) @ P @ (np.eye(6) - K @ H).T + K @ R @ K.T
         cov[k] = packed(P)
     np.testing.assert_allclose(nominal, np.array(means), atol=1e-12)
-    return nominal, record, np.array(measured), expected[:, :, 0]
+    return nominal, rec, np.array(measured), expected[:, :, 0]
 
 
-#: INS core offsets of the linear system: no attitude, no biases, position at 0, velocity at 3.
-LINEAR_IDX = np.array([-1, -1, 0, 3, -1])
+def _offsets():
+    """INS core offsets of the linear system: no attitude, no biases, position at 0, velocity at 3."""
+    from footzoo.filters.structures import Offsets
+
+    return Offsets(att=-1, gyro_bias=-1, pos=0, vel=3, acc_bias=-1)
 
 
-def _trajectories(nominal):
+def _trajectory(nominal):
+    from footzoo.filters.structures import Trajectory
+
     n = len(nominal)
-    return np.zeros((n, 4)), nominal[:, 3:].copy(), nominal[:, :3].copy(), np.zeros((n, 3)), np.zeros((n, 3))
+    return Trajectory(np.zeros((n, 4)), nominal[:, 3:].copy(), nominal[:, :3].copy(), np.zeros((n, 3)),
+                      np.zeros((n, 3)))
 
 
 def test_the_backward_recursion_over_the_whole_run_and_over_each_segment_is_filterpys_rts_smoother():
@@ -134,19 +141,19 @@ def test_the_backward_recursion_over_the_whole_run_and_over_each_segment_is_filt
     from footzoo.filters.smoother import smooth_segments
     from footzoo.filters.stepwise import segment_ends
 
-    nominal, record, measured, expected = _linear_system()
-    quat, vel, pos, gb, ab = _trajectories(nominal)
-    smooth_segments(record, np.array([len(nominal) - 1]), 0, 0, LINEAR_IDX, True, quat, vel, pos, gb, ab)
-    np.testing.assert_allclose(np.hstack([pos, vel]), expected, atol=1e-9)
+    nominal, rec, measured, expected = _linear_system()
+    traj = _trajectory(nominal)
+    smooth_segments(rec, np.array([len(nominal) - 1]), 0, 0, _offsets(), True, traj)
+    np.testing.assert_allclose(np.hstack([traj.pos, traj.vel]), expected, atol=1e-9)
 
     ends = segment_ends(measured, np.arange(len(measured)) * 0.01, closed=True)  # each run's last measured sample
     np.testing.assert_array_equal(ends[:3], [39, 119, 199])
-    quat, vel, pos, gb, ab = _trajectories(nominal)
-    smooth_segments(record, ends, 0, 0, LINEAR_IDX, True, quat, vel, pos, gb, ab)
-    smoothed = np.hstack([pos, vel])
+    traj = _trajectory(nominal)
+    smooth_segments(rec, ends, 0, 0, _offsets(), True, traj)
+    smoothed = np.hstack([traj.pos, traj.vel])
     lo = 0
     for hi in ends:  # the RTS smoother of filterpy on the filtered means and covariances of one segment
-        alone = _filterpy_rts_on(nominal[lo:hi + 1], _unpacked(record[0][lo:hi + 1], 6))
+        alone = _filterpy_rts_on(nominal[lo:hi + 1], _unpacked(rec.cov[lo:hi + 1], 6))
         np.testing.assert_allclose(smoothed[lo:hi + 1], alone, atol=1e-9)
         lo = hi + 1
 
@@ -161,7 +168,7 @@ def _unpacked(cov, n):
 
 
 def test_the_record_keeps_the_upper_triangle_row_by_row():
-    from footzoo.filters.smoother import packed
+    from footzoo.filters.recorders import packed
 
     P = np.arange(9.0).reshape(3, 3)
     P = P + P.T  # [[0, 4, 8], [4, 8, 12], [8, 12, 16]]
@@ -225,7 +232,7 @@ def _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat):
     nav0 = np.zeros(16)
     nav0[:4] = quat[0] if quat is not None else q0
     state = ref.start(nav0)
-    full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.models], 0, True, record=True)
+    full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.setup.models], 0, True, record=True)
     forward = {k: full[k].copy() for k in ("quat", "vel", "pos", "acc_nav", "P_diag", "nis")}
     ref.smooth(full, np.array([len(t) - 1]))
     return full, forward, ref.diagnostics(state)
@@ -298,7 +305,7 @@ def test_a_flickering_stance_costs_the_checkpoints_no_more_room_than_one_per_min
     from footzoo.filters.checkpointed import checkpoint_record
 
     flicker = np.arange(10_001) % 2 == 0  # 5000 stance starts
-    nav, P, mems, spans = checkpoint_record(flicker, 21, 4, 4096, 32)[7]
-    assert len(nav) == len(P) == len(mems) == len(spans) == 1 + 10_000 // 32
+    cp = checkpoint_record(flicker, 21, 4, 4096, 32).checkpoints
+    assert len(cp.nav) == len(cp.P) == len(cp.mems) == len(cp.first) == len(cp.last_update) == 1 + 10_000 // 32
     walk_like = np.arange(10_001) % 100 < 40  # 100 stance starts, one per 100 samples
-    assert len(checkpoint_record(walk_like, 9, 0, 4096, 32)[7][0]) == 1 + 100 + 10_000 // 4096
+    assert len(checkpoint_record(walk_like, 9, 0, 4096, 32).checkpoints.nav) == 1 + 100 + 10_000 // 4096

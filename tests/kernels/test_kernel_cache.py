@@ -229,17 +229,17 @@ def test_compile_loads_a_configs_own_plug_in_and_a_new_process_then_compiles_non
 def test_a_read_only_recording_runs_the_same_compiled_loop():
     """A study freezes its shared recordings; their read-only arrays must not type (and compile) a second loop."""
     from footzoo import Pipeline
-    from footzoo.filters import kalman_fast
+    from footzoo.filters import forward
     from footzoo.sim import simulate
     from footzoo.studies.runner import _read_only
 
     pipe = Pipeline.from_yaml("nguyen2016")
     writable = pipe.run(simulate("rectangle", rate=100, seed=1))
-    n = len(kalman_fast.eskf_loop.signatures)
+    n = len(forward.run.signatures)
     frozen = _read_only(simulate("rectangle", rate=100, seed=1))
     assert not frozen.acc.flags.writeable
     again = pipe.run(frozen)
-    assert len(kalman_fast.eskf_loop.signatures) == n
+    assert len(forward.run.signatures) == n
     np.testing.assert_array_equal(again.pos, writable.pos)
     assert not frozen.acc.flags.writeable  # the recording itself stays frozen
 

@@ -181,8 +181,7 @@ def test_compiled_loop_keeps_the_covariance_exactly_symmetric(walk):
     stance = np.asarray(Pipeline.from_yaml("nguyen2016").detect(walk).stance_)
     state = eng.start(np.array([1.0] + [0.0] * 15))
     eng.advance(state, walk.t, walk.acc, walk.gyr, stance, None, [None], 0)
-    assert np.array_equal(state.P, state.P.T)
-    assert state.work is not None  # the loop's buffers, kept for the next call
+    assert np.array_equal(state.filter.P, state.filter.P.T)
 
 
 def test_alignment_runs_fqa_of_one_sample_as_python_with_the_compiled_kernels_numbers():
@@ -219,14 +218,16 @@ def test_measurement_functions_compile_without_reference_counting_and_allocating
 
     if not _jit.HAVE_NUMBA:
         pytest.skip("numba not installed")
-    assert zero_velocity_measure.targetoptions.get("_nrt") is False
+    from footzoo.kernels.internals import counts_references
+
+    assert not counts_references(zero_velocity_measure.compiled())
     fn = measurement_function(_allocating_measure)  # compiled with reference counting (or loaded so from the cache)
     z, H, R = np.zeros(3), np.zeros((3, 9)), np.zeros(3)
     nav = np.zeros(16)
     nav[7:10] = [1.0, 2.0, 3.0]
     idx = np.array([0, -1, 3, 6, -1], dtype=np.int64)
     conv = fn.compiled()  # the calling convention the loop calls, with the function compiled into it
-    assert conv.targetoptions.get("_nrt") is not False
+    assert counts_references(conv)
     m = conv(0, 0.0, nav, np.zeros(3), np.zeros(3), True, idx, np.array([1e-4]), np.zeros(0), np.zeros(0), z, H, R, 0)
     assert m == 3 and z.tolist() == [1.0, 2.0, 3.0] and H[:, 6:9].tolist() == np.eye(3).tolist()
     # called itself, it is the function as written, in Python: the same rows
@@ -252,10 +253,10 @@ def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call()
     result is the kernel's, and a signature not compiled yet (another dtype, a strided view, a read-only
     array) goes through the dispatcher."""
     from footzoo.kernels import jit as _jit
-    from footzoo.kernels.functions import DirectCall
+    from footzoo.kernels.functions import direct
 
     kernel = _jit.njit(_scaled_sum)
-    call = DirectCall(kernel)
+    call = direct(kernel)
     out, expected = np.zeros(1), np.zeros(1)
     x64 = np.arange(10.0)
     frozen = np.arange(4.0)
@@ -279,6 +280,6 @@ def test_a_direct_call_runs_the_machine_code_numba_would_choose_for_every_call()
 
 
 def test_a_direct_call_of_a_python_function_calls_it():
-    from footzoo.kernels.functions import DirectCall
+    from footzoo.kernels.functions import direct
 
-    assert DirectCall(lambda a, b: a + b)(2, 3) == 5
+    assert direct(lambda a, b: a + b)(2, 3) == 5
