@@ -289,6 +289,12 @@ class GaitScan:
         self._pending: list[int] | None = list(CHECKPOINTS)  # None once judged at the end
         self._motion = [0.0, 0, 0]  # moving time (s), moving samples, of them turning
         self._t_last: float | None = None
+        self._cut: int | None = None  # the first sample of a sensor dropout: the rate is judged before it
+
+    def exclude_from(self, sample: int) -> None:
+        """A sensor dropped out from ``sample`` on (:func:`footzoo.core.sanity.find_frozen`): its data say nothing
+        of the rate, so the rate is judged on the strides and swings before it only."""
+        self._cut = sample if self._cut is None else min(self._cut, sample)
 
     @property
     def strides(self) -> np.ndarray:
@@ -396,6 +402,8 @@ class GaitScan:
         if self._pending is None or "rate" in self.report or "gyro_unit" in self.report or not (self._pending or final):
             return
         rows = np.asarray(self._rows, dtype=float).reshape(-1, 8)
+        if self._cut is not None:
+            rows = rows[rows[:, 6] < self._cut]
         while self._pending and len(rows) >= self._pending[0]:
             m = self._pending[0]
             until = int(rows[m - 1, 6])
@@ -413,7 +421,8 @@ class GaitScan:
         """Judge the rate on the strides ``rows`` and the swings ending by sample ``until`` (None: every stride and
         swing; the strides are then too few to count); warn if a rate is named."""
         gait = stride_summary(rows[:, :6]) if until is not None else None
-        evidence = self.evidence.time_scales(until) if self.evidence is not None else None
+        last = until if until is not None or self._cut is None else self._cut - 1
+        evidence = self.evidence.time_scales(last) if self.evidence is not None else None
         if evidence is not None and evidence["swings"] < MIN_SWINGS:
             evidence = None
         if gait is None and evidence is None:

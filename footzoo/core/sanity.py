@@ -702,6 +702,11 @@ class EstimateScan:
         self.gait.use_evidence(evidence)
         self._plausibility()
 
+    def dropouts(self, found: list[dict[str, Any]]) -> None:
+        """Sensor dropouts (:func:`find_frozen`'s findings): the gait's plausibility judges the rate before them."""
+        if found:
+            self.gait.exclude_from(min(int(d["first"]) for d in found))
+
     def _plausibility(self) -> None:
         if self.gait.report:
             self.report["plausibility"] = self.gait.report

@@ -119,6 +119,10 @@ class Implementation(ABC):
         return nav0
 
 
+class RowCountError(TypeError):
+    """A model's ``measure`` returned something that is not a row count (None, a fraction, an array)."""
+
+
 def model_fault(setup: Setup, j: int, rows: int, k: int, caught: list[BaseException], where: str) -> PluginError:
     """The :class:`~footzoo.core.errors.PluginError` of model ``j`` (−1: not known) that broke its contract at
     sample ``k`` in ``where`` (the engine's loop): a row count ``rows`` outside ``[m, m + max_rows]``, or an
@@ -127,6 +131,8 @@ def model_fault(setup: Setup, j: int, rows: int, k: int, caught: list[BaseExcept
     suspects = [name for name, m in zip(names, models, strict=True)
                 if not all(trusted(fn) for fn in (m.measure, m.feedback, m.after))] or names
     who = names[j] if j >= 0 else suspects[0] if len(suspects) == 1 else "one of " + ", ".join(suspects)
+    if caught and isinstance(caught[0], RowCountError):
+        return PluginError(f"{who}: its measure function {caught[0]} at sample {k}", plugin=who, method="measure")
     if caught:  # a bounds-checked write failed (the call then returns 0, which may also look like a row count)
         err = caught[0]
         text = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__

@@ -2,8 +2,8 @@
 
 A Kalman correction owns its measurement model: a few plain-array functions
 and the arrays they work on, collected in a :class:`MeasurementModel`. The
-compiled loop (:mod:`footzoo.filters.kalman_fast`), the filterpy reference loop
-(:mod:`footzoo.filters.kalman_reference`) and the live stream all call the same
+compiled loop (:mod:`footzoo.filters.forward`), the filterpy reference loop
+(:mod:`footzoo.filters.reference`) and the live stream all call the same
 functions; the engine knows no correction by name.
 
 The three functions (compile them with :func:`measurement_function`,

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
-from .implementation import TRAJECTORY, Implementation, model_fault
+from .implementation import TRAJECTORY, Implementation, RowCountError, model_fault
 from .measurement import BA, BG, MeasurementModel, P, Q, V, calling
 from .process_noise import velocity_variance
 from .recorders import ROW_KEYS, SAMPLE_KEYS, columns, packed, record
@@ -176,7 +176,7 @@ class Loop:
         m = 0
         for j, (model, a) in enumerate(zip(self.state.models, args, strict=True)):
             top = m + model.max_rows
-            m_new = int(call(j, self.k0 + k, self.measures[j], *a, z[:top], H[:top], R[:top], m))
+            m_new = row_count(j, self.k0 + k, call(j, self.k0 + k, self.measures[j], *a, z[:top], H[:top], R[:top], m))
             if m_new < m or m_new > top:
                 raise ModelFault(j, m_new - m, self.k0 + k)
             m = m_new
@@ -220,6 +220,16 @@ def call(j: int, k: int, fn, *args):
         return fn(*args)
     except Exception as err:
         raise ModelFault(j, 0, k, err) from err
+
+
+def row_count(j: int, k: int, got: Any) -> int:
+    """What model ``j``'s ``measure`` returned at sample ``k`` as a row count; anything but a whole number is a
+    :class:`ModelFault` (the compiled loop's signature refuses it when the function compiles)."""
+    if isinstance(got, (int, np.integer)) and not isinstance(got, (bool, np.bool_)):
+        return int(got)
+    raise ModelFault(j, 0, k, RowCountError(
+        f"returned {got!r} ({type(got).__name__}), not a row count: return m plus the number of rows it "
+        "wrote (an int; m itself when it writes none)"))
 
 
 def outputs(n: int, nx: int) -> dict[str, np.ndarray]:

@@ -266,7 +266,7 @@ class Pipeline:
         rec : Recording
             The input.
         engine : {"auto", "fast", "reference"}
-            For Kalman-filter pipelines: the compiled loop (:mod:`footzoo.filters.kalman_fast`)
+            For Kalman-filter pipelines: the compiled loop (:mod:`footzoo.filters.compiled`)
             or the reference loop on filterpy's ``KalmanFilter``; ``auto`` takes the compiled
             one when every correction's measurement model compiles, else the reference with a
             warning. Both give the same numbers.
@@ -304,6 +304,7 @@ class Pipeline:
         steps = self.analyse(rec, stance, nav["quat"], nav["pos"], stances, sagittal)
         guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
+        scan.dropouts(rec.meta.get("sanity", {}).get("frozen", []))  # a frozen channel explains what follows it
         scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
         axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
         axes.push_recording(rec.t, rec.acc, rec.gyr)

@@ -401,6 +401,7 @@ class Stream:
 
         def scan_final(k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
                        pos: np.ndarray) -> None:
+            self._estimates.dropouts(self._signals.report.get("frozen", []))  # found in the raw data, ahead
             self._estimates.push(k, t, acc, gyr, stance, pos)
             self._axes.push(k, t, acc, gyr)
 

@@ -74,6 +74,21 @@ def no_rows(ctx, rows):
     return m
 
 
+def forgets_count(ctx, rows):
+    """Plain Python: writes its row but returns nothing (the row count forgotten)."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
+    if stance:
+        H[m, idx[VEL]] = 1.0
+        R[m] = 0.01
+
+
+def fractional_count(ctx, rows):
+    """Plain Python: returns a row count that is not a whole number."""
+    z, H, R, m = rows
+    return m + 0.5
+
+
 @feedback_function
 def far_memory(ctx, dx):
     """Writes past the end of its two-value memory."""
@@ -81,7 +96,10 @@ def far_memory(ctx, dx):
 
 
 FUNCTIONS = {"three_rows": (three_rows, None), "far_write": (far_write, None), "claims_rows": (claims_rows, None),
-             "gives_back": (gives_back, None), "far_memory": (no_rows, far_memory)}
+             "gives_back": (gives_back, None), "far_memory": (no_rows, far_memory),
+             "forgets_count": (forgets_count, None), "fractional_count": (fractional_count, None)}
+#: Plain-Python functions: only the reference engine runs them (``auto`` falls back to it with a warning).
+PLAIN = ("forgets_count", "fractional_count")
 
 
 class Careless(KalmanCorrection):
@@ -124,10 +142,11 @@ def _config(how: str) -> dict:
 
 CAUSES = {"three_rows": "outside the rows its model declares", "far_write": "outside the rows its model declares",
           "claims_rows": "returned 5 rows at sample", "gives_back": "below the first free row",
-          "far_memory": "outside the rows its model declares"}
+          "far_memory": "outside the rows its model declares", "forgets_count": r"returned None \(NoneType\)",
+          "fractional_count": r"returned \d+\.5 \(float\), not a row count"}
 
 
-@pytest.mark.parametrize("how", list(FUNCTIONS))
+@pytest.mark.parametrize("how", [h for h in FUNCTIONS if h not in PLAIN])
 def test_a_careless_kalman_plugin_is_a_plugin_error_naming_it(how, walk):
     pipe = Pipeline.from_dict(_config(how))
     with pytest.raises(PluginError, match=CAUSES[how]) as info:
@@ -137,6 +156,15 @@ def test_a_careless_kalman_plugin_is_a_plugin_error_naming_it(how, walk):
     # the process goes on: the same pipeline without the plug-in still runs and gives the right numbers
     good = Pipeline.from_dict({**_config(how), "corrections": [{"type": "ekf_zupt"}]}).run(walk)
     assert np.isfinite(good.pos).all()
+
+
+@pytest.mark.parametrize("how", PLAIN)
+def test_a_measure_that_returns_no_row_count_is_a_plugin_error_naming_it(how, walk):
+    """None (a forgotten return) or a fraction is refused with what it returned and what to return."""
+    with pytest.raises(PluginError, match=CAUSES[how]) as info:
+        Pipeline.from_dict(_config(how)).run(walk, engine="reference")
+    assert info.value.plugin == f"correction 'test_careless_{how}'" and info.value.method == "measure"
+    assert "return m plus the number of rows" in str(info.value)
 
 
 @pytest.mark.parametrize("how", ["three_rows", "claims_rows", "far_memory"])

@@ -139,3 +139,34 @@ def test_a_gyroscope_in_rad_s_declared_as_deg_s_is_named_batch_and_live(walk):
     _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([5, 40])))
     assert stream.sensor["plausibility"]["gyro_unit"]["sample"] == finding["sample"]
     assert len(live) == 1
+
+
+def _frozen_acc(rec: Recording, lo: int, hi: int, name: str) -> Recording:
+    """``rec`` with its accelerometer repeating sample ``lo``'s reading up to ``hi`` (a dropout; it is warned)."""
+    acc = rec.acc.copy()
+    acc[lo:hi] = acc[lo]
+    with pytest.warns(SensorWarning, match="the accelerometer repeats one reading"):
+        return Recording(t=rec.t, acc=acc, gyr=rec.gyr, meta={"name": name})
+
+
+def test_a_dropped_out_accelerometer_is_not_named_a_wrong_rate_batch_and_live():
+    """Its frozen reading makes the gait implausible after it, which the dropout explains (and its warning names)."""
+    straight = simulate(n_strides=20, rate=100.0, noise=NoiseModel(seed=1))
+    rec = _frozen_acc(straight, 300, 1200, "dropout")
+    # recommended: its Kalman filter turns the frozen stretch into short, fast strides (named ½ the rate before)
+    res, found = _sensor_warnings(lambda: Pipeline.from_yaml("recommended").run(rec))
+    assert "rate" not in res.diagnostics["sensor"].get("plausibility", {}) and not any("sampled at" in m for m in found)
+    stream = Stream(Pipeline.from_yaml("recommended_live"), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([1, 23, 7, 64])))
+    assert stream.sensor["frozen"][0]["first"] == 300  # the live scan found the dropout
+    assert "rate" not in stream.sensor.get("plausibility", {}) and not any("sampled at" in m for m in live)
+
+
+def test_a_wrong_rate_before_a_dropout_is_still_named(walk):
+    """The strides before the dropout are judged: ×2 is named with the real rate."""
+    half = Recording(t=walk.t / 2.0, acc=walk.acc, gyr=walk.gyr, meta={"name": "relabelled"})
+    rec = _frozen_acc(half, walk.n - 200, walk.n - 20, "relabelled")
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["rate"]
+    assert finding["likely_rate"] == 100.0 and finding["until_sample"] < walk.n - 200
+    assert sum("probably sampled at 100 Hz" in m for m in found) == 1
