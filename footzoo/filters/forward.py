@@ -40,7 +40,7 @@ from ..kernels.dispatch import by_type
 from ..kernels.jit import njit
 from ..kernels.views import unowned
 from .measurement import BA, BG, P, Q, V
-from .process_noise import Noise, add_process_noise
+from .process_noise import add_process_noise, unowned_noise
 from .recorders import before, begin, end, row, transition, updated, views
 from .smoother import feed_back_attitude, unowned_trajectory
 from .strapdown import mid_rotation, quat_product, rotvec_quat
@@ -93,7 +93,7 @@ def forward_span(signals, core, state, models, out, k0, work, rec, lo, hi):
     # handing them to the models' functions and to the inlined steps costs no reference counting
     t, acc, gyr, stance, quat_ext = signals.t, signals.acc, signals.gyr, signals.stance, signals.quat_ext
     offs, gravity = core.offsets, core.gravity
-    noise = Noise(unowned(core.noise.q), core.noise.impact, core.noise.integration)
+    noise = unowned_noise(core.noise)
     st8 = FilterState(unowned(state.nav), unowned(state.P), unowned(state.mems))
     functions, arrays = models.functions, unowned_arrays(models.arrays)
     w = unowned_workspace(work)

@@ -52,7 +52,7 @@ import numpy as np
 
 from ..kernels.jit import njit
 from ..kernels.views import unowned
-from .process_noise import Noise, velocity_variance
+from .process_noise import unowned_noise, velocity_variance
 from .strapdown import mid_rotation, quat_product, rotvec_quat
 from .structures import ForwardPass, Record, Trajectory, Transitions, UpdateRows
 
@@ -233,7 +233,7 @@ def smooth_free_span(lo, hi, cov, r_lo, lam, fwd, noise, gravity, offs, use_ext,
         return
     # views that own no reference (the arguments outlive the call), read at every sample
     fwd = ForwardPass(unowned(fwd.t), unowned(fwd.quat), unowned(fwd.acc_nav), unowned(fwd.acc))
-    noise = Noise(unowned(noise.q), noise.impact, noise.integration)
+    noise = unowned_noise(noise)
     tr = work.transitions
     mus, phis = unowned(work.mus), Transitions(unowned(tr.dt), unowned(tr.skew_dt), unowned(tr.c_dt))
     e, mu, c, lam = unowned(work.e), unowned(work.mu), unowned(work.c), unowned(lam)
