@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .checks import check_positive
+from .checks import check_positive, gap_limit
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
 from .errors import FootzooWarning, RecordingError
 from .norms import row_norms
@@ -30,12 +30,6 @@ TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
 
 #: Shortest recording footzoo accepts (s): the initial alignment needs still samples.
 MIN_DURATION = 1.0
-#: Default largest gap between samples that is bridged (s); longer gaps are refused. A logger that
-#: drops a tenth of a second now and then (110-120 ms gaps in annotated 100 Hz gait recordings) is
-#: read with a warning; a gap this long in a swing loses the swing's motion, which the warning says.
-DEFAULT_MAX_GAP = 0.25
-#: ... or this many median sample periods, when that is longer (slow loggers).
-DEFAULT_MAX_GAP_PERIODS = 5.0
 #: A bridged gap longer than this (s) is named in the warning: in a swing it loses motion.
 LOSSY_GAP = 0.1
 #: Plausible median sampling rate of a foot-mounted IMU (Hz); outside it the time stamps are not in seconds.
@@ -491,19 +485,6 @@ def _check_truth(truth: Truth, n: int) -> None:
                     f"ground truth {name}: {where}; truth must cover every IMU sample: trim the recording to the "
                     "reference's time span, or drop the truth columns"
                 )
-
-
-def gap_limit(period: float, max_gap: float | None = None) -> float:
-    """Largest gap bridged (s): ``max_gap`` when given, else ``max(DEFAULT_MAX_GAP, 5 periods)``.
-
-    Parameters
-    ----------
-    period : float
-        Median sample period (s).
-    max_gap : float, optional
-        The user's limit (s).
-    """
-    return max_gap if max_gap is not None else max(DEFAULT_MAX_GAP, DEFAULT_MAX_GAP_PERIODS * period)
 
 
 def _max_gap(rec: Recording, period: float) -> float:

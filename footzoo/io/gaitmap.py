@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.checks import check_positive, check_range
-from ..core.data import Recording, Truth, gap_limit
+from ..core.checks import check_positive, check_range, gap_limit
+from ..core.data import Recording, Truth
 from ..core.errors import FootzooWarning, FormatError
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import RECORDING_OPTIONS, Option, Reader, first_line, frame_options, text_source

@@ -78,7 +78,7 @@ def read(
     duplicates : {"drop", "error"}
         Repeated time stamps (the example file has about 1 % exact duplicates).
     max_gap : float, optional
-        Largest gap bridged (s); default :data:`footzoo.core.data.DEFAULT_MAX_GAP`.
+        Largest gap bridged (s); default :data:`footzoo.core.checks.DEFAULT_MAX_GAP`.
     closed_loop : bool, optional
         Whether the walk ends where it started. Default: true for x-io's example walk, else what
         the metadata sidecar says, else false.

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.checks import validate_block, validate_sample
+from ..core.checks import gap_limit, validate_block, validate_sample
 from ..core.context import RunContext
 from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
@@ -73,8 +73,10 @@ class Stream:
         Nominal sampling rate (Hz) of the run context; default: measured over the still start.
     engine : {"auto", "fast", "reference"}
         As :meth:`Pipeline.run`.
-    max_gap : float
-        Longest accepted time between two pushed samples (s); a longer gap is an error.
+    max_gap : float, optional
+        Longest accepted time between two pushed samples (s); a longer gap is an error. Default: what a
+        batch run bridges (:func:`footzoo.core.checks.gap_limit`: 0.25 s, or 5 periods of the rate when
+        that is longer), so a recording that runs in batch runs live.
     max_wait : float
         How long the stream waits for the first still period (s) before it gives up with an error.
     fits : list of dict or Result, optional
@@ -100,7 +102,7 @@ class Stream:
     >>> rest = s.close()                 # at the end of the data: the remaining ones
     """
 
-    def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float = 0.1,
+    def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float | None = None,
                  max_wait: float = 10.0, fits: Any = None, warmup: float = STREAM_WARMUP, guess: bool = True,
                  max_pending: float = 30.0, keep: bool = False):
         if not callable(getattr(pipeline, "live_problems", None)):
@@ -113,6 +115,8 @@ class Stream:
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
         for label, value in (("max_gap", max_gap), ("max_wait", max_wait), ("warmup", warmup),
                              ("max_pending", max_pending)):
+            if label == "max_gap" and value is None:
+                continue
             if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < np.inf):
                 reasons.append(f"{label} must be a positive number of seconds, got {value!r}")
         if reasons:
@@ -120,7 +124,8 @@ class Stream:
         self.pipeline = pipeline
         self.rate = rate
         self.engine = engine
-        self.max_gap, self.max_wait, self.warmup, self.max_pending = max_gap, max_wait, warmup, max_pending
+        self.max_wait, self.warmup, self.max_pending = max_wait, warmup, max_pending
+        self._max_gap = max_gap  # as given; the limit in force is max_gap (with the rate once it is known)
         self.guess = guess
         self.init = dict(pipeline.init)
         self._fits = _fit_reports(fits)
@@ -146,6 +151,13 @@ class Stream:
         self.log: list[dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ public
+    @property
+    def max_gap(self) -> float:
+        """The longest gap between two pushed samples accepted now (s): ``max_gap`` as given, else the batch
+        run's limit at the stream's rate (the given one, or the one measured at the start; 0.25 s before)."""
+        rate = self.ctx.rate if self.ctx is not None else self.rate
+        return gap_limit(1.0 / rate if rate else 0.0, self._max_gap)
+
     @property
     def latency(self) -> Latency:
         """The pipeline's declared latency at the stream's rate (at its nominal rate before the start)."""

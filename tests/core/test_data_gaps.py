@@ -8,7 +8,7 @@ import pytest
 
 import footzoo
 from footzoo import Recording, RecordingError
-from footzoo.core.data import DEFAULT_MAX_GAP
+from footzoo.core.checks import DEFAULT_MAX_GAP
 from footzoo.core.errors import FootzooWarning
 from footzoo.evaluation.metrics import loop_closure
 from footzoo.sim import simulate

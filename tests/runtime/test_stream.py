@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import footzoo
-from footzoo import ConfigError, Pipeline, Recording, RecordingError, Stream
+from footzoo import ConfigError, FootzooWarning, Pipeline, Recording, RecordingError, Stream
 from footzoo.config import names
 from footzoo.core.context import RunContext
 from footzoo.plugins.incremental import WHOLE_RECORDING, Latency
@@ -281,3 +281,24 @@ def test_the_stepwise_smoother_closes_a_long_stance_after_max_segment_seconds():
     final = {key: np.concatenate([q[key] for q in parts]) for key in parts[0]}
     assert max(held) <= (MAX_SEGMENT + 1.5) * rec.rate + 25
     assert_final_equals_batch(final, batch, "recommended (stepwise), standing")
+
+
+def test_a_gap_that_a_batch_run_bridges_is_bridged_live_with_the_same_estimates():
+    """A 0.2 s gap (a logger that dropped 20 samples) runs in batch and live, to the same numbers."""
+    walk = simulate(n_strides=6, rate=100.0, noise=NoiseModel(seed=3))
+    keep = np.ones(walk.n, bool)
+    keep[400:419] = False  # 19 samples dropped: one gap of 0.2 s
+    with pytest.warns(FootzooWarning, match="gap"):
+        rec = Recording(t=walk.t[keep], acc=walk.acc[keep], gyr=walk.gyr[keep])
+    pipe = Pipeline.from_yaml("recommended_live")
+    batch = pipe.run(rec)
+    stream = Stream(pipe, rate=rec.rate)  # the batch run's rate (its median), as every live == batch test
+    assert stream.max_gap == 0.25  # the batch run's limit at 100 Hz
+    live = stream.run(rec, chunk=np.array([7, 50]))
+    np.testing.assert_allclose(live["pos"], batch.pos, rtol=0, atol=1e-9)
+
+
+def test_the_gap_limit_follows_a_slow_rate_and_a_given_one():
+    pipe = Pipeline.from_yaml("recommended_live")
+    assert Stream(pipe, rate=10.0).max_gap == pytest.approx(0.5)  # 5 periods of 0.1 s
+    assert Stream(pipe, rate=100.0, max_gap=0.05).max_gap == 0.05
