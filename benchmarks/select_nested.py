@@ -66,7 +66,14 @@ from accuracy import (  # noqa: E402
     run_stride_references,
 )
 from nested_cv import held_out_of, improves, nested_choice, stratified_folds  # noqa: E402
-from select_recommended import RATE_CHECK_M, REFINE_FIXED, build, class_score, rate_check  # noqa: E402
+from select_recommended import (  # noqa: E402
+    NESTED_MARK,
+    RATE_CHECK_M,
+    REFINE_FIXED,
+    build,
+    class_score,
+    rate_check,
+)
 
 from footzoo.studies import Study  # noqa: E402
 from footzoo.studies.report import to_markdown  # noqa: E402
@@ -105,7 +112,6 @@ CHECKS = {
     "Köroğlu footprint RMS, mean of 31-33 (m)": "min",
     "Köroğlu stride count errors (sum of abs)": "min",
 }
-NESTED_MARK = "<!-- nested: written by select_recommended.py --nested -->"
 
 
 def name_of(th: float, vs: float, roll: float) -> str:

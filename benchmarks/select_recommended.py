@@ -152,6 +152,8 @@ REFINE_FIXED = {"noise": (1e-6, 0.03, 0.03), "impact": 0.0, "smoother": "rts", "
 REFINE_STAIRS = {"path": "stairs", "n_strides": 6, "landing_strides": 3, "cycle": 1.2, "clearance": 0.1,
                  "profile": "physical", "noise": {"scale": 1}}
 REFINE_MARK = "<!-- refinement: written by select_recommended.py --refine -->"
+#: Where ``--nested``'s section starts (a ``--refine`` run keeps it).
+NESTED_MARK = "<!-- nested: written by select_recommended.py --nested -->"
 
 
 def build(det: dict[str, Any], noise: tuple[float, float, float], impact: float, smoother: str,
@@ -322,8 +324,10 @@ def main(argv: list[str] | None = None) -> int:
     out = ROOT / "benchmarks" / "recommended_selection.md"
     if args.refine:
         lines = refine_section(cands, err, err3, best, classes, folds, cv, final, insample, args)
-        head = out.read_text().split(REFINE_MARK)[0].rstrip("\n") if out.exists() else ""
-        out.write_text(f"{head}\n\n{REFINE_MARK}\n\n" + "\n".join(lines))
+        text = out.read_text() if out.exists() else ""
+        head = text.split(REFINE_MARK)[0].split(NESTED_MARK)[0].rstrip("\n")
+        nested = f"\n\n{NESTED_MARK}{text.split(NESTED_MARK, 1)[1]}" if NESTED_MARK in text else ""
+        out.write_text(f"{head}\n\n{REFINE_MARK}\n\n" + "\n".join(lines) + nested)
     else:
         out.write_text("\n".join(lines))
     print("\n".join(lines))
