@@ -26,14 +26,17 @@ error-state Kalman filter's noises, RTS smoothing, no swing guard, the speed-ada
 
 Outer folds: 6, stratified by motion class (:func:`nested_cv.stratified_folds`, seed :data:`SEED`): every
 fold holds 6 trials, 3 or 4 walking and 1 or 2 running/fast, and the slow unusual and inverted trials sit
-in three different folds. Stratified k-fold, not leave-one-class-out: the question is how the procedure
-does on new trials of the kinds it was chosen on (the hidden PyShoe trials, other labs' walks), and
-leaving a whole class out would hold out 23 walking trials in one fold and a single trial in another,
-and score every inverted or slow trial by a choice that never saw one. The inner choice is the existing
+in three different folds (the folds are listed in the report). Stratified k-fold, not leave-one-class-out:
+the question is how the procedure does on new trials of the kinds it was chosen on (more recordings of the
+same lab, other labs' walks), and leaving a whole class out would hold out 23 walking trials in one fold and
+a single trial in another, and score both slow trials by a choice that saw no slow motion (the one inverted
+trial is scored without an inverted trial either way). The inner choice is the existing
 selection on the training trials only: among the settings that pass the rate check (simulated
 mixed-speed walk at 100 and 200 Hz, :func:`select_recommended.rate_check`), the best score (per motion
 class the geometric mean of error / PyShoe's per-trial best, classes weighted equally,
 :func:`select_recommended.class_score`). A failed run counts as infinitely wrong in the held-out figures.
+The report also cross-validates the same procedure among the 12 zero-velocity candidates alone (``zupt
+grid``: the refinement's own choice, held out).
 """
 
 from __future__ import annotations
@@ -177,6 +180,7 @@ def other_references(cands: list[dict[str, Any]], data: Path, folder: Path, jobs
 
 
 def _other_rows(paths: dict[str, Path], data: Path, folder: Path, jobs: int) -> dict[str, dict[str, Any]]:
+    """:func:`other_references` for the candidates not cached: name -> {reference column: value}."""
     from accuracy_events import event_cell
     from accuracy_events import recordings as event_recordings
     from joblib import Parallel, delayed
