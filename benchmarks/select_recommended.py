@@ -119,6 +119,20 @@ RATE_CHECK_SIM = {"path": "mixed_speed", "profile": "physical", "clearance": 0.1
 RATE_CHECK_M = 0.5
 
 
+def rate_check(cands: list[dict[str, Any]], folder: Path, jobs: int) -> pd.Series:
+    """Per setting, the worse ARMSE (m) of the simulated mixed-speed walk at 100 and 200 Hz (the rate check).
+
+    PyShoe is all 200 Hz; a setting qualifies only if it also tracks the simulated mixed-speed walk (0.85 to
+    3.2 m/s, Table II noise) at 100 and at 200 Hz within :data:`RATE_CHECK_M`.
+    """
+    sim = Study.from_dict({"name": "select_recommended_rates", "base": cands, "metrics": ["armse_3d_m"],
+                           "recordings": [{"simulate": {**RATE_CHECK_SIM, "rate": r}, "seeds": [0],
+                                           "label": f"mixed_speed_{r}hz"} for r in (100, 200)]})
+    st = run_cached(sim, folder, jobs)
+    sim_err = st[st["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value")
+    return sim_err.max().reindex([c["name"] for c in cands])
+
+
 def candidates() -> list[dict[str, Any]]:
     """Every grid setting as a full config."""
     return [build(*c) for c in itertools.product(detector_grid(), NOISE_GRID, IMPACT, SMOOTHERS, GUARDS)]
@@ -138,6 +152,8 @@ REFINE_FIXED = {"noise": (1e-6, 0.03, 0.03), "impact": 0.0, "smoother": "rts", "
 REFINE_STAIRS = {"path": "stairs", "n_strides": 6, "landing_strides": 3, "cycle": 1.2, "clearance": 0.1,
                  "profile": "physical", "noise": {"scale": 1}}
 REFINE_MARK = "<!-- refinement: written by select_recommended.py --refine -->"
+#: Where ``--nested``'s section starts (a ``--refine`` run keeps it).
+NESTED_MARK = "<!-- nested: written by select_recommended.py --nested -->"
 
 
 def build(det: dict[str, Any], noise: tuple[float, float, float], impact: float, smoother: str,
@@ -236,6 +252,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--refine", action="store_true",
                     help="only the speed-adaptive detector x its provisional pass's shortest swing x the roll lever "
                          "(REFINE_*)")
+    ap.add_argument("--nested", action="store_true",
+                    help="nested cross-validation of the selection procedure on the NESTED_* candidates and the "
+                         "decision rule (with --write: recommended.yaml and recommended_live.yaml if it says so)")
     args = ap.parse_args(argv)
     os.environ.setdefault("PYTHONWARNINGS", "ignore::UserWarning")
     warnings.simplefilter("ignore", UserWarning)
@@ -243,15 +262,12 @@ def main(argv: list[str] | None = None) -> int:
     if not folder.is_dir():
         print(f"no PyShoe trials in {folder}: nothing to select on")
         return 1
+    if args.nested:
+        from select_nested import nested
+
+        return nested(args)
     cands = refine_candidates() if args.refine else candidates()
-    # rate check: PyShoe is all 200 Hz; a setting qualifies only if it also tracks the simulated
-    # mixed-speed walk (0.85 to 3.2 m/s, Table II noise) at 100 and at 200 Hz within RATE_CHECK_M
-    sim = Study.from_dict({"name": "select_recommended_rates", "base": cands, "metrics": ["armse_3d_m"],
-                           "recordings": [{"simulate": {**RATE_CHECK_SIM, "rate": r}, "seeds": [0],
-                                           "label": f"mixed_speed_{r}hz"} for r in (100, 200)]})
-    st = run_cached(sim, args.results / "select_recommended_rates", args.jobs)
-    sim_err = st[st["metric"] == "armse_3d_m"].pivot_table(index="recording", columns="base", values="value")
-    worst_sim = sim_err.max().reindex([c["name"] for c in cands])
+    worst_sim = rate_check(cands, args.results / "select_recommended_rates", args.jobs)
     qualified = set(worst_sim[worst_sim <= RATE_CHECK_M].index)
     print(f"{len(qualified)} of {len(cands)} settings pass the rate check")
     # the selection: footzoo.tune, leave-one-motion-class-out, among the settings that pass the rate check
@@ -308,8 +324,10 @@ def main(argv: list[str] | None = None) -> int:
     out = ROOT / "benchmarks" / "recommended_selection.md"
     if args.refine:
         lines = refine_section(cands, err, err3, best, classes, folds, cv, final, insample, args)
-        head = out.read_text().split(REFINE_MARK)[0].rstrip("\n") if out.exists() else ""
-        out.write_text(f"{head}\n\n{REFINE_MARK}\n\n" + "\n".join(lines))
+        text = out.read_text() if out.exists() else ""
+        head = text.split(REFINE_MARK)[0].split(NESTED_MARK)[0].rstrip("\n")
+        nested = f"\n\n{NESTED_MARK}{text.split(NESTED_MARK, 1)[1]}" if NESTED_MARK in text else ""
+        out.write_text(f"{head}\n\n{REFINE_MARK}\n\n" + "\n".join(lines) + nested)
     else:
         out.write_text("\n".join(lines))
     print("\n".join(lines))
