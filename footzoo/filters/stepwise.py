@@ -55,10 +55,16 @@ The start of a segment pinned (Colomar, Nilsson & Händel 2012, with the emitted
     e_s = 0`` (it ends where it ended before), and the correction grows with the distance the foot
     travels: a stance (no path) is not moved, so a standing foot stays still, and the extra move
     of a sample is ``|u_p| · |p_k − p_{k−1}| / ℓ_s``, a share of the foot's own move. Applied as the
-    feedback is (``p ← p + w u_p``, ``q ← exp(w u_φ) ⊗ q``, ``b ← b − w u_b``), with the velocity
-    kept the derivative of the position that moved::
+    feedback is::
 
-        v_k ← v_k + w_k u_v + ẇ_k u_p,    ẇ_k = (w_k − w_{k−1}) / (t_k − t_{k−1})          (2)
+        p_k ← p_k + w_k u_p,   v_k ← v_k + w_k u_v,   q_k ← exp(w_k u_φ) ⊗ q_k,   b_k ← b_k − w_k u_b   (2)
+
+    The velocity is not given the rate of the position's share, ``ẇ_k u_p``: ``u_p`` is what the
+    next stance tells of where the past was (mostly its heading), not a motion of the foot, and the
+    smoothed velocity is the better estimate of the foot's motion (measured on a simulated walk,
+    ``duong2015_zupt``, velocity RMSE against the truth: 0.0327 m/s without it, 0.0396 with it, the
+    filter's 0.0369, RTS 0.0301). Inside a stride the position so moves by ``u_p`` more than the
+    velocity integrates to, spread as the foot moves.
 
     When the foot does not move in a segment (ℓ_s = 0, a stance split by :data:`MAX_SEGMENT`)
     ``w_k = 1 − (t_k − t_{s₀+1}) / (t_s − t_{s₀+1})``                                      (3)
@@ -191,7 +197,7 @@ def pin_start(traj, t, lo, hi, u, offs, use_ext):
     """Take the correction ``u = e_lo`` of a smoothed segment's first sample back, restored along its path.
 
     ``ẽ_k = e_k − w_k u`` for k = lo … hi − 1 (module docstring, eqs. (1)–(3)): the position and
-    velocity ``p_k + w_k u_p``, ``v_k + w_k u_v + ẇ_k u_p``, the attitude ``exp(w_k u_φ) ⊗ q_k``,
+    velocity ``p_k + w_k u_p``, ``v_k + w_k u_v``, the attitude ``exp(w_k u_φ) ⊗ q_k``,
     the biases ``b_k − w_k u_b``, with ``w_k = 1 − ℓ_k / ℓ_hi`` (``ℓ_k``: the smoothed path length
     from sample lo to k, m); by time when the foot did not move. Sample hi stays as it is.
     """
@@ -204,22 +210,20 @@ def pin_start(traj, t, lo, hi, u, offs, use_ext):
         total += step_length(pos, k, prev)
     span = t[hi] - t[lo]
     prev[:] = pos[lo]
-    ell, w_before = 0.0, 1.0
+    ell = 0.0
     for k in range(lo, hi):
         ell += step_length(pos, k, prev) if k > lo else 0.0
         prev[:] = pos[k]  # before this sample is moved
         w = 1.0 - (ell / total if total > 0.0 else (t[k] - t[lo]) / span if span > 0.0 else 0.0)
-        rate = (w - w_before) / (t[k] - t[k - 1]) if k > lo and t[k] > t[k - 1] else 0.0
         for i in range(3):
             pos[k, i] += w * u[pos_i + i]
-            vel[k, i] += w * u[vel_i + i] + rate * u[pos_i + i]
+            vel[k, i] += w * u[vel_i + i]
             if gb_i >= 0:
                 traj.gyro_bias[k, i] -= w * u[gb_i + i]
             if ab_i >= 0:
                 traj.acc_bias[k, i] -= w * u[ab_i + i]
         if att >= 0 and not use_ext:
             feed_back_attitude(traj.quat[k], -w * u[att], -w * u[att + 1], -w * u[att + 2])
-        w_before = w
 
 
 def segment_ends(stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
