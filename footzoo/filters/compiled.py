@@ -156,7 +156,8 @@ class CompiledEngine(Implementation):
         rec = recorders.segment_record(longest, self.setup.layout.n, self.setup.m_max, n)
         self.step(state, sig, data, out, 0, rec)
         lo = int(rec.record.offset[0])
-        smooth_copy(rec.record, rec.smoothed, lo, n - 1, lo, self.core.offsets, self.core.use_ext, trajectory(out))
+        smooth_copy(rec.record, rec.smoothed, lo, n - 1, lo, self.core.offsets, self.core.use_ext, trajectory(out),
+                    sig.t)
         self.keep_forward(out, rec.smoothed)
 
     def _run_rts(self, state: CompiledState, sig: Signals, data: np.ndarray, out: dict[str, np.ndarray]) -> None:

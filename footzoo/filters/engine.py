@@ -29,7 +29,7 @@ from .implementation import Implementation, Setup
 from .measurement import CORE_BLOCKS, MeasurementModel, NotCompilable, StateBlock
 from .process_noise import noise_of
 from .reference import ReferenceEngine
-from .smoothing import smoothing
+from .smoothing import Smoothing, smoothing
 
 ENGINES = ("auto", "fast", "reference")
 
@@ -248,9 +248,10 @@ class KalmanEngine:
         """The models' results (e.g. a calibration) from their memory."""
         return self.implementation.diagnostics(state)
 
-    def smooth(self, rows: dict[str, np.ndarray], ends: np.ndarray) -> None:
-        """Smooth ``rows`` (per-sample ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and a record's
-        columns, sample k in row k) in place, segment by segment up to each of ``ends`` (increasing)."""
-        self.implementation.smooth(rows, ends)
+    def smooth(self, rows: dict[str, np.ndarray], ends: np.ndarray, smoother: bool | str | Smoothing) -> None:
+        """Smooth ``rows`` (per-sample ``t``, ``quat``, ``vel``, ``pos``, ``gyro_bias``, ``acc_bias`` and a record's
+        columns, sample k in row k) in place, segment by segment up to each of ``ends`` (increasing), as
+        ``smoother`` does (:mod:`footzoo.filters.smoothing`)."""
+        self.implementation.smooth(rows, ends, smoothing(smoother))
 
 

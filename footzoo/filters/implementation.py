@@ -22,7 +22,7 @@ from .eskf import Layout
 from .measurement import CORE_BLOCKS, MeasurementModel
 from .process_noise import Noise
 from .recorders import SAMPLE_KEYS, from_columns
-from .smoother import smooth_segments
+from .smoothing import Smoothing
 from .structures import Offsets, Trajectory
 
 #: The per-sample outputs a run returns, (N, 3) but ``quat`` (N, 4).
@@ -104,13 +104,13 @@ class Implementation(ABC):
                 diag.update(m.diagnostics(mem))
         return diag
 
-    def smooth(self, rows: dict[str, np.ndarray], ends: np.ndarray) -> None:
-        """Smooth ``rows`` (a chunk's outputs with its record's columns, sample k in row k) in place, segment by
-        segment up to each of ``ends`` (:func:`footzoo.filters.smoother.smooth_segments`)."""
+    def smooth(self, rows: dict[str, np.ndarray], ends: np.ndarray, smoothing: Smoothing) -> None:
+        """Smooth ``rows`` (a chunk's ``t`` and outputs with its record's columns, sample k in row k) in place,
+        segment by segment up to each of ``ends``, as ``smoothing`` does (:meth:`Smoothing.smooth`)."""
         rec = from_columns({k: rows[k] for k in SAMPLE_KEYS}, rows)
         traj = Trajectory(*(rows[k] for k in TRAJECTORY))
-        smooth_segments(rec, np.asarray(ends, np.int64), 0, 0, self.setup.offsets, not self.setup.carries_attitude,
-                        traj)
+        smoothing.smooth(rec, np.asarray(ends, np.int64), self.setup.offsets, not self.setup.carries_attitude, traj,
+                         rows["t"])
 
     def initial_nav(self, q0: np.ndarray, quat_ext: np.ndarray | None) -> np.ndarray:
         """The nominal state at sample 0: the attitude ``quat_ext[0]`` or ``q0``, at rest at the origin."""

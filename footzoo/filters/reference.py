@@ -97,7 +97,8 @@ class ReferenceEngine(Implementation):
         if smoothing:
             for key in ("quat", "vel", "pos"):
                 out[f"{key}_forward"] = out[key].copy()
-            self.smooth(out, smoothing.ends(np.asarray(stance, bool), np.asarray(t, float), True))
+            self.smooth({**out, "t": np.asarray(t, float)},
+                        smoothing.ends(np.asarray(stance, bool), np.asarray(t, float), True), smoothing)
         for key in (*SAMPLE_KEYS, *ROW_KEYS):
             out.pop(key, None)
         out["diagnostics"] = self.diagnostics(state)

@@ -25,7 +25,9 @@ from typing import ClassVar
 import numpy as np
 
 from ..core.errors import ConfigError
-from .stepwise import WAITS_FOR, segment_ends
+from .smoother import smooth_segments
+from .stepwise import WAITS_FOR, segment_ends, smooth_strides
+from .structures import Offsets, Record, Trajectory
 
 
 class Smoothing(ABC):
@@ -39,6 +41,12 @@ class Smoothing(ABC):
     @abstractmethod
     def ends(self, stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
         """The last sample of each segment that has closed (int, increasing); ``closed``: the data ends here."""
+
+    def smooth(self, rec: Record, ends: np.ndarray, offsets: Offsets, use_ext: bool, traj: Trajectory,
+               t: np.ndarray) -> None:
+        """Smooth ``traj`` in place, segment by segment up to each of ``ends`` (sample k in row k of ``rec``; ``t``
+        (N,) s): the closed-loop RTS recursion of :func:`footzoo.filters.smoother.smooth_segments`."""
+        smooth_segments(rec, ends, 0, 0, offsets, use_ext, traj)
 
     def __bool__(self) -> bool:
         return self.name != "none"
@@ -72,6 +80,11 @@ class Stepwise(Smoothing):
 
     def ends(self, stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
         return segment_ends(stance, t, closed)
+
+    def smooth(self, rec: Record, ends: np.ndarray, offsets: Offsets, use_ext: bool, traj: Trajectory,
+               t: np.ndarray) -> None:
+        """Each stride smoothed and its start pinned (:func:`footzoo.filters.stepwise.smooth_strides`)."""
+        smooth_strides(rec, ends, 0, 0, offsets, use_ext, traj, np.ascontiguousarray(t, dtype=float))
 
 
 #: The smoothers by name.

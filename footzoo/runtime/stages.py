@@ -317,7 +317,7 @@ class KalmanStage:
         if not ends.size:  # most packets end no stance: nothing to do
             return {}
         held = {**rows, "record_first": rows["record_first"] - self.rows_before, **self._open_rows()}
-        self.engine.smooth(held, ends)
+        self.engine.smooth(held, ends, self.smoothing)
         n_final = int(ends[-1]) + 1
         done = take(_public(rows), 0, n_final)
         released = int(held["record_first"][n_final - 1] + held["record_count"][n_final - 1])

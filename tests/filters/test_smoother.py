@@ -234,7 +234,7 @@ def _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat):
     state = ref.start(nav0)
     full = ref.advance(state, t, acc, gyr, stance, quat, [m.data for m in ref.setup.models], 0, True, record=True)
     forward = {k: full[k].copy() for k in ("quat", "vel", "pos", "acc_nav", "P_diag", "nis")}
-    ref.smooth(full, np.array([len(t) - 1]))
+    ref.smooth({**full, "t": t}, np.array([len(t) - 1]), "rts")
     return full, forward, ref.diagnostics(state)
 
 
