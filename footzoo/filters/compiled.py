@@ -157,7 +157,7 @@ class CompiledEngine(Implementation):
         self.step(state, sig, data, out, 0, rec)
         lo = int(rec.record.offset[0])
         smooth_copy(rec.record, rec.smoothed, lo, n - 1, lo, self.core.offsets, self.core.use_ext, trajectory(out),
-                    sig.t)
+                    sig.t, rec.work)
         self.keep_forward(out, rec.smoothed)
 
     def _run_rts(self, state: CompiledState, sig: Signals, data: np.ndarray, out: dict[str, np.ndarray]) -> None:

@@ -84,7 +84,7 @@ def trajectory(n_samples: int) -> Trajectory:
 def segment_record(longest: int, n: int, m_max: int, n_samples: int) -> SegmentRecord:
     """The step-wise smoother's record over a whole recording of ``n_samples``: the open segment's rows
     (at most ``longest`` samples) and the smoothed trajectory."""
-    return SegmentRecord(record(longest, n, m_max), trajectory(n_samples))
+    return SegmentRecord(record(longest, n, m_max), trajectory(n_samples), np.zeros((3, n)))
 
 
 def packed(P: np.ndarray) -> np.ndarray:
@@ -216,7 +216,7 @@ def _before_none(recorder, k, stance, t, offsets, use_ext, out, state):
 
 
 def _before_segment(recorder, k, stance, t, offsets, use_ext, out, state):
-    close_segment(recorder.record, recorder.smoothed, k, stance, t, offsets, use_ext, out.trajectory)
+    close_segment(recorder.record, recorder.smoothed, k, stance, t, offsets, use_ext, out.trajectory, recorder.work)
 
 
 def _before_checkpoint(recorder, k, stance, t, offsets, use_ext, out, state):
@@ -319,7 +319,8 @@ def _views_record(recorder):
 
 
 def _views_segment(recorder):
-    return SegmentRecord(unowned_record(recorder.record), unowned_trajectory(recorder.smoothed))
+    return SegmentRecord(unowned_record(recorder.record), unowned_trajectory(recorder.smoothed),
+                         unowned(recorder.work))
 
 
 def _views_checkpoint(recorder):

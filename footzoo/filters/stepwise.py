@@ -137,23 +137,24 @@ def _segment_ends(stance, t, closed):
 
 
 @njit(inline=True)
-def close_segment(rec, smoothed, k, stance, t, offs, use_ext, forward):
+def close_segment(rec, smoothed, k, stance, t, offs, use_ext, forward, work):
     """In the loop over a whole recording, before sample k: smooth the segment that sample k − 1 ended.
 
     The rule of :func:`segment_ends` (:func:`ends_segment`); ``rec`` (its ``offset``: the open
     segment's first sample) then starts afresh at sample k. ``forward``: the loop's outputs
-    (a :class:`~footzoo.filters.structures.Trajectory`), copied into ``smoothed`` and smoothed there.
+    (a :class:`~footzoo.filters.structures.Trajectory`), copied into ``smoothed`` and smoothed there;
+    ``work`` (3, n) the backward pass's.
     """
     lo = rec.offset[0]
     if ends_segment(stance, t, k - 1, lo):
-        smooth_copy(rec, smoothed, lo, k - 1, lo, offs, use_ext, forward, t)
+        smooth_copy(rec, smoothed, lo, k - 1, lo, offs, use_ext, forward, t, work)
         rec.offset[0] = k
 
 
 @njit
-def smooth_copy(rec, smoothed, lo, hi, off, offs, use_ext, forward, t):
+def smooth_copy(rec, smoothed, lo, hi, off, offs, use_ext, forward, t, work):
     """Samples ``lo … hi`` of the ``forward`` trajectory into ``smoothed``, smoothed there (record rows ``k − off``):
-    :func:`smooth_stride`."""
+    :func:`smooth_stride` (``work`` (3, n): its λ, μ, e)."""
     for k in range(lo, hi + 1):
         for i in range(4):
             smoothed.quat[k, i] = forward.quat[k, i]
@@ -162,8 +163,7 @@ def smooth_copy(rec, smoothed, lo, hi, off, offs, use_ext, forward, t):
             smoothed.pos[k, i] = forward.pos[k, i]
             smoothed.gyro_bias[k, i] = forward.gyro_bias[k, i]
             smoothed.acc_bias[k, i] = forward.acc_bias[k, i]
-    n = rec.rows.h.shape[1]
-    smooth_stride(rec, lo, hi, off, offs, use_ext, smoothed, t, np.empty(n), np.empty(n), np.empty(n))
+    smooth_stride(rec, lo, hi, off, offs, use_ext, smoothed, t, work[0], work[1], work[2])
 
 
 @njit
@@ -190,9 +190,9 @@ def smooth_strides(rec, ends, lo, off, offs, use_ext, traj, t):
 
 
 @njit(inline=True)
-def step_length(pos, k, prev):
-    """``|pos[k] − prev|`` (m), ``prev`` (3,) the position before sample k."""
-    return math.sqrt((pos[k, 0] - prev[0]) ** 2 + (pos[k, 1] - prev[1]) ** 2 + (pos[k, 2] - prev[2]) ** 2)
+def step_length(pos, k, x, y, z):
+    """``|pos[k] − (x, y, z)|`` (m), ``(x, y, z)`` the position before sample k."""
+    return math.sqrt((pos[k, 0] - x) ** 2 + (pos[k, 1] - y) ** 2 + (pos[k, 2] - z) ** 2)
 
 
 @njit
@@ -206,17 +206,15 @@ def pin_start(traj, t, lo, hi, u, offs, use_ext):
     """
     att, gb_i, pos_i, vel_i, ab_i = offs.att, offs.gyro_bias, offs.pos, offs.vel, offs.acc_bias
     pos, vel = traj.pos, traj.vel
-    prev = np.empty(3)
     total = 0.0
     for k in range(lo + 1, hi + 1):
-        prev[:] = pos[k - 1]
-        total += step_length(pos, k, prev)
+        total += step_length(pos, k, pos[k - 1, 0], pos[k - 1, 1], pos[k - 1, 2])
     span = t[hi] - t[lo]
-    prev[:] = pos[lo]
+    x, y, z = pos[lo, 0], pos[lo, 1], pos[lo, 2]
     ell = 0.0
     for k in range(lo, hi):
-        ell += step_length(pos, k, prev) if k > lo else 0.0
-        prev[:] = pos[k]  # before this sample is moved
+        ell += step_length(pos, k, x, y, z) if k > lo else 0.0
+        x, y, z = pos[k, 0], pos[k, 1], pos[k, 2]  # before this sample is moved
         w = 1.0 - (ell / total if total > 0.0 else (t[k] - t[lo]) / span if span > 0.0 else 0.0)
         for i in range(3):
             pos[k, i] += w * u[pos_i + i]

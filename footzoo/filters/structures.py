@@ -216,10 +216,12 @@ class Record(NamedTuple):
 
 class SegmentRecord(NamedTuple):
     """The step-wise smoother inside the loop over a whole recording: the open segment's ``record``
-    (its first sample is ``record.offset[0]``) and the ``smoothed`` trajectory the closed segments go to."""
+    (its first sample is ``record.offset[0]``), the ``smoothed`` trajectory the closed segments go to
+    and the backward pass's ``work`` (3, n): λ, μ, e (the loop allocates nothing)."""
 
     record: Record
     smoothed: Trajectory
+    work: np.ndarray
 
 
 class Checkpoints(NamedTuple):

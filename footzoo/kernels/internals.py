@@ -1,7 +1,7 @@
 """Every use of numba's private API in footzoo, in one module.
 
-Tested with numba 0.61 to 0.68 (``setup.cfg`` pins ``numba>=0.61,<0.69``; CI installs the newest
-release in that range). A numba release outside it may move one of the names below: this is the
+Tested with numba 0.61.2 (with NumPy 2.2: the kernels', filters' and stream's tests) and 0.68.1 (the
+whole suite); ``setup.cfg`` pins ``numba>=0.61,<0.69`` and CI installs the newest release in that range. A numba release outside it may move one of the names below: this is the
 one file to read and adapt. The rest of footzoo uses numba's public API only (``numba.njit``,
 ``numba.types``, ``numba.extending.overload`` and ``intrinsic``), through :mod:`footzoo.kernels`.
 
@@ -23,7 +23,10 @@ What footzoo takes from numba's internals, and why:
     A kernel called straight into its machine code, its arguments typed only when they change;
     tuples of first-class functions are typed here without numba's experimental-feature warning.
 ``targetoptions["_nrt"] = False`` (:func:`compile_options`)
-    A measurement function compiled without reference counting when it allocates nothing.
+    A measurement function, or a kernel's loop (``njit(refcounts=False)``: the Kalman filter's forward
+    loop), compiled without reference counting when it allocates nothing: numba otherwise calls its
+    runtime to count a reference each time the loop takes an array out of a named tuple (about twenty
+    calls per sample in the forward loop, each a call through a pointer).
 ``numba.core.registry.CPUDispatcher`` (:func:`is_dispatcher`)
     Telling a numba dispatcher from any other callable.
 ``sys.unraisablehook`` (:func:`capture_faults`)

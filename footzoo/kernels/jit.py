@@ -44,10 +44,10 @@ class _Kernel:
     and every footzoo module attribute that named it is rebound to the dispatcher.
     """
 
-    def __init__(self, fn: Callable[..., Any], inline: bool = False):
+    def __init__(self, fn: Callable[..., Any], inline: bool = False, refcounts: bool = True):
         functools.update_wrapper(self, fn)
         self.py_func = fn
-        self.inline = inline
+        self.inline, self.refcounts = inline, refcounts
         self.dispatcher: Any = None
 
     def __call__(self, *args: Any) -> Any:
@@ -64,13 +64,15 @@ class _Kernel:
         return compiled(self)._numba_type_
 
 
-def _compile(fn: Callable[..., Any], inline: bool = False) -> Any:
+def _compile(fn: Callable[..., Any], inline: bool = False, refcounts: bool = True) -> Any:
     # no C-callable wrapper: kernels are called from Python and from kernels, never through a
     # function pointer (the measurement functions, which are, are compiled elsewhere)
     options = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
     if inline:  # numba copies its typed body into each caller: no compilation and no cache entry of its own
         options["inline"] = "always"
     from . import internals
+
+    options.update(internals.compile_options(refcounts))
 
     return internals.attach(_numba.njit(**options)(fn))
 
@@ -103,7 +105,7 @@ def _materialise() -> None:
         kernels = {id(k): k for k in _pending}
         for k in kernels.values():
             k.dispatcher = k.make() if isinstance(k, _Lazy) else (
-                _compile(k.py_func, k.inline) if numba is not None else k.py_func)
+                _compile(k.py_func, k.inline, k.refcounts) if numba is not None else k.py_func)
         _pending.clear()
         _materialised = True
         for name, module in list(sys.modules.items()):
@@ -115,22 +117,27 @@ def _materialise() -> None:
                     attrs[attr] = value.dispatcher
 
 
-def njit(fn: Callable[..., Any] | None = None, *, inline: bool = False) -> Any:
+def njit(fn: Callable[..., Any] | None = None, *, inline: bool = False, refcounts: bool = True) -> Any:
     """``numba.njit(cache=True, nogil=True)`` when available (created lazily), else the function itself.
 
     ``@njit(inline=True)`` marks a small scalar helper of other kernels: numba inlines its typed
     body into each kernel that calls it instead of compiling it on its own (the same arithmetic;
     one compilation fewer per helper). Called from Python it is compiled as usual.
+
+    ``@njit(refcounts=False)``: a loop over arrays its caller owns, which allocates nothing (nor does
+    anything it calls): compiled without reference counting (:func:`footzoo.kernels.internals.compile_options`),
+    so taking an array out of a named tuple costs no call. numba refuses, when it compiles, any
+    allocation in it.
     """
     if fn is None:
-        return functools.partial(njit, inline=inline)
+        return functools.partial(njit, inline=inline, refcounts=refcounts)
     if not HAVE_NUMBA:
         return fn
     if _numba is not None:  # numba already imported: a module imported after the first kernel call
-        return _compile(fn, inline)
+        return _compile(fn, inline, refcounts)
     if _materialised:  # numba failed to import
         return fn
-    kernel = _Kernel(fn, inline)
+    kernel = _Kernel(fn, inline, refcounts)
     _pending.append(kernel)
     return kernel
 
