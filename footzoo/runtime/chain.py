@@ -20,13 +20,13 @@ from ..core.data import Recording
 from ..plugins.base import Calibration, Samples
 from ..plugins.incremental import Chunk, length
 from .alignment import initial_attitude
+from .stage import Stage
 from .stages import (
     BatchNavigationStage,
     CalibrationStage,
     DetectorStage,
     KalmanStage,
     OrientationStage,
-    Stage,
 )
 
 

@@ -44,7 +44,7 @@ from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window
 from .chain import Chain, build_chain, with_init
 from .pipeline import STREAM_WARMUP
-from .stages import Queue, Stage
+from .stage import Queue, Stage
 from .stream_state import check_channel, check_open, check_unused
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
