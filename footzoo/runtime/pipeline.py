@@ -1,11 +1,13 @@
 """Compose plug-ins into a pipeline and run it on a recording.
 
-``Pipeline.run`` is five named stages: :meth:`~Pipeline.calibrate` (in-situ sensor calibration,
-if any), :meth:`~Pipeline.detect` (gait phase),
-:meth:`~Pipeline.orient` (attitude, unless the Kalman filter carries it),
-:meth:`~Pipeline.navigate` (velocity and position: the error-state Kalman engine, or batch
-corrections and integration) and :meth:`~Pipeline.analyse` (strides and analysis plug-ins).
-The stages read the plug-ins' base classes and declared capabilities, never their names.
+``Pipeline.run`` pushes the whole recording, as one finished chunk, through the chain of stages
+a live :class:`footzoo.Stream` runs (:func:`footzoo.runtime.chain.build_chain`: calibrations,
+detector and guard, orientation unless the Kalman filter carries it, the Kalman engine or batch
+navigation), then adds the steps and analyses (:meth:`~Pipeline.analyse`) and the checks of the
+estimate. Each stage alone is a public method: :meth:`~Pipeline.calibrate`,
+:meth:`~Pipeline.detect` and :meth:`~Pipeline.guard`, :meth:`~Pipeline.orient`,
+:meth:`~Pipeline.navigate`. The stages read the plug-ins' base classes and declared
+capabilities, never their names.
 """
 
 from __future__ import annotations
