@@ -237,8 +237,11 @@ class StanceGuard(Settings):
         )
 
 
-def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str) -> dict[str, Any]:
+def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str,
+                stacklevel: int = 4) -> dict[str, Any]:
     """Report (and warn about) an estimated speed above ``max_speed`` (m/s): the estimate has diverged.
+
+    ``stacklevel``: of the warning (:func:`warnings.warn`), the caller's frame that it names.
 
     Returns
     -------
@@ -256,6 +259,6 @@ def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str
             f"{recording}: the estimated foot speed reaches {top:.3g} m/s (above {max_speed:g} m/s from "
             f"t = {t[over[0]]:.2f} s, {over.size} samples): faster than any foot moves, the estimate has diverged "
             "(missed stances or a wrong attitude). Details in Result.diagnostics['guards']",
-            GuardWarning, stacklevel=4,
+            GuardWarning, stacklevel=stacklevel,
         )
     return report

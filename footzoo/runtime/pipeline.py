@@ -1,11 +1,13 @@
 """Compose plug-ins into a pipeline and run it on a recording.
 
-``Pipeline.run`` is five named stages: :meth:`~Pipeline.calibrate` (in-situ sensor calibration,
-if any), :meth:`~Pipeline.detect` (gait phase),
-:meth:`~Pipeline.orient` (attitude, unless the Kalman filter carries it),
-:meth:`~Pipeline.navigate` (velocity and position: the error-state Kalman engine, or batch
-corrections and integration) and :meth:`~Pipeline.analyse` (strides and analysis plug-ins).
-The stages read the plug-ins' base classes and declared capabilities, never their names.
+``Pipeline.run`` pushes the whole recording, as one finished chunk, through the chain of stages
+a live :class:`footzoo.Stream` runs (:func:`footzoo.runtime.chain.build_chain`: calibrations,
+detector and guard, orientation unless the Kalman filter carries it, the Kalman engine or batch
+navigation), then adds the steps and analyses (:meth:`~Pipeline.analyse`) and the checks of the
+estimate. Each stage alone is a public method: :meth:`~Pipeline.calibrate`,
+:meth:`~Pipeline.detect` and :meth:`~Pipeline.guard`, :meth:`~Pipeline.orient`,
+:meth:`~Pipeline.navigate`. The stages read the plug-ins' base classes and declared
+capabilities, never their names.
 """
 
 from __future__ import annotations
@@ -27,15 +29,13 @@ from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording
-from ..core.errors import ConfigError, PluginError, RecordingError, prefixed
+from ..core.errors import ConfigError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
-from ..evaluation.metrics import nis_summary
 from ..evaluation.result import Result
 from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
-from ..filters.strapdown import integrate_position, integrate_velocity, motion_acceleration, sample_intervals
 from ..plugins.base import (
     AccelerationCorrection,
     Analysis,
@@ -46,17 +46,16 @@ from ..plugins.base import (
     Plugin,
     Samples,
     VelocityCorrection,
-    call,
     check_parameters,
     checked,
     inputs_checked_once,
 )
-from ..plugins.contract import detector_diagnostics
 from ..plugins.extensions import load_plugins
-from ..plugins.incremental import WHOLE_RECORDING, Latency, total
+from ..plugins.incremental import WHOLE_RECORDING, Chunk, Latency, total
 from ..plugins.registry import build
-from .alignment import initial_attitude
+from .chain import Chain, build_chain, navigation_stage, recording_chunk, with_signals
 from .guards import StanceGuard, check_speed
+from .stages import CalibrationStage, detected, estimate_attitude, guarded
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
 STREAM_WARMUP = 30.0
@@ -293,34 +292,39 @@ class Pipeline:
             raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}{hint}")
         self._check_inputs(rec)
         ctx = self.context(rec)
-        rec, calibration = self.calibrate(rec)
-        detector = self.detect(rec, ctx)
-        stance, guard_report = self.guard(rec, detector, ctx)
-        q0 = initial_attitude(rec.t, rec.acc, rec.gyr, rec.mag if self._use_mag(rec) else None, **self.init)
-        quat = self.orient(rec, stance, q0, ctx)
-        nav = self.navigate(rec, stance, q0, quat, engine, covariance, ctx)
-        stances = real_stances(stance, nav["pos"])  # the steps and the mounting report share them and the rate
-        sagittal = sagittal_rate(nav["quat"], rec.gyr, nav["pos"], stances) if len(stances) >= 2 else None
-        steps = self.analyse(rec, stance, nav["quat"], nav["pos"], stances, sagittal)
-        guard_report.update(check_speed(rec.t, nav["vel"], self.guards.max_speed, rec.name))
-        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, detector.name)
+        chunk = recording_chunk(rec, ctx, self.init["duration"])
+        chain = build_chain(self, ctx, chunk, engine, covariance, truth=rec.truth, whole=True)
+        out = chain.push(chunk, finish=True)  # the whole recording, in one finished chunk
+        if self.calibration:
+            rec = with_signals(rec, out)
+        return self._result(rec, ctx, out, chain.report(), chain.engine)
+
+    def _result(self, rec: Recording, ctx: RunContext, out: Chunk, reports: dict[str, Any], engine: str) -> Result:
+        """The Result of a batch run from the chain's outputs and reports: steps, analyses and the checks of the
+        estimate."""
+        stance, quat, pos = out["stance"], out["quat"], out["pos"]
+        stances = real_stances(stance, pos)  # the steps and the mounting report share them and the rate
+        sagittal = sagittal_rate(quat, rec.gyr, pos, stances) if len(stances) >= 2 else None
+        steps = self.analyse(rec, stance, quat, pos, stances, sagittal)
+        reports["guards"].update(check_speed(rec.t, out["vel"], self.guards.max_speed, rec.name, stacklevel=5))
+        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, self.detector.name)
         scan.dropouts(rec.meta.get("sanity", {}).get("frozen", []))  # a frozen channel explains what follows it
-        scan.push(np.arange(rec.n), rec.t, rec.acc, rec.gyr, stance, nav["pos"])
+        scan.push(out["k"], rec.t, rec.acc, rec.gyr, stance, pos)
         axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
         axes.push_recording(rec.t, rec.acc, rec.gyr)
         scan.use_evidence(axes)  # the gait's plausibility weighs the gyroscope-accelerometer evidence of the rate
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
         if axes.finish():
             sensor["consistency"] = axes.report
-        diagnostics = {**detector_diagnostics(detector, rec.n),  # a missing statistic is NaN, with a note
-                       "guards": guard_report, **nav["diagnostics"], "sensor": sensor}
-        if self.calibration:
+        calibration = reports.pop("calibration", None)
+        diagnostics = {**reports, "sensor": sensor}  # a missing detector statistic is NaN, with a note
+        if calibration is not None:
             diagnostics["calibration"] = calibration
-        diagnostics["mounting"] = mounting_report(nav["quat"], rec.gyr, nav["pos"], stances, sagittal)
+        diagnostics["mounting"] = mounting_report(quat, rec.gyr, pos, stances, sagittal)
         warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"))
         config = self.to_dict()
-        config["engine"] = nav["engine"]
-        samples = samples_frame(rec.t, nav["quat"], nav["pos"], nav["vel"], nav["acc_nav"], stance)
+        config["engine"] = engine
+        samples = samples_frame(rec.t, quat, pos, out["vel"], out["acc_nav"], stance)
         if "pos_std" in diagnostics:  # covariance=True: the position's standard deviation beside the position
             for j, axis in enumerate("ned"):
                 samples[f"pos_std_{axis}"] = diagnostics["pos_std"][:, j]
@@ -343,32 +347,24 @@ class Pipeline:
         for a in self.analysis:
             checked(a.check, dict(rec.meta))
 
+    # ------------------------------------------------------- the stages alone
     def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
         """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""
         if not self.calibration:
             return rec, []
-        out = copy.copy(rec)
-        reports = []
-        for c in self.calibration:
-            fitted = checked(c.clone().calibrate, out.t, out.acc, out.gyr, out.mag)
-            out.acc, out.gyr, out.mag = _calibrated(c, out, fitted)
-            reports.append({"type": c.name, **fitted.report_})
-        return out, reports
+        ctx = self.context(rec)
+        stage = CalibrationStage(self.calibration, ctx)
+        out = stage.fit(recording_chunk(rec, ctx, self.init["duration"]), whole=True)
+        return with_signals(rec, out), stage.reports
 
     def detect(self, rec: Recording, ctx: RunContext | None = None) -> Detector:
         """Stage 1: the fitted detector (``stance_``, ``statistic_``)."""
-        ctx = ctx or self.context(rec)
-        detector = self.detector.clone()
-        if detector.needs_truth:
-            return checked(detector.detect, rec.t, rec.acc, rec.gyr, rec.truth)
-        return call(detector.detect, rec.t, rec.acc, rec.gyr, ctx=ctx)
+        return detected(self.detector, rec.t, rec.acc, rec.gyr, ctx or self.context(rec), rec.truth)
 
     def guard(self, rec: Recording, detector: Detector,
               ctx: RunContext | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report."""
-        stance, report = self.guards.apply(rec.t, rec.gyr, detector.stance_, ctx or self.context(rec))
-        self.guards.warn(report, detector.name, rec.name)
-        return stance, report
+        return guarded(self.guards, rec.t, rec.gyr, detector, ctx or self.context(rec), rec.name)
 
     def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray,
                ctx: RunContext | None = None) -> np.ndarray | None:
@@ -376,42 +372,22 @@ class Pipeline:
         if self.orientation.carried_by_filter and self.filter_corrections:
             return None
         mag = rec.mag if self._use_mag(rec) else None
-        return call(self.orientation.clone().estimate, rec.t, rec.acc, rec.gyr, mag, stance, q0,
-                    ctx=ctx or self.context(rec)).quat_
+        return estimate_attitude(self.orientation, rec.t, rec.acc, rec.gyr, mag, stance, q0, ctx or self.context(rec))
 
     def navigate(self, rec: Recording, stance: np.ndarray, q0: np.ndarray, quat: np.ndarray | None,
                  engine: str = "auto", covariance: bool = False, ctx: RunContext | None = None) -> dict[str, Any]:
-        """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections."""
+        """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections.
+
+        A dict of ``quat``, ``vel``, ``pos``, ``acc_nav`` (the samples'), ``diagnostics`` and ``engine``.
+        """
         ctx = ctx or self.context(rec)
-        kalman = [c.clone() for c in self.filter_corrections]
-        if kalman:
-            samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + self.init["duration"])
-            eng = self.kalman_engine(kalman, samples, engine)
-            out = eng.run(rec.t, rec.acc, rec.gyr, stance, q0, quat, covariance, smoother=self.smoother)
-            out["diagnostics"].update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
-            if covariance:
-                out["diagnostics"]["P_diag"] = out["P_diag"]
-                out["diagnostics"]["nis"] = out["nis"]
-                out["diagnostics"]["nis_rows"] = out["nis_rows"]
-                out["diagnostics"]["consistency"] = nis_summary(out["nis"], out["nis_rows"])
-                if eng.layout.has("pos"):  # the forward filter's position standard deviation (m), N, E, D
-                    out["diagnostics"]["pos_std"] = np.sqrt(out["P_diag"][:, eng.layout["pos"]])
-            out["diagnostics"].update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
-            out["engine"] = eng.engine
-            return out
-        acc_nav = motion_acceleration(quat, rec.acc, self.gravity)
-        for c in self.corrections:
-            if isinstance(c, AccelerationCorrection):
-                acc_nav = call(c.clone().apply_acceleration, quat, acc_nav, stance, ctx=ctx)
-        velocity = [c for c in self.corrections if isinstance(c, VelocityCorrection)]
-        if velocity:
-            corr = call(velocity[0].clone().apply, rec.t, acc_nav, stance, ctx=ctx)
-            vel, pos = corr.vel_, corr.pos_
-        else:
-            dt = sample_intervals(rec.t)
-            vel = integrate_velocity(acc_nav, dt)
-            pos = integrate_position(vel, dt)
-        return {"quat": quat, "vel": vel, "pos": pos, "acc_nav": acc_nav, "diagnostics": {}, "engine": "none"}
+        chunk = {**recording_chunk(rec, ctx, self.init["duration"]), "stance": stance}
+        if quat is not None:
+            chunk["quat"] = quat
+        stage = navigation_stage(self, ctx, chunk, q0, engine, covariance)
+        out = stage.push(chunk, finish=True)
+        return {**{k: out[k] for k in ("quat", "vel", "pos", "acc_nav")}, "diagnostics": stage.report(),
+                "engine": Chain([stage]).engine}
 
     def kalman_engine(self, kalman: list[KalmanCorrection], samples: Samples, engine: str = "auto") -> KalmanEngine:
         """The error-state engine for these (fresh) corrections, with their models built from ``samples``."""
@@ -498,25 +474,6 @@ def pipeline_arguments(d: dict[str, Any], base_dir: str | Path | None = None,
         guards=d.get("guards"),
         calibration=calibration,
     )
-
-
-def _calibrated(c: Calibration, rec: Recording, fitted: Calibration) -> tuple[np.ndarray, ...]:
-    """The calibrated signals, checked: same shapes as the input, finite (a plug-in error names the plug-in)."""
-    out = []
-    for name, before in (("acc", rec.acc), ("gyr", rec.gyr), ("mag", rec.mag)):
-        after = getattr(fitted, f"{name}_", None)
-        if before is None and after is None:
-            out.append(None)
-            continue
-        after = None if after is None else np.asarray(after, dtype=float)
-        if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
-            what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
-                    else "NaN/inf")
-            raise PluginError(f"calibration {c.name!r} on {rec.name!r}: {name}_ is {what}; it must be a finite "
-                              f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)",
-                              plugin=f"calibration {c.name!r}", method="calibrate")
-        out.append(after)
-    return tuple(out)
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

@@ -1,15 +1,17 @@
-"""The stages of a live run: each wraps one block of a pipeline behind the same four calls.
+"""The stages of a run: each wraps one block of a pipeline behind one interface, :class:`Stage`.
 
 ``push(chunk)`` gives the stage the next samples' inputs (final ones: the upstream stage's
 final outputs, with the raw signals of the same samples) and returns the outputs that became
 final; ``finish()`` the rest at the end of the data; ``guess(extra)`` the stage's current guess
 for every sample after its final outputs — its own pending samples, then the ``extra`` samples
-whose inputs are themselves only guesses (computed on a copy: the stage's state is untouched).
-:class:`footzoo.Stream` chains them; :meth:`footzoo.Pipeline.run` runs the same blocks on the
-whole recording, so the final outputs of a stream equal the batch run.
+whose inputs are themselves only guesses (computed on a copy: the stage's state is untouched);
+``report()`` what the stage adds to ``Result.diagnostics``.
 
-Chunks are dicts of per-sample arrays (:data:`footzoo.plugins.incremental.Chunk`), all with the
-samples' absolute index in ``k``.
+A stream pushes chunk after chunk; a batch run (:meth:`footzoo.Pipeline.run`) pushes the whole
+recording as one chunk with ``finish``, and a stage given that runs its block's batch code on
+it (the block's ``detect``, ``estimate``, ``apply``; the Kalman engine's ``run``, which the
+RTS smoother needs). :func:`footzoo.runtime.chain.build_chain` makes the stages of a pipeline
+for both, so the final outputs of a stream equal the batch run.
 """
 
 from __future__ import annotations
@@ -21,10 +23,17 @@ from typing import Any
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.errors import GuardWarning
+from ..core.errors import GuardWarning, PluginError
+from ..evaluation.metrics import nis_summary
 from ..filters.recorders import ROW_KEYS, SAMPLE_KEYS
 from ..filters.smoothing import smoothing as smoother_named
-from ..filters.strapdown import Integrator, motion_acceleration
+from ..filters.strapdown import (
+    Integrator,
+    integrate_position,
+    integrate_velocity,
+    motion_acceleration,
+    sample_intervals,
+)
 from ..plugins.base import (
     AccelerationCorrection,
     Calibration,
@@ -33,106 +42,86 @@ from ..plugins.base import (
     Orientation,
     Samples,
     VelocityCorrection,
+    call,
     checked,
 )
+from ..plugins.contract import detector_diagnostics
 from ..plugins.incremental import Chunk, Columns, concat, length, take
 from .guards import StanceGuard
-
-#: Raw signals every chunk carries (``mag``, ``dist`` only when the recording has them).
-RAW = ("k", "t", "acc", "gyr", "mag", "dist")
+from .stage import Queue, Stage, pad_to
 
 
-def raw(chunk: Chunk) -> Chunk:
-    """The raw-signal columns of a chunk."""
-    return {k: v for k, v in chunk.items() if k in RAW}
+class CalibrationStage(Stage):
+    """In-situ calibrations, applied in order before every other stage.
 
-
-def with_columns(chunk: Chunk, outputs: Chunk, names: tuple[str, ...]) -> Chunk:
-    """The samples of ``outputs`` (a prefix of ``chunk``'s, by ``k``) with the named columns of ``chunk``."""
-    m = length(outputs)
-    return {**{k: v[:m] for k, v in chunk.items() if k in names}, **outputs}
-
-
-def pad_to(guess: Chunk, samples: Chunk, name: str, last: Any) -> np.ndarray:
-    """``guess[name]`` for the first samples, then ``last`` repeated up to the length of ``samples``."""
-    have = guess.get(name, np.zeros(0))
-    n = length(samples)
-    if len(have) >= n:
-        return np.asarray(have[:n])
-    fill = np.repeat(np.asarray([last]), n - len(have), axis=0)
-    return np.concatenate([np.asarray(have), fill]) if len(have) else fill
-
-
-class Queue:
-    """Samples waiting between stages: appended at the end, taken from the front, by absolute index ``k``.
-
-    Backed by :class:`~footzoo.plugins.incremental.Columns`: appending and taking cost the samples
-    moved, not the samples held.
+    :meth:`fit` fits them on the run's start — a batch run's whole recording, or a stream's
+    first seconds (its warm-up), where calibrations whose parameters give their fit are taken
+    as given and the others are fixed to the fit for the samples to come — and keeps their
+    reports; the samples fitted on are released as the fit calibrated them, later samples are
+    calibrated by the fits (:meth:`step`).
     """
 
-    def __init__(self) -> None:
-        self._columns = Columns()
+    def __init__(self, calibrations: list[Calibration], ctx: RunContext):
+        self.blocks = list(calibrations)
+        self.ctx = ctx
+        self.reports: list[dict[str, Any]] = []
+        self._fitted: Chunk = {}  # the samples fitted on, calibrated, until they are pushed
 
-    def put(self, chunk: Chunk) -> None:
-        if length(chunk):
-            self._columns.append(chunk)
+    def fit(self, chunk: Chunk, whole: bool = False) -> Chunk:
+        """Fit the calibrations on ``chunk``, each on the signals the ones before it calibrated; the chunk calibrated.
 
-    def take(self, stop_k: int) -> Chunk:
-        """The samples with absolute index below ``stop_k`` (removed)."""
-        if not len(self._columns):
-            return {}
-        view = self._columns.view()
-        n = int(np.searchsorted(view["k"], stop_k))
-        out = take(view, 0, n)
-        self._columns.drop(n)
+        ``whole``: ``chunk`` is the whole recording (a batch run): every calibration is fitted on
+        it (``calibrate``). Else a calibration that is fitted already is applied as it is (its
+        report says ``given``), and the others are fitted and then fixed to their fit.
+        """
+        out = dict(chunk)
+        for i, c in enumerate(self.blocks):
+            if c.is_fitted() and not whole:
+                self.reports.append({"type": c.name, "applied": True, "given": True, **_fit_of(c)})
+                out.update(_applied(c, out))
+                continue
+            fitted = checked(c.clone().calibrate, out["t"], out["acc"], out["gyr"], out.get("mag"))
+            out.update(calibrated_signals(c, out, fitted, self.ctx.name))
+            self.reports.append({"type": c.name, **fitted.report_})
+            if not whole:
+                self.blocks[i] = checked(c.fixed, fitted.report_)
+        self._fitted = out
         return out
 
-    def peek(self) -> Chunk:
-        """The samples held (views: read them before the next change)."""
-        return self._columns.view() if len(self._columns) else {}
+    def whole(self, chunk: Chunk) -> Chunk:
+        return self._released(chunk) or self.fit(chunk, whole=True)
 
-    def __len__(self) -> int:
-        return len(self._columns)
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
+        return (self._released(chunk) or self.apply(chunk)) if length(chunk) else {}
 
-
-class CalibrationStage:
-    """In-situ calibrations with their fit known (given, or fitted online on the stream's first seconds).
-
-    :meth:`fit` fits every calibration whose parameters do not give its fit on a chunk (the
-    stream's warm-up) and keeps the report; then :meth:`push` applies the fits sample by sample.
-    """
-
-    def __init__(self, calibrations: list[Calibration], ctx: RunContext, warmup: float):
-        self.blocks = calibrations
-        self.ctx, self.warmup = ctx, warmup
-        self.reports: list[dict[str, Any]] = []
-
-    def fit(self, chunk: Chunk) -> None:
-        """Fit the calibrations that need it on ``chunk`` (their ``calibrate``), as a batch run fits on a recording."""
-        for i, c in enumerate(self.blocks):
-            if c.is_fitted():
-                self.reports.append({"type": c.name, "applied": True, "given": True, **_fit_of(c)})
-            else:
-                fitted = checked(c.clone().calibrate, chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag"))
-                self.reports.append({"type": c.name, **fitted.report_})
-                self.blocks[i] = checked(c.fixed, fitted.report_)
+    def _released(self, chunk: Chunk) -> Chunk:
+        """The chunk as the fit calibrated it when its samples are the ones fitted on (else empty)."""
+        done, self._fitted = self._fitted, {}
+        same = length(done) == length(chunk) and length(chunk) and done["k"][0] == chunk["k"][0]
+        return done if same else {}
 
     def apply(self, chunk: Chunk) -> Chunk:
         """The chunk with the calibrated signals."""
         out = dict(chunk)
         for c in self.blocks:
-            res = checked(c.step, out["t"], out["acc"], out["gyr"], out.get("mag"))
-            out.update({k: v for k, v in res.items() if k in ("acc", "gyr", "mag")})
+            out.update(_applied(c, out))
         return out
-
-    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
-        return self.apply(chunk) if length(chunk) else {}
 
     def held(self) -> int:
         return 0
 
-    def finish(self) -> Chunk:
-        return {}
+    def provisional(self, extra: Chunk) -> Chunk:
+        return self.apply(extra) if length(extra) else {}
+
+    def report(self) -> dict[str, Any]:
+        """The calibrations' reports (``Result.diagnostics["calibration"]``)."""
+        return {"calibration": self.reports}
+
+
+def _applied(c: Calibration, chunk: Chunk) -> Chunk:
+    """A fitted calibration's signals for ``chunk`` (its ``step``)."""
+    res = checked(c.step, chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag"))
+    return {k: v for k, v in res.items() if k in ("acc", "gyr", "mag")}
 
 
 def _fit_of(c: Calibration) -> dict[str, Any]:
@@ -140,18 +129,75 @@ def _fit_of(c: Calibration) -> dict[str, Any]:
     return {k: v for k, v in c.get_params().items() if v != c.defaults().get(k)}
 
 
-class DetectorStage:
-    """The detector (its ``begin``/``step``/``finish``) and the maximum-swing guard after it."""
+def calibrated_signals(c: Calibration, chunk: Chunk, fitted: Calibration, recording: str) -> Chunk:
+    """A fitted calibration's signals, checked: same shapes as the input, finite (a plug-in error names the plug-in)."""
+    out = {}
+    for name in ("acc", "gyr", "mag"):
+        before, after = chunk.get(name), getattr(fitted, f"{name}_", None)
+        if before is None and after is None:
+            continue
+        after = None if after is None else np.asarray(after, dtype=float)
+        if after is None or after.shape != np.shape(before) or not np.isfinite(after).all():
+            what = ("missing" if after is None else f"shape {after.shape}" if after.shape != np.shape(before)
+                    else "NaN/inf")
+            raise PluginError(f"calibration {c.name!r} on {recording!r}: {name}_ is {what}; it must be a finite "
+                              f"array shaped like the input {np.shape(before)} (fix the calibration plug-in)",
+                              plugin=f"calibration {c.name!r}", method="calibrate")
+        out[name] = after
+    return out
 
-    def __init__(self, detector: Detector, guard: StanceGuard, ctx: RunContext):
-        self.detector = checked(detector.clone().begin, ctx)
-        self.guard = guard.stream(ctx)
+
+def detected(detector: Detector, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, ctx: RunContext,
+             truth: Any = None) -> Detector:
+    """A fresh copy of ``detector`` fitted on a whole recording (``detect``; given ``truth`` when it needs it)."""
+    fitted = detector.clone()
+    if fitted.needs_truth:
+        return checked(fitted.detect, t, acc, gyr, truth)
+    return call(fitted.detect, t, acc, gyr, ctx=ctx)
+
+
+def guarded(guards: StanceGuard, t: np.ndarray, gyr: np.ndarray, detector: Detector, ctx: RunContext,
+            recording: str) -> tuple[np.ndarray, dict[str, Any]]:
+    """The stance mask after the maximum-swing guard over a whole recording, and its report (warned once)."""
+    stance, report = guards.apply(t, gyr, detector.stance_, ctx)
+    guards.warn(report, detector.name, recording)
+    return stance, report
+
+
+class DetectorStage(Stage):
+    """The detector and the maximum-swing guard after it.
+
+    Whole recording: the detector's ``detect`` (given the reference when it ``needs_truth``) and
+    the guard's ``apply``; live: the detector's ``begin``/``step``/``finish`` and the guard's stream.
+    """
+
+    def __init__(self, detector: Detector, guard: StanceGuard, ctx: RunContext, truth: Any = None):
+        self.block, self.guards, self.truth = detector, guard, truth
         self.ctx, self.max_swing = ctx, guard.max_swing
         self.raw = Queue()  # samples pushed whose detector stance is not final
         self.guarding = Queue()  # samples with their detector stance, whose guarded stance is not final
         self.last = True
+        self.fitted: Detector | None = None  # the detector fitted on a whole recording
+        self.guard_report: dict[str, Any] = {}
 
-    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
+    def begin(self) -> None:
+        self.detector = checked(self.block.clone().begin, self.ctx)
+        self.guard = self.guards.stream(self.ctx)
+
+    def whole(self, chunk: Chunk) -> Chunk:
+        self.fitted = detected(self.block, chunk["t"], chunk["acc"], chunk["gyr"], self.ctx, self.truth)
+        stance, self.guard_report = guarded(self.guards, chunk["t"], chunk["gyr"], self.fitted, self.ctx,
+                                            self.ctx.name)
+        self.n = length(chunk)
+        return {**chunk, "stance": stance}
+
+    def report(self) -> dict[str, Any]:
+        """The detector's stance and statistic and the guard's report (of a whole recording; live: none)."""
+        if self.fitted is None:
+            return {}
+        return {**detector_diagnostics(self.fitted, self.n), "guards": self.guard_report}
+
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
         self.raw.put(chunk)
         out = checked(self.detector.step, chunk["t"], chunk["acc"], chunk["gyr"]) if length(chunk) else {}
         if finish:
@@ -179,7 +225,7 @@ class DetectorStage:
                       f"guard marked {starts.size} still instant(s) there as stance, the first at t = {t_first:.2f} s: "
                       "the trajectory in that swing is suspect — the detector misses the stances of this motion "
                       "(running?); choose one made for it, or switch the guard off with guards: {max_swing: 0}",
-                      GuardWarning, stacklevel=6)
+                      GuardWarning, stacklevel=8)
 
     def held(self) -> int:
         """Samples waiting for the detector's or the guard's final stance."""
@@ -192,11 +238,13 @@ class DetectorStage:
         rows = queue.take(queue.peek()["k"][0] + length(out))
         return {**rows, "stance": np.asarray(out["stance"], dtype=bool)}
 
-    def finish(self) -> Chunk:
-        return self.push({}, finish=True)
+    def provisional(self, extra: Chunk) -> Chunk:
+        """Every sample after the final ones, with the guard's and the detector's current stance guess.
 
-    def guess(self) -> Chunk:
-        """Every sample after the final ones, with the guard's and the detector's current stance guess."""
+        ``extra`` must be empty: the stages before the detector (calibrations) hold no samples.
+        """
+        if length(extra):
+            raise ValueError("DetectorStage.guess: the detector holds every sample pushed; it takes no extra samples")
         guarding, pending = self.guarding.peek(), self.raw.peek()
         parts = []
         if length(guarding):
@@ -208,23 +256,41 @@ class DetectorStage:
         return concat(parts)
 
 
-class OrientationStage:
-    """An orientation filter (``begin(ctx, q0)``/``step``): the attitude of every sample once its stance is final."""
+def estimate_attitude(orientation: Orientation, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray,
+                      mag: np.ndarray | None, stance: np.ndarray, q0: np.ndarray, ctx: RunContext) -> np.ndarray:
+    """The attitude (N, 4) of a whole recording from a fresh copy of ``orientation`` (its ``estimate``)."""
+    return call(orientation.clone().estimate, t, acc, gyr, mag, stance, q0, ctx=ctx).quat_
+
+
+class OrientationStage(Stage):
+    """An orientation filter: the attitude of every sample once its stance is final.
+
+    Whole recording: its ``estimate``; live: ``begin(ctx, q0)``/``step``/``finish``.
+    """
 
     def __init__(self, orientation: Orientation, ctx: RunContext, q0: np.ndarray, use_mag: bool):
-        self.block = checked(orientation.clone().begin, ctx, q0)
+        self.orientation, self.ctx, self.q0 = orientation, ctx, q0
         self.use_mag = use_mag
         self.waiting = Queue()  # samples of the filter's warm-up
         self.last_q = np.asarray(q0, dtype=float)
 
+    def begin(self) -> None:
+        self.block = checked(self.orientation.clone().begin, self.ctx, self.q0)
+
+    def whole(self, chunk: Chunk) -> Chunk:
+        mag = chunk.get("mag") if self.use_mag else None
+        quat = estimate_attitude(self.orientation, chunk["t"], chunk["acc"], chunk["gyr"], mag, chunk["stance"],
+                                 self.q0, self.ctx)
+        return {**chunk, "quat": quat}
+
     def _step(self, block: Orientation, chunk: Chunk, finish: bool = False) -> Chunk:
         out = checked(block.step, chunk["t"], chunk["acc"], chunk["gyr"], chunk.get("mag") if self.use_mag else None,
-                         chunk["stance"]) if length(chunk) else {}
+                      chunk["stance"]) if length(chunk) else {}
         if finish:
             out = concat([out, checked(block.finish)])
         return out
 
-    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
         self.waiting.put(chunk)
         out = self._step(self.block, chunk, finish)
         if not length(out):
@@ -233,14 +299,11 @@ class OrientationStage:
         self.last_q = out["quat"][-1]
         return {**rows, "quat": out["quat"]}
 
-    def finish(self) -> Chunk:
-        return self.push({}, finish=True)
-
     def held(self) -> int:
         """Samples of the filter's warm-up, not given an attitude yet."""
         return len(self.waiting)
 
-    def guess(self, extra: Chunk) -> Chunk:
+    def provisional(self, extra: Chunk) -> Chunk:
         samples = concat([self.waiting.peek(), extra])
         if not length(samples):
             return {}
@@ -252,30 +315,48 @@ class OrientationStage:
         return {**samples, "quat": quat}
 
 
-class KalmanStage:
-    """The error-state Kalman engine, advanced sample by sample from its carried state.
+class KalmanStage(Stage):
+    """The error-state Kalman engine.
 
-    With ``smoother="stepwise"`` (:mod:`footzoo.filters.stepwise`) the engine also records each
-    sample for the backward pass; the samples wait in the open segment until the segment closes
-    (the first sample after a stance has been seen, or the end of the data), are smoothed as
-    the batch run smooths them (the segments of :class:`footzoo.filters.smoothing.Stepwise`, the
-    same kernel) and become final. Their provisional estimates are the forward filter's.
+    Whole recording: the engine's ``run`` with the pipeline's smoother (the RTS smoother needs
+    the whole recording) and ``covariance``; its diagnostics are the stage's :meth:`report`.
+    Live: advanced sample by sample from its carried state. With ``smoother="stepwise"``
+    (:mod:`footzoo.filters.stepwise`) the engine also records each sample for the backward pass;
+    the samples wait in the open segment until the segment closes (the first sample after a
+    stance has been seen, or the end of the data), are smoothed as the batch run smooths them
+    (the segments of :class:`footzoo.filters.smoothing.Stepwise`, the same kernel) and become
+    final. Their provisional estimates are the forward filter's.
     """
 
     def __init__(self, engine: Any, corrections: list[KalmanCorrection], q0: np.ndarray, external_attitude: bool,
-                 smoother: str = "none"):
+                 smoother: str = "none", covariance: bool = False):
         self.engine = engine
         self.corrections = corrections
-        nav0 = np.zeros(16)
-        nav0[:4] = q0
-        self.state = engine.start(nav0)
+        self.q0 = q0
         self.external = external_attitude
+        self.smoother, self.covariance = smoother, covariance
+        self.diagnostics: dict[str, Any] = {}
         self.prev: Chunk | None = None  # the last sample the engine has processed (its row 0 of a chunk)
         self.smoothing = smoother_named(smoother)
         self.stepwise = bool(self.smoothing)
         self.open = Columns()  # step-wise smoother: the open segment's samples, forward estimates and record
         self.open_rows = Columns()  # ... and its update rows (record_first: absolute row numbers)
         self.rows_before = 0  # rows of the samples released (the absolute number of open_rows' first row)
+
+    def begin(self) -> None:
+        nav0 = np.zeros(16)
+        nav0[:4] = self.q0
+        self.state = self.engine.start(nav0)
+
+    def whole(self, chunk: Chunk) -> Chunk:
+        out = self.engine.run(chunk["t"], chunk["acc"], chunk["gyr"], chunk["stance"], self.q0,
+                              chunk["quat"] if self.external else None, self.covariance, smoother=self.smoother)
+        self.diagnostics = kalman_diagnostics(out, self.engine, self.covariance)
+        return {**chunk, **{k: out[k] for k in ("quat", "vel", "pos", "acc_nav")}}
+
+    def report(self) -> dict[str, Any]:
+        """The engine's diagnostics of a whole recording (:func:`kalman_diagnostics`; live: none)."""
+        return self.diagnostics
 
     def _advance(self, state: Any, chunk: Chunk, prev: Chunk | None, record: bool = False) -> dict[str, np.ndarray]:
         """Run the engine over ``chunk`` from ``state`` (the state of ``prev``, or the initial one)."""
@@ -296,7 +377,7 @@ class KalmanStage:
             done["record_first"] = done["record_first"] - rows_kept
         return done
 
-    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
         if length(chunk):
             out = self._advance(self.state, chunk, self.prev, record=self.stepwise)
             self.prev = take(chunk, length(chunk) - 1)
@@ -334,14 +415,11 @@ class KalmanStage:
         return {"row_h": np.zeros((0, n)), "row_gain": np.zeros((0, n)), "row_scaled": np.zeros(0),
                 "row_nu": np.zeros(0), "row_s": np.zeros(0)}
 
-    def finish(self) -> Chunk:
-        return self._close_segments(True) if self.stepwise else {}
-
     def held(self) -> int:
         """Samples of the open segment (step-wise smoother), waiting for the end of the next stance."""
         return len(self.open)
 
-    def guess(self, extra: Chunk) -> Chunk:
+    def provisional(self, extra: Chunk) -> Chunk:
         parts = [_public(self.open.view())] if len(self.open) else []
         if length(extra):
             state = self.engine.fork(self.state)
@@ -352,23 +430,63 @@ class KalmanStage:
         return concat(parts)
 
 
+def kalman_diagnostics(out: dict[str, Any], engine: Any, covariance: bool) -> dict[str, Any]:
+    """A whole run's Kalman diagnostics: the models', the bias estimates, with ``covariance`` the variances, the
+    innovations and the position's standard deviation, and the forward pass of a smoothed run."""
+    diagnostics = out["diagnostics"]
+    diagnostics.update(gyro_bias=out["gyro_bias"], acc_bias=out["acc_bias"])
+    if covariance:
+        diagnostics["P_diag"] = out["P_diag"]
+        diagnostics["nis"] = out["nis"]
+        diagnostics["nis_rows"] = out["nis_rows"]
+        diagnostics["consistency"] = nis_summary(out["nis"], out["nis_rows"])
+        if engine.layout.has("pos"):  # the forward filter's position standard deviation (m), N, E, D
+            diagnostics["pos_std"] = np.sqrt(out["P_diag"][:, engine.layout["pos"]])
+    diagnostics.update({k: out[k] for k in ("quat_forward", "vel_forward", "pos_forward") if k in out})
+    return diagnostics
+
+
 def _public(rows: Chunk) -> Chunk:
     """The columns of a sample (without the step-wise smoother's record and the bias estimates)."""
     return {k: v for k, v in rows.items() if k not in SAMPLE_KEYS and k not in ("gyro_bias", "acc_bias")}
 
 
-class BatchNavigationStage:
+class BatchNavigationStage(Stage):
     """Without a Kalman filter: motion acceleration, the acceleration corrections, then a velocity correction
-    (or plain integration)."""
+    (or plain integration).
+
+    Whole recording: the corrections' ``apply_acceleration`` and ``apply``; live: their
+    ``begin``/``step_acceleration``/``step``/``finish``.
+    """
 
     def __init__(self, corrections: list[Any], ctx: RunContext, gravity: float):
         self.ctx, self.gravity = ctx, gravity
-        self.accel = [checked(c.clone().begin, ctx) for c in corrections if isinstance(c, AccelerationCorrection)]
-        velocity = [c for c in corrections if isinstance(c, VelocityCorrection)]
-        self.velocity = checked(velocity[0].clone().begin, ctx) if velocity else None
-        self.integrator = None if velocity else Integrator()
+        self.corrections = corrections
         self.waiting = Queue()
         self.q_prev: np.ndarray | None = None  # the last attitude (the mid-interval rotation needs it)
+
+    def begin(self) -> None:
+        self.accel = [checked(c.clone().begin, self.ctx) for c in self.corrections
+                      if isinstance(c, AccelerationCorrection)]
+        velocity = [c for c in self.corrections if isinstance(c, VelocityCorrection)]
+        self.velocity = checked(velocity[0].clone().begin, self.ctx) if velocity else None
+        self.integrator = None if velocity else Integrator()
+
+    def whole(self, chunk: Chunk) -> Chunk:
+        quat, stance = chunk["quat"], chunk["stance"]
+        acc_nav = motion_acceleration(quat, chunk["acc"], self.gravity)
+        for c in self.corrections:
+            if isinstance(c, AccelerationCorrection):
+                acc_nav = call(c.clone().apply_acceleration, quat, acc_nav, stance, ctx=self.ctx)
+        velocity = [c for c in self.corrections if isinstance(c, VelocityCorrection)]
+        if velocity:
+            corr = call(velocity[0].clone().apply, chunk["t"], acc_nav, stance, ctx=self.ctx)
+            vel, pos = corr.vel_, corr.pos_
+        else:
+            dt = sample_intervals(chunk["t"])
+            vel = integrate_velocity(acc_nav, dt)
+            pos = integrate_position(vel, dt)
+        return {**chunk, "acc_nav": acc_nav, "vel": vel, "pos": pos}
 
     def _acc_nav(self, chunk: Chunk, q_prev: np.ndarray | None, accel: list[AccelerationCorrection]) -> np.ndarray:
         quat = chunk["quat"]
@@ -396,7 +514,7 @@ class BatchNavigationStage:
             out = {}
         return out, rows
 
-    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
         out, rows = self._navigate(chunk, self.velocity, self.integrator, self.q_prev, self.accel, finish)
         if length(rows):
             self.q_prev = rows["quat"][-1]
@@ -406,14 +524,11 @@ class BatchNavigationStage:
         done = self.waiting.take(self.waiting.peek()["k"][0] + length(out))
         return {**done, "vel": out["vel"], "pos": out["pos"]}
 
-    def finish(self) -> Chunk:
-        return self.push({}, finish=True)
-
     def held(self) -> int:
         """Samples of the open swing, waiting for the velocity correction."""
         return len(self.waiting)
 
-    def guess(self, extra: Chunk) -> Chunk:
+    def provisional(self, extra: Chunk) -> Chunk:
         velocity, integrator, accel = copy.deepcopy((self.velocity, self.integrator, self.accel))
         out, rows = self._navigate(extra, velocity, integrator, self.q_prev, accel, False)
         samples = concat([self.waiting.peek(), rows])

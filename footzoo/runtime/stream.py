@@ -39,18 +39,12 @@ from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..core.sanity import EstimateScan, SignalScan
 from ..filters.consistency import ConsistencyScan
-from ..plugins.base import Samples, checked
+from ..plugins.base import checked
 from ..plugins.incremental import Chunk, Latency, length, take
-from .alignment import first_still_window, initial_attitude
+from .alignment import first_still_window
+from .chain import Chain, build_chain, with_init
 from .pipeline import STREAM_WARMUP
-from .stages import (
-    BatchNavigationStage,
-    CalibrationStage,
-    DetectorStage,
-    KalmanStage,
-    OrientationStage,
-    Queue,
-)
+from .stage import Queue, Stage
 from .stream_state import check_channel, check_open, check_unused
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
@@ -134,7 +128,7 @@ class Stream:
         self._raw = Queue()  # samples before the start
         self._out = Queue()  # final estimates not taken yet
         self._last_final: dict[str, Any] | None = None
-        self._stages: list[Any] = []
+        self._chain: Chain | None = None  # the pipeline's stages, made when the stream starts
         self._k = 0
         self._t_prev: float | None = None
         self._dist_width: int | None = None
@@ -219,7 +213,7 @@ class Stream:
 
     def pending(self) -> int:
         """How many samples the stream holds because their final estimate is not known yet (its memory)."""
-        return len(self._raw) + sum(stage.held() for stage in self._stages)
+        return len(self._raw) + (self._chain.held() if self._chain is not None else 0)
 
     def final(self) -> dict[str, np.ndarray]:
         """The final estimates that became available since the last call: arrays ``t``, ``quat``, ``pos``,
@@ -231,11 +225,11 @@ class Stream:
         """End of the data: every remaining sample's final estimate (as :meth:`final`)."""
         if not self._closed:
             self._closed = True
-            if not self._stages and len(self._raw):
+            if self._chain is None and len(self._raw):
                 if not self._start(last=True):  # shorter than the still start: never aligned
                     raise RecordingError(self._no_start_message())
                 self._feed(self._raw.take(np.iinfo(np.int64).max))
-            if self._stages:
+            if self._chain is not None:
                 self._feed({}, finish=True)
             self._scan_raw.flush()
             if self._estimates is not None:
@@ -320,8 +314,13 @@ class Stream:
         return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
 
     # ------------------------------------------------------------------ the chain
+    @property
+    def _stages(self) -> list[Stage]:
+        """The chain's stages (none before the start)."""
+        return self._chain.stages if self._chain is not None else []
+
     def _take(self, row: Chunk) -> dict[str, Any] | None:
-        if not self._stages:
+        if self._chain is None:
             self._raw.put(row)
             if not self._start():
                 return None
@@ -332,12 +331,10 @@ class Stream:
 
     def _with_init(self, chunk: Chunk) -> Chunk:
         """The chunk with ``init``: its samples in the still start used for the alignment (Samples.init_window)."""
-        return {**chunk, "init": chunk["t"] <= self.ctx.t0 + self.init["duration"]}
+        return with_init(chunk, self.ctx, self.init["duration"])
 
     def _feed(self, chunk: Chunk, finish: bool = False) -> None:
-        out = chunk
-        for stage in self._stages:
-            out = stage.push(out, finish=finish) if (length(out) or finish) else {}
+        out = self._chain.push(chunk, finish=finish)
         if length(out):
             self._scan_final.add(out["k"], out["t"], out["acc"], out["gyr"], out["stance"], out["pos"])
             self._out.put({k: v for k, v in out.items() if k in ("k", *COLUMNS)})
@@ -351,10 +348,7 @@ class Stream:
             return {**_copy(self._last_final), "final": True}
         if not self.guess:
             return None if self._last_final is None else {**_copy(self._last_final), "final": False}
-        detector, *rest = self._stages[1:] if isinstance(self._stages[0], CalibrationStage) else self._stages
-        guess = detector.guess()
-        for stage in rest:
-            guess = stage.guess(guess)
+        guess = self._chain.guess()
         if not length(guess):
             return None if self._last_final is None else {**_copy(self._last_final), "final": False}
         return {"t": float(guess["t"][-1]), "quat": guess["quat"][-1].copy(), "pos": guess["pos"][-1].copy(),
@@ -421,30 +415,10 @@ class Stream:
         b = self._with_init(take(b, 0))  # a copy, with the still-start flag
         self._raw = Queue()
         self._raw.put(b)
-        stages: list[Any] = []
-        calibrated = b
-        if pipe.calibration:
-            cal = CalibrationStage(self._calibrations(), self.ctx, self.warmup)
-            cal.fit(b)  # given fits, or online on the warm-up: the start's samples (fed through it again below)
-            stages.append(cal)
-            calibrated = cal.apply(b)
-            self.fits = cal.reports
-        use_mag = self._has_mag and bool(getattr(pipe.orientation, "use_magnetometer", False))
-        q0 = initial_attitude(calibrated["t"], calibrated["acc"], calibrated["gyr"],
-                              calibrated.get("mag") if use_mag else None, duration, max_gyr)
-        stages.append(DetectorStage(pipe.detector, pipe.guards, self.ctx))
-        kalman = [c.clone() for c in pipe.filter_corrections]
-        if not (kalman and pipe.orientation.carried_by_filter):
-            stages.append(OrientationStage(pipe.orientation, self.ctx, q0, use_mag))
-        if kalman:
-            samples = Samples(b["t"], calibrated["acc"], calibrated["gyr"], calibrated.get("mag"), b.get("dist"),
-                              b["init"])
-            engine = pipe.kalman_engine(kalman, samples, self.engine)
-            stages.append(KalmanStage(engine, kalman, q0, external_attitude=not pipe.orientation.carried_by_filter,
-                                      smoother=pipe.smoother))
-        else:
-            stages.append(BatchNavigationStage(pipe.corrections, self.ctx, pipe.gravity))
-        self._stages = stages
+        calibrations = self._calibrations() if pipe.calibration else None
+        self._chain = build_chain(pipe, self.ctx, b, self.engine, calibrations=calibrations)
+        if pipe.calibration:  # given fits, or fitted online on the warm-up: the start's samples
+            self.fits = self._chain.report()["calibration"]
         return True
 
     def _calibrations(self) -> list[Any]:

@@ -1,0 +1,144 @@
+"""The chain of stages of a run, made in one place for a batch run and a live stream.
+
+:func:`build_chain` decides which stages a pipeline has — its calibrations (if any), the
+detector and its guard, the orientation filter (unless the Kalman filter carries the
+attitude), then the Kalman engine or batch navigation — and makes them for a run's start:
+the whole recording (:meth:`footzoo.Pipeline.run` pushes it as one finished chunk) or a
+stream's first seconds (:class:`footzoo.Stream` pushes chunk after chunk). The start gives the
+calibrations' fit, the initial attitude and the Kalman models.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+
+from ..core.context import RunContext
+from ..core.data import Recording
+from ..plugins.base import Calibration, Samples
+from ..plugins.incremental import Chunk, length
+from .alignment import initial_attitude
+from .stage import Stage
+from .stages import (
+    BatchNavigationStage,
+    CalibrationStage,
+    DetectorStage,
+    KalmanStage,
+    OrientationStage,
+)
+
+
+class Chain:
+    """Stages in series: each stage's final outputs are the next one's inputs."""
+
+    def __init__(self, stages: list[Stage]):
+        self.stages = stages
+
+    def push(self, chunk: Chunk, finish: bool = False) -> Chunk:
+        """The next samples (``finish``: the data ends after them); the samples whose outputs became final."""
+        out = chunk
+        for stage in self.stages:
+            out = stage.push(out, finish=finish) if (length(out) or finish) else {}
+        return out
+
+    def held(self) -> int:
+        """Samples the stages hold, their outputs not final yet."""
+        return sum(stage.held() for stage in self.stages)
+
+    def guess(self) -> Chunk:
+        """The current guess for every sample after the final ones (each stage's guess fed to the next)."""
+        out: Chunk = {}
+        for stage in self.stages:
+            out = stage.guess(out)
+        return out
+
+    def report(self) -> dict[str, Any]:
+        """The stages' reports, in order (for ``Result.diagnostics``)."""
+        out: dict[str, Any] = {}
+        for stage in self.stages:
+            out.update(stage.report())
+        return out
+
+    @property
+    def engine(self) -> str:
+        """The Kalman engine that runs (``"fast"``, ``"reference"``), or ``"none"`` without a filter."""
+        kalman = [stage for stage in self.stages if isinstance(stage, KalmanStage)]
+        return kalman[0].engine.engine if kalman else "none"
+
+
+def with_init(chunk: Chunk, ctx: RunContext, duration: float) -> Chunk:
+    """The chunk with ``init``: its samples in the still start used for the alignment (Samples.init_window)."""
+    return {**chunk, "init": chunk["t"] <= ctx.t0 + duration}
+
+
+def recording_chunk(rec: Recording, ctx: RunContext, duration: float) -> Chunk:
+    """A whole recording as one chunk (its arrays, not copies), with ``init`` (``duration``: s of the still start)."""
+    chunk = {"k": np.arange(rec.n), "t": rec.t, "acc": rec.acc, "gyr": rec.gyr}
+    if rec.mag is not None:
+        chunk["mag"] = rec.mag
+    if rec.dist is not None:
+        chunk["dist"] = rec.dist
+    return with_init(chunk, ctx, duration)
+
+
+def with_signals(rec: Recording, out: Chunk) -> Recording:
+    """A copy of ``rec`` with the signals of ``out`` (the calibrated ones; ``rec`` stays)."""
+    calibrated = copy.copy(rec)
+    calibrated.acc, calibrated.gyr, calibrated.mag = out["acc"], out["gyr"], out.get("mag")
+    return calibrated
+
+
+def build_chain(pipeline: Any, ctx: RunContext, start: Chunk, engine: str = "auto", covariance: bool = False,
+                truth: Any = None, calibrations: list[Calibration] | None = None, whole: bool = False) -> Chain:
+    """The stages of ``pipeline`` (a :class:`footzoo.Pipeline`) for a run that starts with ``start``.
+
+    Parameters
+    ----------
+    pipeline : Pipeline
+        The blocks and settings.
+    ctx : RunContext
+        The run's context.
+    start : Chunk
+        The run's first samples, with ``init`` (:func:`with_init`): the calibrations are fitted on
+        them, the initial attitude is aligned on their still start and the Kalman models are
+        built from them.
+    engine : {"auto", "fast", "reference"}
+        The Kalman engine (:meth:`footzoo.Pipeline.run`).
+    covariance : bool
+        Keep the Kalman filter's variances and innovations (a whole recording's run).
+    truth : Truth, optional
+        The reference, for a detector that ``needs_truth`` (a batch run).
+    calibrations : list of Calibration, optional
+        The calibrations to fit (default: the pipeline's; a stream passes them with given fits).
+    whole : bool
+        ``start`` is the whole recording (a batch run): every calibration is fitted on it.
+    """
+    stages: list[Stage] = []
+    calibrated = start
+    if pipeline.calibration:
+        cal = CalibrationStage(pipeline.calibration if calibrations is None else calibrations, ctx)
+        calibrated = cal.fit(start, whole=whole)
+        stages.append(cal)
+    use_mag = "mag" in calibrated and bool(getattr(pipeline.orientation, "use_magnetometer", False))
+    q0 = initial_attitude(calibrated["t"], calibrated["acc"], calibrated["gyr"],
+                          calibrated["mag"] if use_mag else None, **pipeline.init)
+    stages.append(DetectorStage(pipeline.detector, pipeline.guards, ctx, truth))
+    if not (pipeline.filter_corrections and pipeline.orientation.carried_by_filter):
+        stages.append(OrientationStage(pipeline.orientation, ctx, q0, use_mag))
+    stages.append(navigation_stage(pipeline, ctx, calibrated, q0, engine, covariance))
+    return Chain(stages)
+
+
+def navigation_stage(pipeline: Any, ctx: RunContext, start: Chunk, q0: np.ndarray, engine: str = "auto",
+                     covariance: bool = False) -> Stage:
+    """The velocity and position stage of ``pipeline``: the Kalman engine (its models built from ``start``),
+    or batch navigation without a filter."""
+    kalman = [c.clone() for c in pipeline.filter_corrections]
+    if not kalman:
+        return BatchNavigationStage(pipeline.corrections, ctx, pipeline.gravity)
+    samples = Samples(start["t"], start["acc"], start["gyr"], start.get("mag"), start.get("dist"), start["init"])
+    eng = pipeline.kalman_engine(kalman, samples, engine)
+    return KalmanStage(eng, kalman, q0, external_attitude=not pipeline.orientation.carried_by_filter,
+                       smoother=pipeline.smoother, covariance=covariance)
