@@ -1,8 +1,9 @@
 """Every use of numba's private API in footzoo, in one module.
 
 Tested with numba 0.61.2 (with NumPy 2.2: the kernels', filters' and stream's tests) and 0.68.1 (the
-whole suite); ``setup.cfg`` pins ``numba>=0.61,<0.69`` and CI installs the newest release in that range. A numba release outside it may move one of the names below: this is the
-one file to read and adapt. The rest of footzoo uses numba's public API only (``numba.njit``,
+whole suite); ``setup.cfg`` pins ``numba>=0.61,<0.69`` and CI installs the newest release in that
+range. A numba release outside it may move one of the names below: this is the one file to read and
+adapt. The rest of footzoo uses numba's public API only (``numba.njit``,
 ``numba.types``, ``numba.extending.overload`` and ``intrinsic``), through :mod:`footzoo.kernels`.
 
 What footzoo takes from numba's internals, and why:
