@@ -148,7 +148,7 @@ def test_the_extra_stances_on_simulated_stairs_are_at_the_heel_strike():
     extra = r["detected_steps"] - r["true_steps"]
     # measured: 15 extra phases of 3 samples, one per heel strike after the first swing
     assert extra == r["false_steps"] == 15
-    ic = rec.truth.steps["end_s"].to_numpy()
+    ic = rec.truth.steps["swing_end"].to_numpy()  # the heel touches the floor
     truth_runs = intervals(rec.truth.stance)
     for a, b in intervals(d.stance_):
         if any(a < e and s < b for s, e in truth_runs):
