@@ -173,6 +173,8 @@ def test_the_reference_engine_refuses_the_same_plugins(how, walk):
         Pipeline.from_dict(_config(how)).run(walk, engine="reference")
 
 
+# slow: compiles the forward loop for a signature no shipped config has (about 12 s on a fresh install)
+@pytest.mark.slow
 @pytest.mark.parametrize("smoother", ["rts", "stepwise"])
 @pytest.mark.parametrize("how", ["three_rows", "claims_rows", "far_memory"])
 def test_a_smoothed_run_refuses_the_same_plugins(how, smoother, walk):

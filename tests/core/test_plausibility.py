@@ -149,6 +149,8 @@ def _frozen_acc(rec: Recording, lo: int, hi: int, name: str) -> Recording:
         return Recording(t=rec.t, acc=acc, gyr=rec.gyr, meta={"name": name})
 
 
+# slow: the live stream of the Kalman flagship on a 20-stride walk (about 13 s on a fresh install)
+@pytest.mark.slow
 def test_a_dropped_out_accelerometer_is_not_named_a_wrong_rate_batch_and_live():
     """Its frozen reading makes the gait implausible after it, which the dropout explains (and its warning names)."""
     straight = simulate(n_strides=20, rate=100.0, noise=NoiseModel(seed=1))

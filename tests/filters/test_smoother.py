@@ -188,6 +188,8 @@ def _filterpy_rts_on(means, covs):
     return out[:, :, 0]
 
 
+# slow: compiles the forward loop for a signature no shipped config has (about 12 s on a fresh install)
+@pytest.mark.slow
 def test_stepwise_smoothing_improves_on_the_filter_and_comes_close_to_rts(walk):
     """Against the simulator's truth: every stride smoothed alone is better than the forward filter
     and about as good as the whole-recording smoother."""
@@ -238,6 +240,8 @@ def _smoothed_over_one_record(make, t, acc, gyr, stance, q0, quat):
     return full, forward, ref.diagnostics(state)
 
 
+# slow: compiles the forward loop for a signature no shipped config has (about 12 s on a fresh install)
+@pytest.mark.slow
 @pytest.mark.parametrize(("block", "min_gap"), [(1, 32), (7, 32), (1024, 32), (10**6, 1), (10**6, 10**6)])
 @pytest.mark.parametrize("name", ["nguyen2016", "duong2015_zupt_height", "madgwick+zupt"])
 def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample(walk, name, block, min_gap,
