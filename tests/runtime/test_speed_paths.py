@@ -283,3 +283,17 @@ def test_a_direct_call_of_a_python_function_calls_it():
     from footzoo.kernels.functions import direct
 
     assert direct(lambda a, b: a + b)(2, 3) == 5
+
+
+def test_the_forward_loop_counts_no_references_and_other_kernels_do():
+    """The Kalman filter's loop is compiled without reference counting (njit(refcounts=False): it allocates
+    nothing), a kernel declared without the option keeps it."""
+    from footzoo.filters import forward
+    from footzoo.kernels import jit as _jit
+
+    if not _jit.HAVE_NUMBA:
+        pytest.skip("numba not installed")
+    from footzoo.kernels.internals import counts_references
+
+    assert not counts_references(_jit.compiled(forward.forward_span))
+    assert counts_references(_jit.compiled(forward.run))
