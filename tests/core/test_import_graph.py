@@ -10,6 +10,7 @@ The contracts are read from pyproject.toml, not copied here.
 from __future__ import annotations
 
 import ast
+import functools
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -105,8 +106,18 @@ def _imports() -> list[Import]:
     return out
 
 
-IMPORTS = _imports()
-INTERNAL = [i for i in IMPORTS if i.target.split(".")[0] == "footzoo"]
+@functools.cache
+def imports() -> tuple[Import, ...]:
+    """Every import statement of the package (parsed once, when a test first asks: about 3 s, not at collection)."""
+    return tuple(_imports())
+
+
+@functools.cache
+def internal() -> tuple[Import, ...]:
+    """The imports of footzoo's own modules."""
+    return tuple(i for i in imports() if i.target.split(".")[0] == "footzoo")
+
+
 CONTRACTS = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["importlinter"]["contracts"]
 
 
@@ -151,20 +162,20 @@ def _cycles(edges: dict[str, set[str]]) -> list[list[str]]:
 
 def test_the_parser_sees_function_level_and_relative_imports():
     """The collection itself, on imports known to be there (a test of the test)."""
-    assert len(MODULES) > 100 and len(INTERNAL) > 300
-    assert sum(i.in_function for i in INTERNAL) > 50  # imports inside functions are counted
-    assert any(i.source == "footzoo.runtime.pipeline" and i.target == "footzoo.core.data" for i in INTERNAL)
+    assert len(MODULES) > 100 and len(internal()) > 300
+    assert sum(i.in_function for i in internal()) > 50  # imports inside functions are counted
+    assert any(i.source == "footzoo.runtime.pipeline" and i.target == "footzoo.core.data" for i in internal())
     assert any(i.source == "footzoo.apps.cli" and i.target == "footzoo.runtime.pipeline" and i.in_function
-               for i in INTERNAL)
-    assert not any(i.source == "footzoo" and i.target == "footzoo.apps.testing" for i in INTERNAL)  # TYPE_CHECKING
+               for i in internal())
+    assert not any(i.source == "footzoo" and i.target == "footzoo.apps.testing" for i in internal())  # TYPE_CHECKING
 
 
 def test_no_cycle_among_footzoo_modules_counting_imports_inside_functions():
     edges: dict[str, set[str]] = {}
-    for i in INTERNAL:
+    for i in internal():
         edges.setdefault(i.source, set()).add(i.target)
     cycles = _cycles(edges)
-    details = [f"{' <-> '.join(c)}: " + "; ".join(str(i) for i in INTERNAL if i.source in c and i.target in c)
+    details = [f"{' <-> '.join(c)}: " + "; ".join(str(i) for i in internal() if i.source in c and i.target in c)
                for c in cycles]
     assert not cycles, "import cycles:\n" + "\n".join(details)
 
@@ -184,7 +195,7 @@ def _layer_violations(contract: dict) -> list[str]:
         # per layer, top first: its independent groups ("a | b"), each a list of siblings ("a : b")
         layers = [[[f"{container}.{m.strip()}" if container else m.strip() for m in group.split(":")]
                    for group in layer.split("|")] for layer in contract["layers"]]
-        for i in INTERNAL:
+        for i in internal():
             a, b = _place(layers, i.source), _place(layers, i.target)
             if a is None or b is None:
                 continue
@@ -204,7 +215,7 @@ def test_each_layers_contract_holds_for_every_import(contract):
 
 @pytest.mark.parametrize("contract", [c for c in CONTRACTS if c["type"] == "forbidden"], ids=lambda c: c["name"])
 def test_each_forbidden_contract_holds_for_every_direct_import(contract):
-    bad = [str(i) for i in IMPORTS
+    bad = [str(i) for i in imports()
            if any(_within(i.source, s) for s in contract["source_modules"])
            and any(_within(i.target, f) for f in contract["forbidden_modules"])]
     assert not bad, "\n".join(bad)

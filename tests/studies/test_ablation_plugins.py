@@ -177,6 +177,9 @@ def test_a_pipeline_yaml_loads_its_plugins_and_keeps_them_in_to_dict(tmp_path, m
 # --------------------------------------------------------------------------- studies
 
 
+# slow (7 s: two worker processes start): the fast suite runs plug-in files in workers with the tests below that
+# take a config's plug-in and a calibration plug-in
+@pytest.mark.slow
 def test_a_study_with_a_plugin_file_runs_serially_and_with_two_jobs(tmp_path):
     write_plugin(tmp_path)
     (tmp_path / "study.yaml").write_text(yaml.safe_dump(study_dict("my_detector.py", det_name(tmp_path))))
