@@ -130,6 +130,8 @@ MIN_SWINGS = 4
 CHECKPOINTS = (12, 24, 48)
 #: Most strides measured (the scan's memory is bounded; a rate does not change within a recording).
 MAX_STRIDES = 256
+#: Samples per block in which a long chunk (a batch run's recording) is scanned.
+BLOCK = 4096
 #: Longest stride, stance and swing (s) measured: a longer one is a pause or a missed stance.
 MAX_STRIDE_TIME = 4.0
 MAX_STANCE_TIME = 3.0
@@ -173,13 +175,14 @@ def stride_summary(strides: np.ndarray) -> dict[str, float]:
         ``swing_time_s`` (the detector's swing), ``rotation_rad`` (∫|ω| dt over the swing),
         ``rolling_m_rad`` (length per radian of rotation) and ``peak_rate_rad_s``.
     """
-    T, L, h, rot, peak, swing = (strides[:, j] for j in range(6))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return {"strides": int(len(strides)), "cadence_steps_min": float(120.0 / np.median(T)),
-                "stride_length_m": float(np.median(L)), "speed_m_s": float(np.median(L / T)),
-                "clearance_m": float(np.median(h)), "swing_time_s": float(np.median(swing)),
-                "rotation_rad": float(np.median(rot)), "rolling_m_rad": float(np.median(L / np.maximum(rot, 1e-9))),
-                "peak_rate_rad_s": float(np.median(peak))}
+    T, L, rot = strides[:, 0], strides[:, 1], strides[:, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):  # the medians of every column at once
+        m = np.median(np.column_stack([strides[:, :6], L / T, L / np.maximum(rot, 1e-9)]), axis=0)
+        cadence = float(120.0 / m[0])
+    m = m.tolist()
+    return {"strides": int(len(strides)), "cadence_steps_min": cadence, "stride_length_m": m[1],
+            "speed_m_s": m[6], "clearance_m": m[2], "swing_time_s": m[5], "rotation_rad": m[3],
+            "rolling_m_rad": m[7], "peak_rate_rad_s": m[4]}
 
 
 def _outside(x: float, lo: float, hi: float) -> float:
@@ -202,20 +205,27 @@ def gait_costs(gait: dict[str, float], factor: float) -> dict[str, float]:
             "rolling": _outside(gait["rolling_m_rad"] * f, *ROLLING_RANGE)}
 
 
-def consistency_cost(evidence: dict[str, Any] | None, factor: float) -> float:
-    """Cost of the time scale ``factor`` by the gyroscope–accelerometer residuals (0 without evidence).
+#: log of the multiples of a time scale whose lowest residual counts (:data:`SCALE_WINDOW`), the scale itself last.
+_WINDOW = np.append(np.linspace(math.log(SCALE_WINDOW[0]), math.log(SCALE_WINDOW[1]), 9), 0.0)
+#: The hypotheses in the order :func:`judge_rate` scores them: the declared rate (1), then :data:`FACTORS`.
+_HYPOTHESES = (1.0, *FACTORS)
+_LOG_HYPOTHESES = np.array([math.log(f) for f in _HYPOTHESES])
 
-    The lowest residual between ``factor`` times the ends of :data:`SCALE_WINDOW` counts: on real
+
+def consistency_costs(evidence: dict[str, Any] | None) -> dict[float, float]:
+    """Cost of each hypothesis (1, then :data:`FACTORS`) by the gyroscope–accelerometer residuals (0 without evidence).
+
+    The lowest residual between the factor times the ends of :data:`SCALE_WINDOW` counts: on real
     recordings the residual is lowest a little above the right time scale (1.09× it, the median over
     the 42 real recordings as recorded), on a simulation at it.
     """
     if evidence is None:
-        return 0.0
+        return dict.fromkeys(_HYPOTHESES, 0.0)
     scales, residual = np.log(evidence["scales"]), np.log(np.maximum(evidence["residual"], 1e-12))
     order = np.argsort(scales)
-    around = math.log(factor) + np.append(np.linspace(math.log(SCALE_WINDOW[0]), math.log(SCALE_WINDOW[1]), 9), 0.0)
-    at = float(np.min(np.interp(around, scales[order], residual[order])))
-    return ((at - float(residual.min())) / CONSISTENCY_TOLERANCE) ** 2
+    at = np.interp(_LOG_HYPOTHESES[:, None] + _WINDOW, scales[order], residual[order]).min(axis=1)
+    cost = ((at - float(residual.min())) / CONSISTENCY_TOLERANCE) ** 2
+    return dict(zip(_HYPOTHESES, cost.tolist(), strict=True))
 
 
 def likely_rate(declared: float, factor: float) -> float:
@@ -245,19 +255,14 @@ def judge_rate(gait: dict[str, float] | None, evidence: dict[str, Any] | None) -
         the factor on its side of 1 whose residual is lowest), ``alternative`` (a second one almost
         as likely, or None).
     """
-    informative = gait is not None and min(sum(gait_costs(gait, f).values()) for f in (1.0, *FACTORS)) \
-        <= GAIT_INFORMATIVE
-
-    def cost(f: float) -> float:
-        c = consistency_cost(evidence, f) + (sum(gait_costs(gait, f).values()) if informative else 0.0)
-        return c + (0.0 if f == 1.0 else PRIOR)
-
-    costs = {f: cost(f) for f in (1.0, *FACTORS)}
+    gaits = {f: sum(gait_costs(gait, f).values()) for f in _HYPOTHESES} if gait is not None else None
+    informative = gaits is not None and min(gaits.values()) <= GAIT_INFORMATIVE
+    fit = consistency_costs(evidence)
+    costs = {f: fit[f] + (gaits[f] if informative else 0.0) + (0.0 if f == 1.0 else PRIOR) for f in _HYPOTHESES}
     best, out = min(FACTORS, key=costs.get), {"costs": costs, "gait_informative": informative, "factor": None,
                                               "alternative": None}
     if costs[1.0] - costs[best] < MARGIN or evidence is None:
         return out  # the gait alone never names a rate: a detector that splits strides mimics one read too fast
-    fit = {f: consistency_cost(evidence, f) for f in (1.0, *FACTORS)}
     if fit[1.0] - fit[best] < SUPPORT:
         return out  # the gyroscope and the accelerometer do not prefer it
     # which factor: the residuals, which depend on it directly (the gait's ranges tell that the rate is wrong)
@@ -284,10 +289,14 @@ class GaitScan:
     def __init__(self, name: str = "recording", gravity: float = GRAVITY, evidence: RateEvidence | None = None):
         self.name, self.gravity, self.evidence = name, gravity, evidence
         self.report: dict[str, Any] = {}
-        self._rows: list[list[float]] = []  # per stride: T, L, h, rot, peak, swing, last sample, samples spanned
+        # per stride: T, L, h, rot, peak, swing, last sample, samples spanned (the first ``_count`` rows)
+        self._table = np.empty((MAX_STRIDES, 8))
+        self._count = 0
         self._buf: dict[str, np.ndarray] | None = None
         self._pending: list[int] | None = list(CHECKPOINTS)  # None once judged at the end
-        self._motion = [0.0, 0, 0]  # moving time (s), moving samples, of them turning
+        self._motion = [0.0, 0, 0, 0.0, 0.0]  # moving time (s), moving samples, of them turning, peak |ω| (rad/s)
+        # of the moving samples and of all samples: until MOTION_TIME s of motion are seen (then decided)
+        self._unit_decided = False
         self._t_last: float | None = None
         self._cut: int | None = None  # the first sample of a sensor dropout: the rate is judged before it
 
@@ -299,19 +308,35 @@ class GaitScan:
     @property
     def strides(self) -> np.ndarray:
         """(n, 6): per stride T (s), L (m), h (m), θ (rad), peak |ω| (rad/s), the detector's swing (s)."""
-        return np.asarray(self._rows, dtype=float).reshape(-1, 8)[:, :6]
+        return self._rows[:, :6].copy()
+
+    @property
+    def _rows(self) -> np.ndarray:
+        """The strides measured so far (n, 8): a read-only view of the table."""
+        view = self._table[:self._count]
+        view.flags.writeable = False
+        return view
 
     def push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
              pos: np.ndarray) -> None:
         """The next final estimates: sample indices ``k``, time (s), signals (FRD, SI), stance, position (m, NED)."""
-        if not len(t):
-            return
+        # a long chunk (a batch run's whole recording) in blocks, as a stream would feed it, until the gyroscope's
+        # unit is decided and every stride the scan judges is measured: the rest of the data changes nothing, and
+        # the scan's cost is bounded whatever the recording's length
+        for lo in range(0, len(t), BLOCK):
+            if self._unit_decided and self._count >= MAX_STRIDES:
+                return
+            hi = lo + BLOCK
+            self._push(np.asarray(k[lo:hi]), t[lo:hi], acc[lo:hi], gyr[lo:hi], stance[lo:hi], pos[lo:hi])
+
+    def _push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
+              pos: np.ndarray) -> None:
         w = row_norms(gyr)
-        if "gyro_unit" not in self.report:
-            self._gyro_unit(np.asarray(k), t, acc, w)
-        if len(self._rows) >= MAX_STRIDES:
-            return  # every stride the scan judges is measured: the rest of the data changes nothing
-        new = {"k": np.asarray(k), "t": np.asarray(t, dtype=float), "w": w, "stance": np.asarray(stance, dtype=bool),
+        if not self._unit_decided:
+            self._gyro_unit(k, t, acc, w)
+        if self._count >= MAX_STRIDES:
+            return
+        new = {"k": k, "t": np.asarray(t, dtype=float), "w": w, "stance": np.asarray(stance, dtype=bool),
                "pos": np.asarray(pos, dtype=float)}
         self._buf = new if self._buf is None else {n: np.concatenate([self._buf[n], v]) for n, v in new.items()}
         self._strides()
@@ -344,7 +369,7 @@ class GaitScan:
             m0, m1 = (a0 + b0 - 1) // 2, (a1 + b1 - 1) // 2
             T, stance = t[m1] - t[m0], t[b0 - 1] - t[a0]
             ok = np.flatnonzero((T <= MAX_STRIDE_TIME) & (stance <= MAX_STANCE_TIME))  # else a pause, a missed stance
-            ok = ok[:MAX_STRIDES - len(self._rows)]
+            ok = ok[:MAX_STRIDES - self._count]
             if len(ok):
                 a0, b0, a1, m0, m1, T = a0[ok], b0[ok], a1[ok], m0[ok], m1[ok], T[ok]
                 # the swing of each stride: samples b0 - 1 .. a1 (the last stance sample to the first of the next)
@@ -354,7 +379,8 @@ class GaitScan:
                     T, np.hypot(*(pos[m1, :2] - pos[m0, :2]).T),
                     pos[m0, 2] - np.minimum.reduceat(pos[:, 2], swing)[::2], turned[a1] - turned[b0 - 1],
                     np.maximum.reduceat(w, swing)[::2], t[a1] - t[b0 - 1], k[m1], k[m1] - k[m0]])
-                self._rows.extend(rows.tolist())
+                self._table[self._count:self._count + len(rows)] = rows
+                self._count += len(rows)
         if len(starts) and t[-1] - t[(starts[-1] + ends[-1] - 1) // 2] <= MAX_STRIDE_TIME:
             keep = int(starts[-1])  # the next stride starts at the middle of the last stance that ended
         else:  # no stride can end in what follows (or no stance has ended yet): keep the stance going on, if any
@@ -372,16 +398,22 @@ class GaitScan:
         self._t_last = float(t[-1])
         moving = np.abs(row_norms(acc) - self.gravity) > MOTION_ACC
         if not moving.any():
+            self._motion[4] = max(self._motion[4], float(np.max(w)))
             return
         time = self._motion[0] + np.cumsum(np.where(moving, dt, 0.0))
         reached = np.flatnonzero(time >= MOTION_TIME)
         upto = int(reached[0]) + 1 if len(reached) else len(t)
         count = self._motion[1] + int(np.count_nonzero(moving[:upto]))
         turning = self._motion[2] + int(np.count_nonzero(moving[:upto] & (w[:upto] > TURN_RATE)))
-        self._motion = [float(time[upto - 1]), count, turning]
-        if not len(reached) or turning >= TURN_FRACTION * count:
+        peaks = (max(self._motion[3], float(np.max(w[:upto][moving[:upto]], initial=0.0))),
+                 max(self._motion[4], float(np.max(w[:upto]))))
+        self._motion = [float(time[upto - 1]), count, turning, *peaks]
+        if not len(reached):
             return
-        peak = float(np.max(w[:upto][moving[:upto]])) if turning == count else float(np.max(w[:upto]))
+        self._unit_decided = True  # on the first MOTION_TIME s of motion
+        if turning >= TURN_FRACTION * count:
+            return
+        peak = peaks[0] if turning == count else peaks[1]
         self.report["gyro_unit"] = {"sample": int(k[upto - 1]), "moving_s": self._motion[0], "moving_samples": count,
                                     "turning_samples": turning, "peak_rate_rad_s": peak,
                                     "peak_if_rad_s": peak / DEG}
@@ -401,7 +433,7 @@ class GaitScan:
         """Judge the rate at each checkpoint whose evidence is complete (all of them at the end, then every stride)."""
         if self._pending is None or "rate" in self.report or "gyro_unit" in self.report or not (self._pending or final):
             return
-        rows = np.asarray(self._rows, dtype=float).reshape(-1, 8)
+        rows = self._rows
         if self._cut is not None:
             rows = rows[rows[:, 6] < self._cut]
         while self._pending and len(rows) >= self._pending[0]:

@@ -81,6 +81,24 @@ SWING_RANGE = (0.15, 3.0)
 MIN_RATE_SWINGS = 4
 
 
+@njit(inline="always")
+def _half_turn(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
+    """``exp(r/2)`` of the rotation vector r (rad), as :func:`~footzoo.filters.strapdown.rotvec_quat`, by the series
+    of cos h and sin h / h in h² (h = |r|/2) up to h¹² where h ≤ 0.5: no square root, sine, cosine or division.
+
+    The first omitted terms are below 1e-15 there; over the swings of a real walk the residuals
+    equal those of the closed form to 1e-13 (relative), at about half the cost of the scan.
+    """
+    u = 0.25 * (rx * rx + ry * ry + rz * rz)
+    if u > 0.25:
+        return rotvec_quat(rx, ry, rz)
+    c = 1.0 + u * (-1.0 / 2.0 + u * (1.0 / 24.0 + u * (-1.0 / 720.0 + u * (1.0 / 40320.0 + u * (
+        -1.0 / 3628800.0 + u * (1.0 / 479001600.0))))))
+    k = 0.5 * (1.0 + u * (-1.0 / 6.0 + u * (1.0 / 120.0 + u * (-1.0 / 5040.0 + u * (1.0 / 362880.0 + u * (
+        -1.0 / 39916800.0 + u * (1.0 / 6227020800.0)))))))
+    return c, k * rx, k * ry, k * rz
+
+
 @njit
 def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray,
                scale: np.ndarray, signs: np.ndarray, g: float, out: np.ndarray) -> None:
@@ -101,11 +119,11 @@ def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarra
                 vx += nx * dt
                 vy += ny * dt
                 vz += (nz + g) * dt
-                d0, d1, d2, d3 = rotvec_quat(gyr[i, 0] * signs[c, 0] * dt, gyr[i, 1] * signs[c, 1] * dt,
-                                             gyr[i, 2] * signs[c, 2] * dt)
+                d0, d1, d2, d3 = _half_turn(gyr[i, 0] * signs[c, 0] * dt, gyr[i, 1] * signs[c, 1] * dt,
+                                            gyr[i, 2] * signs[c, 2] * dt)
                 w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
-                n = math.sqrt(w * w + x * x + y * y + z * z)
-                w, x, y, z = w / n, x / n, y / n, z / n
+                m = 1.5 - 0.5 * (w * w + x * x + y * y + z * z)  # back to unit length (one Newton step of 1/√n)
+                w, x, y, z = w * m, x * m, y * m, z * m
             out[s, c] = math.sqrt(vx * vx + vy * vy + vz * vz) / (g * (t[b] - t[a]) * scale[c])
 
 
