@@ -364,8 +364,8 @@ def check_folder(path: str | os.PathLike, names: Any, what: str = "--out") -> No
 def _metrics_payload(result: Any) -> dict[str, Any]:
     notes: dict[str, str] = {}
     try:
-        metrics: Any = result.metrics
-        notes = result.metric_notes
+        # once, without a second warning of the NaNs the run already warned about: their reasons go into the file
+        metrics, notes = result.checked_metrics()
     except Exception as err:  # a failing metric must not lose the result
         warnings.warn(FootzooWarning(f"Result.save: the metrics could not be computed ({type(err).__name__}: {err}); "
                                      "saved without them"), stacklevel=4)

@@ -95,6 +95,11 @@ class Result:
         """Why each NaN of :attr:`metrics` is NaN: metric -> reason (empty when every metric could be scored)."""
         return self._checked_metrics()[1]
 
+    def checked_metrics(self) -> tuple[dict[str, float], dict[str, str]]:
+        """:attr:`metrics` and :attr:`metric_notes` in one computation, without the warning: for callers that
+        keep or show the reasons themselves (:meth:`save` writes them into ``metrics.json``)."""
+        return self._checked_metrics()
+
     def _checked_metrics(self) -> tuple[dict[str, float], dict[str, str]]:
         t = self.samples["t"].to_numpy()
         return result_metrics_checked(t, self.pos, self.steps, self.reference)

@@ -68,3 +68,21 @@ def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
     assert main(["ablate", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert WARNING not in capsys.readouterr().err
     assert WARNING in (tmp_path / "out" / LOG).read_text()
+
+
+# the unknown foot's warning and the refused metrics' are this test's subject: let through, counted below
+@pytest.mark.filterwarnings("always::footzoo.core.errors.FootzooWarning")
+def test_a_refused_metric_is_warned_once_and_saving_the_result_warns_nothing_more(tmp_path, capsys):
+    # huang2016 on a walk that names no foot and whose strides show no swing arc: the FPA metrics are refused
+    # (NaN, a MetricWarning with the reason) during the run; saving the result keeps the reasons, silently
+    walk = simulate(path="straight", n_strides=6, rate=100.0, noise=NoiseModel(seed=0))
+    del walk.meta["foot"]
+    straight = write(walk, tmp_path / "no_foot.csv")
+    out = tmp_path / "run"
+    assert main(["run", "huang2016", "--data", str(straight), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("metrics refused (NaN): fpa_mean_deg") == 1
+    assert main(["run", "huang2016", "--data", str(straight), "--out", str(out), "--quiet"]) == 0
+    assert "not shown" not in capsys.readouterr().err  # every warning is in the log, none escaped it
+    assert "metrics refused (NaN): fpa_mean_deg" in (out / LOG).read_text()
+    assert "fpa_mean_deg" in Result.load(out).metric_notes
