@@ -50,6 +50,9 @@ KEYS = ("time", "acc", "gyr", "mag", "axes", "delimiter", "decimal", "skip_rows"
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9, "datetime": None}
 DELIMITERS = {",": ",", ";": ";", "\t": "\t", "\\t": "\t", "tab": "\t", " ": r"\s+", "whitespace": r"\s+"}
 
+#: Where the description format is documented, for the messages.
+FORMAT_DOCS = "the format: docs/readers/generic.md, or help(footzoo.io.generic)"
+
 
 def sidecar_of(path: Path) -> Path:
     """The description of a data file: ``<file>.footzoo.yaml``."""
@@ -73,7 +76,9 @@ class _Spec:
                 self.fail(str(key), f"unknown key{did_you_mean(str(key), list(KEYS))}; valid: {list(KEYS)}")
         for key in ("time", "acc", "gyr", "axes"):
             if key not in raw and not (key == "axes" and "axes" in given):
-                self.fail(key, "missing: a description needs time, acc, gyr and axes (see footzoo.io.generic)")
+                hint = (": the file's axes in footzoo's forward-right-down frame, e.g. axes: [x, y, z] for a sensor "
+                        "already FRD, [x, -y, -z] for forward-left-up" if key == "axes" else "")
+                self.fail(key, f"missing: a description needs time, acc, gyr and axes{hint} ({FORMAT_DOCS})")
         self.raw = raw
         self.header = self._bool("header", True)
         self.delimiter = self._choice("delimiter", ",", DELIMITERS)
@@ -189,7 +194,7 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
     """
     side = Path(sidecar) if sidecar is not None else sidecar_of(path)
     if not side.exists():
-        raise FormatError(f"{path}: no description {side.name} next to it; write one (see footzoo.io.generic) or "
+        raise FormatError(f"{path}: no description {side.name} next to it; write one ({FORMAT_DOCS}) or "
                           "pass sidecar= (the path of a description shared by several files)")
     spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit)
     source = text_source(path)

@@ -172,3 +172,14 @@ def test_a_sidecar_option_implies_the_generic_format(walk, tmp_path, capsys):
             "--option", "acc_unit=mg", "--option", "gyr_unit=rad/s"]
     assert main(args) == 0, capsys.readouterr().err
     assert "strides" in capsys.readouterr().out
+
+
+def test_a_description_without_axes_says_what_axes_means_and_where_the_format_is(walk, tmp_path):
+    path, units = write_generic(walk, tmp_path / "trial.txt")
+    side = path.with_name(path.name + ".footzoo.yaml")
+    side.write_text("".join(line for line in side.read_text().splitlines(keepends=True) if not line.startswith("axes")))
+    with pytest.raises(FormatError, match=r"axes: missing: .*forward-right-down.*axes: \[x, y, z\].*"
+                                          r"docs/readers/generic\.md"):
+        load(path)
+    rec = load(path, axes=MOUNT, **units)  # the option that gives the axes instead
+    np.testing.assert_allclose(rec.gyr, walk.gyr, rtol=0, atol=1e-9)
