@@ -131,7 +131,7 @@ CHECKPOINTS = (12, 24, 48)
 #: Most strides measured (the scan's memory is bounded; a rate does not change within a recording).
 MAX_STRIDES = 256
 #: Samples per block in which a long chunk (a batch run's recording) is scanned.
-BLOCK = 4096
+BLOCK = 16384
 #: Longest stride, stance and swing (s) measured: a longer one is a pause or a missed stance.
 MAX_STRIDE_TIME = 4.0
 MAX_STANCE_TIME = 3.0

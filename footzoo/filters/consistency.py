@@ -81,17 +81,20 @@ SWING_RANGE = (0.15, 3.0)
 MIN_RATE_SWINGS = 4
 
 
-@njit(inline="always")
-def _half_turn(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
-    """``exp(r/2)`` of the rotation vector r (rad), as :func:`~footzoo.filters.strapdown.rotvec_quat`, by the series
-    of cos h and sin h / h in h² (h = |r|/2) up to h¹² where h ≤ 0.5: no square root, sine, cosine or division.
+#: Largest half-angle (rad) of one sample's rotation, at the largest time scale, for which a swing is integrated with
+#: :func:`_series_turn`; a swing that turns faster in one sample is integrated with the closed form.
+SERIES_HALF_ANGLE = 0.5
 
-    The first omitted terms are below 1e-15 there; over the swings of a real walk the residuals
-    equal those of the closed form to 1e-13 (relative), at about half the cost of the scan.
+
+@njit(inline="always")
+def _series_turn(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
+    """``exp(r/2)`` of the rotation vector r (rad), as :func:`~footzoo.filters.strapdown.rotvec_quat`, by the series
+    of cos h and sin h / h in h² (h = |r|/2) up to h¹²: no square root, sine, cosine, division or branch.
+
+    For h ≤ :data:`SERIES_HALF_ANGLE` the first omitted terms are below 1e-15; over the swings of a
+    real walk the residuals equal those of the closed form to 1e-13 (relative).
     """
     u = 0.25 * (rx * rx + ry * ry + rz * rz)
-    if u > 0.25:
-        return rotvec_quat(rx, ry, rz)
     c = 1.0 + u * (-1.0 / 2.0 + u * (1.0 / 24.0 + u * (-1.0 / 720.0 + u * (1.0 / 40320.0 + u * (
         -1.0 / 3628800.0 + u * (1.0 / 479001600.0))))))
     k = 0.5 * (1.0 + u * (-1.0 / 6.0 + u * (1.0 / 120.0 + u * (-1.0 / 5040.0 + u * (1.0 / 362880.0 + u * (
@@ -99,32 +102,65 @@ def _half_turn(rx: float, ry: float, rz: float) -> tuple[float, float, float, fl
     return c, k * rx, k * ry, k * rz
 
 
+@njit(inline="always")
+def _integrate(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, scale: np.ndarray,
+               axes: np.ndarray, g: float, state: np.ndarray, series: bool) -> None:
+    """Strapdown over samples ``a``–``b`` of every column ``c`` of ``state`` (rows w, x, y, z, vx, vy, vz) at once,
+    one sample at a time: the velocity by the specific force, then the attitude by the rotation vector (by
+    :func:`_series_turn`, or by the closed form where ``series`` is False); ``axes`` (3, columns) the gyroscope
+    axes' signs."""
+    for i in range(a, b):
+        dt0, fx, fy, fz = t[i + 1] - t[i], acc[i, 0], acc[i, 1], acc[i, 2]
+        for c in range(scale.shape[0]):  # independent columns: this loop vectorises
+            dt = dt0 * scale[c]
+            w, x, y, z = state[0, c], state[1, c], state[2, c], state[3, c]
+            nx, ny, nz = rotate(w, x, y, z, fx, fy, fz)
+            state[4, c] += nx * dt
+            state[5, c] += ny * dt
+            state[6, c] += (nz + g) * dt
+            rx, ry, rz = gyr[i, 0] * axes[0, c] * dt, gyr[i, 1] * axes[1, c] * dt, gyr[i, 2] * axes[2, c] * dt
+            if series:
+                d0, d1, d2, d3 = _series_turn(rx, ry, rz)
+                w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
+                m = 1.5 - 0.5 * (w * w + x * x + y * y + z * z)  # back to unit length (a Newton step of 1/√n)
+            else:
+                d0, d1, d2, d3 = rotvec_quat(rx, ry, rz)
+                w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
+                m = 1.0 / math.sqrt(w * w + x * x + y * y + z * z)
+            state[0, c], state[1, c], state[2, c], state[3, c] = w * m, x * m, y * m, z * m
+
+
 @njit
 def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray,
                scale: np.ndarray, signs: np.ndarray, g: float, out: np.ndarray) -> None:
     """``out[s, c] = |v| / (g T)`` of swing ``s``: strapdown from sample ``first[s]`` (tilt from its ``acc``) to
-    ``last[s]``, with the time scaled by ``scale[c]`` and the gyroscope axes signed by ``signs[c]``."""
+    ``last[s]``, with the time scaled by ``scale[c]`` and the gyroscope axes signed by ``signs[c]``.
+
+    Every column advances one sample at a time (independent columns side by side: the loop over
+    them vectorises); a swing whose rotations stay within :data:`SERIES_HALF_ANGLE` per sample at
+    the largest scale by the series (:func:`_series_turn`), another by the closed form.
+    """
+    state = np.empty((7, scale.shape[0]))
+    axes = np.ascontiguousarray(signs.T)  # (3, columns): each axis's signs side by side, as the columns advance
+    reach = np.max(np.abs(scale))
     for s in range(first.shape[0]):
         a, b = first[s], last[s]
         fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
         roll = math.atan2(-fy, -fz)
         pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
         cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+        state[0], state[1], state[2], state[3], state[4:] = cp * cr, cp * sr, sp * cr, -sp * sr, 0.0
+        turn = 0.0
+        for i in range(a, b):
+            turn = max(turn, (gyr[i, 0] ** 2 + gyr[i, 1] ** 2 + gyr[i, 2] ** 2) * (t[i + 1] - t[i]) ** 2)
+        series = 0.5 * math.sqrt(turn) * reach <= SERIES_HALF_ANGLE
+        if series:  # two copies of the loop, each without a branch inside
+            _integrate(t, acc, gyr, a, b, scale, axes, g, state, True)
+        else:
+            _integrate(t, acc, gyr, a, b, scale, axes, g, state, False)
         for c in range(scale.shape[0]):
-            w, x, y, z = cp * cr, cp * sr, sp * cr, -sp * sr
-            vx = vy = vz = 0.0
-            for i in range(a, b):
-                dt = (t[i + 1] - t[i]) * scale[c]
-                nx, ny, nz = rotate(w, x, y, z, acc[i, 0], acc[i, 1], acc[i, 2])
-                vx += nx * dt
-                vy += ny * dt
-                vz += (nz + g) * dt
-                d0, d1, d2, d3 = _half_turn(gyr[i, 0] * signs[c, 0] * dt, gyr[i, 1] * signs[c, 1] * dt,
-                                            gyr[i, 2] * signs[c, 2] * dt)
-                w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
-                m = 1.5 - 0.5 * (w * w + x * x + y * y + z * z)  # back to unit length (one Newton step of 1/√n)
-                w, x, y, z = w * m, x * m, y * m, z * m
-            out[s, c] = math.sqrt(vx * vx + vy * vy + vz * vz) / (g * (t[b] - t[a]) * scale[c])
+            v = math.sqrt(state[4, c] ** 2 + state[5, c] ** 2 + state[6, c] ** 2)
+            out[s, c] = v / (g * (t[b] - t[a]) * scale[c])
 
 
 #: Columns of the residuals: 0 the signals as given, then each axis fault undone, then each time scale.

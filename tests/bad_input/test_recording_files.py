@@ -280,7 +280,7 @@ def test_a_results_metrics_json_keeps_nested_metadata():
 
     from footzoo.core.archive import _metrics_payload
 
-    result = SimpleNamespace(metrics={"strides": 3.0}, metric_notes={}, config={}, versions={}, recording={
+    result = SimpleNamespace(checked_metrics=lambda: ({"strides": 3.0}, {}), config={}, versions={}, recording={
         "name": "m", "subject": {"age": 30}, "tags": ["a"], "arr": np.arange(2.0), "t0": float("nan")})
     assert _metrics_payload(result)["recording"] == {"name": "m", "subject": {"age": 30}, "tags": ["a"],
                                                      "arr": [0.0, 1.0], "t0": None}
