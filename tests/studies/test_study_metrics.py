@@ -1,5 +1,7 @@
 """One metric registry for footzoo run, Result.metrics and studies; refused metrics (NaN with a reason)."""
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
