@@ -37,12 +37,13 @@ from typing import Any
 
 import numpy as np
 
-from ..core.atomic import atomic_path, check_target, folder_lock, refuse_inputs, write_bytes
+from ..core.atomic import atomic_path, check_target, folder_lock, refuse_inputs
 from ..core.context import RunContext
 from ..core.conventions import ACC_UNITS, GYR_UNITS
 from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
 from ..core.files import why_missing
 from ..core.params import describe as describe_parameters
+from ..core.warninglog import LOG, log_text, warning_texts
 from ..plugins.base import BASES
 from ..plugins.registry import describe
 
@@ -235,8 +236,6 @@ def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | 
 
 #: Files ``footzoo run --out DIR`` writes (a result archive with CSV tables, :mod:`footzoo.core.archive`).
 RUN_OUTPUTS = ("samples.csv", "steps.csv", "metrics.json", "result.json", "arrays.npz", "manifest.json")
-#: The log of a command that writes a folder: every warning it gave (:func:`write_log`).
-LOG = "footzoo.log"
 #: The figures ``--plot`` may add (:func:`footzoo.evaluation.plots.run_figures`).
 RUN_FIGURES = ("trajectory.png", "states.png", "errors.png", "strides.png", "fpa.png")
 
@@ -332,12 +331,6 @@ def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
     return 0
 
 
-def warning_texts(caught: list[warnings.WarningMessage]) -> list[str]:
-    """``"Category: message"`` of each distinct warning caught, in order."""
-    return list(dict.fromkeys(f"{type(w.message).__name__ if isinstance(w.message, Warning) else w.category.__name__}"
-                              f": {w.message}" for w in caught))
-
-
 class kept_warnings:
     """Record the warnings of a block; shown as they come unless ``--quiet``, kept either way.
 
@@ -360,19 +353,6 @@ class kept_warnings:
                 if str(w.message) not in shown:
                     shown.add(str(w.message))
                     warnings.showwarning(w.message, w.category, w.filename, w.lineno)
-
-
-def log_text(texts: list[str]) -> bytes:
-    """The content of ``footzoo.log``: every warning of the command, one per line (or that there was none)."""
-    return (("\n".join(texts) if texts else "no warnings") + "\n").encode("utf-8")
-
-
-def write_log(folder: Path, texts: list[str], inputs: list[str] | None = None) -> Path:
-    """``folder/footzoo.log`` (:func:`log_text`), atomically (a run's is saved with its result instead)."""
-
-    target = folder / LOG
-    refuse_inputs([target], inputs or [], "--out")
-    return write_bytes(target, log_text(texts), what="the command's log")
 
 
 def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
@@ -554,10 +534,9 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     out = args.out or f"ablation_{Path(args.study).stem}"
     prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
              "max_bytes": None if args.cache_max_size is None else int(args.cache_max_size * 1e6)}
-    with kept_warnings(args) as caught:
+    with kept_warnings(args):  # and in OUT/footzoo.log, written with the study's report
         table = run_study(args.study, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet,
                           max_cells=args.max_cells, prune=prune)
-    write_log(Path(out), warning_texts(caught))
     a = table.attrs
     notes = [f"{len(a['recomputed'])} damaged cache entries run again (see {out}/cache_report.log)"
              if a["recomputed"] else "", f"{len(a['retried'])} failed runs retried" if a["retried"] else ""]
@@ -594,9 +573,8 @@ def cmd_tune(args: argparse.Namespace) -> int:
     out = _writable_dir(args.out or f"tune_{Path(args.study).stem}")
     if args.config:
         spec.config = str(_writable_file(args.config, "--config"))
-    with kept_warnings(args) as caught:
+    with kept_warnings(args):  # and in OUT/footzoo.log, written with the tune's tables
         result = tune(study, spec, jobs=args.jobs, scheduler=args.scheduler, out=out, progress=not args.quiet)
-    write_log(out, warning_texts(caught))
     print(f"{len(result.settings_)} settings x {len(result.values_)} recordings in {result.groups_.nunique()} "
           f"groups; objective {spec.objective} ({spec.aggregate}, {spec.direction})")
     print("leave-one-group-out (each group scored by the setting chosen without it):")

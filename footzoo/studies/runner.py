@@ -38,8 +38,9 @@ import numpy as np
 import pandas as pd
 
 from ..core import errors
-from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker
+from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
 from ..core.errors import ConfigError, FootzooWarning
+from ..core.warninglog import LOG, WarningLog, log_text
 from ..evaluation.metrics import reference_steps, run_metrics
 from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
 from ..plugins.contract import checked, no_statistic_note
@@ -289,9 +290,11 @@ def run_study(
         Output folder: ``cache/`` (one checked file per run, keyed by the hash of the
         resolved config, the data, footzoo's version and the plug-ins' source, so a rerun
         resumes), ``results.parquet``, ``results.csv``, ``trajectories.parquet``,
-        ``roc.parquet``, ``summary.md``, ``summary.tex`` and plots. A rerun whose table,
-        runs and footzoo source are unchanged, and whose outputs are all present and
-        intact (``outputs.json`` records their checksums), leaves them as they are.
+        ``roc.parquet``, ``summary.md``, ``summary.tex``, plots and ``footzoo.log`` (every
+        warning of the call, the workers' included, or ``no warnings``). ``outputs.json``,
+        written last, records each of them with its checksum. A rerun whose table, runs and
+        footzoo source are unchanged, and whose outputs are all present and intact, leaves
+        them as they are (its log replaced when its warnings differ).
     progress : bool
         Show one progress bar over the whole command (loading, runs, report).
     max_runs : int, optional
@@ -309,7 +312,9 @@ def run_study(
         (what :func:`footzoo.studies.tune.tune` needs).
     quiet : bool
         Do not repeat the runs' warnings (each distinct warning of the workers is otherwise
-        issued once here, with the number of runs that gave it); they stay in ``attrs["warnings"]``.
+        issued once here, with the number of runs that gave it); they stay in ``attrs["warnings"]``
+        and in ``out/footzoo.log``. Every warning of the call reaches the caller when the call
+        ends (after the progress bar), once the log is written.
 
     Returns
     -------
@@ -325,31 +330,31 @@ def run_study(
         validated before any run (:meth:`Study.check`): an invalid study raises ConfigError. Trajectories and
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
-    if not isinstance(study, Study):
-        study = Study.from_yaml(study, max_cells=max_cells)
-    if jobs is None:
-        jobs = study.jobs or 1
-    check_jobs(jobs)
-    if scheduler is not None:
-        scheduler = check_scheduler(scheduler)
-    study.check(max_cells)
-    bar = _Progress(progress, "study")
-    lock = contextlib.nullcontext() if out is None else folder_lock(out, "study output folder",
-                                                                     f"study {study.name!r}", study_identity(study))
-    try:
-        with lock:
-            if scheduler is None:
-                table = _run_study(study, jobs, None, out, max_runs, bar, report, prune)
-            else:
-                cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, when needed
-                try:
-                    table = _run_study(study, jobs, cluster, out, max_runs, bar, report, prune)
-                finally:
-                    cluster.close()
-    finally:
-        bar.close()
-    if not quiet:
-        _replay_warnings(table.attrs["warnings"], table.attrs["refused"])
+    with WarningLog() as log:  # the study's warnings, for its footzoo.log; the caller gets them at the end
+        if not isinstance(study, Study):
+            study = Study.from_yaml(study, max_cells=max_cells)
+        if jobs is None:
+            jobs = study.jobs or 1
+        check_jobs(jobs)
+        if scheduler is not None:
+            scheduler = check_scheduler(scheduler)
+        study.check(max_cells)
+        bar = _Progress(progress, "study")
+        lock = contextlib.nullcontext() if out is None else folder_lock(out, "study output folder",
+                                                                         f"study {study.name!r}", study_identity(study))
+        options = {"max_runs": max_runs, "report": report, "prune": prune, "quiet": quiet, "log": log}
+        try:
+            with lock:
+                if scheduler is None:
+                    table = _run_study(study, jobs, None, out, bar, **options)
+                else:
+                    cluster = _Cluster(scheduler)  # one connection for the runs and the report's figures, when needed
+                    try:
+                        table = _run_study(study, jobs, cluster, out, bar, **options)
+                    finally:
+                        cluster.close()
+        finally:
+            bar.close()
     return table
 
 
@@ -360,19 +365,26 @@ def study_identity(study: Study) -> str:
     return hashlib.sha256(json.dumps(spec, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def _replay_warnings(worker: dict[str, int], refused: dict[str, int]) -> None:
-    """Issue each distinct warning of the runs once, with the number of runs that gave it."""
+def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: WarningLog, quiet: bool) -> None:
+    """Issue each distinct warning of the runs once, with the number of runs that gave it (``quiet``: into the
+    study's log only)."""
 
+    replayed = []
     for text, n in worker.items():
         name, _, message = text.partition(": ")
         category = MetricWarning if name == "MetricWarning" else (getattr(errors, name, None)
                                                                   or getattr(builtins, name, None))
         if not (isinstance(category, type) and issubclass(category, Warning)):
             category = UserWarning
-        warnings.warn(f"{n} run(s): {message}" if n > 1 else message, category, stacklevel=3)
+        replayed.append((category, f"{n} run(s): {message}" if n > 1 else message))
     if refused:
         text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
-        warnings.warn(f"metrics refused (NaN, see the table's note column): {text}", MetricWarning, stacklevel=3)
+        replayed.append((MetricWarning, f"metrics refused (NaN, see the table's note column): {text}"))
+    for category, message in replayed:
+        if quiet:
+            log.keep([f"{category.__name__}: {message}"])
+        else:  # named at the line that called run_study
+            warnings.warn(message, category, stacklevel=4)
 
 
 def _counts(values) -> dict[str, int]:
@@ -382,8 +394,8 @@ def _counts(values) -> dict[str, int]:
     return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
-def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bool = True,
-               prune: dict[str, Any] | None = None) -> pd.DataFrame:
+def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None, report: bool,
+               prune: dict[str, Any] | None, quiet: bool, log: WarningLog) -> pd.DataFrame:
     bar.phase("loading")
     bar.set_description(study.name)
     cells = study.cells()
@@ -456,22 +468,29 @@ def _run_study(study, jobs, scheduler, out, max_runs, bar: _Progress, report: bo
     if cache_dir is not None:
         table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
                                             **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
+    _replay_warnings(table.attrs["warnings"], table.attrs["refused"], log, quiet)  # before the log is written
     if out is not None and report:
         if recomputed:
             _log_damaged(Path(out), recomputed)
         bar.phase("report")
         figures = study.figure_metrics()
         digest = _outputs_digest(table, runs, list(study.factors), figures)
-        if _outputs_current(Path(out), digest):
+        kept = _outputs_current(Path(out), digest)
+        if kept is not None:
             bar.update(report_steps)  # nothing changed since the outputs were written: keep them
-            end_folder(out, MANIFEST)  # the earlier marker back, as it was
+            written = [name for name in kept if name != LOG]
         else:
             # figures on the local workers with jobs: N; on the Dask workers, in memory, written here
             written = write_outputs(table, runs, list(study.factors), Path(out), step=bar.update,
                                     jobs=jobs if scheduler is None else 1,
                                     scheduler=scheduler.client if isinstance(scheduler, _Cluster) else scheduler,
                                     figures=figures)
-            _write_manifest(Path(out), digest, written)
+        # the command's log, with every warning it gave, then the completion marker that lists it
+        logged = _write_log(Path(out), log.texts())
+        if kept is not None and kept.get(LOG) == logged:
+            end_folder(out, MANIFEST)  # the earlier marker back, as it was
+        else:
+            _write_manifest(Path(out), digest, [*written, LOG])
     return table
 
 
@@ -488,14 +507,29 @@ def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: li
     return h.hexdigest()
 
 
-def _outputs_current(out: Path, digest: str) -> bool:
-    """True when ``out`` holds every output of a report with this digest, each with its recorded content."""
+def _outputs_current(out: Path, digest: str) -> dict[str, str] | None:
+    """The files of the earlier report in ``out`` (name -> SHA-256) when it has this digest and each output (the
+    log aside: every command writes its own) still has its recorded content; else None."""
     try:
         manifest = previous_marker(out, MANIFEST)  # set aside while this study runs (begin_folder)
-        return manifest["digest"] == digest and all(
-            _file_sha256(out / name) == sha for name, sha in manifest["files"].items())
+        current = manifest["digest"] == digest and all(
+            _file_sha256(out / name) == sha for name, sha in manifest["files"].items() if name != LOG)
+        return dict(manifest["files"]) if current else None
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        return False
+        return None
+
+
+def _write_log(out: Path, texts: list[str]) -> str:
+    """``out/footzoo.log`` listing ``texts`` (:func:`~footzoo.core.warninglog.log_text`), written atomically unless
+    it already says that; its SHA-256."""
+    text = log_text(texts)
+    try:
+        same = (out / LOG).read_bytes() == text
+    except OSError:
+        same = False
+    if not same:
+        write_bytes(out / LOG, text, what="the study's log")
+    return hashlib.sha256(text).hexdigest()
 
 
 def _write_manifest(out: Path, digest: str, written: list[str]) -> None:

@@ -56,6 +56,7 @@ import yaml
 from ..config.library import resolve
 from ..core.atomic import FileGroup, folder_lock, json_safe, write_text
 from ..core.errors import ConfigError, FootzooWarning, did_you_mean
+from ..core.warninglog import LOG, WarningLog, log_text
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import METRICS
 from .runner import run_study
@@ -444,29 +445,32 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
     jobs, scheduler, progress, quiet
         As :func:`footzoo.studies.run_study` (cached in ``out/cache``, parallel).
     out : path, optional
-        Folder of the cache, ``tune_folds.csv``, ``tune_scores.csv`` and ``best.yaml``.
+        Folder of the cache, ``tune_folds.csv``, ``tune_scores.csv``, ``best.yaml`` and
+        ``footzoo.log`` (every warning of the call, the runs' included, or ``no warnings``),
+        written together once the tune is done. Every warning of the call reaches the caller
+        when the call ends.
     """
-    if not isinstance(study, Study):
-        study, file_spec = load_tune_file(study)
-        spec = spec if spec is not None else file_spec
-    if spec is None:
-        raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
-    spec = spec if isinstance(spec, TuneSpec) else TuneSpec.from_dict(spec)
-    if groups is None:
-        groups = recording_groups(study, spec.group_by)
-    else:
-        groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
-    score = score or spec.score_function()
-    if out is None:
-        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=None,
-                                                                progress=progress, quiet=quiet))
-    with folder_lock(out, "tune output folder", f"tune {study.name!r}"):  # its studies run in it too
-        return _tune(study, spec, score, eligible, groups, dict(jobs=jobs, scheduler=scheduler, out=out,
-                                                                progress=progress, quiet=quiet))
+    with WarningLog() as log:  # the tune's warnings, for its footzoo.log; the caller gets them at the end
+        if not isinstance(study, Study):
+            study, file_spec = load_tune_file(study)
+            spec = spec if spec is not None else file_spec
+        if spec is None:
+            raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
+        spec = spec if isinstance(spec, TuneSpec) else TuneSpec.from_dict(spec)
+        if groups is None:
+            groups = recording_groups(study, spec.group_by)
+        else:
+            groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
+        score = score or spec.score_function()
+        options = dict(jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet)
+        if out is None:
+            return _tune(study, spec, score, eligible, groups, options, log)
+        with folder_lock(out, "tune output folder", f"tune {study.name!r}"):  # its studies run in it too
+            return _tune(study, spec, score, eligible, groups, options, log)
 
 
 def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], bool] | None, groups: pd.Series,
-          options: dict[str, Any]) -> TuneResult:
+          options: dict[str, Any], log: WarningLog) -> TuneResult:
     """:func:`tune` once its output folder (if any) is locked."""
     out = options["out"]
     run = _Runner(study, spec, groups, options)
@@ -488,15 +492,17 @@ def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], 
     for edge in edges:
         warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=2)
     target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
-    with FileGroup(what="tune output") as written:  # the tables and the chosen config of this tune, or none of them
+    # the tables, the chosen config and the log of this tune (every warning it gave), or none of them
+    with FileGroup(what="tune output") as written:
+        if target is not None:
+            written.path(target).write_text(result.config_text(name=study.name), encoding="utf-8")
         if out is not None:
             folder = Path(out)
             folder.mkdir(parents=True, exist_ok=True)
             written.path(folder / "tune_folds.csv").write_text(folds.to_csv(index=False), encoding="utf-8")
             written.path(folder / "tune_scores.csv").write_text(
                 scores.rename("score").to_csv(index_label="setting"), encoding="utf-8")
-        if target is not None:
-            written.path(target).write_text(result.config_text(name=study.name), encoding="utf-8")
+            written.path(folder / LOG).write_bytes(log_text(log.texts()))
     return result
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from footzoo import Result
@@ -68,6 +70,18 @@ def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
     assert main(["ablate", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert WARNING not in capsys.readouterr().err
     assert WARNING in (tmp_path / "out" / LOG).read_text()
+    assert LOG in json.loads((tmp_path / "out" / "outputs.json").read_text())["files"]  # part of the report
+
+
+def test_a_quiet_tune_logs_the_runs_warnings(straight, tmp_path, capsys):
+    tune_file = tmp_path / "tune.yaml"
+    tune_file.write_text(f"name: t\nbase: yun2012\nfactors: {{detector.threshold: [10.0, 1.0]}}\n"
+                         f"recordings: [{{path: {straight}, group: a}}, {{path: {straight}, group: b, label: again}}]\n"
+                         "tune: {objective: armse_3d_m}\n")
+    assert main(["tune", str(tune_file), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert WARNING not in capsys.readouterr().err
+    # one walk (read twice) and two settings: the same warning from 4 runs, once
+    assert f"CalibrationWarning: 4 run(s): {WARNING}" in (tmp_path / "out" / LOG).read_text()
 
 
 # the unknown foot's warning and the refused metrics' are this test's subject: let through, counted below

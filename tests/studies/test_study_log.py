@@ -1,0 +1,104 @@
+"""A study's and a tune's footzoo.log: every warning of the call, the runs' in their workers included, written
+inside the folder's lock and before the completion marker (outputs.json lists it), so a folder that looks
+complete never holds another run's log."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import warnings
+
+import pytest
+
+from footzoo.core import atomic
+from footzoo.core.atomic import INCOMPLETE, lock_holder
+from footzoo.core.errors import CalibrationWarning, FormatError
+from footzoo.core.warninglog import LOG
+from footzoo.studies import Study, read_trajectories, run_study, runner, tune
+
+#: yun2012 fits a hard-iron calibration that a straight simulated walk cannot give: each run says so in its worker
+UNCALIBRATED = "hard_iron: magnetometer left uncalibrated"
+SIM = {"path": "straight", "n_strides": 4, "rate": 50, "noise": {"scale": 1}}
+WARNS = {"name": "warns", "base": "yun2012", "recordings": [{"simulate": SIM, "seeds": [0, 1]}],
+         "metrics": ["strides"], "figures": "none"}
+#: the same walks without a magnetometer calibration: no warning
+CALM = {**WARNS, "name": "calm", "base": {"name": "calm", "orientation": {"type": "fqa_complementary"},
+                                          "detector": {"type": "angular_rate_fsm"},
+                                          "corrections": [{"type": "zvu_dedrift"}]}}
+
+
+def texts(caught) -> set[str]:
+    return {f"{type(w.message).__name__}: {w.message}" for w in caught}
+
+
+def listed(out) -> dict[str, str]:
+    """The files the folder's completion marker lists, with their SHA-256."""
+    return json.loads((out / "outputs.json").read_text())["files"]
+
+
+@pytest.mark.parametrize("jobs", [1, pytest.param(2, marks=pytest.mark.slow)])  # slow: two worker processes start
+def test_the_log_lists_the_warnings_the_runs_gave_in_their_workers(tmp_path, jobs):
+    with pytest.warns(CalibrationWarning, match=UNCALIBRATED) as caught:  # the caller gets them too
+        run_study(Study.from_dict(WARNS), out=tmp_path, jobs=jobs)
+    log = (tmp_path / LOG).read_text().splitlines()
+    # one distinct warning per walk (their direction spreads differ), each given by one run
+    assert len(log) == 2 and all(line.startswith(f"CalibrationWarning: {UNCALIBRATED}: the sensor turned too "
+                                                 "little") for line in log)
+    assert set(log) == texts(caught)
+    assert listed(tmp_path)[LOG] == hashlib.sha256((tmp_path / LOG).read_bytes()).hexdigest()
+
+
+def test_a_quiet_study_keeps_the_runs_warnings_in_its_log_only(tmp_path):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        table = run_study(Study.from_dict(WARNS), out=tmp_path, quiet=True)
+    assert not [w for w in caught if UNCALIBRATED in str(w.message)]
+    log = (tmp_path / LOG).read_text().splitlines()
+    assert sorted(log) == sorted(table.attrs["warnings"]) and len(log) == 2  # each given by one run
+
+
+def test_the_log_is_in_place_before_the_marker_and_never_the_previous_study_s(tmp_path, monkeypatch):
+    with pytest.warns(CalibrationWarning, match=UNCALIBRATED):
+        run_study(Study.from_dict(WARNS), out=tmp_path)
+    assert UNCALIBRATED in (tmp_path / LOG).read_text()
+
+    at_marker = []
+
+    def interrupted(folder, marker, text=None):  # Ctrl-C just as the next study writes its completion marker
+        at_marker.append((tmp_path / LOG).read_text())
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "end_folder", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(Study.from_dict(CALM), out=tmp_path)
+    assert at_marker == ["no warnings\n"]  # the calm study's own log, written before its marker
+    assert (tmp_path / LOG).read_text() == "no warnings\n"
+    assert not (tmp_path / "outputs.json").exists() and (tmp_path / INCOMPLETE).exists()
+    with pytest.raises(FormatError, match="is incomplete"):
+        read_trajectories(tmp_path)
+    monkeypatch.undo()
+    run_study(Study.from_dict(CALM), out=tmp_path)  # run again: complete, its log listed with the report
+    assert not (tmp_path / INCOMPLETE).exists() and (tmp_path / LOG).read_text() == "no warnings\n"
+    assert listed(tmp_path)[LOG] == hashlib.sha256(b"no warnings\n").hexdigest()
+
+
+def test_a_tune_writes_its_log_with_its_tables_inside_its_lock(tmp_path, monkeypatch):
+    study = {**WARNS, "name": "tuned", "factors": {"detector.threshold": [10.0, 1.0]},
+             "recordings": [{"simulate": SIM, "seeds": [0], "group": "day1"},
+                            {"simulate": SIM, "seeds": [1], "group": "day2"}]}
+    commits = []
+    commit = atomic.FileGroup.commit
+
+    def watched(group):  # who holds the folder, and whether a log is there yet, at each commit
+        commits.append(((lock_holder(tmp_path) or {}).get("owner"), (tmp_path / LOG).exists()))
+        return commit(group)
+
+    monkeypatch.setattr(atomic.FileGroup, "commit", watched)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tune(Study.from_dict(study), {"objective": "armse_3d_m"}, out=tmp_path, quiet=True)
+    assert not [w for w in caught if UNCALIBRATED in str(w.message)]  # quiet: the runs' warnings in the log only
+    assert commits[-1] == ("tune 'tuned'", False)  # the log comes with the tune's last commit, the lock held
+    log = (tmp_path / LOG).read_text().splitlines()  # each walk's warning, given by the runs of both settings
+    assert len(log) == 2 and all(line.startswith(f"CalibrationWarning: 2 run(s): {UNCALIBRATED}") for line in log)
+    assert {"tune_folds.csv", "tune_scores.csv", "best.yaml"} <= {p.name for p in tmp_path.iterdir()}
