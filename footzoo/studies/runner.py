@@ -469,6 +469,10 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
                                             **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
     _replay_warnings(table.attrs["warnings"], table.attrs["refused"], log, quiet)  # before the log is written
+    # the cached runs warned when they ran (not again here); the folder's log still lists what its results carry
+    cached = _counts(w for r in runs if r.get("cached") for w in r.get("warnings") or [])
+    log.keep([f"{text} (from {n} cached run{'s' if n > 1 else ''}: warned when {'they' if n > 1 else 'it'} ran)"
+              for text, n in cached.items()])
     if out is not None and report:
         if recomputed:
             _log_damaged(Path(out), recomputed)

@@ -102,3 +102,16 @@ def test_a_tune_writes_its_log_with_its_tables_inside_its_lock(tmp_path, monkeyp
     log = (tmp_path / LOG).read_text().splitlines()  # each walk's warning, given by the runs of both settings
     assert len(log) == 2 and all(line.startswith(f"CalibrationWarning: 2 run(s): {UNCALIBRATED}") for line in log)
     assert {"tune_folds.csv", "tune_scores.csv", "best.yaml"} <= {p.name for p in tmp_path.iterdir()}
+
+
+def test_a_rerun_from_the_cache_keeps_the_runs_warnings_in_its_log_without_repeating_them(tmp_path):
+    with pytest.warns(CalibrationWarning, match=UNCALIBRATED):
+        run_study(Study.from_dict(WARNS), out=tmp_path)
+    first = (tmp_path / LOG).read_text().splitlines()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        table = run_study(Study.from_dict(WARNS), out=tmp_path)
+    assert table.attrs["cached"] == 2 and not [w for w in caught if UNCALIBRATED in str(w.message)]
+    log = (tmp_path / LOG).read_text().splitlines()
+    assert log == [f"{line} (from 1 cached run: warned when it ran)" for line in first]  # the same two, marked
+    assert listed(tmp_path)[LOG] == hashlib.sha256((tmp_path / LOG).read_bytes()).hexdigest()
