@@ -93,7 +93,7 @@ def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_ar
     relabel = load_benchmark("relabel")
     pipeline = Pipeline.from_yaml("recommended")
     named = wrong = total = 0
-    for dataset, rec in relabel.recordings(DATA):
+    for dataset, rec in relabel.recordings(DATA, {"pyshoe", "gaitmap", "xio", "koroglu"}):
         for case in relabel.cases(dataset, rec):
             if case["kind"] == "clean" or (case["kind"] == "rate" and case["factor"] in (2.0, 0.5)
                                            and "time stamps" in case["case"]):
@@ -104,6 +104,6 @@ def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_ar
                     total += 1
                     named += row["right"] or row["alternative"]
                     wrong += row["caught"] and not (row["right"] or row["alternative"])
-    # 84 restamped files (benchmarks/relabel.md): 73 named with the real rate; two slow short-stepped walks at half
-    # their rate named at two thirds of it; not the other shuffling walks, the crawling, the upside-down trial and a run
-    assert total == 84 and named >= 72 and wrong <= 2
+    # 84 restamped files (benchmarks/relabel.md): 78 named with the real rate, none with another; not the fast run
+    # and the crawl (×2, ×½), the upside-down slow walk and the shortest-stepped walk (×½): benchmarks/relabel_misses.md
+    assert total == 84 and named >= 77 and wrong == 0

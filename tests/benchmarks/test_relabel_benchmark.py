@@ -66,3 +66,24 @@ def test_the_summary_counts_caught_right_and_missed(relabel):
     assert rows.loc["rate ×2", "right fix"] == "2 (1 as the alternative)"
     assert (rows.loc["rate ×2", "wrong fix"], rows.loc["rate ×2", "missed"]) == (1, 1)
     assert rows.loc["rate ×2", "other warnings"] == 1
+
+
+def test_a_case_keeps_what_the_checks_measured_and_why_nothing_else_was_named(relabel, walk):
+    pipeline = Pipeline.from_dict(BASE)
+    cases = {c["case"]: c for c in relabel.cases("pyshoe", walk)}
+    clean = relabel.run_case(pipeline, "walk", cases["as recorded"])
+    assert clean["why"] == "the declared rate costs the least"
+    assert clean["cadence"] == pytest.approx(120.0, rel=0.02)  # the simulator's 1 s cycle: 120 steps/min
+    assert clean["lowest_at"] == pytest.approx(1.0, rel=0.1) and clean["at_real"] == pytest.approx(clean["residual"])
+    twice = relabel.run_case(pipeline, "walk", cases["rate ×2, time stamps"])
+    assert twice["why"].startswith("named ×2") and twice["cadence"] == pytest.approx(240.0, rel=0.02)
+    assert twice["lowest_at"] == pytest.approx(2.0, rel=0.1) and twice["at_real"] < twice["residual"] / 2
+
+
+def test_the_simulated_recordings_are_each_scenario_at_each_rate(relabel):
+    recs = list(relabel.simulated())
+    assert len(recs) == len(relabel.SIMULATED) * len(relabel.SIMULATED_RATES)
+    for (dataset, rec), (name, rate) in zip(recs, [(n, r) for n in relabel.SIMULATED for r in relabel.SIMULATED_RATES],
+                                            strict=True):
+        assert dataset == "sim" and rec.name == f"{name} {rate:g} Hz"
+        assert rec.rate == pytest.approx(rate, rel=1e-9)
