@@ -122,6 +122,23 @@ def test_a_walk_read_at_the_wrong_rate_is_named_once_with_the_real_rate_batch_an
     assert len(live) == 1 and "probably sampled at 100 Hz" in live[0]
 
 
+#: The simulator's run (3.2 m/s) and slow walk (0.85 m/s) with its physical foot model and sensor noise.
+SIMULATED = {"run": {"path": "run", "n_strides": 16}, "slow walk": {"path": "mixed_speed", "speeds": [("slow", 12)]}}
+
+
+@pytest.mark.parametrize("rate", [100.0, 250.0, 400.0])
+@pytest.mark.parametrize("gait", sorted(SIMULATED))
+def test_a_simulated_run_or_slow_walk_is_named_only_when_relabelled_and_then_with_its_rate(gait, rate):
+    rec = simulate(profile="physical", rate=rate, noise=NoiseModel(seed=2), magnetometer=False, **SIMULATED[gait])
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    assert "plausibility" not in res.diagnostics["sensor"] and not found  # at its real rate: no warning at all
+    for f in (2.0, 0.5):
+        relabelled = Recording(t=rec.t / f, acc=rec.acc, gyr=rec.gyr, meta={"name": "relabelled"})
+        res, found = _sensor_warnings(lambda r=relabelled: Pipeline.from_dict(BASE).run(r))
+        assert res.diagnostics["sensor"]["plausibility"]["rate"]["likely_rate"] == rate
+        assert sum(f"probably sampled at {rate:g} Hz" in m for m in found) == 1
+
+
 def test_the_same_walk_at_its_real_rate_is_not_named(walk):
     res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(walk))
     assert "plausibility" not in res.diagnostics["sensor"] and not found
