@@ -23,8 +23,12 @@ Two profiles:
   toe-off at a 1 s cycle), which falls back to zero at heel strike; so the
   rate passes through zero at heel strike, and the sensor leaves the toe with
   its velocity and acceleration, which fade over the swing (velocity and
-  acceleration continuous at toe-off and heel strike). Only foot flat (and
-  standing) is stance.
+  acceleration continuous at toe-off and heel strike). The foot also rolls
+  about its long axis through heel strike (:data:`HEEL_ROLL`): it lands
+  inverting at 1.5 rad/s and everts flat in the loading response, as real feet
+  do, so ``|ω|`` does not fall below 1 rad/s while the sagittal rate crosses
+  zero; the sensor arrives on the heel with the velocity and acceleration of
+  that rotation. Only foot flat (and standing) is stance.
 
 In both, the swing carries the sensor along the straight horizontal line
 between its positions at toe-off and heel strike with the corrected Gaussian
