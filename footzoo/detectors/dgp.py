@@ -267,7 +267,10 @@ class DGP(Detector):
     on the true stance ended at 4 ms after heel-off 0.20 m, at 8 ms 1.07 m (250 Hz,
     seed 0); its mean over 24 seeds with DGP 0.97 / 0.81 / 1.05 m at 250 / 400 /
     1000 Hz, 0.26 m at 100 Hz (benchmarks/accuracy.md). On gaitmap's walk the
-    thresholds (2.2–3.1) leave the end to the bound too.
+    thresholds (2.2–3.1) leave the end to the bound too. The simulated loading
+    response turns faster than gaitmap's (sagittal peak within 150 ms of IC,
+    median 12.9 rad/s against 7.4 and 6.6), so its threshold is no prediction of
+    a real one.
 
     Parameters
     ----------
