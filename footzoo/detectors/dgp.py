@@ -238,20 +238,39 @@ class DGP(Detector):
     threshold ``Mc − Md`` is large when ``s_c`` rises in short bursts that ``s_d``
     does not follow: a push-off whose rate levels off before its final peak (the
     physical profile's, as on real feet: on gaitmap's example walk the rate stays
-    at 0.78–0.87 of its peak over the 75 ms before it) gives ``d_g`` ≈ 0.1–0.4 on
-    the level stretch and thresholds of 1.05–1.16 on the simulated stairs and
-    mixed-speed walks (0.38–0.47 with the earlier simulator's single raised-cosine
-    push-off; 2.2–3.1 on gaitmap, 0.25–0.61 on four PyShoe walks). Any later
-    stretch with ``|ω|`` below ``max_stance_rate`` and ``max_cd`` below that
-    threshold is then stance. The simulator's heel strike is such a stretch: the
-    rate passes through zero from the swing into a rotation about the heel that
-    starts at zero rate, without an impact, so ``|ω| < 1`` rad/s for 25–40 ms
-    (gaitmap: 5 ms; PyShoe: 12–17 ms) and ``max_cd`` falls to 0.62 on the
-    stairs. DGP then marks a 3-sample stance at every heel strike of the stairs
-    (31 stance phases for 16) and at 10 of 36 of the mixed-speed walk (48 for 37,
-    at 100 and 200 Hz); on the hallway walk (threshold 0.44) none. On gaitmap's
-    walk, whose heel strikes cross zero fast with an impact, ``max_cd`` at the
-    crossing stays at 1.3 (1–2 false stances in 28–29 swings).
+    at 0.78–0.87 of its peak over the 75 ms before it) gives thresholds of about
+    1.1 on the simulated stairs and mixed-speed walks (2.2–3.1 on gaitmap,
+    0.25–0.61 on four PyShoe walks). Any later stretch with ``|ω|`` below
+    ``max_stance_rate`` and ``max_cd`` below that threshold is then stance. At
+    heel strike the sagittal rate crosses zero, below 1 rad/s for 12–44 ms on
+    real feet (medians: IPOL, gaitmap, PyShoe walks; simulator 23–34 ms), but
+    the foot also rolls (1.3–1.7 rad/s about the other axes at IC, real and
+    simulated), so ``|ω|`` stays above the bound (benchmarks/heel_strike.md)
+    and DGP marks no stance there; a foot that only pitched gave a 3-sample
+    stance at every heel strike of the simulated stairs. The threshold learned
+    when a stance begins applies from the next sample: where the delayed
+    condition ``s_d`` is still above the new, lower threshold, that stance is
+    split once (the first walking stance of the simulated stairs and mixed-speed
+    walk, 0.8 → 0.44: 17 stance phases for 16, 38 for 37 at 100 Hz, 39 at
+    200 Hz). On gaitmap's walk, whose heel strikes cross zero with an impact,
+    ``max_cd`` at the crossing stays at 1.3 (1–2 false stances in 28–29 swings).
+    The stance's end at heel-off is set by eq. 15 only while ``max_cd`` there
+    passes the threshold first; otherwise by ``max_stance_rate``, a few ms later.
+    On the simulated rectangle walk (seed 0) ``Mc`` and ``Md`` both come from the
+    loading response (``Mc`` ≈ 6.2 at 32 ms before foot flat, ``Md`` ≈ 5.5 at foot
+    flat, 250 Hz), and the landing's roll raises their difference from 0.44–0.49
+    to 0.63–0.66 (100–1000 Hz): ``max_cd`` at 8 ms after heel-off (0.47) no longer
+    passes it and the bound ends the stance (the first swing sample 8 → 12 ms
+    after heel-off at 250 Hz, 7.5 → 10 ms at 400 Hz, 8 → 9 ms at 1000 Hz; at
+    100 Hz 10 ms either way). The last stance sample then turns at 0.5 rad/s
+    about the toe, and a ZUPT there costs the INS pipelines a step: ``nguyen2016``
+    on the true stance ended at 4 ms after heel-off 0.20 m, at 8 ms 1.07 m (250 Hz,
+    seed 0); its mean over 24 seeds with DGP 0.97 / 0.81 / 1.05 m at 250 / 400 /
+    1000 Hz, 0.26 m at 100 Hz (benchmarks/accuracy.md). On gaitmap's walk the
+    thresholds (2.2–3.1) leave the end to the bound too. The simulated loading
+    response turns faster than gaitmap's (sagittal peak within 150 ms of IC,
+    median 12.9 rad/s against 7.4 and 6.6), so its threshold is no prediction of
+    a real one.
 
     Parameters
     ----------

@@ -23,8 +23,12 @@ Two profiles:
   toe-off at a 1 s cycle), which falls back to zero at heel strike; so the
   rate passes through zero at heel strike, and the sensor leaves the toe with
   its velocity and acceleration, which fade over the swing (velocity and
-  acceleration continuous at toe-off and heel strike). Only foot flat (and
-  standing) is stance.
+  acceleration continuous at toe-off and heel strike). The foot also rolls
+  about its long axis through heel strike (:data:`HEEL_ROLL`): it lands
+  inverting at 1.5 rad/s and everts flat in the loading response, as real feet
+  do, so ``|ω|`` does not fall below 1 rad/s while the sagittal rate crosses
+  zero; the sensor arrives on the heel with the velocity and acceleration of
+  that rotation. Only foot flat (and standing) is stance.
 
 In both, the swing carries the sensor along the straight horizontal line
 between its positions at toe-off and heel strike with the corrected Gaussian
@@ -43,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.conventions import quat_from_euler, quat_mul, quat_to_matrix
-from .profiles import FootPitch, GaussianSwing, rotation_progress
+from .profiles import FootPitch, GaussianSwing, SmoothRate, rotation_progress
 
 #: Table I angles (rad): initial contact −6.5 rad/s × 0.1 s, pre-swing −7.5 rad/s × 0.1 s.
 IC_ANGLE = 0.65
@@ -58,6 +62,33 @@ PS_ANGLE = 0.75
 PUSH_RISE = 0.4
 PUSH_TURN = 0.2
 SWING_DECLINE = 0.25
+#: Physical profile: the foot's roll about its long axis through heel strike, as knots ``(time from IC s, rate
+#: rad/s)`` of a :class:`~footzoo.sim.profiles.SmoothRate` at a 1 s cycle (times scale with the cycle, rates
+#: inversely; positive: inversion, the sole turning inward). The foot lands inverting at 1.5 rad/s and everts
+#: flat in the loading response; the eversion peak (``None``) makes the net roll zero (4.6 rad/s at +35 ms).
+#: On gaitmap's example walk (57 motion-capture ICs, median over strides) the sensor's roll rate is 1.2–1.7 rad/s
+#: from 30 ms before IC to 10 ms after it, inversion on both feet, then eversion peaking at 4.8 rad/s 30–50 ms
+#: after IC and back to zero by +70 ms; the rate about the axes other than the sagittal one is 1.7 rad/s at IC
+#: (PyShoe's walks 1.3, IPOL 1.7), so ``|ω|`` stays above 1 rad/s while the sagittal rate crosses zero
+#: (benchmarks/heel_strike.md).
+HEEL_ROLL = ((-0.10, 0.0), (-0.04, 1.5), (0.01, 1.5), (0.035, None), (0.07, 0.0))
+
+
+def heel_strike_roll(cycle: float, swing: float, contact: float, side: int) -> SmoothRate:
+    """The roll through heel strike (:data:`HEEL_ROLL`) of a stride: time 0 at IC, net roll zero.
+
+    ``cycle`` (s) scales the knots; the part before IC is squeezed into the last half of the ``swing`` and
+    the part after it into 90 % of the ``contact`` (heel rotation) phase when they are shorter. ``side``: +1
+    right foot, −1 left (inversion is a positive roll of a right foot, a negative one of a left foot).
+    """
+    before = min(cycle, 0.5 * swing / -HEEL_ROLL[0][0])
+    after = min(cycle, 0.9 * contact / HEEL_ROLL[-1][0])
+    times = np.array([k[0] * (before if k[0] < 0 else after) for k in HEEL_ROLL])
+    rates = np.array([0.0 if k[1] is None else k[1] / cycle for k in HEEL_ROLL])
+    j = next(i for i, k in enumerate(HEEL_ROLL) if k[1] is None)
+    # net roll zero: the rate x at knot j adds x (t_{j+1} − t_{j−1}) / 2 to the roll made with x = 0
+    rates[j] = -2 * SmoothRate(times, rates).total / (times[j + 1] - times[j - 1])
+    return SmoothRate(times, side * rates)
 
 
 @dataclass
@@ -139,6 +170,40 @@ def _ry(theta: np.ndarray, order: int = 0) -> np.ndarray:
     return np.stack([np.stack(r, -1) for r in rows], -2)
 
 
+def _fading(x: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """Quintic Hermite functions on ``x ∈ [0, 1]`` and their first two derivatives in ``x``: ``f`` (slope 1 at 0)
+    and ``g`` (curvature 1 at 0), both zero at 0 otherwise and zero with their first two derivatives at 1."""
+    f = (x - 6 * x**3 + 8 * x**4 - 3 * x**5, 1 - 18 * x**2 + 32 * x**3 - 15 * x**4, -36 * x + 96 * x**2 - 60 * x**3)
+    g = (x**2 / 2 - 1.5 * x**3 + 1.5 * x**4 - x**5 / 2, x - 4.5 * x**2 + 6 * x**3 - 2.5 * x**4,
+         1 - 9 * x + 18 * x**2 - 10 * x**3)
+    return f, g
+
+
+def _rx(phi: np.ndarray, order: int = 0) -> np.ndarray:
+    """Rx(φ) or its first/second derivative with respect to φ."""
+    c, s = np.cos(phi), np.sin(phi)
+    z = np.zeros_like(phi)
+    if order == 0:
+        rows = [[z + 1, z, z], [z, c, -s], [z, s, c]]
+    elif order == 1:
+        rows = [[z, z, z], [z, -s, -c], [z, c, -s]]
+    else:
+        rows = [[z, z, z], [z, -c, s], [z, -s, -c]]
+    return np.stack([np.stack(r, -1) for r in rows], -2)
+
+
+def _pitch_roll(th, thd, thdd, ph, phd, phdd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``R = Ry(θ) Rx(φ)`` and its first and second time derivatives, (n, 3, 3) each."""
+    y0, y1, y2 = _ry(th), _ry(th, 1), _ry(th, 2)
+    x0, x1, x2 = _rx(ph), _rx(ph, 1), _rx(ph, 2)
+    a, b = thd[:, None, None], phd[:, None, None]
+    r = y0 @ x0
+    r1 = y1 @ x0 * a + y0 @ x1 * b
+    r2 = (y2 @ x0 * a**2 + 2 * (y1 @ x1) * a * b + y0 @ x2 * b**2
+          + y1 @ x0 * thdd[:, None, None] + y0 @ x1 * phdd[:, None, None])
+    return r, r1, r2
+
+
 @dataclass
 class Segment:
     """One phase of the timeline, evaluated in closed form."""
@@ -160,13 +225,21 @@ class Segment:
     foot_pitch: FootPitch | None = None  # physical ps and swing: the pitch from heel-off to heel strike
     v0: np.ndarray | None = None  # physical swing: the sensor's velocity at toe-off (NED, m/s)
     a0: np.ndarray | None = None  # physical swing: the sensor's acceleration at toe-off (NED, m/s²)
+    roll: SmoothRate | None = None  # physical swing and ic: the roll through heel strike (time 0 at t_contact)
+    t_contact: float = 0.0  # the heel strike's time (s)
+    v1: np.ndarray | None = None  # physical swing: the sensor's velocity at heel strike (NED, m/s)
+    a1: np.ndarray | None = None  # physical swing: the sensor's acceleration at heel strike (NED, m/s²)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
-        """Position, velocity, acceleration (NED), yaw ψ, pitch θ and their rates at absolute times ``t``."""
+        """Position, velocity, acceleration (NED), yaw ψ, pitch θ, roll φ and their rates at absolute times ``t``."""
         tl = np.asarray(t, dtype=float) - self.t0
         n = tl.shape[0]
         T = self.t1 - self.t0
         out = {k: np.zeros((n, 3)) for k in ("p", "v", "a")}
+        if self.roll is not None:
+            out["phi"], out["phi_dot"], phi_ddot = self.roll.angle(tl + self.t0 - self.t_contact)
+        else:
+            out["phi"], out["phi_dot"], phi_ddot = np.zeros(n), np.zeros(n), np.zeros(n)
         if self.kind == "swing":
             s, s1, s2 = self.swing.progress(tl)
             u, u1, u2 = rotation_progress(tl, T, self.smooth)
@@ -181,6 +254,8 @@ class Segment:
             out["theta"], out["theta_dot"] = self.theta[0] + dth * u, dth * u1
             if self.foot_pitch is not None:
                 self._push_through_toe_off(tl, T, out)
+            if self.v1 is not None:
+                self._land_on_heel(tl, T, out)
             return out
         if self.kind == "still":
             out["p"] = np.tile(self.a, (n, 1))
@@ -203,10 +278,10 @@ class Segment:
             return out
         rz = _rz(np.array(self.psi[0]))
         r = self.r_contact
-        out["p"] = self.contact - np.einsum("ij,njk,k->ni", rz, _ry(th), r)
-        out["v"] = -np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thd[:, None]
-        out["a"] = -(np.einsum("ij,njk,k->ni", rz, _ry(th, 2), r) * thd[:, None] ** 2
-                     + np.einsum("ij,njk,k->ni", rz, _ry(th, 1), r) * thdd[:, None])
+        rot, rot1, rot2 = _pitch_roll(th, thd, thdd, out["phi"], out["phi_dot"], phi_ddot)
+        out["p"] = self.contact - np.einsum("ij,njk,k->ni", rz, rot, r)
+        out["v"] = -np.einsum("ij,njk,k->ni", rz, rot1, r)
+        out["a"] = -np.einsum("ij,njk,k->ni", rz, rot2, r)
         return out
 
 
@@ -222,12 +297,25 @@ class Segment:
         """
         out["theta"], out["theta_dot"], _ = self.foot_pitch.pitch(self.foot_pitch.ps + tl)
         x = (tl / T)[:, None]
-        f = (x - 6 * x**3 + 8 * x**4 - 3 * x**5, 1 - 18 * x**2 + 32 * x**3 - 15 * x**4, -36 * x + 96 * x**2 - 60 * x**3)
-        g = (x**2 / 2 - 1.5 * x**3 + 1.5 * x**4 - x**5 / 2, x - 4.5 * x**2 + 6 * x**3 - 2.5 * x**4,
-             1 - 9 * x + 18 * x**2 - 10 * x**3)
+        f, g = _fading(x)
         out["p"] = out["p"] + T * f[0] * self.v0 + T**2 * g[0] * self.a0
         out["v"] = out["v"] + f[1] * self.v0 + T * g[1] * self.a0
         out["a"] = out["a"] + f[2] / T * self.v0 + g[2] * self.a0
+
+    def _land_on_heel(self, tl: np.ndarray, T: float, out: dict[str, np.ndarray]) -> None:
+        """Physical swing: the sensor arrives with the velocity ``v1`` and acceleration ``a1`` of the rotation about
+        the heel at heel strike (the roll, and the pitch's angular deceleration, go on through it).
+
+        The mirror image of :meth:`_push_through_toe_off`: ``−T f(1 − x) v1 + T² g(1 − x) a1`` is added to the
+        path, which vanishes with its first two derivatives at toe-off and has slope ``v1`` and curvature ``a1``
+        at heel strike.
+        """
+        x = (1.0 - tl / T)[:, None]
+        f, g = _fading(x)
+        out["p"] = out["p"] - T * f[0] * self.v1 + T**2 * g[0] * self.a1
+        out["v"] = out["v"] + f[1] * self.v1 - T * g[1] * self.a1
+        out["a"] = out["a"] - f[2] / T * self.v1 + g[2] * self.a1
+
 
 def flexion_angle(t: np.ndarray, duration: float, amplitude: float, cycles: int):
     """Slow dorsi-/plantar-flexions: ``θ = A sin³(2π n t/T)`` with rate and acceleration, zero at both ends."""
@@ -340,16 +428,22 @@ class GaitTimeline:
                          foot_pitch=pitch)
             t += ph["ps"]
             # initial contact of the next stance: rotate about the heel, θ_ic -> 0
+            # (physical: the foot lands rolling, :data:`HEEL_ROLL`)
             ic_t0 = t + ph["swing"]
+            roll = heel_strike_roll(spec.cycle, ph["swing"], ph["ic"], geo.side) if physical else None
             ic = Segment(ic_t0, ic_t0 + ph["ic"], "ic", not physical, (psi_b, psi_b), (IC_ANGLE, 0.0),
-                         contact=heel_b if physical else None, r_contact=geo.heel, a=pb, smooth=physical)
+                         contact=heel_b if physical else None, r_contact=geo.heel, a=pb, smooth=physical,
+                         roll=roll, t_contact=ic_t0)
             at_to = ps.evaluate(np.array([ps.t1]))
+            at_ic = ic.evaluate(np.array([ic.t0]))
             a_sw = at_to["p"][0]
-            b_sw = ic.evaluate(np.array([ic.t0]))["p"][0]
+            b_sw = at_ic["p"][0]
             sw = Segment(t, t + ph["swing"], "swing", False, (psi_a, psi_b), (-PS_ANGLE, IC_ANGLE), a=a_sw, b=b_sw,
                          clearance=spec.clearance, smooth=False,
                          swing=GaussianSwing(ph["swing"]), foot_pitch=pitch,
-                         v0=at_to["v"][0] if physical else None, a0=at_to["a"][0] if physical else None)
+                         v0=at_to["v"][0] if physical else None, a0=at_to["a"][0] if physical else None,
+                         roll=roll, t_contact=ic_t0,
+                         v1=at_ic["v"][0] if physical else None, a1=at_ic["a"][0] if physical else None)
             t = ic.t1
             ff = Segment(t, t + ph["ff"], "still", True, (psi_b, psi_b), (0.0, 0.0), a=pb)
             t += ph["ff"]
@@ -371,7 +465,7 @@ class GaitTimeline:
         n = t.shape[0]
         out = {"p": np.zeros((n, 3)), "v": np.zeros((n, 3)), "a": np.zeros((n, 3)),
                "psi": np.zeros(n), "psi_dot": np.zeros(n), "theta": np.zeros(n), "theta_dot": np.zeros(n),
-               "still": np.zeros(n, bool)}
+               "phi": np.zeros(n), "phi_dot": np.zeros(n), "still": np.zeros(n, bool)}
         # group the samples by segment in one sort (a mask per segment costs N × segments: hours for a
         # one-hour walk evaluated at sub-sample times)
         order = np.argsort(idx, kind="stable")
@@ -383,13 +477,14 @@ class GaitTimeline:
             for k, v in res.items():
                 out[k][m] = v
             out["still"][m] = self.segments[j].still
-        q_foot = quat_mul(quat_from_euler(np.zeros(n), np.zeros(n), out["psi"]),
-                          quat_from_euler(np.zeros(n), out["theta"], np.zeros(n)))
+        q_foot = quat_from_euler(out["phi"], out["theta"], out["psi"])  # Rz(ψ) Ry(θ) Rx(φ)
         q_mount = self.geometry.mount_quat()
         out["q"] = quat_mul(q_foot, np.broadcast_to(q_mount, q_foot.shape))
-        # body rate: ω_foot = Ry(θ)^T [0, 0, ψ̇] + [0, θ̇, 0]; ω_body = R_mount^T ω_foot
-        w_foot = np.einsum("nji,j->ni", _ry(out["theta"]), np.array([0.0, 0.0, 1.0])) * out["psi_dot"][:, None]
-        w_foot[:, 1] += out["theta_dot"]
+        # body rate: ω_foot = Rx(φ)^T (Ry(θ)^T [0, 0, ψ̇] + [0, θ̇, 0]) + [φ̇, 0, 0]; ω_body = R_mount^T ω_foot
+        w_pitch = np.einsum("nji,j->ni", _ry(out["theta"]), np.array([0.0, 0.0, 1.0])) * out["psi_dot"][:, None]
+        w_pitch[:, 1] += out["theta_dot"]
+        w_foot = np.einsum("nji,nj->ni", _rx(out["phi"]), w_pitch)
+        w_foot[:, 0] += out["phi_dot"]
 
         out["w"] = w_foot @ quat_to_matrix(q_mount)
         return out

@@ -152,3 +152,47 @@ class FootPitch:
                           [-w * np.pi * np.sin(x1) / (2 * r), (w + p) * np.pi * np.sin(x3) / (2 * d),
                            -p * np.pi * np.sin(x5) / (2 * q)], 0.0)
         return theta, rate, accel
+
+
+class SmoothRate:
+    """An angular rate through knots ``(t_k, v_k)``, a half raised cosine from each knot to the next.
+
+    Between ``t_k`` and ``t_{k+1}`` the rate goes from ``v_k`` to ``v_{k+1}`` as
+    ``v_k + (v_{k+1} − v_k)(1 − cos πs)/2`` (``s`` from 0 to 1), so the rate and its derivative are
+    continuous (the derivative is zero at every knot); two equal rates in a row hold it. Each piece adds
+    ``(v_k + v_{k+1}) Δt / 2`` to the angle. Outside ``[t_0, t_last]`` the rate is zero and the angle is
+    0 before and the total after (give ``v_0 = v_last = 0``).
+
+    Parameters
+    ----------
+    times : sequence of float
+        Knot times (s), increasing.
+    rates : sequence of float
+        Rates at the knots (rad/s).
+    """
+
+    def __init__(self, times, rates):
+        self.t = np.asarray(times, dtype=float)
+        self.v = np.asarray(rates, dtype=float)
+        if self.t.shape != self.v.shape or self.t.size < 2 or np.any(np.diff(self.t) <= 0):
+            raise ValueError(f"SmoothRate: needs two or more knots at increasing times, got {self.t} and {self.v}")
+        self.dt = np.diff(self.t)
+        self.cum = np.concatenate([[0.0], np.cumsum((self.v[:-1] + self.v[1:]) * self.dt / 2)])
+
+    @property
+    def total(self) -> float:
+        """The angle turned from the first knot to the last (rad)."""
+        return float(self.cum[-1])
+
+    def angle(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Angle (rad, 0 at the first knot), rate (rad/s) and angular acceleration (rad/s²) at ``t`` (s)."""
+        t = np.asarray(t, dtype=float)
+        k = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.dt.size - 1)
+        d, v0, dv = self.dt[k], self.v[k], self.v[k + 1] - self.v[k]
+        s = np.clip((t - self.t[k]) / d, 0.0, 1.0)
+        inside = (t >= self.t[0]) & (t <= self.t[-1])
+        ang = self.cum[k] + v0 * d * s + dv * d * (s - np.sin(np.pi * s) / np.pi) / 2
+        ang = np.where(t < self.t[0], 0.0, np.where(t > self.t[-1], self.total, ang))
+        rate = np.where(inside, v0 + dv * (1 - np.cos(np.pi * s)) / 2, 0.0)
+        acc = np.where(inside, dv * np.pi * np.sin(np.pi * s) / (2 * d), 0.0)
+        return ang, rate, acc

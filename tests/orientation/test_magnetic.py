@@ -72,17 +72,25 @@ def test_rejection_keeps_the_heading_through_a_disturbance(corner_walks, orienta
 
 
 def test_rejection_barely_changes_an_undisturbed_walk(corner_walks):
-    """Without a disturbance the rejection leaves the heading within 0.1° and the loop within 5 mm.
+    """Without a disturbance the rejection leaves the heading within 0.2° and no farther from the truth, the loop
+    within 5 mm.
 
-    It is not silent: the dip is tested where | |f| − g | < 0.1 g, and while the simulated push-off turns the
-    foot at 9.4 rad/s |f| passes g, so a few samples are taken for disturbed (measured: heading 0.00° apart for
-    fqa_complementary, 0.06° for madgwick; closure 1 mm apart).
+    It is not silent: the dip is tested where | |f| − g | < 0.1 g, and while the foot turns fast (the simulated
+    push-off at 9.4 rad/s, the landing's roll and loading response) |f| passes g with f off the vertical, so a few
+    samples are taken for disturbed (measured: 2.3 per stride, 1.0 at push-off and 1.3 at heel strike) and madgwick
+    follows the gyro there (heading 0.00° apart for fqa_complementary, 0.14° for madgwick, whose largest error
+    against the truth is 0.64° with the rejection, 0.66° without; closure 1 mm apart).
     """
     _, clean, _ = corner_walks
     base = {"detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
+
+    def heading_gap(q, reference):
+        return np.degrees(np.abs(np.angle(np.exp(1j * (yaw(q) - yaw(reference))))))
+
     for orientation in ("fqa_complementary", "madgwick"):
         spec = {"type": orientation}
         on = footzoo.Pipeline.from_dict({**base, "orientation": spec}).run(clean)
         off = footzoo.Pipeline.from_dict({**base, "orientation": {**spec, "mag_rejection": False}}).run(clean)
-        assert np.degrees(np.abs(np.angle(np.exp(1j * (yaw(on.quat) - yaw(off.quat)))))).max() < 0.1
+        assert heading_gap(on.quat, off.quat).max() < 0.2
+        assert heading_gap(on.quat, clean.truth.quat).max() <= heading_gap(off.quat, clean.truth.quat).max()
         assert abs(loop_closure(on.pos)["loop_closure_xy_m"] - loop_closure(off.pos)["loop_closure_xy_m"]) < 0.005
