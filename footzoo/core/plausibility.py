@@ -63,7 +63,7 @@ one at ×1.5 that the residuals alone leave below the margin).
 As recorded, none of the 78 real recordings of the data folder is named (the 42 the checks were
 designed on and IPOL's 36, held out), nor any of 18 simulated walks, runs, a shuffle and stairs
 at 100, 250 and 400 Hz; relabelled at ×2, ×½ or ×1.5 (time stamps divided by the factor), 40,
-38 and 38 of the 42 are named with the real rate, all 36 of IPOL's, and 15, 18 and 15 of the 18
+38 and 38 of the 42 are named with the real rate, all 36 of IPOL's, and 16, 18 and 15 of the 18
 simulated ones (``recommended``; ``benchmarks/relabel.md``). What is left — a fast run with
 hardly a still instant, a crawl, a slow walk whose foot hardly turns, the simulated shuffle — is
 analysed in ``benchmarks/relabel_misses.md``.
