@@ -48,8 +48,7 @@ from footzoo.filters.implementation import TRAJECTORY  # noqa: E402
 from footzoo.filters.recorders import SAMPLE_KEYS, from_columns  # noqa: E402
 from footzoo.filters.stepwise import segment_ends  # noqa: E402
 from footzoo.filters.structures import Trajectory  # noqa: E402
-from footzoo.plugins.base import Samples  # noqa: E402
-from footzoo.runtime.alignment import initial_attitude  # noqa: E402
+from footzoo.runtime.chain import recorded_forward  # noqa: E402
 from footzoo.sim import simulate  # noqa: E402
 
 CONFIGS = {"rts": "recommended", "stepwise": "recommended_live"}
@@ -87,15 +86,7 @@ def strides_alone(rec: footzoo.Recording, forward: np.ndarray) -> np.ndarray:
     """The positions of ``recommended_live``'s filter with each stride smoothed alone, its start not pinned: the
     step-wise smoother before :func:`footzoo.filters.stepwise.pin_start` (the same forward pass and segments),
     in the frame of the run's ``forward`` positions (N, 3) m (:func:`same_frame`)."""
-    p = footzoo.Pipeline.from_yaml(CONFIGS["stepwise"])
-    stance = p.detect(rec).stance_
-    q0 = initial_attitude(rec.t, rec.acc, rec.gyr, None, **p.init)
-    samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + p.init["duration"])
-    eng = p.kalman_engine([c.clone() for c in p.filter_corrections], samples, "fast")
-    nav0 = np.zeros(16)
-    nav0[:4] = q0
-    full = eng.advance(eng.start(nav0), rec.t, rec.acc, rec.gyr, stance, None, [m.data for m in eng.setup.models], 0,
-                       False, record=True)
+    eng, stance, full = recorded_forward(footzoo.Pipeline.from_yaml(CONFIGS["stepwise"]), rec)
     moved = same_frame(full["pos"], forward)
     traj = Trajectory(*(full[k] for k in TRAJECTORY))
     # through the module: a compiled function pickled into a worker by value would lose its dispatcher

@@ -142,3 +142,32 @@ def navigation_stage(pipeline: Any, ctx: RunContext, start: Chunk, q0: np.ndarra
     eng = pipeline.kalman_engine(kalman, samples, engine)
     return KalmanStage(eng, kalman, q0, external_attitude=not pipeline.orientation.carried_by_filter,
                        smoother=pipeline.smoother, covariance=covariance)
+
+
+def recorded_forward(pipeline: Any, rec: Recording, engine: str = "fast") -> tuple[Any, np.ndarray, dict[str, Any]]:
+    """The Kalman filter of ``pipeline`` run forward over ``rec`` alone, with a record of every sample: for a smoother
+    applied by hand (:mod:`footzoo.filters.smoother`, :mod:`footzoo.filters.stepwise`) in a test or a benchmark.
+
+    No calibration or orientation stage runs (the filter carries the attitude, from the initial
+    attitude of ``rec``'s still start); the positions are in the engine's frame (NED, m), before a
+    run's output frame is applied.
+
+    Returns
+    -------
+    engine : KalmanEngine
+        The engine (its ``setup.offsets`` index the records' state blocks).
+    stance : (N,) bool array
+        The pipeline's detector on ``rec``.
+    records : dict
+        :meth:`~footzoo.filters.engine.KalmanEngine.advance` with ``record=True``: the trajectory
+        (``quat``, ``vel``, ``pos``, biases) and each sample's record.
+    """
+    stance = pipeline.detect(rec).stance_
+    q0 = initial_attitude(rec.t, rec.acc, rec.gyr, None, **pipeline.init)
+    samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + pipeline.init["duration"])
+    eng = pipeline.kalman_engine([c.clone() for c in pipeline.filter_corrections], samples, engine)
+    nav0 = np.zeros(16)
+    nav0[:4] = q0
+    records = eng.advance(eng.start(nav0), rec.t, rec.acc, rec.gyr, stance, None, [m.data for m in eng.setup.models],
+                          0, False, record=True)
+    return eng, stance, records

@@ -84,18 +84,9 @@ def _smoothed(rec, how: str):
     from footzoo.filters.recorders import SAMPLE_KEYS, from_columns
     from footzoo.filters.smoother import smooth_segments
     from footzoo.filters.stepwise import segment_ends, smooth_strides
-    from footzoo.plugins.base import Samples
-    from footzoo.runtime.alignment import initial_attitude
+    from footzoo.runtime.chain import recorded_forward
 
-    p = Pipeline.from_yaml("recommended")
-    stance = p.detect(rec).stance_
-    q0 = initial_attitude(rec.t, rec.acc, rec.gyr, None, **p.init)
-    samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + p.init["duration"])
-    eng = p.kalman_engine([c.clone() for c in p.filter_corrections], samples, "fast")
-    nav0 = np.zeros(16)
-    nav0[:4] = q0
-    full = eng.advance(eng.start(nav0), rec.t, rec.acc, rec.gyr, stance, None, [m.data for m in eng.setup.models], 0,
-                       False, record=True)
+    eng, stance, full = recorded_forward(Pipeline.from_yaml("recommended"), rec)
     rows = from_columns({k: full[k] for k in SAMPLE_KEYS}, full)
     traj = Trajectory(*(full[k].copy() for k in ("quat", "vel", "pos", "gyro_bias", "acc_bias")))
     ends = segment_ends(stance, rec.t, True)
