@@ -334,6 +334,7 @@ class GaitScan:
 
     def _push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray,
               pos: np.ndarray) -> None:
+        """One block of :meth:`push`: the gyroscope's unit until decided, then the strides and the rate's verdict."""
         w = row_norms(gyr)
         if not self._unit_decided:
             self._gyro_unit(k, t, acc, w)
