@@ -50,7 +50,7 @@ from ..core.conventions import GRAVITY
 from ..core.errors import SensorWarning
 from ..core.norms import row_norms, row_norms_squared
 from ..kernels.jit import njit
-from .strapdown import quat_product, rotate, rotvec_quat
+from .strapdown import quat_product, rotate, rotvec_quat, series_rotvec_quat
 
 #: (name, gyroscope axis signs, the fix) of each axis fault the scan can name.
 CANDIDATES: tuple[tuple[str, tuple[float, float, float], str], ...] = (
@@ -98,24 +98,9 @@ MIN_RATE_SWINGS = 4
 
 
 #: Largest half-angle (rad) of one sample's rotation, at the largest time scale, for which a swing is integrated with
-#: :func:`_series_turn`; a swing that turns faster in one sample is integrated with the closed form.
+#: :func:`~footzoo.filters.strapdown.series_rotvec_quat` in every column (its omitted terms below 1e-15); a swing
+#: that turns faster in one sample is integrated with the closed form.
 SERIES_HALF_ANGLE = 0.5
-
-
-@njit(inline="always")
-def _series_turn(rx: float, ry: float, rz: float) -> tuple[float, float, float, float]:
-    """``exp(r/2)`` of the rotation vector r (rad), as :func:`~footzoo.filters.strapdown.rotvec_quat`, by the series
-    of cos h and sin h / h in h² (h = |r|/2) up to h¹²: no square root, sine, cosine, division or branch.
-
-    For h ≤ :data:`SERIES_HALF_ANGLE` the first omitted terms are below 1e-15; over the swings of a
-    real walk the residuals equal those of the closed form to 1e-13 (relative).
-    """
-    u = 0.25 * (rx * rx + ry * ry + rz * rz)
-    c = 1.0 + u * (-1.0 / 2.0 + u * (1.0 / 24.0 + u * (-1.0 / 720.0 + u * (1.0 / 40320.0 + u * (
-        -1.0 / 3628800.0 + u * (1.0 / 479001600.0))))))
-    k = 0.5 * (1.0 + u * (-1.0 / 6.0 + u * (1.0 / 120.0 + u * (-1.0 / 5040.0 + u * (1.0 / 362880.0 + u * (
-        -1.0 / 39916800.0 + u * (1.0 / 6227020800.0)))))))
-    return c, k * rx, k * ry, k * rz
 
 
 @njit(inline="always")
@@ -123,8 +108,8 @@ def _integrate(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, 
                axes: np.ndarray, g: float, state: np.ndarray, series: bool) -> None:
     """Strapdown over samples ``a``–``b`` of every column ``c`` of ``state`` (rows w, x, y, z, vx, vy, vz) at once,
     one sample at a time: the velocity by the specific force, then the attitude by the rotation vector (by
-    :func:`_series_turn`, or by the closed form where ``series`` is False); ``axes`` (3, columns) the gyroscope
-    axes' signs."""
+    :func:`~footzoo.filters.strapdown.series_rotvec_quat`, or by the closed form where ``series`` is False);
+    ``axes`` (3, columns) the gyroscope axes' signs."""
     for i in range(a, b):
         dt0, fx, fy, fz = t[i + 1] - t[i], acc[i, 0], acc[i, 1], acc[i, 2]
         for c in range(scale.shape[0]):  # independent columns: this loop vectorises
@@ -136,7 +121,7 @@ def _integrate(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, 
             state[6, c] += (nz + g) * dt
             rx, ry, rz = gyr[i, 0] * axes[0, c] * dt, gyr[i, 1] * axes[1, c] * dt, gyr[i, 2] * axes[2, c] * dt
             if series:
-                d0, d1, d2, d3 = _series_turn(rx, ry, rz)
+                d0, d1, d2, d3 = series_rotvec_quat(rx, ry, rz)
                 w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
                 m = 1.5 - 0.5 * (w * w + x * x + y * y + z * z)  # back to unit length (a Newton step of 1/√n)
             else:
@@ -154,7 +139,8 @@ def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarra
 
     Every column advances one sample at a time (independent columns side by side: the loop over
     them vectorises); a swing whose rotations stay within :data:`SERIES_HALF_ANGLE` per sample at
-    the largest scale by the series (:func:`_series_turn`), another by the closed form.
+    the largest scale by the series (:func:`~footzoo.filters.strapdown.series_rotvec_quat`), another by the closed
+    form.
     """
     state = np.empty((7, scale.shape[0]))
     axes = np.ascontiguousarray(signs.T)  # (3, columns): each axis's signs side by side, as the columns advance

@@ -28,13 +28,42 @@ def quat_product(a0, a1, a2, a3, b0, b1, b2, b3):
             a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
 
 
+#: Largest half-angle h = |r|/2 (rad) of a rotation vector r for which :func:`rotvec_quat` takes its series
+#: (:func:`series_rotvec_quat`): the first term it omits is then below 1e-19, far below a double's rounding.
+#: One sample of a foot's rotation stays below it up to 50 rad/s at 100 Hz.
+SERIES_HALF_ANGLE = 0.25
+
+
+@njit(inline="always")
+def series_rotvec_quat(rx, ry, rz):
+    """``exp(r/2)`` of the rotation vector r (rad), scalar first, by the series of cos h and sin h / h in h²
+    (h = |r|/2) up to h¹²: no square root, sine, cosine, division or branch.
+
+    The first omitted terms are h¹⁴/14! and h¹⁴/(2·15!): below 1e-15 for h ≤ 0.5, below 1e-19 for
+    h ≤ :data:`SERIES_HALF_ANGLE`.
+    """
+    u = 0.25 * (rx * rx + ry * ry + rz * rz)
+    c = 1.0 + u * (-1.0 / 2.0 + u * (1.0 / 24.0 + u * (-1.0 / 720.0 + u * (1.0 / 40320.0 + u * (
+        -1.0 / 3628800.0 + u * (1.0 / 479001600.0))))))
+    k = 0.5 * (1.0 + u * (-1.0 / 6.0 + u * (1.0 / 120.0 + u * (-1.0 / 5040.0 + u * (1.0 / 362880.0 + u * (
+        -1.0 / 39916800.0 + u * (1.0 / 6227020800.0)))))))
+    return c, k * rx, k * ry, k * rz
+
+
 @njit(inline=True)
 def rotvec_quat(rx, ry, rz):
-    """Unit quaternion ``exp(r/2)`` of the rotation vector r (rad), scalar first, for compiled loops."""
-    angle = math.sqrt(rx * rx + ry * ry + rz * rz)
-    half = 0.5 * angle
-    kk = math.sin(half) / angle if angle > 1e-12 else 0.5 - angle * angle / 48.0
-    return math.cos(half), kk * rx, kk * ry, kk * rz
+    """Unit quaternion ``exp(r/2)`` of the rotation vector r (rad), scalar first, for compiled loops.
+
+    By :func:`series_rotvec_quat` up to the half-angle :data:`SERIES_HALF_ANGLE` (equal to the closed
+    form to a double's rounding, and about twice as fast: one sample of the strapdown loop, a feedback),
+    by ``(cos h, sin h / |r| · r)`` beyond.
+    """
+    a2 = rx * rx + ry * ry + rz * rz
+    if a2 <= 4.0 * SERIES_HALF_ANGLE * SERIES_HALF_ANGLE:
+        return series_rotvec_quat(rx, ry, rz)
+    angle = math.sqrt(a2)
+    kk = math.sin(0.5 * angle) / angle
+    return math.cos(0.5 * angle), kk * rx, kk * ry, kk * rz
 
 
 @njit(inline=True)
