@@ -5,8 +5,9 @@ Usage: python benchmarks/side_by_side.py OTHER [--samples 3e5] [--rounds 4] [--r
 ``OTHER`` is another checkout of footzoo (for example an older commit, ``git worktree add
 --detach ../footzoo-old <commit>``). Each round runs one new process per tree, this tree and
 ``OTHER`` in turn, so that load on a shared machine falls on both alike; a process times
-``Pipeline.run`` of each config on the same simulated walk (:func:`benchmarks.throughput.walk`)
-after a warm-up run (compiled kernels loaded), CPU time, the minimum of ``--repeat`` runs. The
+``Pipeline.run`` of each config on the same simulated walk (:func:`benchmarks.throughput.walk`,
+simulated once by this tree and handed to both as arrays, so that a change in the simulator does not
+change what is timed) after a warm-up run (compiled kernels loaded), CPU time, the minimum of ``--repeat`` runs. The
 table gives the minimum over the rounds and the speed of this tree relative to ``OTHER``
 (above 1: this tree is faster). Configs are read from each tree's own files (``configs/`` in
 trees older than footzoo 0.3); only the configs both trees ship are timed.
@@ -18,20 +19,27 @@ import argparse
 import json
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
 _CHILD = r"""
 import gc, json, os, sys, time, warnings
-root, names, n, repeat = sys.argv[1], sys.argv[2].split(","), int(float(sys.argv[3])), int(sys.argv[4])
+root, names, arrays, repeat = sys.argv[1], sys.argv[2].split(","), sys.argv[3], int(sys.argv[4])
 sys.path.insert(0, root)
-from benchmarks.throughput import walk
+import numpy as np
 import footzoo
+def walk(path):
+    with np.load(path) as a:
+        return footzoo.Recording(t=a["t"], acc=a["acc"], gyr=a["gyr"], mag=a["mag"], dist=a["dist"],
+                                 meta={"foot": "right", "name": "bench"})
 folder = os.path.join(root, "footzoo", "config", "builtin")
 folder = folder if os.path.isdir(folder) else os.path.join(root, "configs")
 warnings.simplefilter("ignore")
-rec, warm = walk(n), walk(20000)
+rec, warm = walk(arrays + "-run.npz"), walk(arrays + "-warm.npz")
 pipes = {c: footzoo.Pipeline.from_yaml(os.path.join(folder, c + ".yaml")) for c in names}
 for p in pipes.values():
     p.run(warm)
@@ -53,9 +61,19 @@ def shipped(tree: Path) -> set[str]:
     return {p.stem for p in folder.glob("*.yaml") if not p.stem.startswith("study")}
 
 
-def time_tree(tree: Path, names: list[str], samples: float, repeat: int) -> dict[str, float]:
-    """CPU seconds per run of each config, in a new process running ``tree``'s code."""
-    proc = subprocess.run([sys.executable, "-c", _CHILD, str(tree), ",".join(names), str(samples), str(repeat)],
+def write_walks(samples: float, stem: Path) -> None:
+    """This tree's timed walk and warm-up walk as arrays, ``stem-run.npz`` and ``stem-warm.npz``."""
+    sys.path.insert(0, str(ROOT))
+    from benchmarks.throughput import walk
+
+    for suffix, n in (("run", int(samples)), ("warm", 20000)):
+        r = walk(n)
+        np.savez(f"{stem}-{suffix}.npz", t=r.t, acc=r.acc, gyr=r.gyr, mag=r.mag, dist=r.dist)
+
+
+def time_tree(tree: Path, names: list[str], arrays: Path, repeat: int) -> dict[str, float]:
+    """CPU seconds per run of each config, in a new process running ``tree``'s code on ``arrays``."""
+    proc = subprocess.run([sys.executable, "-c", _CHILD, str(tree), ",".join(names), str(arrays), str(repeat)],
                           capture_output=True, text=True, check=True, cwd=tree)
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -73,12 +91,15 @@ def main() -> None:
     if args.configs:
         names = [c for c in args.configs.split(",") if c in names]
     runs: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
-    for _ in range(args.rounds):
-        runs["other"].append(time_tree(other, names, args.samples, args.repeat))
-        runs["this"].append(time_tree(ROOT, names, args.samples, args.repeat))
+    with tempfile.TemporaryDirectory() as folder:
+        arrays = Path(folder) / "walk"
+        write_walks(args.samples, arrays)
+        for _ in range(args.rounds):
+            runs["other"].append(time_tree(other, names, arrays, args.repeat))
+            runs["this"].append(time_tree(ROOT, names, arrays, args.repeat))
     n = int(args.samples)
-    print(f"{n} samples of a simulated 100 Hz walk; CPU time per run, minimum over {args.rounds} rounds × "
-          f"{args.repeat} runs; OTHER = {other}\n")
+    print(f"{n} samples of one simulated 100 Hz walk (this tree's simulator), the same for both trees; "
+          f"CPU time per run, minimum over {args.rounds} rounds × {args.repeat} runs; OTHER = {other}\n")
     print("| config | OTHER: ms per run | this tree: ms per run | speed of this tree / OTHER |")
     print("|---|---|---|---|")
     for c in names:
