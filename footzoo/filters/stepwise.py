@@ -133,7 +133,7 @@ def _segment_ends(stance, t, closed):
     if closed and n > 0 and (m == 0 or out[m - 1] != n - 1):
         out[m] = n - 1
         m += 1
-    return out[:m]
+    return out[:m].copy()  # a stride's worth, not a view that keeps 8 bytes per sample
 
 
 @njit(inline=True)

@@ -11,6 +11,7 @@ calibrations' fit, the initial attitude and the Kalman models.
 from __future__ import annotations
 
 import copy
+import operator
 from typing import Any
 
 import numpy as np
@@ -73,9 +74,40 @@ def with_init(chunk: Chunk, ctx: RunContext, duration: float) -> Chunk:
     return {**chunk, "init": chunk["t"] <= ctx.t0 + duration}
 
 
+class SampleIndices:
+    """The sample indices ``start … stop − 1`` of a whole recording's chunk, as ``np.arange`` gives them, made only
+    where they are read (a slice, one index, or the whole as an array): a batch run of 10⁶ samples keeps 8 MB less.
+
+    A batch run's stages read the first index (the calibrations, the Kalman stage) and the estimate's
+    scans read them block by block (:class:`footzoo.core.plausibility.GaitScan`); a stream's chunks carry arrays.
+    """
+
+    __slots__ = ("start", "stop")
+
+    def __init__(self, start: int, stop: int):
+        self.start, self.stop = int(start), int(stop)
+
+    def __len__(self) -> int:
+        return self.stop - self.start
+
+    def __getitem__(self, i: int | slice) -> np.ndarray | np.int64:
+        if isinstance(i, slice):
+            lo, hi, step = i.indices(len(self))
+            return np.arange(self.start + lo, self.start + hi, step)
+        j = operator.index(i)
+        j = j + len(self) if j < 0 else j
+        if not 0 <= j < len(self):
+            raise IndexError(f"sample index {i} out of range for {len(self)} samples")
+        return np.int64(self.start + j)
+
+    def __array__(self, dtype: Any = None, copy: bool | None = None) -> np.ndarray:
+        return np.arange(self.start, self.stop, dtype=dtype)
+
+
 def recording_chunk(rec: Recording, ctx: RunContext, duration: float) -> Chunk:
-    """A whole recording as one chunk (its arrays, not copies), with ``init`` (``duration``: s of the still start)."""
-    chunk = {"k": np.arange(rec.n), "t": rec.t, "acc": rec.acc, "gyr": rec.gyr}
+    """A whole recording as one chunk (its arrays, not copies; the sample indices :class:`SampleIndices`), with
+    ``init`` (``duration``: s of the still start)."""
+    chunk = {"k": SampleIndices(0, rec.n), "t": rec.t, "acc": rec.acc, "gyr": rec.gyr}
     if rec.mag is not None:
         chunk["mag"] = rec.mag
     if rec.dist is not None:
