@@ -236,7 +236,9 @@ def main(argv: list[str] | None = None) -> None:
               f"within {1e3 * LOADING_SPAN:.0f} ms after IC, when it comes, and when |ω| first falls below "
               f"{LEVEL:g} rad/s after it (foot flat); medians and quartiles over the heel strikes. The simulator's "
               "scenarios keep Table I's 1 s cycle (stairs 1.2 s), gaitmap's walk has a 1.09 s cycle. "
-              "`footzoo.sim.gait.LOADING_RESPONSE` takes gaitmap's medians.", "",
+              "The simulator's loading response peaks near 13 rad/s (Table I's 0.1 s heel rotation), about twice "
+              "gaitmap's and IPOL's; DGP learns its threshold from this phase, so the simulated DGP rows do not "
+              "predict real feet (docs/results.md).", "",
               to_markdown(pd.DataFrame(loading), digits=3), ""]
     text = "\n".join(lines)
     print(text)
