@@ -34,7 +34,9 @@ def quat_product(a0, a1, a2, a3, b0, b1, b2, b3):
 SERIES_HALF_ANGLE = 0.25
 
 
-@njit(inline="always")
+# an ordinary compiled function, not inlined by numba: the machine code inlines it all the same (the loops run as
+# fast), and numba inlining it into every loop made the wheel's kernel compile take about 4 s longer
+@njit
 def series_rotvec_quat(rx, ry, rz):
     """``exp(r/2)`` of the rotation vector r (rad), scalar first, by the series of cos h and sin h / h in h²
     (h = |r|/2) up to h¹²: no square root, sine, cosine, division or branch.
