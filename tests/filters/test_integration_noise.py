@@ -110,9 +110,6 @@ def test_gaitmap_stride_lengths_against_motion_capture(foot):
     assert timed < 0.03 < uniform - 0.015
 
 
-# slow: the live step-wise loop with the integration noise is a variant no shipped config has (it compiles for about
-# 14 s on a fresh install)
-@pytest.mark.slow
 def test_live_chunks_give_the_batch_numbers(walk):
     """The change ``f_k − f_{k−1}`` spans the chunks' borders: live (step-wise smoothing) equals the batch run."""
     rec, _ = unresolved_impacts(walk)

@@ -205,9 +205,7 @@ def test_stepwise_smoothing_improves_on_the_filter_and_comes_close_to_rts(walk):
         np.testing.assert_allclose(runs["stepwise"].pos[-1], runs["none"].pos[-1], atol=1e-12)
 
 
-# nguyen2016 slow: its step-wise loop (15 states, the heading reduction) is a variant no shipped config has; it
-# compiles for about 20 s on a fresh install
-@pytest.mark.parametrize("name", ["duong2015_zupt", pytest.param("nguyen2016", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", ["duong2015_zupt", "nguyen2016"])
 def test_both_engines_smooth_stride_by_stride_alike(walk, name):
     """The compiled loop smooths each stride as it closes; the reference (filterpy) after the loop."""
     p = _pipeline(name, "stepwise")
