@@ -84,6 +84,7 @@ every stride at the end of the data: batch and live give the same finding.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from typing import Any, Protocol
@@ -276,6 +277,17 @@ def judge_rate(gait: dict[str, float] | None, evidence: dict[str, Any] | None) -
     return out
 
 
+@dataclasses.dataclass
+class Motion:
+    """What :class:`GaitScan` has seen of the motion before it decides the gyroscope's unit."""
+
+    seconds: float = 0.0  #: moving time (s): |‖f‖ − g| above MOTION_ACC
+    samples: int = 0  #: moving samples
+    turning: int = 0  #: of them, turning faster than TURN_RATE
+    peak_moving: float = 0.0  #: largest |ω| of the moving samples (rad/s)
+    peak_all: float = 0.0  #: largest |ω| of all samples (rad/s)
+
+
 class GaitScan:
     """The strides of a run and their plausibility, fed its final estimates chunk by chunk (module docstring).
 
@@ -297,8 +309,7 @@ class GaitScan:
         self._count = 0
         self._buf: dict[str, np.ndarray] | None = None
         self._pending: list[int] | None = list(CHECKPOINTS)  # None once judged at the end
-        self._motion = [0.0, 0, 0, 0.0, 0.0]  # moving time (s), moving samples, of them turning, peak |ω| (rad/s)
-        # of the moving samples and of all samples: until MOTION_TIME s of motion are seen (then decided)
+        self._motion = Motion()  # until MOTION_TIME s of motion are seen (then the gyroscope's unit is decided)
         self._unit_decided = False
         self._t_last: float | None = None
         self._cut: int | None = None  # the first sample of a sensor dropout: the rate is judged before it
@@ -402,27 +413,27 @@ class GaitScan:
         self._t_last = float(t[-1])
         moving = np.abs(row_norms(acc) - self.gravity) > MOTION_ACC
         if not moving.any():
-            self._motion[4] = max(self._motion[4], float(np.max(w)))
+            self._motion.peak_all = max(self._motion.peak_all, float(np.max(w)))
             return
-        time = self._motion[0] + np.cumsum(np.where(moving, dt, 0.0))
+        time = self._motion.seconds + np.cumsum(np.where(moving, dt, 0.0))
         reached = np.flatnonzero(time >= MOTION_TIME)
         upto = int(reached[0]) + 1 if len(reached) else len(t)
-        count = self._motion[1] + int(np.count_nonzero(moving[:upto]))
-        turning = self._motion[2] + int(np.count_nonzero(moving[:upto] & (w[:upto] > TURN_RATE)))
-        peaks = (max(self._motion[3], float(np.max(w[:upto][moving[:upto]], initial=0.0))),
-                 max(self._motion[4], float(np.max(w[:upto]))))
-        self._motion = [float(time[upto - 1]), count, turning, *peaks]
+        count = self._motion.samples + int(np.count_nonzero(moving[:upto]))
+        turning = self._motion.turning + int(np.count_nonzero(moving[:upto] & (w[:upto] > TURN_RATE)))
+        self._motion = Motion(float(time[upto - 1]), count, turning,
+                              max(self._motion.peak_moving, float(np.max(w[:upto][moving[:upto]], initial=0.0))),
+                              max(self._motion.peak_all, float(np.max(w[:upto]))))
         if not len(reached):
             return
         self._unit_decided = True  # on the first MOTION_TIME s of motion
         if turning >= TURN_FRACTION * count:
             return
-        peak = peaks[0] if turning == count else peaks[1]
-        self.report["gyro_unit"] = {"sample": int(k[upto - 1]), "moving_s": self._motion[0], "moving_samples": count,
-                                    "turning_samples": turning, "peak_rate_rad_s": peak,
+        peak = self._motion.peak_moving if turning == count else self._motion.peak_all
+        self.report["gyro_unit"] = {"sample": int(k[upto - 1]), "moving_s": self._motion.seconds,
+                                    "moving_samples": count, "turning_samples": turning, "peak_rate_rad_s": peak,
                                     "peak_if_rad_s": peak / DEG}
         warnings.warn(
-            f"{self.name}: the accelerometer shows {self._motion[0]:.1f} s of motion (|‖f‖ − g| above "
+            f"{self.name}: the accelerometer shows {self._motion.seconds:.1f} s of motion (|‖f‖ − g| above "
             f"{MOTION_ACC:g} m/s², {count} samples) but the gyroscope turns faster than {TURN_RATE:g} rad/s in "
             f"only {turning} of them, at most {peak:.3g} rad/s: a moving foot turns at 5–20 rad/s. The gyroscope's "
             f"values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} rad/s): declare "
