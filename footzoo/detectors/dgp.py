@@ -268,9 +268,9 @@ class DGP(Detector):
     seed 0); its mean over 24 seeds with DGP 0.97 / 0.81 / 1.05 m at 250 / 400 /
     1000 Hz, 0.26 m at 100 Hz (benchmarks/accuracy.md). On gaitmap's walk the
     thresholds (2.2–3.1) leave the end to the bound too. The simulated loading
-    response turns faster than gaitmap's (sagittal peak within 150 ms of IC,
-    median 12.9 rad/s against 7.4 and 6.6), so its threshold is no prediction of
-    a real one.
+    response turns faster than real ones (plantar-flexion peak within 150 ms of
+    IC, median: simulator 12.6–13.0 rad/s, gaitmap 7.08, IPOL 6.72;
+    benchmarks/heel_strike.md), so its threshold is no prediction of a real one.
 
     Parameters
     ----------
