@@ -2,11 +2,13 @@
 
 numba compiles each kernel at its first call (about 5 s for a Kalman pipeline) and caches the
 machine code on disk. :func:`compile_kernels` runs each config once on two short simulated walks
-(with magnetometer and distance sensors, and without), which compiles and caches every kernel the
-config uses: run it once on a new machine, or before a study starts its workers
-(``footzoo compile configs/*.yaml``; a study file stands for every config of its grid). With
-``ship`` it writes the code into a folder instead: ``setup.py`` does so when it builds a wheel,
-which then carries the compiled kernels of the shipped configs (see :class:`footzoo.kernels.internals.KernelCache`).
+(with magnetometer and distance sensors, and without), in a batch run and, where the config can run
+live, in a :class:`~footzoo.runtime.stream.Stream` (whose step-wise smoother keeps a record of each open
+stride: another compile of the loop). That compiles and caches every kernel the config uses: run it
+once on a new machine, or before a study starts its workers (``footzoo compile configs/*.yaml``;
+a study file stands for every config of its grid). With ``ship`` it writes the code into a folder
+instead: ``setup.py`` does so when it builds a wheel, which then carries the compiled kernels of the
+shipped configs (see :class:`footzoo.kernels.internals.KernelCache`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from ..config.schema import load_yaml
 from ..core.errors import ConfigError, RecordingError
 from ..kernels import jit as _jit
 from ..runtime.pipeline import Pipeline
+from ..runtime.stream import Stream
 from ..sim import simulate
 from ..studies.study import Study
 
@@ -90,6 +93,8 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
                 warnings.simplefilter("ignore")
                 try:
                     pipeline.run(recording)
+                    if not pipeline.live_problems():  # live: in packets and sample by sample
+                        Stream(pipeline, rate=recording.rate).run(recording, chunk=[50, 1, 1])
                 except RecordingError:  # a config that needs a channel the second walk lacks
                     if recording is recordings[0]:
                         raise

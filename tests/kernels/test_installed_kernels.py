@@ -1,0 +1,57 @@
+"""The installed wheel's machine code covers every shipped config, in a batch run and live.
+
+Runs only beside a wheel install (``pip install .``, as CI does): an editable install ships no kernels.
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from footzoo.kernels import jit as _jit
+from footzoo.kernels.installed import installed_kernels
+
+pytestmark = [pytest.mark.skipif(not _jit.HAVE_NUMBA, reason="needs numba"),
+              pytest.mark.skipif(installed_kernels() is None, reason="no installed wheel with compiled kernels "
+                                 "(an editable install): pip install . ships them")]
+
+# every shipped pipeline config, batch and (where it can run) live in packets and sample by sample, on a walk
+# that is not the one the wheel was compiled on; print the footzoo kernels numba compiled for each
+RUN = """
+import json, warnings
+warnings.simplefilter("ignore")
+from numba.core import event
+import footzoo
+from footzoo.config.library import names
+from footzoo.sim import simulate
+compiled = {}
+class Listener(event.Listener):
+    def on_start(self, ev):
+        d = ev.data.get("dispatcher")
+        if d is not None and getattr(d.py_func, "__module__", "").startswith("footzoo"):
+            compiled.setdefault(NAME, []).append(d.py_func.__qualname__)
+    def on_end(self, ev):
+        pass
+rec = simulate(n_strides=5, rate=200.0, profile="physical", magnetometer=False)
+with event.install_listener("numba:compile", Listener()):
+    for NAME in names("pipeline"):
+        p = footzoo.Pipeline.from_yaml(NAME)
+        p.run(rec)
+        if not p.live_problems():
+            footzoo.Stream(p, rate=rec.rate).run(rec, chunk=[37, 1])
+print(json.dumps(compiled))
+"""
+
+
+@pytest.mark.slow  # a new process runs every shipped config twice (about 10 s)
+def test_no_shipped_config_compiles_a_kernel_in_a_batch_run_or_live(tmp_path):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONWARNINGS": "ignore"}
+    env.pop("NUMBA_DISABLE_JIT", None)
+    proc = subprocess.run([sys.executable, "-c", RUN], env=env, capture_output=True, text=True, timeout=600,
+                          cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == {}
+    assert not any(Path(tmp_path / "cache").rglob("*.nbi"))  # nothing compiled, so nothing cached
