@@ -51,8 +51,8 @@ def _pipelines(path: str | os.PathLike) -> list[tuple[str, Pipeline]]:
     return pipelines
 
 
-def compile_kernels(configs: Iterable[str | os.PathLike],
-                    ship: str | os.PathLike | None = None) -> list[tuple[str, float]]:
+def compile_kernels(configs: Iterable[str | os.PathLike], ship: str | os.PathLike | None = None,
+                    live: bool = True) -> list[tuple[str, float]]:
     """Run every pipeline config once on a short simulated walk; return ``(config, seconds)`` per config.
 
     Parameters
@@ -62,6 +62,10 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
     ship : path, optional
         Write the machine code into this folder (a wheel's ``footzoo/_compiled``) instead of numba's
         cache. Must be given before any kernel has run in this process.
+    live : bool
+        Also run each config that can run live in a :class:`~footzoo.runtime.stream.Stream`. A step-wise
+        smoothed config (``recommended_live``) then compiles its loop once more (about 14 s): a wheel's
+        build leaves it out (``--batch-only``) to keep the install short, so its first live run compiles it.
 
     Raises
     ------
@@ -93,7 +97,7 @@ def compile_kernels(configs: Iterable[str | os.PathLike],
                 warnings.simplefilter("ignore")
                 try:
                     pipeline.run(recording)
-                    if not pipeline.live_problems():  # live: in packets and sample by sample
+                    if live and not pipeline.live_problems():  # live: in packets and sample by sample
                         Stream(pipeline, rate=recording.rate).run(recording, chunk=[50, 1, 1])
                 except RecordingError:  # a config that needs a channel the second walk lacks
                     if recording is recordings[0]:

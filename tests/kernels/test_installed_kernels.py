@@ -1,4 +1,4 @@
-"""The installed wheel's machine code covers every shipped config, in a batch run and live.
+"""The installed wheel's machine code covers the shipped configs' batch runs, and their live runs but the step-wise one.
 
 Runs only beside a wheel install (``pip install .``, as CI does): an editable install ships no kernels.
 """
@@ -7,7 +7,6 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -32,15 +31,17 @@ class Listener(event.Listener):
     def on_start(self, ev):
         d = ev.data.get("dispatcher")
         if d is not None and getattr(d.py_func, "__module__", "").startswith("footzoo"):
-            compiled.setdefault(NAME, []).append(d.py_func.__qualname__)
+            compiled.setdefault(RUN, []).append(d.py_func.__qualname__)
     def on_end(self, ev):
         pass
 rec = simulate(n_strides=5, rate=200.0, profile="physical", magnetometer=False)
 with event.install_listener("numba:compile", Listener()):
     for NAME in names("pipeline"):
         p = footzoo.Pipeline.from_yaml(NAME)
+        RUN = NAME + " batch"
         p.run(rec)
         if not p.live_problems():
+            RUN = NAME + " live " + p.smoother
             footzoo.Stream(p, rate=rec.rate).run(rec, chunk=[37, 1])
 print(json.dumps(compiled))
 """
@@ -53,5 +54,6 @@ def test_no_shipped_config_compiles_a_kernel_in_a_batch_run_or_live(tmp_path):
     proc = subprocess.run([sys.executable, "-c", RUN], env=env, capture_output=True, text=True, timeout=600,
                           cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    assert json.loads(proc.stdout.strip().splitlines()[-1]) == {}
-    assert not any(Path(tmp_path / "cache").rglob("*.nbi"))  # nothing compiled, so nothing cached
+    compiled = json.loads(proc.stdout.strip().splitlines()[-1])
+    # the live loop of the step-wise smoother is left out of the wheel (setup.py: install time)
+    assert [run for run in compiled if not run.endswith(" live stepwise")] == [], compiled
