@@ -70,7 +70,12 @@ def trusted(fn: Callable[..., Any]) -> bool:
 
 def identity(fn: Callable[..., Any]) -> str | None:
     """A text that names ``fn`` and the content of its source (its file, its code, its captured values), or
-    ``None`` when it has no source file or captures a value that cannot be written down the same way twice."""
+    ``None`` when it has no source file or captures a value that cannot be written down the same way twice.
+
+    Not the file's path: a wheel's build compiles footzoo's own functions in a build folder, and the installed
+    package must find that code under the same identity (with the path in it, every measurement function of a
+    shipped config was compiled again at its first run after ``pip install``).
+    """
     try:
         source = inspect.getfile(fn)
         with open(source, "rb") as fh:
@@ -82,7 +87,7 @@ def identity(fn: Callable[..., Any]) -> str | None:
     if any(type(c).__name__ in ("CPUDispatcher", "ModelFunction") for c in captured):
         return None
     code = hashlib.sha256(fn.__code__.co_code).hexdigest()
-    return f"{fn.__module__}.{fn.__qualname__}|{source}|{content}|{code}|{values}"
+    return f"{fn.__module__}.{fn.__qualname__}|{content}|{code}|{values}"
 
 
 def compile_model_function(fn: Callable[..., Any], role: str,
