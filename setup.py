@@ -45,10 +45,10 @@ class BuildWithKernels(build_py):
         groups = [configs] if cores < 2 else [g for g in _groups(configs) if g]
         # one process per group, side by side, each into its own part of the folder (a numba index names its
         # data files by number: two processes must not write into one folder; footzoo reads every part)
-        # batch runs only: the live loop of a step-wise smoothed config (recommended_live) would add about 35 s of
-        # CPU to every install (14 s wall for that config; the groups then share fewer kernels), for a compile of
-        # 14 s at the first live run of that one config
-        procs = [subprocess.Popen([sys.executable, "-m", "footzoo", "compile", "--batch-only", "--ship",
+        # not the live loop of a step-wise smoothed config (recommended_live): it would add about 14 s to this
+        # build (35 s of CPU with the groups rebalanced for it), for a compile of 14 s at the first live run of
+        # that one config
+        procs = [subprocess.Popen([sys.executable, "-m", "footzoo", "compile", "--no-smoothed-live", "--ship",
                                    str(target / f"part-{k}" if len(groups) > 1 else target), *group],
                                   env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
                  for k, group in enumerate(groups)]

@@ -459,7 +459,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
     # deferred: numba, loaded only to compile
     from .compile import compile_kernels
 
-    for config, seconds in compile_kernels(args.configs, ship=args.ship, live=not args.batch_only):
+    for config, seconds in compile_kernels(args.configs, ship=args.ship, smoothed_live=not args.no_smoothed_live):
         print(f"{config}: {seconds:.1f} s")
     return 0
 
@@ -697,8 +697,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "e.g. configs/*.yaml")
     comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
                       "(what setup.py does for a wheel's footzoo/_compiled)")
-    comp.add_argument("--batch-only", action="store_true", help="compile what a batch run uses only, not also "
-                      "a live run's (a step-wise smoothed config's live loop: about 14 s more; setup.py's choice)")
+    comp.add_argument("--no-smoothed-live", action="store_true", help="leave out the live runs of step-wise "
+                      "smoothed configs (their live loop: about 14 s more each; what setup.py does for a wheel)")
     comp.set_defaults(func=cmd_compile)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")

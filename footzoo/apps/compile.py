@@ -52,7 +52,7 @@ def _pipelines(path: str | os.PathLike) -> list[tuple[str, Pipeline]]:
 
 
 def compile_kernels(configs: Iterable[str | os.PathLike], ship: str | os.PathLike | None = None,
-                    live: bool = True) -> list[tuple[str, float]]:
+                    smoothed_live: bool = True) -> list[tuple[str, float]]:
     """Run every pipeline config once on a short simulated walk; return ``(config, seconds)`` per config.
 
     Parameters
@@ -62,10 +62,11 @@ def compile_kernels(configs: Iterable[str | os.PathLike], ship: str | os.PathLik
     ship : path, optional
         Write the machine code into this folder (a wheel's ``footzoo/_compiled``) instead of numba's
         cache. Must be given before any kernel has run in this process.
-    live : bool
-        Also run each config that can run live in a :class:`~footzoo.runtime.stream.Stream`. A step-wise
-        smoothed config (``recommended_live``) then compiles its loop once more (about 14 s): a wheel's
-        build leaves it out (``--batch-only``) to keep the install short, so its first live run compiles it.
+    smoothed_live : bool
+        Also run the step-wise smoothed configs (``recommended_live``) live; the other configs that can run
+        live always are. Live, the step-wise smoother keeps a record of each open stride: one more compile of
+        the loop (about 14 s). A wheel's build leaves it out (``--no-smoothed-live``) to keep the install
+        short, so the first live run of such a config compiles it.
 
     Raises
     ------
@@ -97,7 +98,8 @@ def compile_kernels(configs: Iterable[str | os.PathLike], ship: str | os.PathLik
                 warnings.simplefilter("ignore")
                 try:
                     pipeline.run(recording)
-                    if live and not pipeline.live_problems():  # live: in packets and sample by sample
+                    live = not pipeline.live_problems() and (smoothed_live or pipeline.smoother == "none")
+                    if live:  # in packets and sample by sample
                         Stream(pipeline, rate=recording.rate).run(recording, chunk=[50, 1, 1])
                 except RecordingError:  # a config that needs a channel the second walk lacks
                     if recording is recordings[0]:
