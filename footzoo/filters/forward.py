@@ -296,7 +296,7 @@ def measure(measures, arrays, k, t_k, state, w, st, data_k):
     a = arrays
     z, H, R, fault, mems = w.z, w.H, w.R, w.fault, state.mems
     m = 0
-    for j in range(len(measures)):
+    for j in range(a.rows.shape[0]):  # the models' own: ``measures`` may have no-op functions after them
         top = m + a.rows[j]
         m_new = measures[j](k, t_k, state.nav, w.w, w.f, st, a.idx[j], a.par[a.par_off[j]:a.par_off[j + 1]],
                             mems[a.mem_off[j]:a.mem_off[j + 1]], data_k[a.data_off[j]:a.data_off[j + 1]], z[:top],
@@ -393,7 +393,7 @@ def feed_back(state, dx, offs, use_ext, feedbacks, arrays, k, t_k, w, st, data_k
             nav[BG + i] += dx[offs.gyro_bias + i]
         if offs.acc_bias >= 0:
             nav[BA + i] += dx[offs.acc_bias + i]
-    for j in range(len(feedbacks)):
+    for j in range(a.has_feedback.shape[0]):
         if a.has_feedback[j]:
             feedbacks[j](k, t_k, nav, w.w, w.f, st, a.idx[j], a.par[a.par_off[j]:a.par_off[j + 1]],
                          mems[a.mem_off[j]:a.mem_off[j + 1]], data_k[a.data_off[j]:a.data_off[j + 1]], dx)
@@ -403,7 +403,7 @@ def feed_back(state, dx, offs, use_ext, feedbacks, arrays, k, t_k, w, st, data_k
 def after(afters, arrays, k, t_k, state, w, st, data_k):
     """Each model's ``after`` function, once per sample after the update (bookkeeping on the corrected state)."""
     a, mems = arrays, state.mems
-    for j in range(len(afters)):
+    for j in range(a.has_after.shape[0]):
         if a.has_after[j]:
             afters[j](k, t_k, state.nav, w.w, w.f, st, a.idx[j], a.par[a.par_off[j]:a.par_off[j + 1]],
                       mems[a.mem_off[j]:a.mem_off[j + 1]], data_k[a.data_off[j]:a.data_off[j + 1]])

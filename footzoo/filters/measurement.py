@@ -271,7 +271,11 @@ def after_function(fn: Callable[..., None]) -> Callable[..., None]:
     return _lazy(fn, "after")
 
 
-def _no_feedback(ctx, dx):  # noqa: ARG001 - the signature is the contract
+def _no_rows(ctx, rows):  # noqa: ARG001 - the signature is the contract
+    return rows.m
+
+
+def _no_feedback(ctx, dx):  # noqa: ARG001
     return None
 
 
@@ -279,6 +283,7 @@ def _no_after(ctx):  # noqa: ARG001
     return None
 
 
+NO_MEASURE = measurement_function(_no_rows)
 NO_FEEDBACK = feedback_function(_no_feedback)
 NO_AFTER = after_function(_no_after)
 
