@@ -126,7 +126,8 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
     Each task carries only what its figure reads (the runs of one recording, the rows of one
     metric, the threshold sweeps), so the tasks are cheap to send to worker processes and can
     be shared out evenly; their figures together are the whole call's, labels included. A box plot
-    is drawn per factor for each metric of the table that ``figures`` names (default: every one).
+    is drawn per factor for each metric of the table that ``figures`` names (default: every one) and at
+    least one run could compute (a metric NaN in every run would be an empty plot: the table's ``note`` says why).
     """
     tasks: list[tuple] = []
     labels = run_labels(runs, factors)
@@ -134,6 +135,8 @@ def figure_tasks(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[
         mine = [r for r in runs if r["recording"] == rec]
         tasks.append(("trajectories", mine, {r["key"]: labels[r["key"]] for r in mine}, rec))
     ok = table[table["metric"].notna()]
+    scored = ok.groupby("metric")["value"].apply(lambda v: bool(np.isfinite(v.to_numpy(float)).any()))
+    ok = ok[ok["metric"].map(scored)]  # a metric no run could compute (NaN, its reason in the note) has no figure
     for f in compared(table, factors):
         for metric in sorted(m for m in ok["metric"].unique() if figures is None or m in figures):
             tasks.append(("metric", ok[ok["metric"] == metric], f, metric))

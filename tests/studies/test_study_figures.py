@@ -108,3 +108,25 @@ def test_dictionary_levels_are_labelled_readably_in_the_summary(tmp_path):
     section = summary.split("## detector")[1]
     assert "| shoe | armse_3d_m |" in section and "| angular_rate_fsm (threshold=0.6) | armse_3d_m |" in section
     assert '{"' not in section  # no raw JSON for a reader
+
+
+def test_a_metric_no_run_could_compute_is_kept_in_the_table_but_not_drawn(tmp_path):
+    """A simulated walk without a reference has no stance mask: ``stance_f1`` is NaN with its reason, no empty plot."""
+    import numpy as np
+
+    from footzoo.evaluation.validity import MetricWarning
+    from footzoo.sim import simulate
+
+    walk = simulate(path="straight", n_strides=4, rate=50)
+    walk.truth = None
+    from footzoo.io import canonical
+
+    canonical.write(walk, tmp_path / "walk.csv")
+    spec = {**STUDY, "recordings": [{"path": str(tmp_path / "walk.csv")}], "figures": "all",
+            "metrics": ["strides", "stance_f1"]}
+    with pytest.warns(MetricWarning, match="stance mask"):
+        table = run_study(Study.from_dict(spec), out=tmp_path / "study")
+    f1 = table[table["metric"] == "stance_f1"]
+    assert len(f1) == 2 and f1["value"].isna().all() and f1["note"].str.contains("reference").all()
+    assert _drawn(tmp_path / "study") == {"strides"}
+    assert np.isfinite(table[table["metric"] == "strides"]["value"]).all()
