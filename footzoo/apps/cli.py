@@ -44,6 +44,7 @@ from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, P
 from ..core.files import why_missing
 from ..core.params import describe as describe_parameters
 from ..core.warninglog import LOG, log_text, warning_texts
+from ..io.registry import BUILTIN
 from ..plugins.base import BASES
 from ..plugins.registry import describe
 
@@ -674,8 +675,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
     run.add_argument("config", type=_input_yaml, help="pipeline YAML, e.g. yun2012")
     run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
-    run.add_argument("--format", help="reader name: canonical, xio, pyshoe, gaitmap, sensorconnect, openshoe, "
-                     "generic or an installed one (footzoo formats lists them; default: detect)")
+    run.add_argument("--format", help=f"reader name: {', '.join(BUILTIN)} or an installed one "
+                     "(footzoo formats lists them; default: detect)")
     run.add_argument("--foot", choices=["left", "right", "both"],
                      help="foot to read from a two-foot file (gaitmap; default: both when the file has both), "
                           "or the foot a one-foot recording is from")

@@ -154,7 +154,7 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         File to read.
     format : str, optional
         A reader's name (``canonical``, ``xio``, ``pyshoe``, ``gaitmap``, ``sensorconnect``,
-        ``openshoe``, ``generic`` or an installed reader's, see ``footzoo.io.READERS``); when
+        ``openshoe``, ``xsens``, ``generic`` or an installed reader's, see ``footzoo.io.READERS``); when
         omitted, the one reader that recognises the file.
     **options
         Reader options (``footzoo.io.READERS[format].options``), e.g. ``foot="left"`` for gaitmap

@@ -53,3 +53,13 @@ def test_an_unrecognised_header_lists_the_expected_columns(tmp_path, capsys):
     for expected in ("t, acc_x, acc_y, acc_z, gyr_x, gyr_y, gyr_z", "Gyroscope X (deg/s)", "left_sensor",
                      "scaledAccelX", "--format"):
         assert expected in err
+
+
+def test_run_help_names_every_built_in_format(capsys):
+    from footzoo.io.registry import BUILTIN
+
+    assert main(["run", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    listed = text.split("--format FORMAT", 2)[-1]
+    assert all(name in listed for name in BUILTIN), listed[:300]
+    assert "xsens" in listed
