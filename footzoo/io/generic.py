@@ -223,7 +223,7 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         found = [str(c) for c in df.columns][:20]
         close = "".join(did_you_mean(str(m), found) for m in missing if isinstance(m, str))
         raise FormatError(f"{path}: column(s) {missing} named in {side.name} are not in the file{close}; "
-                          f"its columns are {found}")
+                          f"its columns are {found}{_delimiter_hint(found, spec.delimiter)}")
 
     def numbers(cols: list[Any]) -> np.ndarray:
         return df[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
@@ -246,6 +246,17 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         meta.setdefault("mag_unit", spec.mag["unit"])
     truth = Truth(closed_loop=True, source="closed loop (description)") if spec.closed_loop else None
     return Recording.from_dataframe(frame, meta=meta, truth=truth, **options)
+
+
+def _delimiter_hint(columns: list[str], delimiter: str) -> str:
+    """The fix when the header split into one column that holds another delimiter: the description's ``delimiter``."""
+    if len(columns) != 1:
+        return ""
+    for key, sep in (('";"', ";"), ('"\\t"', "\t"), ('" "', " "), ('","', ",")):
+        if sep != delimiter and sep in columns[0].strip():
+            return (f": the header line did not split, its names are separated by {sep!r}; "
+                    f"add delimiter: {key} to the description")
+    return ""
 
 
 def _epoch_seconds(column: pd.Series, path: Path, side: Path) -> np.ndarray:

@@ -26,7 +26,7 @@ import pandas as pd
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import describe_axes, parse_axes, rotate_columns
-from .base import RECORDING_OPTIONS, Reader, frame_options, text_source
+from .base import MAT_ROUTE, RECORDING_OPTIONS, Reader, frame_options, text_source
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
@@ -48,7 +48,9 @@ def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str =
         raise FormatError(f"{path}: cannot read as a MATLAB .mat file: {err}") from None
     missing = [k for k in ("imu", "ts") if k not in d]
     if missing:
-        raise FormatError(f"{path}: not a PyShoe trial, missing variable(s) {missing}")
+        have = sorted(k for k in d if not k.startswith("__"))
+        raise FormatError(f"{path}: not a PyShoe trial, missing variable(s) {missing} (it has {have[:12]}); "
+                          f"for a MATLAB file of another layout, {MAT_ROUTE}")
     try:
         imu = np.asarray(d["imu"], dtype=float)
         t = np.asarray(d["ts"], dtype=float).ravel()

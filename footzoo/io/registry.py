@@ -34,7 +34,7 @@ from typing import Any
 
 from ..core.errors import FootzooWarning, FormatError, did_you_mean
 from ..core.files import SNIFF_BYTES, foreign_encoding
-from .base import first_line
+from .base import MAT_ROUTE, first_line
 
 #: The entry-point group readers register under.
 GROUP = "footzoo.readers"
@@ -197,9 +197,12 @@ class Readers(Mapping[str, Any]):
                      f"describe it (delimiter, decimal) in a sidecar {p.name}.footzoo.yaml")
         if p.suffix.lower() == ".mat":
             seen += f" ({_mat_contents(p)})"
+            fix = f"A MATLAB file of another layout: {MAT_ROUTE}; or {how}"
+        else:
+            fix = (f"Rename the columns, describe them in a sidecar {p.name}.footzoo.yaml (the 'generic' format), "
+                   f"or {how}")
         raise FormatError(f"{p}: cannot tell the format: no reader recognises this file{seen}. Formats: "
-                          f"{self.listing()}. Rename the columns, describe them in a sidecar {p.name}.footzoo.yaml "
-                          f"(the 'generic' format), or {how}")
+                          f"{self.listing()}. {fix}")
 
 
 def _mat_contents(p: Path) -> str:

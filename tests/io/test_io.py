@@ -148,3 +148,20 @@ def test_canonical_in_g_needs_a_declared_unit(tmp_path):
 def test_rotation_helper_used_by_the_handedness_test():
     p = np.array([[0.0, 0, 0], [1.0, 0, 0]])
     np.testing.assert_allclose(rotate_about_vertical(p, np.pi / 2)[1], [0, 1, 0], atol=1e-12)
+
+
+def test_a_matlab_file_of_another_layout_is_told_the_python_route(tmp_path):
+    """No description format reads a .mat file: the message gives the route that works, not a sidecar."""
+    import scipy.io
+
+    from footzoo.sim import simulate
+
+    walk = simulate(n_strides=2, rate=50.0)
+    p = tmp_path / "lab.mat"
+    scipy.io.savemat(p, {"accel": walk.acc, "gyro": walk.gyr, "time": walk.t})
+    for options in ({}, {"format": "pyshoe"}):
+        with pytest.raises(FormatError) as err:
+            load(p, **options)
+        text = str(err.value)
+        assert "accel" in text and "scipy.io.loadmat" in text and "Recording.from_dataframe" in text, text
+        assert "lab.mat.footzoo.yaml" not in text, text  # no sidecar reads a binary file

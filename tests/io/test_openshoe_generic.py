@@ -8,6 +8,7 @@ example walk described by a sidecar, which must read exactly as the dedicated x-
 
 from __future__ import annotations
 
+import re
 import shutil
 import warnings
 
@@ -238,3 +239,17 @@ def test_date_time_stamps_and_column_positions_with_a_header(walk, tmp_path):
     np.testing.assert_allclose(rec.t - rec.t[0], np.round(walk.t * 1e6) * 1e-6, rtol=0, atol=5e-7)
     assert rec.t[0] == pd.Timestamp("2025-03-01T09:30:00", tz="UTC").timestamp()
     np.testing.assert_array_equal(rec.acc, walk.acc)
+
+
+@pytest.mark.parametrize("sep, key", [(";", '";"'), ("\t", '"\\t"')])
+def test_a_description_without_the_files_delimiter_names_the_delimiter_to_add(walk, tmp_path, sep, key):
+    p = tmp_path / "walk.csv"
+    table = np.column_stack([walk.t, walk.acc, walk.gyr])
+    np.savetxt(p, table, delimiter=sep, header=sep.join(["t", "ax", "ay", "az", "gx", "gy", "gz"]), comments="")
+    desc = ("time: {column: t, unit: s}\nacc: {columns: [ax, ay, az], unit: m/s^2}\n"
+            "gyr: {columns: [gx, gy, gz], unit: rad/s}\naxes: [x, y, z]\n")
+    (tmp_path / "walk.csv.footzoo.yaml").write_text(desc)
+    with pytest.raises(FormatError, match="the header line did not split.*add delimiter: " + re.escape(key)):
+        load(p)
+    (tmp_path / "walk.csv.footzoo.yaml").write_text(desc + f"delimiter: {key}\n")
+    np.testing.assert_allclose(load(p).acc, walk.acc, rtol=1e-6)
