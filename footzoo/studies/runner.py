@@ -125,26 +125,31 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
 
 # --------------------------------------------------------------------------- one cell, one chunk
 
-_RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> Recording, per process
+_RECORDINGS: OrderedDict[str, Any] = OrderedDict()  # identity -> (Recording, its reader's warnings), per process
 _RECORDINGS_LOCK = threading.Lock()
 
 
-def _recording(cell: Cell, identity: str):
-    """The cell's recording, loaded or simulated once per process and shared by the configs that use it."""
+def _recording(cell: Cell, identity: str) -> tuple[Any, list[str]]:
+    """The cell's recording, loaded or simulated once per process and shared by the configs that use it, with
+    the warnings its reader gave (``"Category: message"``): every run on it carries them back to the study,
+    which shows or logs them as ``--quiet`` says, rather than a worker process printing them."""
     with _RECORDINGS_LOCK:  # Dask workers may run several chunks in threads of one process
-        rec = _RECORDINGS.get(identity)
-        if rec is not None:
+        got = _RECORDINGS.get(identity)
+        if got is not None:
             _RECORDINGS.move_to_end(identity)
-            return rec
-    rec = _read_only(cell.recording.load())
+            return got
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rec = _read_only(cell.recording.load())
     if rec.truth is not None and rec.truth.steps is not None:  # footzoo's column names once, not per run
 
         rec.truth.steps = reference_steps(rec.truth.steps)
+    got = (rec, list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught)))
     with _RECORDINGS_LOCK:
-        _RECORDINGS[identity] = rec
+        _RECORDINGS[identity] = got
         while len(_RECORDINGS) > RECORDINGS_PER_PROCESS:
             _RECORDINGS.popitem(last=False)
-    return rec
+    return got
 
 
 def _read_only(rec):
@@ -215,11 +220,11 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
     """
 
     setup_error: BaseException | None = None
-    rec = None
+    rec, read_warnings = None, []
     start = time.process_time()
     try:
         load_plugins(plugins)
-        rec = _recording(cells[0], identity)
+        rec, read_warnings = _recording(cells[0], identity)
     except Exception as err:  # a plug-in, reader or simulator failure fails this recording's cells only
         setup_error = err
     out = []
@@ -228,6 +233,7 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
             record = _fail(_new_record(cell, key), setup_error)
         else:
             record = _compute(cell, key, rec, metric_names, sweep_points)
+            record["warnings"] = list(dict.fromkeys([*read_warnings, *record["warnings"]]))
         # CPU seconds of this run in its worker (the first run of a chunk includes loading the recording)
         record["cpu_s"] = round(time.process_time() - start, 6)
         start = time.process_time()

@@ -115,3 +115,23 @@ def test_a_rerun_from_the_cache_keeps_the_runs_warnings_in_its_log_without_repea
     log = (tmp_path / LOG).read_text().splitlines()
     assert log == [f"{line} (from 1 cached run: warned when it ran)" for line in first]  # the same two, marked
     assert listed(tmp_path)[LOG] == hashlib.sha256((tmp_path / LOG).read_bytes()).hexdigest()
+
+
+@pytest.mark.parametrize("jobs", [1, pytest.param(2, marks=pytest.mark.slow)])  # slow: two worker processes start
+def test_a_readers_warnings_go_with_the_runs_to_the_log_and_a_quiet_study_prints_none(tmp_path, capfd, jobs):
+    """A reader that warns while a worker loads the file (a repeated time stamp, dropped): the warning goes back with
+    each run, into the log, and a quiet study (``footzoo ablate/tune --quiet``) prints nothing of it."""
+    import pandas as pd
+
+    from footzoo.sim import simulate
+
+    frame = simulate(**{k: v for k, v in SIM.items() if k != "noise"}).to_dataframe()
+    pd.concat([frame.iloc[:50], frame.iloc[49:]]).to_csv(tmp_path / "walk.csv", index=False)  # one repeated stamp
+    spec = {**CALM, "recordings": [{"path": str(tmp_path / "walk.csv"), "duplicates": "drop"}]}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        table = run_study(Study.from_dict(spec), out=tmp_path / "study", quiet=True, jobs=jobs)
+    assert not [w for w in caught if "repeats the previous one" in str(w.message)]
+    assert "repeats the previous one" not in capfd.readouterr().err
+    assert any("dropped 1 row(s) whose time stamp repeats" in w for w in table.attrs["warnings"])
+    assert "dropped 1 row(s) whose time stamp repeats" in (tmp_path / "study" / LOG).read_text()
