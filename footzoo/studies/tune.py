@@ -484,6 +484,12 @@ def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], 
         if not chosen_from:
             raise ConfigError("no setting is eligible")
         folds, held_out, best = cross_validate(values[chosen_from], groups, score)
+    left_out = [r for r in run.all_groups.index if r not in values.index]
+    if left_out:
+        warnings.warn(FootzooWarning(
+            f"tune: {len(left_out)} of {len(run.all_groups)} recording(s) gave no {spec.objective} in any setting "
+            f"and are left out of the cross-validation: {left_out[:5]}; the study's note column and {LOG} say why "
+            "(e.g. no reference that can score it)"), stacklevel=2)
     settings = run.settings
     scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
     config = run.configs[best]

@@ -194,3 +194,19 @@ def test_tune_says_when_the_chosen_value_is_the_grid_s_edge(tmp_path):
                       eligible=lambda name: name == "detector.threshold=10")  # forced to the edge
     assert result.best_ == "detector.threshold=10" and len(result.edges_) == 1
     assert "# at the edge: detector.threshold = 10 is the largest value" in (tmp_path / "best.yaml").read_text()
+
+
+def test_a_recording_that_cannot_give_the_objective_is_named_as_left_out(tmp_path):
+    """A recording without a reference gives no ``armse_3d_m``: the tune says it is left out, not just fewer rows."""
+    from footzoo.io.canonical import write
+    from footzoo.sim import simulate
+
+    bare = simulate(**{k: v for k, v in SIM.items() if k != "noise"})
+    bare.truth = None
+    write(bare, tmp_path / "bare.csv")
+    d = {**STUDY, "recordings": [*STUDY["recordings"], {"path": str(tmp_path / "bare.csv"), "group": "day3"}]}
+    with pytest.warns(FootzooWarning, match=r"tune: 1 of 5 recording\(s\) gave no armse_3d_m in any setting and are "
+                                            r"left out of the cross-validation: \['bare'\]"):
+        result = tune(Study.from_dict(d), {"objective": "armse_3d_m"}, out=tmp_path / "out", quiet=True)
+    assert "bare" not in result.values_.index and result.groups_.nunique() == 2
+    assert "left out of the cross-validation" in (tmp_path / "out" / "footzoo.log").read_text()
