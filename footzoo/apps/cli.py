@@ -222,7 +222,10 @@ def _two_feet(args: argparse.Namespace) -> bool:
     fmt = args.format or detect_format(check_input_file(args.data), _reader_options(args))
     if fmt != "gaitmap":
         if args.foot == "both":
-            raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file")
+            how = (" (a file with both feet's columns: one description per foot, each run with --option sidecar=, or "
+                   "both at once in Python as a footzoo.Session: docs/readers/generic.md, 'Both feet in one file')"
+                   if fmt == "generic" else "")
+            raise FormatError(f"{args.data}: a {fmt} file holds one foot; --foot both needs a gaitmap file{how}")
         return False
     return len(feet(Path(args.data))) == 2 or args.foot == "both"
 

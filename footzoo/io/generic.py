@@ -62,8 +62,8 @@ def sidecar_of(path: Path) -> Path:
 class _Spec:
     """A validated description (every problem a FormatError naming the sidecar and the key).
 
-    ``given``: the options that replace the description's keys (``axes``, ``acc_unit``, ``gyr_unit``);
-    a key an option gives may be left out of the description.
+    ``given``: the options that replace the description's keys (``axes``, ``acc_unit``, ``gyr_unit``, and
+    ``rate``, which replaces ``time``: ``t = row / rate``); a key an option gives may be left out of the description.
     """
 
     def __init__(self, raw: Any, source: Path, given: dict[str, Any] | None = None):
@@ -75,7 +75,7 @@ class _Spec:
             if key not in KEYS:
                 self.fail(str(key), f"unknown key{did_you_mean(str(key), list(KEYS))}; valid: {list(KEYS)}")
         for key in ("time", "acc", "gyr", "axes"):
-            if key not in raw and not (key == "axes" and "axes" in given):
+            if key not in raw and not (key == "axes" and "axes" in given) and not (key == "time" and "rate" in given):
                 hint = (": the file's axes in footzoo's forward-right-down frame, e.g. axes: [x, y, z] for a sensor "
                         "already FRD, [x, -y, -z] for forward-left-up" if key == "axes" else "")
                 self.fail(key, f"missing: a description needs time, acc, gyr and axes{hint} ({FORMAT_DOCS})")
@@ -93,7 +93,13 @@ class _Spec:
             self.fail("comment", f"must be one character such as '#', got {self.comment!r}")
         self.rows = (parse_axes(given["axes"], "axes") if "axes" in given else
                      parse_axes(raw["axes"], f"{source}: axes"))
-        self.time = self._time(raw["time"])
+        if "rate" in given:
+            rate = given["rate"]
+            if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 < rate < 1e5:
+                raise FormatError(f"rate={rate!r}: must be the sampling rate in Hz (a number > 0), e.g. rate=100")
+            self.time = {"rate": float(rate)}
+        else:
+            self.time = self._time(raw["time"])
         self.acc = self._block("acc", ACC_UNITS, required_unit="acc_unit" not in given)
         self.gyr = self._block("gyr", GYR_UNITS, required_unit="gyr_unit" not in given)
         for key, block, units in (("acc_unit", self.acc, ACC_UNITS), ("gyr_unit", self.gyr, GYR_UNITS)):
@@ -177,12 +183,12 @@ class _Spec:
 
 
 def read_description(path: Path, **given: Any) -> _Spec:
-    """The validated description in ``path`` (``given``: options replacing its ``axes`` and units)."""
+    """The validated description in ``path`` (``given``: options replacing its ``axes``, units and time)."""
     return _Spec(load_file(path, FormatError, "data description"), path, given)
 
 
 def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_unit: str | None = None,
-         gyr_unit: str | None = None, **options: Any) -> Recording:
+         gyr_unit: str | None = None, rate: float | None = None, **options: Any) -> Recording:
     """Read a delimited text file as its description (``<file>.footzoo.yaml`` or ``sidecar=``) says.
 
     Parameters
@@ -191,12 +197,15 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         The description to use (default: ``<file>.footzoo.yaml`` next to the file).
     axes, acc_unit, gyr_unit : optional
         Replace the description's ``axes``, ``acc.unit`` and ``gyr.unit``.
+    rate : float, optional
+        Sampling rate (Hz): replaces the description's ``time`` (``t = row / rate``), e.g. the real rate
+        of a file whose description declares another one.
     """
     side = Path(sidecar) if sidecar is not None else sidecar_of(path)
     if not side.exists():
         raise FormatError(f"{path}: no description {side.name} next to it; write one ({FORMAT_DOCS}) or "
                           "pass sidecar= (the path of a description shared by several files)")
-    spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit)
+    spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit, rate=rate)
     source = text_source(path)
     try:
         df = pd.read_csv(source, sep=spec.delimiter, decimal=spec.decimal, skiprows=spec.skip_rows,
@@ -281,6 +290,7 @@ class GenericReader(Reader):
         "sidecar": Option(None, "", "the description to use (default: <file>.footzoo.yaml next to the file); "
                                     "giving it implies this format"),
         **frame_options(None, None, None, where="the description's"),
+        "rate": Option(None, "Hz", "sampling rate: replaces the description's time (t = row / rate)"),
         **RECORDING_OPTIONS,
     }
 

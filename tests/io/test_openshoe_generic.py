@@ -253,3 +253,20 @@ def test_a_description_without_the_files_delimiter_names_the_delimiter_to_add(wa
         load(p)
     (tmp_path / "walk.csv.footzoo.yaml").write_text(desc + f"delimiter: {key}\n")
     np.testing.assert_allclose(load(p).acc, walk.acc, rtol=1e-6)
+
+
+def test_the_rate_option_replaces_the_descriptions_time(walk, tmp_path):
+    """A shared description that declares the wrong rate (or none): ``rate=`` sets t = row / rate for one file."""
+    p = tmp_path / "walk.csv"
+    np.savetxt(p, np.column_stack([walk.acc, walk.gyr]), delimiter=",", header="ax,ay,az,gx,gy,gz", comments="")
+    blocks = "acc: {columns: [ax, ay, az], unit: m/s^2}\ngyr: {columns: [gx, gy, gz], unit: rad/s}\naxes: [x, y, z]\n"
+    (tmp_path / "lab.yaml").write_text("time: {rate: 120}\n" + blocks)
+    (tmp_path / "untimed.yaml").write_text(blocks)  # no time at all: the option gives it
+    rate = 1.0 / float(np.median(np.diff(walk.t)))
+    for side in ("lab.yaml", "untimed.yaml"):
+        rec = load(p, sidecar=tmp_path / side, rate=rate)
+        np.testing.assert_allclose(rec.t, np.arange(walk.n) / rate)
+    with pytest.raises(FormatError, match=r"rate=-3: must be the sampling rate in Hz"):
+        load(p, sidecar=tmp_path / "lab.yaml", rate=-3)
+    with pytest.raises(FormatError, match="untimed.yaml: time: missing"):
+        load(p, sidecar=tmp_path / "untimed.yaml")
