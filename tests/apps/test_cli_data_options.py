@@ -68,10 +68,11 @@ def test_run_help_names_every_built_in_format(capsys):
 def test_foot_both_on_a_described_file_names_the_two_description_route(tmp_path, capsys):
     rec = simulate(n_strides=2, rate=50.0)
     path = tmp_path / "walk.csv"
-    rec.to_dataframe()[["t", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]].to_csv(path, index=False)
+    frame = rec.to_dataframe()[["t", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"]]
+    frame.set_axis(["time", "ax", "ay", "az", "gx", "gy", "gz"], axis=1).to_csv(path, index=False)
     (tmp_path / "walk.csv.footzoo.yaml").write_text(
-        "time: {column: t, unit: s}\nacc: {columns: [acc_x, acc_y, acc_z], unit: m/s^2}\n"
-        "gyr: {columns: [gyr_x, gyr_y, gyr_z], unit: rad/s}\naxes: [x, y, z]\n")
+        "time: {column: time, unit: s}\nacc: {columns: [ax, ay, az], unit: m/s^2}\n"
+        "gyr: {columns: [gx, gy, gz], unit: rad/s}\naxes: [x, y, z]\n")
     assert main(["run", YUN, "--data", str(path), "--foot", "both"]) == 3
     err = capsys.readouterr().err
     assert "one description per foot" in err and "footzoo.Session" in err and "Both feet in one file" in err
