@@ -14,11 +14,15 @@ middle of each stance (foot flat) the sensor's axes in it are ``A_i = F_iᵀ C_b
 ``v_foot = A_i · v_sensor``: the rows of ``A_i`` are the FRD axes of the foot in sensor
 coordinates, the same form as an axis map (:mod:`footzoo.io.axes`). Its element-wise median over
 the stances before the strides of at least 0.5 m (a turn on the spot has no direction of travel),
-made orthonormal again (nearest rotation, SVD), is the measured mounting. Two
+made orthonormal again (nearest rotation, SVD), is the measured mounting. Three
 symptoms are flagged:
 
 * **walks backwards**: the sensor's x axis points against the direction of travel,
   ``A[0, 0] < −0.5`` (more than 120° away);
+* **x across**: the sensor's x axis is more than 75° away from the direction of travel either way,
+  ``|A[0, 0]| < cos 75°`` (an axis map that takes a vertical or sideways sensor axis for x; on the
+  visible recordings read with their own maps ``|A[0, 0]|`` is at least 0.48: a sensor turned on the
+  foot by a few tens of degrees is not flagged);
 * **pitch reversed**: the sensor's y axis points left, ``A[1, 1] < −0.5``: ``gyr_y`` turns
   negative when the toe lifts. The report gives the correlation of ``gyr_y`` with the sagittal
   rate ``ω_ml`` over the swings too (near −1 for a reversed pitch); it is not the criterion,
@@ -51,6 +55,8 @@ MIN_STRIDES = 3
 MIN_STRIDE_LENGTH = 0.5
 #: ``A[0, 0]`` (``A[1, 1]``) below this: the sensor's x axis points backwards (its y axis left), cos 120°.
 REVERSED_COS = -0.5
+#: ``|A[0, 0]|`` below this: the sensor's x axis is more than 75° from the direction of travel either way (cos 75°).
+ACROSS_COS = math.cos(math.radians(75.0))
 
 
 def nearest_rotation(a: np.ndarray) -> np.ndarray:
@@ -121,7 +127,7 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
         ``strides``, ``strides_used`` (those of at least :data:`MIN_STRIDE_LENGTH`); with at
         least :data:`MIN_STRIDES` used also ``sensor_in_foot`` (3 × 3 list,
         ``v_foot = A · v_sensor``), ``x_forward`` (``A[0, 0]``), ``pitch_rate_correlation``
-        (``gyr_y`` against the sagittal rate, over the swings), ``walks_backwards``,
+        (``gyr_y`` against the sagittal rate, over the swings), ``walks_backwards``, ``x_across``,
         ``pitch_reversed`` (bool) and ``suggested_axes`` (the proper signed permutation nearest
         to ``A``, ``[x, y, z]`` when the axes are right, None when no permutation is near).
     """
@@ -150,13 +156,15 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     p = nearest_axis_map(a)
     out.update(sensor_in_foot=np.round(a, 4).tolist(), x_forward=float(a[0, 0]), y_right=float(a[1, 1]),
                pitch_rate_correlation=corr, walks_backwards=bool(a[0, 0] < REVERSED_COS),
+               x_across=bool(abs(a[0, 0]) < ACROSS_COS),
                pitch_reversed=bool(a[1, 1] < REVERSED_COS),
                suggested_axes=None if p is None else axis_map_text(p))
     return out
 
 
 def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | None = None) -> None:
-    """A :class:`SensorWarning` when the report finds the foot walking backwards or its pitch reversed.
+    """A :class:`SensorWarning` when the report finds the foot walking backwards, across the sensor's x axis, or
+    its pitch reversed.
 
     ``axes`` is the axis map the recording was read with (``Recording.meta["axes"]``): the fix is the
     map to read the file with instead, spelled as the ``axes`` option every reader takes
@@ -166,6 +174,10 @@ def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | N
     if report.get("walks_backwards"):
         symptoms.append(f"the foot walks backwards along the sensor's x axis (x · direction of travel = "
                         f"{report['x_forward']:+.2f})")
+    if report.get("x_across"):
+        angle = math.degrees(math.acos(min(1.0, abs(report["x_forward"]))))
+        symptoms.append(f"the sensor's x axis is not along the foot: it is {angle:.0f}° from the direction of travel "
+                        f"(x · direction of travel = {report['x_forward']:+.2f})")
     if report.get("pitch_reversed"):
         symptoms.append(f"the sensor's y axis points left (y · right = {report['y_right']:+.2f}): gyr_y is negative "
                         "when the toe lifts, so heel strike and toe-off swap places for a method reading gyr_y")

@@ -185,8 +185,9 @@ def test_gaitmap_read_with_a_wrong_right_handed_map(name):
     np.testing.assert_allclose(res.steps["end_s"], base["end_s"], atol=0.010)
     rep = res.diagnostics["mounting"]
     assert rep["suggested_axes"] == name
-    flagged = rep["walks_backwards"] or rep["pitch_reversed"]
-    assert flagged is (name != "[y, -x, z]")  # a sensor turned 90° about z: x points left, neither symptom
+    flagged = rep["walks_backwards"] or rep["pitch_reversed"] or rep["x_across"]
+    assert flagged  # a sensor turned 90° about z ([y, -x, z]): its x points left, across the direction of travel
+    assert rep["x_across"] is (name == "[y, -x, z]")
     assert bool(warned) is flagged
 
 
@@ -231,3 +232,14 @@ def test_the_swing_correlation_is_numpys_over_the_swing_samples():
     assert np.isnan(swing_correlation(gyr, np.arange(10.0), np.array([0]), np.array([10])))  # constant gyr_y
     gyr[:, 1] = np.arange(10.0)
     assert abs(swing_correlation(gyr, -2.0 * np.arange(10.0), np.array([0, 6]), np.array([4, 10])) + 1.0) < 1e-15
+
+
+@pytest.mark.parametrize("name", ["[y, -z, -x]", "[y, -x, z]", "[-z, y, x]"])
+def test_an_x_axis_across_the_direction_of_travel_is_named_with_its_fix(walk, name):
+    """An axis map that takes a vertical or sideways sensor axis for x: flagged, with the map that undoes it."""
+    m = next(p for p in proper_axis_permutations() if axis_map_name(p) == name)
+    res, warned = _run(remount(walk, m))
+    rep = res.diagnostics["mounting"]
+    assert rep["x_across"] and abs(rep["x_forward"]) < 0.1 and rep["suggested_axes"] == name
+    text = str(warned[0].message)
+    assert "x axis is not along the foot" in text and f"axes={name.replace(' ', '')}" in text.replace(" ", "")
