@@ -40,7 +40,7 @@ from ..core.data import Recording, Truth
 from ..core.errors import FormatError, did_you_mean
 from ..core.yamlsafe import load_file
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, frame_options, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, frame_options, text_source
 
 #: Suffix of a data file's description: ``<file>.footzoo.yaml``.
 SIDECAR_SUFFIX = ".footzoo.yaml"
@@ -203,8 +203,9 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
     """
     side = Path(sidecar) if sidecar is not None else sidecar_of(path)
     if not side.exists():
-        raise FormatError(f"{path}: no description {side.name} next to it; write one ({FORMAT_DOCS}) or "
-                          "pass sidecar= (the path of a description shared by several files)")
+        raise FormatError(f"{path}: no description {side.name} next to it; write one ({FORMAT_DOCS}"
+                          f"{_first_line_hint(path)}) or pass sidecar= (the path of a description shared by several "
+                          "files)")
     spec = read_description(side, axes=axes, acc_unit=acc_unit, gyr_unit=gyr_unit, rate=rate)
     source = text_source(path)
     try:
@@ -255,6 +256,16 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         meta.setdefault("mag_unit", spec.mag["unit"])
     truth = Truth(closed_loop=True, source="closed loop (description)") if spec.closed_loop else None
     return Recording.from_dataframe(frame, meta=meta, truth=truth, **options)
+
+
+def _first_line_hint(path: Path) -> str:
+    """The file's first line, for a description to be written: the column names it will name."""
+    try:
+        head = first_line(path).strip()
+    except (OSError, UnicodeError):
+        return ""
+    return (f"; the file begins {head[:120]!r}: name its columns under time (or time: {{rate: HZ}} without a "
+            "time column), acc and gyr, with their units, and the axes") if head and head.isprintable() else ""
 
 
 def _delimiter_hint(columns: list[str], delimiter: str) -> str:

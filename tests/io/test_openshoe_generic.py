@@ -270,3 +270,12 @@ def test_the_rate_option_replaces_the_descriptions_time(walk, tmp_path):
         load(p, sidecar=tmp_path / "lab.yaml", rate=-3)
     with pytest.raises(FormatError, match="untimed.yaml: time: missing"):
         load(p, sidecar=tmp_path / "untimed.yaml")
+
+
+def test_a_file_without_its_description_is_told_what_to_describe(walk, tmp_path):
+    p = tmp_path / "walk.csv"
+    np.savetxt(p, np.column_stack([walk.acc, walk.gyr])[:10], delimiter=",", header="ax_g,ay_g,az_g,gx,gy,gz",
+               comments="")
+    with pytest.raises(FormatError, match=r"no description walk.csv.footzoo.yaml next to it.*the file begins "
+                                          r"'ax_g,ay_g,az_g,gx,gy,gz': name its columns under time"):
+        load(p, format="generic")
