@@ -234,7 +234,7 @@ def test_the_swing_correlation_is_numpys_over_the_swing_samples():
     assert abs(swing_correlation(gyr, -2.0 * np.arange(10.0), np.array([0, 6]), np.array([4, 10])) + 1.0) < 1e-15
 
 
-@pytest.mark.parametrize("name", ["[y, -z, -x]", "[y, -x, z]", "[-z, y, x]"])
+@pytest.mark.parametrize("name", ["[y, -z, -x]", "[y, -x, z]"])
 def test_an_x_axis_across_the_direction_of_travel_is_named_with_its_fix(walk, name):
     """An axis map that takes a vertical or sideways sensor axis for x: flagged, with the map that undoes it."""
     m = next(p for p in proper_axis_permutations() if axis_map_name(p) == name)
@@ -243,3 +243,21 @@ def test_an_x_axis_across_the_direction_of_travel_is_named_with_its_fix(walk, na
     assert rep["x_across"] and abs(rep["x_forward"]) < 0.1 and rep["suggested_axes"] == name
     text = str(warned[0].message)
     assert "x axis is not along the foot" in text and f"axes={name.replace(' ', '')}" in text.replace(" ", "")
+
+
+
+def test_a_track_across_x_with_the_pitch_axis_right_is_not_blamed_on_the_map():
+    """mbgtd with only a height correction: the track goes sideways (strides of metres on a 1.2 m walk) while gyr_y
+    is still the pitch rate; the map is right, so no mounting warning names it."""
+    from footzoo import Pipeline
+    from footzoo.sim import NoiseModel, simulate
+
+    rec = simulate(n_strides=3, rate=50.0, profile="physical", noise=NoiseModel(seed=0), distance_sensors=True,
+                   clearance=0.1)
+    cfg = {"orientation": {"type": "ins"}, "detector": {"type": "mbgtd"}, "corrections": [{"type": "height_distance"}]}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rep = Pipeline.from_dict(cfg).run(rec).diagnostics["mounting"]
+    assert abs(rep["x_forward"]) < 0.26 and rep["pitch_rate_correlation"] > 0.8  # measured 0.06 and 0.92
+    assert not rep["x_across"] and not rep["walks_backwards"] and not rep["pitch_reversed"]
+    assert not [w for w in caught if "mounting" in str(w.message)]
