@@ -40,7 +40,15 @@ import numpy as np
 from ..core.atomic import atomic_path, check_target, folder_lock, refuse_inputs
 from ..core.context import RunContext
 from ..core.conventions import ACC_UNITS, GYR_UNITS
-from ..core.errors import ConfigError, FootzooError, FormatError, OutputError, PluginError, RecordingError
+from ..core.errors import (
+    ConfigError,
+    FootzooError,
+    FormatError,
+    OutputError,
+    PluginError,
+    RecordingError,
+    did_you_mean,
+)
 from ..core.files import why_missing
 from ..core.params import describe as describe_parameters
 from ..core.warninglog import LOG, log_text, warning_texts
@@ -50,12 +58,20 @@ from ..plugins.registry import describe
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
-    options: dict[str, Any] = dict(getattr(args, "option", None) or [])
+    """The reader's options of the command line; one given twice (two values, or --acc-unit and --option acc_unit=)
+    is a ConfigError: the last one would silently win."""
+    options: dict[str, Any] = {}
+    given = [(name, value, f"--option {name}=") for name, value in getattr(args, "option", None) or []]
     if getattr(args, "foot", None) and args.foot != "both":
-        options["foot"] = args.foot
-    for key in ("acc_unit", "gyr_unit"):
-        if getattr(args, key, None):
-            options[key] = getattr(args, key)
+        given.append(("foot", args.foot, "--foot "))
+    given += [(key, getattr(args, key), f"--{key.replace('_', '-')} ") for key in ("acc_unit", "gyr_unit")
+              if getattr(args, key, None)]
+    first: dict[str, str] = {}
+    for name, value, how in given:
+        if name in options and options[name] != value:
+            raise ConfigError(f"the reader's option {name!r} is given twice ({first[name]}{options[name]} and "
+                              f"{how}{value}); give it once")
+        options[name], first[name] = value, first.get(name, how)
     return options
 
 
@@ -79,6 +95,22 @@ def _output(text: str) -> str:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
     return text
+
+
+def _metric_names(text: str) -> list[str]:
+    """An argparse ``type`` for ``--show``: comma-separated names of footzoo's metrics (a misspelt one would show
+    an empty table)."""
+    # deferred: the metrics (pandas), read only for --show given
+    from ..evaluation.metrics import METRICS
+
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    for name in names:
+        if name not in METRICS:
+            raise argparse.ArgumentTypeError(f"{name!r} is not a metric{did_you_mean(name, list(METRICS))}; "
+                                             f"metrics: {', '.join(METRICS)}")
+    if not names:
+        raise argparse.ArgumentTypeError("no metric named; give metrics separated by commas, e.g. armse_3d_m,strides")
+    return names
 
 
 def _input_yaml(text: str) -> str:
@@ -189,7 +221,7 @@ def _writable_dir(path: str, option: str = "--out") -> Path:
 def _writable_file(path: str, option: str = "--out") -> Path:
     """Check that the file ``path`` can be written (its folder exists and is writable), before any work."""
 
-    p = check_target(path, f"{option} {path!r}")
+    p = check_target(path, option)
     if p.exists() and not os.access(p, os.W_OK):
         raise OutputError(f"{option} {path!r} is not writable (permission denied); choose a writable place")
     return p
@@ -561,7 +593,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
                if c not in ("run", "base", "recording", "metric", "value", "error", "note")]
     for f in compared(table, factors)[:3]:
         s = readable(summarise(table, f), f)
-        keep = s[s["metric"].isin(args.show.split(","))] if args.show else s
+        keep = s[s["metric"].isin(args.show)] if args.show else s
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
     return 0
@@ -635,8 +667,12 @@ def cmd_configs(args: argparse.Namespace) -> int:
     # deferred: yaml: the command line starts without it
     from ..config import library
 
+    if not args.copy and (args.to is not None or args.force):
+        given = "--to" if args.to is not None else "--force"
+        raise ConfigError(f"{given} goes with --copy NAME (the shipped config to copy): footzoo configs --copy NAME "
+                          "--to DEST")
     if args.copy:
-        target = library.copy(args.copy, args.to, overwrite=args.force)
+        target = library.copy(args.copy, args.to or ".", overwrite=args.force)
         print(f"wrote {target} (a copy of the shipped {library.path(args.copy).stem}); edit it and run "
               f"footzoo run {target}")
         return EXIT_OK
@@ -759,7 +795,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     abl.add_argument("--out", type=_output,
                      help="output folder (default: ablation_<study>); its cache/ makes reruns resume")
-    abl.add_argument("--show", help="comma-separated metrics to print (default: all)")
+    abl.add_argument("--show", type=_metric_names, help="comma-separated metrics to print (default: all)")
     abl.add_argument("--prune-cache", action="store_true",
                      help="remove every cache entry this study did not use (other studies' runs in the same --out)")
     abl.add_argument("--cache-max-age", type=_number(0, 1e6, "days"), default=30.0, metavar="DAYS",
@@ -795,7 +831,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
     cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")
-    cfg.add_argument("--to", default=".", metavar="DEST", type=_destination,
+    cfg.add_argument("--to", default=None, metavar="DEST", type=_destination,
                      help="folder or file name of the copy (default: here)")
     cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
     cfg.set_defaults(func=cmd_configs)

@@ -9,6 +9,7 @@ wins over a name, so a user's edited copy next to their data is read instead.
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -83,6 +84,9 @@ def resolve(spec: str | Path) -> Path:
 def copy(name: str, dest: str | Path = ".", overwrite: bool = False) -> Path:
     """Copy the shipped config ``name`` to ``dest`` (a folder, or a file name) to edit it; returns the new file.
 
+    ``dest`` is a folder when it is one, ends in ``/`` or has no extension (created when missing), else a
+    ``.yaml``/``.yml`` file name.
+
     Raises
     ------
     ConfigError
@@ -90,7 +94,11 @@ def copy(name: str, dest: str | Path = ".", overwrite: bool = False) -> Path:
     """
     src = path(name)
     d = Path(dest)
-    target = d / src.name if d.is_dir() else d
+    folder = d.is_dir() or str(dest).endswith(("/", os.sep)) or (not d.exists() and not d.suffix)
+    if not folder and d.suffix not in (".yaml", ".yml"):
+        raise ConfigError(f"{str(dest)!r}: a config is a YAML file; name the copy '{d.stem}.yaml', or give a folder "
+                          f"(ending in '/') to copy {src.name} into")
+    target = d / src.name if folder else d
     if target.exists() and not overwrite:
         raise ConfigError(f"{target} exists; choose another destination, or overwrite it (--force; overwrite=True)")
     if target.resolve() == src.resolve():

@@ -312,10 +312,12 @@ def _number(name: str, value: Any, example: str) -> float:
         hint = ""
         if isinstance(value, str):
             try:
-                float(value)
-                hint = " (write the number without quotes)"
+                as_number = float(value)
             except ValueError:
-                hint = ""
+                as_number = None
+            if as_number is not None and not math.isfinite(as_number):  # 'nan', 'inf': text, and not finite either
+                raise ConfigError(f"{name} must be a finite number, got {shown(value)}{example}")
+            hint = " (write the number without quotes)" if as_number is not None else ""
         raise ConfigError(f"{name} must be a number, got {type(value).__name__} {shown(value)}{hint}{example}")
     try:
         v = float(value)

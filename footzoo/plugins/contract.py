@@ -222,7 +222,7 @@ def who(plugin: Any) -> str:
 
 
 def _where(plugin: Any) -> str:
-    cls = type(plugin)
+    cls = plugin if isinstance(plugin, type) else type(plugin)
     try:
         path = inspect.getsourcefile(cls)
     except (TypeError, OSError):
@@ -231,7 +231,8 @@ def _where(plugin: Any) -> str:
 
 
 def fault(plugin: Any, method: str, err: BaseException) -> PluginError:
-    """The :class:`PluginError` for an exception ``err`` raised in ``plugin.method``."""
+    """The :class:`PluginError` for an exception ``err`` raised in ``plugin.method`` (``plugin``: the instance, or its
+    class for ``__init__``)."""
     text = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
     hint = "fix the plug-in"
     if isinstance(err, ValueError) and "read-only" in str(err):

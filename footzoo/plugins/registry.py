@@ -56,6 +56,8 @@ def register(cls: type[Plugin]) -> type[Plugin]:
     if not cls.name or not isinstance(cls.name, str):
         raise ValueError(f"{cls.__name__}: set the class attribute name = '...' (the YAML type)")
     source = _source(cls)
+    if source is not None:
+        _load_builtin()  # a plug-in from outside may not take a built-in's name: known now, not at the first lookup
     old = _REGISTRY[cls.kind].get(cls.name)
     if old is not None and old is not cls and old.__module__ != cls.__module__:
         # a module executed again (an edited plug-in file loaded again) replaces its own registrations
@@ -153,8 +155,21 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
         return cls(**cls.validate_params(params))  # the declared arguments checked before the constructor runs
     except ConfigError as err:
         raise ConfigError(f"{where} ({cls.name}): {err}") from None
-    except (TypeError, ValueError) as err:
+    except (TypeError, ValueError) as err:  # a plug-in's own check of its parameters
         raise ConfigError(f"{where} ({cls.name}): {err}") from None
+    except (KeyboardInterrupt, MemoryError):
+        raise
+    except BaseException as err:  # noqa: BLE001 - any failure of a plug-in's own constructor is a named error
+        if _source(cls) is None:
+            raise
+        raise _constructor_fault(cls, err) from err
+
+
+def _constructor_fault(cls: type[Plugin], err: BaseException) -> Exception:
+    """The PluginError of an outside plug-in whose ``__init__`` raised (its parameters had passed their checks)."""
+    from .contract import fault  # deferred: the contract needs numpy and pandas; the command line starts without
+
+    return fault(cls, "__init__", err)
 
 
 def _live(cls: type[Plugin]) -> str:
@@ -214,6 +229,10 @@ def describe(kind: str | None = None, name: str | None = None) -> str:
                              f"{f' [{unit}]' if unit else ''}  (not declared)")
         lines.append("")
     if name is not None and not found:
+        other = [k for k in KINDS if name in available(k)]
+        if kind and other:
+            raise ConfigError(f"no {kind} plug-in named {name!r}: {name!r} is a {' and a '.join(other)} plug-in; "
+                              f"leave out --kind {kind} (footzoo list {name})")
         names = sorted({n for k in ([kind] if kind else KINDS) for n in available(k)})
         raise ConfigError(f"no plug-in named {name!r}{did_you_mean(name, names)}; footzoo list shows them all")
     return "\n".join(lines).rstrip() + "\n"

@@ -30,7 +30,7 @@ import time
 import traceback
 import warnings
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -269,7 +269,7 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
 
 
 def run_study(
-    study: Study | str | Path,
+    study: Study | Mapping[str, Any] | str | Path,
     jobs: int | None = None,
     scheduler: str | None = None,
     out: str | Path | None = None,
@@ -284,8 +284,8 @@ def run_study(
 
     Parameters
     ----------
-    study : Study or path
-        The study (or its YAML file).
+    study : Study, mapping or path
+        The study, its YAML file, or the mapping such a file holds (paths relative to the working folder).
     jobs : int, optional
         Local worker processes (joblib); 1 runs serially, -1 uses every core. Default: the
         study file's ``jobs``, else 1.
@@ -337,7 +337,9 @@ def run_study(
         threshold sweeps are in ``out`` (see :func:`read_trajectories`).
     """
     with WarningLog() as log:  # the study's warnings, for its footzoo.log; the caller gets them at the end
-        if not isinstance(study, Study):
+        if isinstance(study, Mapping):  # the study file's mapping, paths relative to the working folder
+            study = Study.from_dict(study, max_cells=max_cells)
+        elif not isinstance(study, Study):
             study = Study.from_yaml(study, max_cells=max_cells)
         if jobs is None:
             jobs = study.jobs or 1

@@ -424,16 +424,18 @@ def recording_groups(study: Study, group_by: str | None = None) -> pd.Series:
     return pd.Series(out, name="group")
 
 
-def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = None, score: Score | None = None,
-         eligible: Callable[[str], bool] | None = None, groups: Callable[[str], str] | None = None,
+def tune(study: Study | dict[str, Any] | str | Path, spec: TuneSpec | dict[str, Any] | None = None,
+         score: Score | None = None, eligible: Callable[[str], bool] | None = None,
+         groups: Callable[[str], str] | None = None,
          jobs: int | None = None, scheduler: str | None = None, out: str | Path | None = None,
          progress: bool = False, quiet: bool = False) -> TuneResult:
     """Choose a setting by leave-one-group-out cross-validation (see the module's docstring).
 
     Parameters
     ----------
-    study : Study or path
-        The candidates' study (its factors are the grid) or a tune file (study + ``tune:`` block).
+    study : Study, dict or path
+        The candidates' study (its factors are the grid), a tune file (study + ``tune:`` block) or the
+        mapping such a file holds (paths relative to the working folder).
     spec : TuneSpec or dict, optional
         The ``tune:`` block (required with a Study; a tune file's own otherwise).
     score : callable, optional
@@ -451,8 +453,10 @@ def tune(study: Study | str | Path, spec: TuneSpec | dict[str, Any] | None = Non
         when the call ends.
     """
     with WarningLog() as log:  # the tune's warnings, for its footzoo.log; the caller gets them at the end
-        if not isinstance(study, Study):
-            study, file_spec = load_tune_file(study)
+        if isinstance(study, dict) and "tune" not in study and spec is not None:
+            study = Study.from_dict(study)
+        elif not isinstance(study, Study):
+            study, file_spec = tune_mapping(study) if isinstance(study, dict) else load_tune_file(study)
             spec = spec if spec is not None else file_spec
         if spec is None:
             raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
@@ -632,17 +636,22 @@ def load_tune_file(path: str | Path) -> tuple[Study, TuneSpec]:
 
     p = resolve(path)
     data = load_file(p, ConfigError, "tune file")
-    if not isinstance(data, dict) or "tune" not in data:
-        raise ConfigError(f"{p}: a tune file is a study file with a 'tune:' block (objective, search, group_by, ...)")
-    data = dict(data)
-    block = data.pop("tune")
     try:
-        spec = TuneSpec.from_dict(block)
-        if spec.search != "grid":
-            data.pop("factors", None)
-        study = Study.from_dict(data, root=p.parent)
+        return tune_mapping(data, root=p.parent)
     except ConfigError as err:
         raise ConfigError(f"{p}: {err}") from None
+
+
+def tune_mapping(data: Any, root: str | Path = ".") -> tuple[Study, TuneSpec]:
+    """A tune file's mapping: the study (without its ``tune:`` block) and the spec; paths relative to ``root``."""
+    if not isinstance(data, dict) or "tune" not in data:
+        raise ConfigError("a tune file is a study file with a 'tune:' block (objective, search, group_by, ...)")
+    data = dict(data)
+    block = data.pop("tune")
+    spec = TuneSpec.from_dict(block)
+    if spec.search != "grid":
+        data.pop("factors", None)
+    study = Study.from_dict(data, root=root)
     if spec.config is not None and not Path(spec.config).is_absolute():
-        spec.config = str(p.parent / spec.config)
+        spec.config = str(Path(root) / spec.config)
     return study, spec
