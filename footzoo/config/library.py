@@ -10,6 +10,7 @@ wins over a name, so a user's edited copy next to their data is read instead.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -69,6 +70,12 @@ def resolve(spec: str | Path) -> Path:
         raise ConfigError("the config is an empty name; give a shipped config's name (footzoo configs lists them) "
                           "or the path of a YAML file")
     p = Path(spec)
+    if isinstance(spec, str) and not p.exists() and ("\n" in spec or re.match(r"\s*[\w.-]+\s*:\s", spec)):
+        raise ConfigError(f"{spec[:60]!r} looks like the text of a YAML config, not a file name nor a shipped "
+                          "config's name; write it to a .yaml file and give its path, or pass the mapping itself "
+                          "(Pipeline.from_dict({...}))")
+    if p.is_symlink() and not p.exists():
+        return p  # a link in a loop or to nothing: the file's reader names why
     if p.exists() or not is_name(spec):
         if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml", ".yml"):
             if p.suffix:  # a file name: say that the file is missing, then which names are shipped

@@ -18,7 +18,7 @@ import pandas as pd
 from .checks import check_positive, gap_limit
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
 from .errors import FootzooWarning, RecordingError
-from .norms import row_norms
+from .norms import row_norms, unit_error
 from .sanity import check_impossible, scan
 
 ACC_COLS = ["acc_x", "acc_y", "acc_z"]
@@ -38,6 +38,8 @@ RATE_RANGE = (10.0, 20_000.0)
 GAP_PERIODS = 1.5
 #: Gyro peak (in the declared unit rad/s) above which the data must be in deg/s.
 GYRO_DEG_S_SUSPICION = 50.0
+#: Largest ``| |q|² − 1 |`` of a reference quaternion read from a file (4-decimal exports stay well inside).
+TRUTH_QUAT_TOLERANCE = 0.01
 
 
 @dataclass
@@ -280,6 +282,16 @@ class Recording:
                         f"row {row} (t = {float(t[row]):.6f} s) has values in only its first {filled} of "
                         f"{len(empty)} columns: the file is cut short there, or the row is damaged; remove or "
                         "repair that row (a file still being written? copy it once it is complete)")
+                text = df[cols[col]].iloc[row]
+                if isinstance(text, str) and text.strip():  # text where a number belongs, not a NaN the file holds
+                    cells = [str(v).strip() for v in df.iloc[row]]
+                    if cells[:len(df.columns)] == [str(c).strip() for c in df.columns]:
+                        raise RecordingError(
+                            f"row {row} repeats the header line (two files joined into one?); remove that line, or "
+                            "split the file there into two recordings")
+                    raise RecordingError(
+                        f"column {cols[col]!r} holds the text {text[:40]!r} at row {row} (t = {float(t[row]):.6f} s), "
+                        "not a number; repair or drop that row, or pass nan_policy='interpolate'")
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
                     f"first at row {row} (t = {float(t[row]):.6f} s); drop or repair those rows, "
@@ -364,13 +376,25 @@ def _truth_from_columns(df: pd.DataFrame) -> Truth | None:
         return df[cols].to_numpy(dtype=float) if found else None
 
     pos, vel, quat = get(TRUTH_POS_COLS), get(TRUTH_VEL_COLS), get(TRUTH_QUAT_COLS)
+    if quat is not None:  # rows without a reference (NaN) are allowed; a reference that is no rotation is not
+        known = np.isfinite(quat).all(axis=1)
+        worst, k = unit_error(quat[known])
+        if worst > TRUTH_QUAT_TOLERANCE:
+            row = int(np.flatnonzero(known)[k])
+            raise RecordingError(
+                f"columns {TRUTH_QUAT_COLS}: row {row} holds {np.round(quat[row], 4).tolist()}, of length "
+                f"{float(np.linalg.norm(quat[row])):.4g}, not a unit quaternion (the reference attitude body -> NED, "
+                "scalar first); fix the reference (normalise it, or leave a row without one empty) or drop these "
+                "columns")
     stance = None
     if "true_stance" in df.columns:
         flags = pd.to_numeric(df["true_stance"], errors="coerce").to_numpy(dtype=float)
         if not np.isin(flags, (0.0, 1.0)).all():
             k = int(np.argmax(~np.isin(flags, (0.0, 1.0))))
+            value = df["true_stance"].iloc[k]
+            value = value.item() if isinstance(value, np.generic) else value
             raise RecordingError(
-                f"column 'true_stance' must hold 0 or 1 in every row, got {df['true_stance'].iloc[k]!r} at row {k}; "
+                f"column 'true_stance' must hold 0 or 1 in every row, got {value!r} at row {k}; "
                 "fix the column or drop it"
             )
         stance = flags.astype(bool)

@@ -81,6 +81,28 @@ def foreign_encoding(head: bytes) -> str | None:
     return None
 
 
+def not_utf8(path: str | os.PathLike) -> str:
+    """Where a text file stops being UTF-8: the byte, its offset and line, and the fix (the file read in blocks).
+
+    A parser's own ``UnicodeDecodeError`` counts from the start of the block it was decoding, not of the file.
+    """
+    decoder = codecs.getincrementaldecoder("utf-8")()
+    offset, line = 0, 1
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 20):
+            try:
+                decoder.decode(block)
+            except UnicodeDecodeError as err:
+                at = offset + err.start
+                line += block.count(b"\n", 0, err.start)
+                return (f"not UTF-8 text (byte 0x{block[err.start]:02x} at offset {at}, line {line}): another "
+                        "encoding (Latin-1 or Windows-1252, e.g. a degree sign or a name with an accent); save the "
+                        "file as UTF-8 (iconv -f latin1 -t utf-8 in.csv > out.csv)")
+            offset += len(block)
+            line += block.count(b"\n")
+    return "not UTF-8 text; save the file as UTF-8 (iconv -f latin1 -t utf-8 in.csv > out.csv)"
+
+
 def _reads_as(head: bytes, name: str) -> bool:
     """Whether ``head`` decodes as mostly printable text in ``name`` (UTF-16/32; either byte order)."""
     width = 4 if name == "UTF-32" else 2

@@ -39,7 +39,7 @@ import numpy as np
 from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
-from ..core.files import why_missing
+from ..core.files import not_utf8, why_missing
 from . import xio
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import REQUIRED, Option, Reader
@@ -186,7 +186,7 @@ def load(path: str | Path, format: str | None = None, **options: Any) -> Recordi
         raise
     except UnicodeDecodeError as err:
         raise FormatError(
-            f"{p}: not UTF-8 text (byte offset {err.start}); is it really a {fmt} file? Pass format= if not"
+            f"{p}: {not_utf8(p) if p.is_file() else 'not UTF-8 text'}; is it really a {fmt} file? Pass format= if not"
         ) from err
     except (KeyboardInterrupt, MemoryError):
         raise

@@ -27,6 +27,7 @@ from ..core.checks import check_bool
 from ..core.conventions import quat_from_matrix, quat_mul
 from ..core.data import ACC_COLS, GYR_COLS, MAG_COLS, TRUTH_POS_COLS, TRUTH_QUAT_COLS, TRUTH_VEL_COLS, Recording, Truth
 from ..core.errors import FootzooWarning, FormatError, OutputError, did_you_mean
+from ..core.files import not_utf8
 from .axes import describe_axes, parse_axes, rotate_columns
 from .base import (
     RECORDING_OPTIONS,
@@ -76,8 +77,8 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
             df = pd.read_parquet(path)
         else:
             df = pd.read_csv(text_source(path), comment="#", **EXACT_CSV)
-    except UnicodeDecodeError as err:
-        raise FormatError(f"{path}: not UTF-8 text (byte offset {err.start}); is it a CSV file?") from None
+    except UnicodeDecodeError:
+        raise FormatError(f"{path}: {not_utf8(path)}") from None
     except FormatError:
         raise
     except (ValueError, OSError, pd.errors.ParserError) as err:

@@ -190,7 +190,7 @@ class Readers(Mapping[str, Any]):
         if p.suffix.lower() in (".csv", ".txt", ".tsv", "") and not head:
             raise FormatError(f"{p}: the file has no header line (it is empty or blank); check the file")
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
-        sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"))
+        sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"), (" ", "spaces"))
                     if head and ch in head and "," not in head), "")
         if sep:
             seen += (f"; its values are separated by {sep}, not commas: save it as comma-separated CSV, or "
