@@ -67,6 +67,27 @@ CASES = [
           ("tcp://host:99999", "is not HOST:PORT with a port in 1-65535"),
           ("http://host:8786", "unknown protocol 'http'"), ("inproc://x", "is not an in-process address (inproc://HOST/PID/N"),
           ("", "is not HOST:PORT"), ("tcp://[::1:8786", "the IPv6 host must be in brackets")])],
+    # a reader's option given twice: the last one would silently win
+    ("option-given-twice", lambda d, w: ["run", "yun2012", "--data", str(w), "--option", "max_gap=1", "--option",
+                                         "max_gap=2"], EXIT_USAGE,
+     "the reader's option 'max_gap' is given twice (--option max_gap=1 and --option max_gap=2); give it once"),
+    ("unit-given-twice", lambda d, w: ["run", "yun2012", "--data", str(w), "--acc-unit", "g", "--option",
+                                       "acc_unit=m/s^2"], EXIT_USAGE, "(--option acc_unit=m/s^2 and --acc-unit g)"),
+    ("option-nan", lambda d, w: ["run", "yun2012", "--data", str(w), "--option", "max_gap=nan"], EXIT_USAGE,
+     "max_gap must be a finite number, got 'nan'"),
+    # a name, a metric or a destination that cannot be what was meant
+    ("list-kind-of-another", lambda d, w: ["list", "shoe", "--kind", "orientation"], EXIT_USAGE,
+     "no orientation plug-in named 'shoe': 'shoe' is a detector plug-in; leave out --kind orientation"),
+    ("show-unknown-metric", lambda d, w: ["ablate", str(QUICK), "--show", "strides,armse_3d"], EXIT_USAGE,
+     "argument --show: 'armse_3d' is not a metric (did you mean 'armse_3d_m'?)"),
+    ("configs-to-without-copy", lambda d, w: ["configs", "--to", str(d / "mine")], EXIT_USAGE,
+     "--to goes with --copy NAME"),
+    ("configs-to-not-yaml", lambda d, w: ["configs", "--copy", "yun2012", "--to", str(d / "mine.txt")], EXIT_USAGE,
+     "a config is a YAML file; name the copy 'mine.yaml', or give a folder"),
+    ("simulate-out-a-folder", lambda d, w: [(d / "o").mkdir(), "simulate"][1:] + ["straight", "--out", "o"], EXIT_DATA,
+     "error: --out 'o' is a directory; give a file name"),
+    ("run-config-link-loop", lambda d, w: [(d / "loop.yaml").symlink_to("loop.yaml"), "run"][1:] + [
+        "loop.yaml", "--data", str(w)], EXIT_USAGE, "config file 'loop.yaml' is a symbolic link in a loop"),
     # arguments in the wrong place
     ("run-swapped", lambda d, w: ["run", str(w), str(YUN)], EXIT_USAGE,
      f"the config comes first and the recording after --data (swapped?): footzoo run {YUN} --data "),

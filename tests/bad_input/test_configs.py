@@ -36,3 +36,20 @@ def test_a_missing_yaml_file_is_called_missing_not_an_unknown_shipped_name(tmp_p
         resolve("my_study.yaml")
     with pytest.raises(footzoo.ConfigError, match=r"no shipped config named 'recomended' \(did you mean 'recommended'"):
         resolve("recomended")
+
+
+def test_yaml_text_given_as_a_configs_name_says_what_it_is(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for text in ("detector: {type: shoe}", "name: x\norientation: {type: ins}\n"):
+        with pytest.raises(footzoo.ConfigError, match="looks like the text of a YAML config, not a file name"):
+            footzoo.Pipeline.from_yaml(text)
+    with pytest.raises(footzoo.ConfigError, match="no shipped config named 'yun'"):  # a name stays a name
+        footzoo.Pipeline.from_yaml("yun")
+
+
+def test_a_config_named_by_a_link_in_a_loop_is_called_a_loop_not_missing(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "c.yaml").symlink_to("c.yaml")
+    for read in (footzoo.Pipeline.from_yaml, footzoo.run_study):
+        with pytest.raises(footzoo.ConfigError, match=r"'c\.yaml' is a symbolic link in a loop \(c\.yaml -> c\.yaml"):
+            read("c.yaml")

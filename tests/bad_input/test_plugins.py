@@ -24,6 +24,7 @@ from footzoo.core.errors import ConfigError, PluginImportError
 from footzoo.detectors.angular_rate_fsm import AngularRateFSM
 from footzoo.io.canonical import write
 from footzoo.orientation.madgwick import Madgwick
+from footzoo.plugins import registry
 from footzoo.plugins.base import Analysis, Calibration, Detector, Orientation, VelocityCorrection
 from footzoo.plugins.contract import QUAT_NORM_TOL, checked
 from footzoo.plugins.extensions import load_plugins
@@ -387,3 +388,41 @@ def test_a_reader_that_exits_is_a_plugin_error(tmp_path, monkeypatch, walk):
     data = write(walk, tmp_path / "w.csv")
     with pytest.raises(PluginError, match=r"the test_exiting reader \(a test package\).*never exit the process"):
         footzoo.load(data, format="test_exiting")
+
+
+def test_a_plugin_that_raises_in_its_constructor_or_takes_a_builtin_name_is_a_plugin_error(tmp_path, capsys,
+                                                                                            monkeypatch):
+    """The command line exits 4 naming the plug-in (before: exit 1, "internal error", a bug in footzoo)."""
+    monkeypatch.chdir(tmp_path)
+    source = '''
+        import footzoo
+        from footzoo.plugins.base import Detector
+
+        @footzoo.register
+        class Bad(Detector):
+            """A detector whose constructor fails, or whose name is a built-in's."""
+            name = "{name}"
+            def __init__(self, threshold: float = 1.0):
+                {init}
+                self.threshold = threshold
+            def detect(self, t, acc, gyr, ctx=None):
+                return self
+    '''
+    sim = write(simulate(n_strides=2, rate=100.0), tmp_path / "walk.csv")
+    for file, name, init, expected in [
+        ("init.py", "raises_in_init", "raise RuntimeError('no licence')",
+         ("detector 'raises_in_init' (footzoo_plugin_", "in init.py) failed in __init__(): RuntimeError: no licence; "
+                                                        "fix the plug-in")),
+        ("clash.py", "shoe", "pass", ("importing plug-in file", "clash.py' failed at line",
+                                      "a detector plug-in named 'shoe' is already registered by "
+                                      "footzoo.detectors.shoe.SHOE; choose another name")),
+    ]:
+        (tmp_path / file).write_text(textwrap.dedent(source).format(name=name, init=init))
+        (tmp_path / "c.yaml").write_text(yaml.safe_dump(_config(detector={"type": name}, plugins=[file])))
+        try:
+            assert main(["run", "c.yaml", "--data", str(sim)]) == EXIT_PLUGIN
+        finally:
+            registry._REGISTRY["detector"].pop("raises_in_init", None)
+        err = capsys.readouterr().err
+        assert all(e in err for e in expected) and "internal error" not in err and "Traceback" not in err
+    assert registry._REGISTRY["detector"]["shoe"].__module__ == "footzoo.detectors.shoe"

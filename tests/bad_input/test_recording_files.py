@@ -115,6 +115,21 @@ class Case:
     match: str
 
 
+def _table(text: bytes) -> pd.DataFrame:
+    return pd.read_csv(io.BytesIO(text))
+
+
+def _put(df: pd.DataFrame, row: int, column: str, value: object) -> pd.DataFrame:
+    df.loc[row, column] = value
+    return df
+
+
+def _lines(text: bytes, at: int, line: bytes | None) -> bytes:
+    """``text`` with ``line`` inserted before its line ``at`` (0: the header)."""
+    lines = text.split(b"\n")
+    return b"\n".join(lines[:at] + ([line] if line is not None else []) + lines[at:])
+
+
 TRIALS_HEAD = "trial,n_strides_manual_koroglu,bipedal_tag_koroglu\n"
 CASES = [
     # encodings and padding
@@ -190,6 +205,23 @@ CASES = [
     Case("truth-column-missing", lambda d, w, x: (lambda: load(_file(d, "r.csv", pd.read_csv(
         io.BytesIO(x)).drop(columns="true_pos_e").to_csv(index=False).encode()))), RecordingError,
         "reference columns incomplete: found ['true_pos_n', 'true_pos_d'], need all of"),
+    Case("truth-quaternion-zero", lambda d, w, x: (lambda: load(_file(d, "r.csv", _table(x).assign(
+        true_qw=0.0, true_qx=0.0, true_qy=0.0, true_qz=0.0).to_csv(index=False).encode()))), RecordingError,
+        "row 0 holds [0.0, 0.0, 0.0, 0.0], of length 0, not a unit quaternion"),
+    # text where numbers belong, another encoding, another delimiter: each named where it is
+    Case("header-repeated-inside", lambda d, w, x: (lambda: load(_file(d, "r.csv", _lines(x, 40, x.split(b"\n")[0])))),
+         RecordingError, "r.csv: row 39 repeats the header line (two files joined into one?)"),
+    Case("text-in-a-number-column", lambda d, w, x: (lambda: load(_file(d, "r.csv", _table(x).astype({"gyr_y": object})
+                                                                        .pipe(_put, 25, "gyr_y", "ERR")
+                                                                        .to_csv(index=False).encode()))),
+         RecordingError, "column 'gyr_y' holds the text 'ERR' at row 25 (t = 0.250000 s), not a number"),
+    Case("latin1-column-name", lambda d, w, x: (lambda: load(_file(d, "r.csv", _lines(x, 1, None).replace(
+        b"\n", b",temp \xb0C\n", 1)))), FormatError,
+        "r.csv: not UTF-8 text (byte 0xb0 at offset"),
+    Case("latin1-deep-in-the-file", lambda d, w, x: (lambda: load(_file(d, "r.csv", x[:99999] + b"\xe9" + x[99999:]))),
+         FormatError, "r.csv: not UTF-8 text (byte 0xe9 at offset 99999, line"),
+    Case("space-separated", lambda d, w, x: (lambda: load(_file(d, "r.csv", _table(x).to_csv(
+        index=False, sep=" ").encode()))), FormatError, "its values are separated by spaces, not commas"),
     # a sidecar that cannot be written
     Case("sidecar-is-a-folder", lambda d, w, x: (lambda: write(w, _folder_sidecar(d))), OutputError,
          "its sidecar s.csv.meta.yaml (its metadata, written next to it) cannot be written: s.csv.meta.yaml is a "

@@ -58,3 +58,20 @@ def test_a_factor_that_cannot_be_set_or_repeats_a_level_is_refused(factors, mess
         study = Study.from_dict({"base": "yun2012", "factors": factors,
                                  "recordings": [{"simulate": {"path": "straight", "n_strides": 4}}]})
         run_study(study, out=tmp_path / "out", quiet=True)
+
+
+def test_a_study_or_a_tune_given_as_a_mapping_is_read_as_its_file_would_be(walk_csv, tmp_path, monkeypatch):
+    """The mapping a study file holds (before: a TypeError from pathlib); its errors name the problem as a file's."""
+    monkeypatch.chdir(walk_csv.parent)
+    study = {"name": "m", "base": "yun2012", "factors": {"detector.threshold": [0.5, 0.6]},
+             "recordings": [{"path": walk_csv.name, "group": "a"}]}
+    with pytest.raises(footzoo.ConfigError, match=r"recordings\[0\]: no file matches 'gone\.csv'"):
+        footzoo.run_study({**study, "recordings": [{"path": "gone.csv"}]}, out=tmp_path / "s")
+    with pytest.raises(footzoo.ConfigError, match="unknown study key 'factor' \\(did you mean 'factors'"):
+        footzoo.run_study({"factor": {}, **study}, out=tmp_path / "s")
+    with pytest.raises(footzoo.ConfigError, match="a tune file is a study file with a 'tune:' block"):
+        footzoo.tune(study, out=tmp_path / "t")
+    with pytest.raises(footzoo.ConfigError, match="tune.direction must be one of"):
+        footzoo.tune({**study, "tune": {"objective": "armse_3d_m", "direction": "up"}}, out=tmp_path / "t")
+    table = footzoo.run_study(study, out=tmp_path / "s", quiet=True)
+    assert set(table["detector.threshold"]) == {0.5, 0.6} and table.attrs["failed"] == 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -99,3 +100,14 @@ def test_a_built_package_carries_its_data_files(tmp_path):
         rel = source.relative_to(root / "footzoo")
         assert (built / rel).is_file(), f"{rel} is not in the built package"
     assert {p.name for p in (built / "configs").glob("*.yaml")} == {p.name for p in (root / "configs").glob("*.yaml")}
+
+
+def test_a_copy_goes_into_a_folder_named_with_a_slash_or_without_an_extension(tmp_path):
+    """``--to new/`` (or ``new``) is a folder to create and copy into, not a file named ``new`` (before: a file)."""
+    for dest in (f"{tmp_path / 'with_slash'}/", str(tmp_path / "no_extension")):
+        target = library.copy("yun2012", dest)
+        assert target == Path(dest.rstrip("/")) / "yun2012.yaml"
+        assert target.read_text() == library.path("yun2012").read_text()
+    assert library.copy("yun2012", tmp_path / "mine.yml").name == "mine.yml"
+    with pytest.raises(ConfigError, match="a config is a YAML file; name the copy 'mine.yaml'"):
+        library.copy("yun2012", tmp_path / "mine.txt")
