@@ -1,4 +1,5 @@
-"""Bad input in memory: complex samples, a path given for a recording, a result folder named like a file."""
+"""Bad input in memory: complex samples, a path given for a recording, a result folder named like a file, a session
+run without a pipeline."""
 
 from __future__ import annotations
 
@@ -41,3 +42,12 @@ def test_a_result_folder_named_like_a_file_is_refused(sim_walk, tmp_path):
         res.save(tmp_path / "result.xlsx")
     assert not (tmp_path / "result.xlsx").exists()
     assert res.save(tmp_path / "result.v2").is_dir()  # a dotted folder name that is no file type is fine
+
+
+def test_a_session_run_without_a_pipeline_says_how_to_build_one(sim_walk):
+    """Before: AttributeError ('NoneType' object has no attribute 'run') from inside the session."""
+    session = footzoo.Session({"left": sim_walk})
+    with pytest.raises(footzoo.ConfigError, match="Session.run needs a footzoo Pipeline, got NoneType None"):
+        session.run(None)
+    with pytest.raises(footzoo.ConfigError, match=r"\(Session.run\(Pipeline.from_yaml\('yun2012'\)\) builds it"):
+        session.run("yun2012")
