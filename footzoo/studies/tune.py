@@ -461,6 +461,11 @@ def tune(study: Study | dict[str, Any] | str | Path, spec: TuneSpec | dict[str, 
         if spec is None:
             raise ConfigError("tune() needs a spec (the tune: block), e.g. {'objective': 'pyshoe_error_m'}")
         spec = spec if isinstance(spec, TuneSpec) else TuneSpec.from_dict(spec)
+        if spec.config is not None and Path(spec.config).suffix.lower() not in (".yaml", ".yml"):
+            # a recording's name here (the arguments swapped?) would be replaced by the config: refused before the runs
+            raise ConfigError(f"tune config {str(spec.config)!r}: the chosen setting is written as a YAML config; "
+                              f"name the file '{Path(spec.config).stem}.yaml' (footzoo never replaces a recording or "
+                              "another file with a config)")
         if groups is None:
             groups = recording_groups(study, spec.group_by)
         else:

@@ -29,6 +29,17 @@ def walk(tmp_path_factory) -> Path:
     return write(simulate(n_strides=2, rate=50.0), tmp_path_factory.mktemp("walk") / "walk.csv")
 
 
+@pytest.fixture(scope="module")
+def walk_text(walk) -> bytes:
+    return walk.read_bytes()
+
+
+def _tune_file(d: Path) -> Path:
+    text = QUICK.read_text().replace("base: yun2012.yaml", f"base: {YUN}")
+    (d / "tune.yaml").write_text(text + "tune: {objective: armse_3d_m, group_by: '(s[0-9])$'}\n")
+    return d / "tune.yaml"
+
+
 def _sim(d: Path, *option: str) -> list[str]:
     return ["simulate", "straight", *option, "--out", str(d / "s.csv")]
 
@@ -88,6 +99,9 @@ CASES = [
      "error: --out 'o' is a directory; give a file name"),
     ("run-config-link-loop", lambda d, w: [(d / "loop.yaml").symlink_to("loop.yaml"), "run"][1:] + [
         "loop.yaml", "--data", str(w)], EXIT_USAGE, "config file 'loop.yaml' is a symbolic link in a loop"),
+    ("tune-config-over-a-recording", lambda d, w: ["tune", str(_tune_file(d)), "--out", str(d / "o"), "--config",
+                                                   str(w)], EXIT_USAGE,
+     "the chosen setting is written as a YAML config; name the file 'walk.yaml'"),
     # arguments in the wrong place
     ("run-swapped", lambda d, w: ["run", str(w), str(YUN)], EXIT_USAGE,
      f"the config comes first and the recording after --data (swapped?): footzoo run {YUN} --data "),
@@ -106,12 +120,14 @@ CASES = [
 
 
 @pytest.mark.parametrize("argv, code, fragment", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
-def test_bad_arguments_are_a_usage_error_before_any_work(argv, code, fragment, tmp_path, walk, capsys, monkeypatch):
+def test_bad_arguments_are_a_usage_error_before_any_work(argv, code, fragment, tmp_path, walk, walk_text, capsys,
+                                                        monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(argv(tmp_path, walk)) == code
     err = capsys.readouterr().err
     assert fragment in err and "Traceback" not in err
     assert not (tmp_path / "s.csv").exists()
+    assert walk.read_bytes() == walk_text  # never replaced by an output
 
 
 def test_case_ids_are_unique():
