@@ -10,6 +10,8 @@ import footzoo
 from footzoo.io.canonical import write
 from footzoo.sim import simulate
 
+from ..conftest import HARD_IRON_NOT_FITTED
+
 
 @pytest.fixture(scope="module")
 def walk_csv(tmp_path_factory):
@@ -73,5 +75,13 @@ def test_a_study_or_a_tune_given_as_a_mapping_is_read_as_its_file_would_be(walk_
         footzoo.tune(study, out=tmp_path / "t")
     with pytest.raises(footzoo.ConfigError, match="tune.direction must be one of"):
         footzoo.tune({**study, "tune": {"objective": "armse_3d_m", "direction": "up"}}, out=tmp_path / "t")
+
+
+@pytest.mark.slow  # two runs of a pipeline (about 2 s)
+@pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)  # a straight walk: yun2012's hard-iron fit is left out (expected)
+def test_a_study_given_as_a_mapping_runs(walk_csv, tmp_path, monkeypatch):
+    monkeypatch.chdir(walk_csv.parent)
+    study = {"name": "m", "base": "yun2012", "factors": {"detector.threshold": [0.5, 0.6]},
+             "recordings": [{"path": walk_csv.name}]}
     table = footzoo.run_study(study, out=tmp_path / "s", quiet=True)
     assert set(table["detector.threshold"]) == {0.5, 0.6} and table.attrs["failed"] == 0
