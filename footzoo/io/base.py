@@ -69,14 +69,13 @@ class Option:
     doc: str = ""
 
 
-#: Options every built-in reader accepts, passed on to :meth:`footzoo.Recording.from_dataframe`.
 #: What to do with a MATLAB file no reader knows: no description format reads binary files.
 MAT_ROUTE = ("read its variables with scipy.io.loadmat and build the recording with "
              "footzoo.Recording.from_dataframe (columns t, acc_x ... gyr_z, and acc_unit=/gyr_unit=; "
              "docs/readers/index.md, 'Your own logger'), then save it with footzoo.io.canonical.write for the "
              "command line")
 
-
+#: Options every built-in reader accepts, passed on to :meth:`footzoo.Recording.from_dataframe`.
 RECORDING_OPTIONS: dict[str, Option] = {
     "duplicates": Option("error", "", "rows whose time stamp repeats the previous one: 'error' or 'drop' "
                                       "(keep the first, warn with the count)"),

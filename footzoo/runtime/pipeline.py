@@ -476,6 +476,16 @@ def pipeline_arguments(d: dict[str, Any], base_dir: str | Path | None = None,
     )
 
 
+def require_pipeline(pipeline: Any, caller: str) -> None:
+    """Raise a :class:`ConfigError` unless ``pipeline`` is a :class:`Pipeline`, saying how to build one
+    (``caller``: what needs it, e.g. ``"Stream"``, ``"Session.run"``)."""
+    if isinstance(pipeline, Pipeline):
+        return
+    hint = (f" ({caller}(Pipeline.from_yaml({pipeline!r})) builds it from a config)"
+            if isinstance(pipeline, (str, os.PathLike)) else "")
+    raise ConfigError(f"{caller} needs a footzoo Pipeline, got {type(pipeline).__name__} {pipeline!r:.80}{hint}")
+
+
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:
     """Reject plug-in combinations that cannot work together, with the reason and the fix."""
     names = [c.name for c in corrections]

@@ -10,7 +10,6 @@ time from the other foot's initial contact to this foot's next initial contact.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -21,11 +20,11 @@ import pandas as pd
 
 from ..core.archive import read_session, save_session
 from ..core.data import Recording
-from ..core.errors import ConfigError, FormatError
+from ..core.errors import FormatError
 from ..evaluation.result import Result
 from ..io import detect_format, load
 from ..io.gaitmap import feet
-from .pipeline import Pipeline
+from .pipeline import Pipeline, require_pipeline
 
 FEET = ("left", "right")
 #: Parameters of the bilateral table: median per foot of these stride-table columns.
@@ -81,11 +80,7 @@ class Session:
 
     def run(self, pipeline: Pipeline, engine: str = "auto") -> SessionResult:
         """Run ``pipeline`` on each foot (``Pipeline.run``) and combine the stride tables."""
-        if not isinstance(pipeline, Pipeline):
-            hint = (f" (Session.run(Pipeline.from_yaml({pipeline!r})) builds it from a config)"
-                    if isinstance(pipeline, (str, os.PathLike)) else "")
-            raise ConfigError(f"Session.run needs a footzoo Pipeline, got {type(pipeline).__name__} "
-                              f"{pipeline!r:.80}{hint}")
+        require_pipeline(pipeline, "Session.run")
         results = {foot: pipeline.run(rec, engine=engine) for foot, rec in self.recordings.items()}
         return SessionResult(results=results, name=self.name)
 

@@ -27,7 +27,6 @@ same fit (:meth:`footzoo.Pipeline.with_fits` and :attr:`Stream.fits`).
 from __future__ import annotations
 
 import math
-import os
 import warnings
 from typing import Any
 
@@ -43,7 +42,7 @@ from ..plugins.base import checked
 from ..plugins.incremental import Chunk, Latency, length, take
 from .alignment import first_still_window
 from .chain import Chain, build_chain, with_init
-from .pipeline import STREAM_WARMUP
+from .pipeline import STREAM_WARMUP, require_pipeline
 from .stage import Queue, Stage
 from .stream_state import check_channel, check_open, check_unused
 
@@ -99,10 +98,7 @@ class Stream:
     def __init__(self, pipeline: Any, rate: float | None = None, engine: str = "auto", max_gap: float | None = None,
                  max_wait: float = 10.0, fits: Any = None, warmup: float = STREAM_WARMUP, guess: bool = True,
                  max_pending: float = 30.0, keep: bool = False):
-        if not callable(getattr(pipeline, "live_problems", None)):
-            hint = (f" (Stream(Pipeline.from_yaml({pipeline!r}), ...) builds it from a config)"
-                    if isinstance(pipeline, (str, os.PathLike)) else "")
-            raise ConfigError(f"Stream needs a footzoo Pipeline, got {type(pipeline).__name__} {pipeline!r}{hint}")
+        require_pipeline(pipeline, "Stream")
         reasons = pipeline.live_problems(fits=_fit_reports(fits))
         if rate is not None and not (isinstance(rate, (int, float)) and not isinstance(rate, bool)
                                      and math.isfinite(rate) and rate > 0):
