@@ -20,6 +20,22 @@ class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
 
 
+class NotARecordingError(RecordingError, TypeError):
+    """An argument that must be a footzoo :class:`~footzoo.Recording` is something else (a path, an array, None).
+
+    Both a :class:`RecordingError` (catch footzoo's errors by subject) and a :class:`TypeError` (Python's
+    convention for an argument of the wrong type); the message says how to build the recording.
+    """
+
+
+class NotAPipelineError(ConfigError, TypeError):
+    """An argument that must be a footzoo :class:`~footzoo.Pipeline` is something else (a config name, None).
+
+    Both a :class:`ConfigError` and a :class:`TypeError`, as :class:`NotARecordingError`; the message says how
+    to build the pipeline.
+    """
+
+
 class OutputError(FootzooError, OSError):
     """An output cannot be written: an unwritable or missing location, or it would replace an input."""
 

@@ -29,7 +29,7 @@ from ..config.schema import GRAVITY_PARAMETER, Init, check_init, check_top_level
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.data import Recording
-from ..core.errors import ConfigError, RecordingError, prefixed
+from ..core.errors import ConfigError, NotAPipelineError, NotARecordingError, RecordingError, prefixed
 from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
 from ..evaluation.result import Result
@@ -289,7 +289,7 @@ class Pipeline:
         if not isinstance(rec, Recording):
             hint = (f": load it first, Pipeline.run(footzoo.load({str(rec)!r}))" if isinstance(rec, (str, os.PathLike))
                     else ": build one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
-            raise TypeError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}{hint}")
+            raise NotARecordingError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}{hint}")
         self._check_inputs(rec)
         ctx = self.context(rec)
         chunk = recording_chunk(rec, ctx, self.init["duration"])
@@ -477,13 +477,14 @@ def pipeline_arguments(d: dict[str, Any], base_dir: str | Path | None = None,
 
 
 def require_pipeline(pipeline: Any, caller: str) -> None:
-    """Raise a :class:`ConfigError` unless ``pipeline`` is a :class:`Pipeline`, saying how to build one
+    """Raise a :class:`NotAPipelineError` unless ``pipeline`` is a :class:`Pipeline`, saying how to build one
     (``caller``: what needs it, e.g. ``"Stream"``, ``"Session.run"``)."""
     if isinstance(pipeline, Pipeline):
         return
     hint = (f" ({caller}(Pipeline.from_yaml({pipeline!r})) builds it from a config)"
-            if isinstance(pipeline, (str, os.PathLike)) else "")
-    raise ConfigError(f"{caller} needs a footzoo Pipeline, got {type(pipeline).__name__} {pipeline!r:.80}{hint}")
+            if isinstance(pipeline, (str, os.PathLike))
+            else "; build one with footzoo.Pipeline.from_yaml(name), name a shipped config or a YAML file")
+    raise NotAPipelineError(f"{caller} needs a footzoo Pipeline, got {type(pipeline).__name__} {pipeline!r:.80}{hint}")
 
 
 def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list[Plugin]) -> None:

@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..core.archive import read_session, save_session
 from ..core.data import Recording
-from ..core.errors import FormatError
+from ..core.errors import FormatError, NotARecordingError
 from ..evaluation.result import Result
 from ..io import detect_format, load
 from ..io.gaitmap import feet
@@ -50,7 +50,8 @@ class Session:
             raise FormatError(f"a session holds recordings keyed 'left' and/or 'right', got {list(recordings)}")
         for foot, rec in recordings.items():
             if not isinstance(rec, Recording):
-                raise FormatError(f"session[{foot!r}] must be a footzoo Recording, got {type(rec).__name__}")
+                raise NotARecordingError(f"session[{foot!r}] must be a footzoo Recording, got {type(rec).__name__}; "
+                                         "build it with footzoo.load(path)")
         self.recordings = dict(recordings)
         self.name = name
 

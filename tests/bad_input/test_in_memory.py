@@ -51,3 +51,18 @@ def test_a_session_run_without_a_pipeline_says_how_to_build_one(sim_walk):
         session.run(None)
     with pytest.raises(footzoo.ConfigError, match=r"\(Session.run\(Pipeline.from_yaml\('yun2012'\)\) builds it"):
         session.run("yun2012")
+
+
+def test_an_argument_of_the_wrong_kind_is_both_the_subjects_error_and_a_type_error(sim_walk):
+    """One convention for every entry point: the footzoo error of the subject, and Python's TypeError."""
+    from footzoo.core.errors import NotAPipelineError, NotARecordingError
+
+    pipe = footzoo.Pipeline.from_yaml("yun2012")
+    for call, subject in [(lambda: pipe.run("walk.csv"), footzoo.RecordingError),
+                          (lambda: footzoo.Session({"left": "walk.csv"}), footzoo.RecordingError),
+                          (lambda: footzoo.Session({"left": sim_walk}).run("yun2012"), footzoo.ConfigError),
+                          (lambda: footzoo.Stream(None, rate=100.0), footzoo.ConfigError)]:
+        with pytest.raises((NotARecordingError, NotAPipelineError)) as info:
+            call()
+        assert isinstance(info.value, subject) and isinstance(info.value, TypeError)
+        assert "footzoo." in str(info.value) or "Pipeline.from_yaml" in str(info.value)
