@@ -13,10 +13,18 @@ angle of the stance at ``end`` is the angle of the heel→toe axis against it,
 positive for toe-out (left foot: heel→toe turned counter-clockwise seen from
 above; right foot: clockwise).
 
-The stride length is gaitmap's (``SpatialParameterCalculation``: the horizontal
-distance between the first and the last position of the stride) of the heel
-marker, and agrees with gaitmap's own per-stride heel trajectories
-(``position_sample.csv``) to 0.6 mm. The events make one stride of the left
+The stride length is gaitmap's (``SpatialParameterCalculation``, after Rampp et
+al. 2015 and Kanzler et al. 2015: the horizontal distance between the first and
+the last position of the stride) of the heel marker, and agrees with gaitmap's
+own per-stride heel trajectories (``position_sample.csv``) to 0.6 mm. The events
+are gaitmap's (``gaitmap.example_data.get_healthy_example_stride_events``:
+extracted from the motion capture, converted to IMU samples; gaitmap warns that
+``min_vel`` need not fall on the IMU's own minimum). footzoo's estimated stride
+runs from the middle of one detected stance to the next and measures the sensor,
+not the heel; on the straight strides of this walk neither difference moves the
+reference by more than a centimetre (both instants moved by 0.1 s: at most
+4 mm; the toe marker instead of the heel: at most 7 mm; tests/io/test_gaitmap_reference.py).
+The events make one stride of the left
 foot's 180° turn from 16.40 s to 18.68 s although the heel stands still for
 0.7 s between two steps in it; :func:`footzoo.evaluation.metrics.match_strides` leaves
 such a stride unpaired (its borders do not match any one estimated stride).
