@@ -20,12 +20,13 @@ from ..core.context import RunContext
 from ..core.data import Recording
 from ..plugins.base import Calibration, Samples
 from ..plugins.incremental import Chunk, length
-from .alignment import initial_attitude
+from .alignment import accelerometer_gain, initial_attitude
 from .stage import Stage
 from .stages import (
     BatchNavigationStage,
     CalibrationStage,
     DetectorStage,
+    GainStage,
     KalmanStage,
     OrientationStage,
 )
@@ -149,9 +150,14 @@ def build_chain(pipeline: Any, ctx: RunContext, start: Chunk, engine: str = "aut
     """
     stages: list[Stage] = []
     calibrated = start
+    gain = accelerometer_gain(start["t"], start["acc"], start["gyr"], pipeline.gravity, name=ctx.name, **pipeline.init)
+    if gain != 1.0:
+        stage = GainStage(gain, pipeline.gravity / gain, pipeline.gravity)
+        calibrated = stage.whole(start)
+        stages.append(stage)
     if pipeline.calibration:
         cal = CalibrationStage(pipeline.calibration if calibrations is None else calibrations, ctx)
-        calibrated = cal.fit(start, whole=whole)
+        calibrated = cal.fit(calibrated, whole=whole)
         stages.append(cal)
     use_mag = "mag" in calibrated and bool(getattr(pipeline.orientation, "use_magnetometer", False))
     q0 = initial_attitude(calibrated["t"], calibrated["acc"], calibrated["gyr"],

@@ -51,6 +51,38 @@ from .guards import StanceGuard
 from .stage import Queue, Stage, pad_to
 
 
+class GainStage(Stage):
+    """The specific force times the accelerometer's gain (dimensionless), before every other stage.
+
+    The gain comes from the run's still start (:func:`footzoo.runtime.alignment.accelerometer_gain`);
+    a gain of 1 leaves the chunks as they are.
+    """
+
+    def __init__(self, gain: float, still: float, gravity: float):
+        self.gain, self.still, self.gravity = float(gain), float(still), float(gravity)
+
+    def _scaled(self, chunk: Chunk) -> Chunk:
+        if self.gain == 1.0 or not length(chunk):
+            return chunk
+        return {**chunk, "acc": chunk["acc"] * self.gain}
+
+    def whole(self, chunk: Chunk) -> Chunk:
+        return self._scaled(chunk)
+
+    def step(self, chunk: Chunk, finish: bool) -> Chunk:
+        return self._scaled(chunk) if length(chunk) else {}
+
+    def held(self) -> int:
+        return 0
+
+    def provisional(self, extra: Chunk) -> Chunk:
+        return self._scaled(extra) if length(extra) else {}
+
+    def report(self) -> dict[str, Any]:
+        """``acc_gain``: the factor applied and the still start's reading it corrects (m/s²), against g."""
+        return {"acc_gain": {"gain": self.gain, "still_m_s2": self.still, "gravity_m_s2": self.gravity}}
+
+
 class CalibrationStage(Stage):
     """In-situ calibrations, applied in order before every other stage.
 
