@@ -1,0 +1,74 @@
+"""An accelerometer that reads too much at rest (a gain error) is scaled back to g from the still start.
+
+The IPOL gait set's left-foot MTw reads 10.04-10.44 m/s² at rest; simulated here as a walk whose
+specific force is 5 % too large, ending with a 6 s stand like the IPOL trials. Truth is the
+simulator's.
+"""
+
+import numpy as np
+import pytest
+
+import footzoo
+from footzoo import Recording
+from footzoo.core.errors import SensorWarning
+from footzoo.runtime import alignment
+from footzoo.sim import simulate
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return simulate(path="straight", n_strides=4, rate=100.0, profile="physical", magnetometer=False, stand_end=6.0)
+
+
+@pytest.fixture(scope="module")
+def pipe():
+    return footzoo.Pipeline.from_yaml("recommended")
+
+
+def _hot(rec, gain=1.05):
+    return Recording(t=rec.t, acc=rec.acc * gain, gyr=rec.gyr, meta={"name": "hot"}, truth=rec.truth)
+
+
+def _end_error(res, rec):
+    return (res.pos[-1] - res.pos[0]) - (rec.truth.pos[-1] - rec.truth.pos[0])
+
+
+def test_a_calibrated_accelerometer_is_used_as_it_is(walk, recwarn):
+    assert alignment.accelerometer_gain(walk.t, walk.acc, walk.gyr, 9.81) == 1.0
+    assert alignment.accelerometer_gain(walk.t, walk.acc * 1.02, walk.gyr, 9.81) == 1.0  # inside the tolerance
+    assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
+
+
+def test_a_gain_error_is_measured_from_the_still_start(walk):
+    with pytest.warns(SensorWarning, match=r"reads 10\.30\d m/s² in the still start .* \+5\.0 % off g = 9\.81"):
+        gain = alignment.accelerometer_gain(walk.t, walk.acc * 1.05, walk.gyr, 9.81, name="hot")
+    assert gain == pytest.approx(1 / 1.05, rel=1e-9)
+
+
+def test_a_walk_read_5_percent_high_ends_where_the_truth_ends(walk, pipe):
+    with pytest.warns(SensorWarning, match="gain"):
+        res = pipe.run(_hot(walk))
+    assert res.diagnostics["acc_gain"]["gain"] == pytest.approx(1 / 1.05, rel=1e-9)
+    assert np.abs(_end_error(res, walk)).max() < 0.01  # noise-free: the scaled signal is the true one
+    assert res.stance[walk.t > walk.t[-1] - 5.0].all()  # the final stand is stance
+
+
+def test_without_the_gain_the_stand_is_missed_and_the_track_climbs(walk, pipe, monkeypatch):
+    """The cause of the IPOL climbs: the stance test compares ‖f‖ with g, so the stand is taken for a swing."""
+    monkeypatch.setattr(alignment, "ACC_GAIN_TOLERANCE", 1.0)
+    with pytest.warns(SensorWarning, match="misses this stillness"):
+        res = pipe.run(_hot(walk))
+    assert "acc_gain" not in res.diagnostics
+    assert res.stance[walk.t > walk.t[-1] - 5.0].mean() < 0.1
+    assert -_end_error(res, walk)[2] > 1.0  # metres up (NED: height = -down)
+
+
+def test_a_stream_scales_the_specific_force_as_a_batch_run(walk):
+    live_pipe = footzoo.Pipeline.from_yaml("recommended_live")
+    hot = _hot(walk)
+    with pytest.warns(SensorWarning, match="gain"):
+        batch = live_pipe.run(hot)
+    with pytest.warns(SensorWarning, match="gain"):
+        live = footzoo.Stream(live_pipe).run(hot, chunk=200)
+    np.testing.assert_allclose(live["pos"], batch.pos, atol=1e-6)
+    assert np.abs(_end_error(batch, walk)).max() < 0.01
