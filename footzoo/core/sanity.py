@@ -287,17 +287,41 @@ def _warn_found(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, found: dict[str
         ks = found.get(key)
         if not ks:
             continue
-        shown = ", ".join(f"{k} (t = {t[k - offset]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
-                          f"{np.linalg.norm(arr[k - offset]):.1f} {unit})" for k in ks[:5])
+        local = np.asarray(ks[:5]) - offset
+        off = burst_heights(arr, np.asarray(ks) - offset)[: len(local)]
+        shown = ", ".join(f"{k} (t = {t[j]:.3f} s, |{'ω' if key[0] == 'g' else 'a'}| = "
+                          f"{np.linalg.norm(arr[j]):.1f} {unit}, {h:.1f} {unit} off)"
+                          for k, j, h in zip(ks[:5], local, off, strict=True))
         more = f" and {len(ks) - 5} more" if len(ks) > 5 else ""
         effect = ("a glitch turns the attitude and misplaces the track" if key[0] == "g" else
                   "a glitch kicks the velocity and misplaces the track")
         warnings.warn(
-            f"{name}: {len(ks)} isolated {label} spike(s) above {bound:g} {unit} at sample(s) {shown}{more} "
-            f"(bursts of 1 to {GLITCH_MAX_LEN} samples): {effect}. Repair those samples (e.g. replace them by the "
+            f"{name}: {len(ks)} isolated {label} spike(s) standing more than {bound:g} {unit} off the signal around "
+            f"them (bursts of 1 to {GLITCH_MAX_LEN} samples, measured from the line between the samples before and "
+            f"after) at sample(s) {shown}{more}: {effect}. Repair those samples (e.g. replace them by the "
             "neighbours' mean). Details in meta['sanity']",
             SensorWarning, stacklevel=stacklevel,
         )
+
+
+def burst_heights(x: np.ndarray, ks: np.ndarray) -> np.ndarray:
+    """How far each glitch sample ``x[k]`` lies off the line between the samples around its burst (unit of ``x``).
+
+    ``ks``: the sorted glitch samples (:func:`find_bursts`); consecutive ones form a burst, measured
+    against the sample before it and the sample after it (the burst's own samples excluded).
+    """
+    ks = np.asarray(ks, dtype=int)
+    out = np.zeros(len(ks))
+    if not len(ks):
+        return out
+    breaks = np.flatnonzero(np.diff(ks) != 1) + 1
+    for run in np.split(np.arange(len(ks)), breaks):
+        a, b = ks[run[0]], ks[run[-1]]
+        before, after = x[max(a - 1, 0)], x[min(b + 1, len(x) - 1)]
+        for j, i in enumerate(run):
+            chord = before + (after - before) * ((j + 1) / (len(run) + 1))
+            out[i] = np.linalg.norm(x[ks[i]] - chord)
+    return out
 
 
 # --------------------------------------------------------------------------- the scans of a run (batch and live)

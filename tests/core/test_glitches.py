@@ -44,7 +44,7 @@ def test_a_long_gyroscope_burst_is_flagged_wherever_it_is_batch_and_live(length,
     faulty, found = _sensor_warnings(lambda: Recording(t=rec.t, acc=rec.acc, gyr=gyr, meta={"name": "burst"}))
     assert faulty.meta["sanity"]["gyro_glitches"] == list(range(starts[0], starts[0] + length))
     assert "saturation" not in faulty.meta["sanity"]
-    assert any(f"(bursts of 1 to {GLITCH_MAX_LEN} samples)" in m and f"at sample(s) {starts[0]} " in m for m in found)
+    assert any(f"(bursts of 1 to {GLITCH_MAX_LEN} samples," in m and f"at sample(s) {starts[0]} (" in m for m in found)
     scan = SignalScan()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SensorWarning)
@@ -60,7 +60,24 @@ def test_a_long_accelerometer_burst_is_flagged(walk, length):
     acc[k:k + length] += [0.0, 0.0, -1500.0]
     rec, found = _sensor_warnings(lambda: Recording(t=walk.t, acc=acc, gyr=walk.gyr, meta={"name": "burst"}))
     assert rec.meta["sanity"]["acc_glitches"] == list(range(k, k + length))
-    assert any(f"accelerometer spike(s) above {ACC_GLITCH_JUMP:g} m/s² at sample(s) {k} " in m for m in found)
+    assert any(f"accelerometer spike(s) standing more than {ACC_GLITCH_JUMP:g} m/s² off the signal around them" in m
+               and f"at sample(s) {k} (" in m for m in found)
+
+
+def test_a_dip_is_reported_by_its_height_off_the_signal_not_by_its_magnitude(walk):
+    """IPOL 8-6_lf: a 2-sample dip from 12.5 rad/s to -5.5 rad/s and back; |ω| there (7.3) is below the bound."""
+    gyr = walk.gyr.copy()
+    k = int(np.searchsorted(walk.t, 3.3))
+    gyr[k - 1:k + 3] = [[12.5, -5.9, -2.3], [-5.5, -4.7, -0.6], [-6.2, -4.1, -3.0], [12.2, -3.7, -2.7]]
+    rec, found = _sensor_warnings(lambda: Recording(t=walk.t, acc=walk.acc, gyr=gyr, meta={"name": "dip"}))
+    assert rec.meta["sanity"]["gyro_glitches"] == [k, k + 1]
+    message = next(m for m in found if "gyroscope spike" in m)
+    # off the line from (12.5, -5.9, -2.3) to (12.2, -3.7, -2.7), a third and two thirds of the way: hand-computed
+    first = np.linalg.norm(np.subtract([-5.5, -4.7, -0.6], [12.4, -5.1667, -2.4333]))
+    second = np.linalg.norm(np.subtract([-6.2, -4.1, -3.0], [12.3, -4.4333, -2.5667]))
+    assert f"{k} (t = {walk.t[k]:.3f} s, |ω| = 7.3 rad/s, {first:.1f} rad/s off)" in message
+    assert f"{k + 1} (t = {walk.t[k + 1]:.3f} s, |ω| = 8.0 rad/s, {second:.1f} rad/s off)" in message
+    assert "standing more than 15 rad/s off the signal around them" in message and first > 15 and second > 15
 
 
 def test_a_clipped_axis_is_saturation_not_a_glitch_and_a_burst_is_not_clipping(walk):
