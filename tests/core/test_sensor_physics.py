@@ -86,7 +86,8 @@ def test_a_gyroscope_burst_of_a_few_samples_is_flagged_batch_and_live(length, he
     gyr[k:k + length] += [0.0, height, 0.0]
     rec, found = _sensor_warnings(lambda: _with(walk, gyr=gyr))
     assert rec.meta["sanity"]["gyro_glitches"] == list(range(k, k + length))
-    assert any(f"isolated gyroscope spike(s) standing more than {GLITCH_JUMP:g} rad/s off" in m and f"at sample(s) {k} (" in m for m in found)
+    assert any(f"isolated gyroscope spike(s) standing more than {GLITCH_JUMP:g} rad/s off" in m
+               and f"at sample(s) {k} (" in m for m in found)
     stream = Stream(Pipeline.from_dict(BASE), rate=walk.rate)
     _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([1, 7, 3, 64])))
     assert stream.sensor["gyro_glitches"] == list(range(k, k + length))
@@ -99,7 +100,8 @@ def test_an_accelerometer_burst_is_flagged(walk):
     acc[k:k + 2] += [0.0, 0.0, -1500.0]
     rec, found = _sensor_warnings(lambda: _with(walk, acc=acc))
     assert rec.meta["sanity"]["acc_glitches"] == [k, k + 1]
-    assert any(f"accelerometer spike(s) standing more than {ACC_GLITCH_JUMP:g} m/s² off" in m and f"at sample(s) {k} (" in m for m in found)
+    assert any(f"accelerometer spike(s) standing more than {ACC_GLITCH_JUMP:g} m/s² off" in m
+               and f"at sample(s) {k} (" in m for m in found)
     res, _ = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
     assert res.diagnostics["sensor"]["acc_glitches"] == [k, k + 1]
 
