@@ -75,6 +75,11 @@ def initial_attitude(
 #: right feet 0.4–1.6 %); the IPOL set's left-foot MTw reads 2.3–6.4 % above g.
 ACC_GAIN_TOLERANCE = 0.03
 
+#: Largest standard deviation of ‖f‖ over the still start, relative to g, for its mean to be taken as gravity: a
+#: sensor at rest scatters by its noise (0.1-0.5 % of g for the recordings above), a start whose gyroscope is quiet
+#: but whose foot accelerates (a slide, a tap) scatters more and says nothing about the gain.
+ACC_GAIN_QUIET = 0.02
+
 
 def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity: float, duration: float = 0.5,
                        max_gyr: float = 0.6, name: str = "recording") -> float:
@@ -82,14 +87,17 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
 
     The still window is the one of :func:`initial_attitude` (:func:`first_still_window`); the
     gain is ``gravity / ‖mean f‖`` over it when ``‖mean f‖`` differs from ``gravity`` (m/s²) by
-    more than :data:`ACC_GAIN_TOLERANCE`, with a :class:`~footzoo.core.errors.SensorWarning` that
-    names the reading; else exactly 1 (a calibrated sensor's samples are used as they are).
+    more than :data:`ACC_GAIN_TOLERANCE` and ‖f‖ is quiet there (:data:`ACC_GAIN_QUIET`), with a
+    :class:`~footzoo.core.errors.SensorWarning` that names the reading; else exactly 1 (a calibrated
+    sensor's samples are used as they are).
     ``t`` (s), ``acc`` (m/s², FRD), ``gyr`` (rad/s), ``duration`` (s), ``max_gyr`` (rad/s).
     """
     start, stop = first_still_window(t, gyr, duration, max_gyr)
     still = float(np.linalg.norm(acc[start:stop].mean(axis=0)))
     if abs(still / gravity - 1.0) <= ACC_GAIN_TOLERANCE:
         return 1.0
+    if float(np.std(np.linalg.norm(acc[start:stop], axis=1))) > ACC_GAIN_QUIET * gravity:
+        return 1.0  # the foot moves in its "still" start: no measure of the gain (the stance guards speak later)
     warnings.warn(
         f"{name}: the accelerometer reads {still:.3f} m/s² in the still start "
         f"(t = {t[start]:.2f}-{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²: "

@@ -99,3 +99,12 @@ def test_a_walk_with_dropped_packets_and_a_gain_error_stands_still_at_its_end(wa
     with pytest.warns(SensorWarning, match="misses this stillness"):
         climbs = pipe.run(holed)
     assert -(climbs.pos[-1, 2] - climbs.pos[stand][0, 2]) > 1.0  # metres up during the stand
+
+
+def test_a_start_whose_foot_accelerates_is_no_measure_of_the_gain(walk, recwarn):
+    """Quiet gyroscope, moving foot (a slide): ‖f‖ scatters, its mean is not gravity, nothing is scaled."""
+    acc = walk.acc * 1.05
+    start, stop = alignment.first_still_window(walk.t, walk.gyr, 0.5, 0.6)
+    acc[start:stop:2, 0] += 3.0  # a 3 m/s² forward jolt every other sample: ‖f‖ scatters by about 1.5 m/s²
+    assert alignment.accelerometer_gain(walk.t, acc, walk.gyr, 9.81) == 1.0
+    assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
