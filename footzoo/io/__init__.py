@@ -43,7 +43,7 @@ from ..core.files import not_utf8, why_missing
 from . import xio
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import REQUIRED, Option, Reader
-from .metadata import read_facts
+from .metadata import meta_path, read_facts, steps_path
 from .registry import GROUP, available, refresh
 
 
@@ -102,6 +102,25 @@ def detect_format(path: str | Path, options: Mapping[str, Any] | None = None) ->
     if len(implied) == 1:
         return implied[0]
     return readers.detect(Path(path))
+
+
+def companion_files(path: str | Path, format: str | None = None, **options: Any) -> list[Path]:
+    """The files besides ``path`` that reading it may use, whether they exist or not: its metadata sidecar
+    ``<file>.meta.yaml`` and true steps ``<file>.steps.csv`` (:mod:`footzoo.io.metadata`), and what its
+    reader's ``companions(path, **options)`` lists (a description, a reference). A study's cache key holds
+    their content, so that a reference or description added, edited or removed runs the file's cells again.
+    A file no reader takes (its runs fail when they read it) has the two sidecars only.
+    """
+    p = Path(path)
+    files = [meta_path(p), steps_path(p)]
+    try:
+        fmt = detect_format(p, options) if format is None else format
+        listed = getattr(available().get_reader(fmt), "companions", None)
+        if callable(listed):
+            files += [Path(f) for f in listed(p, **options)]
+    except Exception:  # noqa: BLE001 - an unreadable file or a reader's bug: its runs fail when they read it
+        pass
+    return list(dict.fromkeys(files))
 
 
 def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> tuple[dict[str, Any], Any, Any]:
@@ -245,7 +264,7 @@ def _complete_meta(rec: Recording, path: Path, fmt: str, reader: Any) -> None:
     rec.meta["input_files"] = files
 
 
-__all__ = ["GROUP", "READERS", "Option", "Reader", "builtin_sample", "check_input_file",
+__all__ = ["GROUP", "READERS", "Option", "Reader", "builtin_sample", "check_input_file", "companion_files",
            "detect_format", "load", "refresh"]
 
 

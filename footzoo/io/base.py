@@ -157,6 +157,13 @@ class Reader:
         """Read the file into a :class:`~footzoo.core.data.Recording` (FRD, SI)."""
         raise NotImplementedError(f"{type(self).__name__}.open")
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """The files besides ``path`` that :meth:`open` reads when they exist (a description, a reference), listed
+        whether they exist or not: a study's cache key includes them, so that adding, editing or removing one runs
+        the file's cells again. The metadata sidecar ``<file>.meta.yaml`` and ``<file>.steps.csv`` count for every
+        reader without being listed (:func:`footzoo.io.companion_files`). Default: none."""
+        return []
+
     def __repr__(self) -> str:
         return f"<footzoo reader {self.name or type(self).__name__!r}: {self.description}>"
 

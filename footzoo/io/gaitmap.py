@@ -165,5 +165,9 @@ class GaitmapReader(Reader):
     def guess_can_open(self, path: Path) -> bool:
         return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """gaitmap's motion-capture reference files in the file's folder (its truth when they are there)."""
+        return [Path(path).parent / f for f in REFERENCE_FILES]
+
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)

@@ -309,5 +309,10 @@ class GenericReader(Reader):
         """A file with a description ``<file>.footzoo.yaml`` next to it."""
         return sidecar_of(Path(path)).exists()
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """The description: ``sidecar=``, else ``<file>.footzoo.yaml`` next to the file."""
+        sidecar = options.get("sidecar")
+        return [Path(sidecar) if sidecar is not None else sidecar_of(Path(path))]
+
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)

@@ -118,6 +118,10 @@ class PyShoeReader(Reader):
             return True
         return {"imu", "ts"} <= names
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """The dataset's ``trials.csv`` next to the trial (its hand-counted strides)."""
+        return [Path(path).with_name("trials.csv")]
+
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)
 

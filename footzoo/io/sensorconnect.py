@@ -148,5 +148,9 @@ class SensorConnectReader(Reader):
     def guess_can_open(self, path: Path) -> bool:
         return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """Köroğlu's ground control points ``<file>.mat`` next to the export."""
+        return [Path(path).with_suffix(".mat")]
+
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)

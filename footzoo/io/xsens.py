@@ -265,5 +265,10 @@ class XsensReader(Reader):
     def guess_can_open(self, path: Path) -> bool:
         return Path(path).suffix.lower() in self.extensions and find_header(Path(path)) is not None
 
+    def companions(self, path: Path, **options: Any) -> list[Path]:
+        """IPOL's annotations ``<trial>.json`` beside a foot file ``<trial>_lf.txt`` / ``<trial>_rf.txt``."""
+        stem = Path(path).stem
+        return [Path(path).with_name(stem[:-3] + ".json")] if stem[-3:].lower() in ("_lf", "_rf") else []
+
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)

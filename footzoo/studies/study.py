@@ -26,7 +26,7 @@ from ..config.schema import load_yaml
 from ..core.errors import ConfigError, FootzooError, RecordingError, did_you_mean, prefixed
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import FIGURE_METRICS, METRICS
-from ..io import _options_for, detect_format
+from ..io import _options_for, companion_files, detect_format
 from ..io import available as available_readers
 from ..io import load as load_recording
 from ..plugins.base import Plugin
@@ -170,7 +170,8 @@ class RecordingSpec:
     group: str | None = None  # cross-validation group (subject, day, motion class): footzoo.studies.tune
 
     def identity(self) -> str:
-        """What the cache key depends on: the file's content hash, or the simulator spec and seed.
+        """What the cache key depends on: the file's content hash and its companions' (a reference, a description,
+        a metadata sidecar: :func:`footzoo.io.companion_files`, absent ones as absent), or the simulator spec and seed.
 
         A path that is not a readable file (a dangling link, a directory, a vanished or unreadable
         file) gets an identity describing the problem, so its cells fail on their own and are run
@@ -178,7 +179,9 @@ class RecordingSpec:
         """
         if self.path is not None:
             problem = self.problem()
-            data = {"problem": problem, "path": self.path} if problem else {"file": _file_digest(self.path)}
+            data = ({"problem": problem, "path": self.path} if problem else
+                    {"file": _file_digest(self.path), "companions": _companion_digests(self.path, self.format,
+                                                                                        self.options)})
             return json.dumps({**data, "format": self.format, "options": self.options}, sort_keys=True, default=str)
 
         return json.dumps({"simulate": self.simulate, "seed": self.seed, "footzoo": _version.__version__},
@@ -641,6 +644,17 @@ def set_dotted(d: dict[str, Any], path: str, value: Any) -> None:
         node["type"] = value
     else:
         node[last] = value
+
+
+def _companion_digests(path: str, format: str | None, options: dict[str, Any]) -> list[str | None]:
+    """The content hash of each file that reading ``path`` may use besides it, in the reader's order (None: absent)."""
+    out: list[str | None] = []
+    for f in companion_files(path, format, **options):
+        try:
+            out.append(_file_digest(str(f)) if f.is_file() else None)
+        except OSError as err:  # unreadable: its runs fail when they read it, and run again once it changes
+            out.append(f"unreadable: {err.strerror or err}")
+    return out
 
 
 def _file_digest(path: str) -> str:

@@ -10,6 +10,7 @@ import yaml
 
 from footzoo import ConfigError, Pipeline
 from footzoo.apps.cli import main
+from footzoo.evaluation.validity import MetricWarning
 from footzoo.io.canonical import write
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import CacheWarning, Study, read_trajectories, run_study
@@ -350,3 +351,50 @@ def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, serial
     assert all(serial[name] == dask[name] for name in serial)
     assert (tmp_path / "dask" / "summary.md").read_text() == summary
     assert table.attrs["failed"] == 0
+
+
+# --------------------------------------------------------------------------- the files beside a recording
+
+
+def test_a_changed_reference_or_description_beside_a_recording_runs_its_cells_again(tmp_path):
+    """The cache key holds what reading a file uses besides it: a metadata sidecar that now says the walk is a
+    closed loop gives the loop closure, not the cached NaN of the run before."""
+    rec = simulate(path="straight", n_strides=4, rate=50, noise=NoiseModel(scale=1, seed=0))
+    walk = tmp_path / "walk.csv"
+    write(rec, walk)
+    study = {"name": "beside", "base": BASE, "recordings": [{"path": str(walk)}], "metrics": ["loop_closure_xy_m"]}
+    with pytest.warns(MetricWarning, match="not known to be a closed walk"):
+        first = run_study(Study.from_dict(study), out=tmp_path / "out")
+    assert first.attrs["computed"] == 1 and first["value"].isna().all()
+    assert "closed walk" in first["note"].iloc[0]
+    write(rec, walk, closed_loop=True)  # the same data; its sidecar now says closed_loop: true
+    second = run_study(Study.from_dict(study), out=tmp_path / "out")
+    assert second.attrs["computed"] == 1 and second.attrs["cached"] == 0
+    assert np.isfinite(second["value"]).all()
+    third = run_study(Study.from_dict(study), out=tmp_path / "out")  # nothing changed since
+    assert third.attrs["cached"] == 1 and third.equals(second)
+
+
+def test_the_companions_of_a_file_are_its_readers_and_its_sidecars(tmp_path):
+    from footzoo.io import companion_files
+
+    data = tmp_path / "trial.csv"
+    names = [f.name for f in companion_files(data, format="gaitmap")]
+    assert names == ["trial.csv.meta.yaml", "trial.csv.steps.csv", "mocap_sample.csv", "stride_events_sample.csv",
+                     "position_sample.csv"]
+    shared = tmp_path / "lab" / "lab.yaml"
+    assert companion_files(data, sidecar=str(shared))[-1] == shared  # sidecar= implies the generic format
+    assert companion_files(data, format="generic")[-1].name == "trial.csv.footzoo.yaml"
+    assert companion_files(tmp_path / "2017-11-22-11-22-03.mat", format="pyshoe")[-1].name == "trials.csv"
+    assert companion_files(tmp_path / "7-1_lf.txt", format="xsens")[-1].name == "7-1.json"
+    assert [f.name for f in companion_files(data)] == ["trial.csv.meta.yaml", "trial.csv.steps.csv"]  # no such file
+    data.write_text("t,ax\n")
+    spec = Study.from_dict({"name": "s", "base": BASE, "recordings": [{"path": str(data), "format": "generic",
+                                                                        "sidecar": str(shared)}]}).recordings[0]
+    before = spec.identity()
+    shared.parent.mkdir()
+    shared.write_text("time: {rate: 100}\n")
+    assert spec.identity() != before  # the shared description appeared
+    changed = spec.identity()
+    shared.write_text("time: {rate: 200}\n")
+    assert spec.identity() != changed  # and was edited
