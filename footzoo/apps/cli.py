@@ -463,12 +463,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
     """Check a config without running it: ``plugins:`` loaded as ``footzoo run`` loads them, every problem listed."""
     # deferred: yaml, pandas and the engine: the command line starts without them
     from ..config.library import resolve
-    from ..config.schema import load_yaml
+    from ..config.schema import is_study_file, load_yaml
     from ..runtime.pipeline import Pipeline
     from ..runtime.validate import config_errors
 
     path = resolve(args.config)
-    errors = config_errors(load_yaml(path), base_dir=path.parent)
+    data = load_yaml(path)
+    if is_study_file(data):
+        return _validate_study(args.config, path, "tune" in data)
+    errors = config_errors(data, base_dir=path.parent)
     if errors:
         print(f"{args.config}: {len(errors)} problem(s)", file=sys.stderr)
         for e in errors:
@@ -478,6 +481,28 @@ def cmd_validate(args: argparse.Namespace) -> int:
     print(f"{args.config}: valid")
     print(live_summary(pipeline))
     print(json.dumps(pipeline.to_dict(), indent=2))
+    return EXIT_OK
+
+
+def _validate_study(name: str, path: Path, tune: bool) -> int:
+    """Check a study (or tune) file as ``footzoo ablate`` (``tune``) does before its first run, without running it."""
+    # deferred: the study runner: the command line starts without it
+    from ..studies import Study
+    from ..studies.tune import load_tune_file
+
+    if tune:
+        study, spec = load_tune_file(path)
+        study.check()
+        what = (f"tune file: {spec.search} search, objective {spec.objective} ({spec.direction}); "
+                f"{len(study.recordings)} recording(s)")
+    else:
+        study = Study.from_yaml(path)
+        study.check()
+        what = (f"study: {len(study.configs())} config(s) x {len(study.recordings)} recording(s) = "
+                f"{len(study.configs()) * len(study.recordings)} runs")
+    command = "footzoo tune" if tune else "footzoo ablate"
+    print(f"{name}: valid {what}; every config of the grid and every recording's reader options checked "
+          f"(the recordings are read when they run: {command} {name})")
     return EXIT_OK
 
 
@@ -836,8 +861,9 @@ def build_parser() -> argparse.ArgumentParser:
     cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
     cfg.set_defaults(func=cmd_configs)
 
-    val = sub.add_parser("validate", help="check a pipeline config without running it")
-    val.add_argument("config", type=_input_yaml, help="pipeline YAML")
+    val = sub.add_parser("validate", help="check a pipeline config (or a study or tune file: every config of its "
+                                          "grid) without running it")
+    val.add_argument("config", type=_input_yaml, help="pipeline YAML, or a study or tune file")
     val.set_defaults(func=cmd_validate)
     return parser
 

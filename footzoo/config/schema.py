@@ -101,15 +101,20 @@ def load_yaml(path: str | Path) -> dict[str, Any]:
     return data
 
 
+def is_study_file(d: Any) -> bool:
+    """True for a study or tune file's mapping (``base`` and ``recordings``, no ``orientation`` or ``detector``)."""
+    return isinstance(d, dict) and {"base", "recordings"} <= set(d) and not {"orientation", "detector"} & set(d)
+
+
 def top_level_errors(d: dict[str, Any]) -> list[str]:
     """Every problem with the top-level keys of a config (unknown, missing, badly typed), as messages."""
     if not isinstance(d, dict):
         return [f"a config must be a mapping, got {type(d).__name__}"]
-    if {"base", "recordings"} <= set(d) and not {"orientation", "detector"} & set(d):
+    if is_study_file(d):
         kind = "tune" if "tune" in d else "study"
         verb = "footzoo tune" if kind == "tune" else "footzoo ablate"
-        return [f"this is a {kind} file (base, recordings), not a pipeline config: run it with {verb} FILE; "
-                "footzoo run takes a pipeline config (orientation, detector, ...)"]
+        return [f"this is a {kind} file (base, recordings), not a pipeline config: run it with {verb} FILE "
+                "(footzoo validate FILE checks it); footzoo run takes a pipeline config (orientation, detector, ...)"]
     errors = []
     valid = list(TOP_LEVEL_KEYS)
     for key in d:

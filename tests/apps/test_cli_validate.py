@@ -31,3 +31,22 @@ def test_compatibility_list_keeps_whole_reasons(capsys):
     assert reason.split(":", 1)[-1].strip() in out
     longest = max((len(line) for line in out.splitlines() if line.startswith("- ")), default=0)
     assert longest > 162  # reasons used to be cut at 160 characters
+
+
+def test_validate_checks_a_study_or_tune_file_without_running_it(tmp_path, capsys):
+    sim = "recordings: [{simulate: {path: straight, n_strides: 4, rate: 50, noise: {scale: 1}}, seeds: [0, 1]}]\n"
+    study = tmp_path / "study.yaml"
+    study.write_text("name: s\nbase: yun2012\nfactors: {detector.threshold: [0.4, 0.6, 0.8]}\n" + sim)
+    assert main(["validate", str(study)]) == 0
+    out = capsys.readouterr().out
+    assert "valid study: 3 config(s) x 2 recording(s) = 6 runs" in out
+    assert not (tmp_path / "ablation_study").exists()  # nothing ran, nothing written
+    study.write_text("name: s\nbase: yun2012\nfactors: {detector.treshold: [0.4, 0.6]}\n" + sim)
+    assert main(["validate", str(study)]) == 2
+    err = capsys.readouterr().err
+    assert "nothing was run" in err and "'treshold'" in err and "Traceback" not in err
+    tune = tmp_path / "tune.yaml"
+    tune.write_text("name: t\nbase: yun2012\nfactors: {detector.threshold: [0.4, 0.6]}\n" + sim
+                    + "tune: {objective: armse_3d_m}\n")
+    assert main(["validate", str(tune)]) == 0
+    assert "valid tune file: grid search, objective armse_3d_m" in capsys.readouterr().out

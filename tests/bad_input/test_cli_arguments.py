@@ -113,7 +113,8 @@ CASES = [
     ("run-config-as-data", lambda d, w: ["run", "yun2012", "--data", str(YUN)], EXIT_DATA,
      "a YAML file (a config or study?), not a recording"),
     ("run-a-study", lambda d, w: ["run", str(QUICK)], EXIT_USAGE,
-     "this is a study file (base, recordings), not a pipeline config: run it with footzoo ablate FILE"),
+     "this is a study file (base, recordings), not a pipeline config: run it with footzoo ablate FILE "
+     "(footzoo validate FILE checks it)"),
     ("ablate-a-config", lambda d, w: ["ablate", str(YUN)], EXIT_USAGE,
      "this is a pipeline config (orientation, detector, ...), not a study: run it with footzoo run FILE"),
 ]
