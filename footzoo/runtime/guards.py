@@ -83,6 +83,12 @@ def _still_instants(score: np.ndarray, still: float, sep: int, half: int) -> np.
     return out
 
 
+#: What a guard that found still instants in a long swing says of the detector, and the fixes.
+MISSED_STANCE = ("the detector, at its setting, misses the stances of this motion: loosen its threshold (more "
+                 "stance), choose a detector made for this motion (running?), or switch the guard off with "
+                 "guards: {max_swing: 0}")
+
+
 @dataclass
 class StanceGuard(Settings):
     """Stance at the stillest instants of every swing longer than ``max_swing`` (see the module docstring).
@@ -221,9 +227,7 @@ class StanceGuard(Settings):
         total = sum(e - s for s, e in long)
         if report["stances_added"]:  # the foot did come to rest there: the detector missed it
             cause = (f"The stance guard marked {report['stances_added']} still instant(s) (|ω| ≤ {self.still_rate:g} "
-                     "rad/s) there as stance: the trajectory in those swings is suspect — the detector misses the "
-                     "stances of this motion (running?); choose one made for it, or switch the guard off with "
-                     "guards: {max_swing: 0}")
+                     f"rad/s) there as stance: the trajectory in those swings is suspect — {MISSED_STANCE}")
         else:  # nor did the angular rate ever come to rest: no detector would find a stance there
             cause = (f"The angular rate never fell to {self.still_rate:g} rad/s there either, so the guard marked no "
                      "stance and the detector is not shown to be at fault: the foot did not come to rest (not a gait "

@@ -47,7 +47,7 @@ from ..plugins.base import (
 )
 from ..plugins.contract import detector_diagnostics
 from ..plugins.incremental import Chunk, Columns, concat, length, take
-from .guards import StanceGuard
+from .guards import MISSED_STANCE, StanceGuard
 from .stage import Queue, Stage, pad_to
 
 
@@ -255,8 +255,7 @@ class DetectorStage(Stage):
         warnings.warn(f"{self.ctx.name}: detector {self.detector.name!r} found no stance for more than "
                       f"{self.max_swing:g} s (guards.max_swing) before t = {float(out['t'][-1]):.2f} s. The stance "
                       f"guard marked {starts.size} still instant(s) there as stance, the first at t = {t_first:.2f} s: "
-                      "the trajectory in that swing is suspect — the detector misses the stances of this motion "
-                      "(running?); choose one made for it, or switch the guard off with guards: {max_swing: 0}",
+                      f"the trajectory in that swing is suspect — {MISSED_STANCE}",
                       GuardWarning, stacklevel=8)
 
     def held(self) -> int:

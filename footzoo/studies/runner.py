@@ -373,18 +373,43 @@ def study_identity(study: Study) -> str:
     return hashlib.sha256(json.dumps(spec, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: WarningLog, quiet: bool) -> None:
-    """Issue each distinct warning of the runs once, with the number of runs that gave it (``quiet``: into the
-    study's log only)."""
+#: A number in a warning's text (``12``, ``-0.77``, ``1e+06``): warnings that differ only in these are alike.
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 
-    replayed = []
+
+def _alike(text: str, labels: list[str]) -> str:
+    """The shape of a warning: its text with the recordings' names and every number blanked."""
+    for label in labels:
+        text = text.replace(label, "<recording>")
+    return _NUMBER.sub("#", text)
+
+
+def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: WarningLog, quiet: bool,
+                     labels: list[str] = ()) -> None:
+    """Issue each distinct warning of the runs once, with the number of runs that gave it (``quiet``: into the
+    study's log only). Warnings that differ only in their numbers and recordings (a guard's finding on every
+    recording, in every setting of a tune) are issued as one, with the count and the first as the example; the
+    log keeps each of them."""
+
+    labels = sorted({str(x) for x in labels if str(x)}, key=len, reverse=True)
+    groups: dict[str, list[tuple[str, int]]] = {}
     for text, n in worker.items():
-        name, _, message = text.partition(": ")
+        groups.setdefault(_alike(text, labels), []).append((text, n))
+    replayed = []
+    for members in groups.values():
+        name, _, message = members[0][0].partition(": ")
         category = MetricWarning if name == "MetricWarning" else (getattr(errors, name, None)
                                                                   or getattr(builtins, name, None))
         if not (isinstance(category, type) and issubclass(category, Warning)):
             category = UserWarning
-        replayed.append((category, f"{n} run(s): {message}" if n > 1 else message))
+        if len(members) == 1:
+            n = members[0][1]
+            replayed.append((category, f"{n} run(s): {message}" if n > 1 else message))
+            continue
+        log.keep([f"{name}: {n} run(s): {text.partition(': ')[2]}" if n > 1 else text for text, n in members])
+        total = sum(n for _, n in members)
+        replayed.append((category, f"{total} run(s) gave {len(members)} warnings like this one, with other numbers or "
+                                   f"recordings (each is in footzoo.log or the table's attrs['warnings']): {message}"))
     if refused:
         text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
         replayed.append((MetricWarning, f"metrics refused (NaN, see the table's note column): {text}"))
@@ -476,7 +501,8 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
     if cache_dir is not None:
         table.attrs["pruned"] = prune_cache(cache_dir, keep=set(keys),
                                             **({"max_age_days": CACHE_MAX_AGE_DAYS} if prune is None else prune))
-    _replay_warnings(table.attrs["warnings"], table.attrs["refused"], log, quiet)  # before the log is written
+    _replay_warnings(table.attrs["warnings"], table.attrs["refused"], log, quiet,  # before the log is written
+                     [r.label for r in study.recordings])
     # the cached runs warned when they ran (not again here); the folder's log still lists what its results carry
     cached = _counts(w for r in runs if r.get("cached") for w in r.get("warnings") or [])
     log.keep([f"{text} (from {n} cached run{'s' if n > 1 else ''}: warned when {'they' if n > 1 else 'it'} ran)"

@@ -220,6 +220,6 @@ def test_a_long_swing_without_a_still_instant_does_not_blame_the_detector():
         with pytest.warns(GuardWarning) as caught:
             guard.warn(report, "fsm", "walk")
         message = str(caught[0].message)
-        assert ("the detector misses the stances" in message) == blamed
+        assert ("misses the stances of this motion: loosen its threshold" in message) == blamed
         assert ("the detector is not shown to be at fault" in message) == (not blamed)
         assert (report["stances_added"] > 0) == blamed
