@@ -135,3 +135,26 @@ def test_a_readers_warnings_go_with_the_runs_to_the_log_and_a_quiet_study_prints
     assert "repeats the previous one" not in capfd.readouterr().err
     assert any("dropped 1 row(s) whose time stamp repeats" in w for w in table.attrs["warnings"])
     assert "dropped 1 row(s) whose time stamp repeats" in (tmp_path / "study" / LOG).read_text()
+
+
+def test_warnings_that_differ_only_in_numbers_and_recordings_are_shown_once_and_logged_each():
+    from footzoo.core.errors import GuardWarning
+    from footzoo.core.warninglog import WarningLog
+
+    guard = "GuardWarning: {}: detector 'fsm' found no stance for {} s (longest of {} swing(s))"
+    worker = {guard.format("walk_a", 2.2, 1): 2, guard.format("walk_b", 10.8, 3): 1,
+              "FootzooWarning: walk_a: dropped 3 row(s)": 2}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with WarningLog() as log:
+            runner._replay_warnings(worker, {}, log, quiet=False, labels=["walk_a", "walk_b"])
+    shown = [(w.category, str(w.message)) for w in caught]
+    assert len(shown) == 2
+    category, message = shown[0]
+    assert category is GuardWarning
+    assert message.startswith("3 run(s) gave 2 warnings like this one") and message.endswith(guard.format(
+        "walk_a", 2.2, 1).partition(": ")[2])
+    assert shown[1] == (runner.FootzooWarning, "2 run(s): walk_a: dropped 3 row(s)")
+    logged = log.texts()
+    assert "GuardWarning: 2 run(s): walk_a: detector 'fsm' found no stance for 2.2 s (longest of 1 swing(s))" in logged
+    assert guard.format("walk_b", 10.8, 3) in logged
