@@ -366,6 +366,7 @@ class Study:
             recordings += _expand_recording(r, root, i)
         if not recordings:
             raise ConfigError("the study has no recordings (check the globs)")
+        _name_feet(recordings)
         seen: dict[str, RecordingSpec] = {}
         for rec in recordings:
             other = seen.setdefault(rec.label, rec)
@@ -601,6 +602,17 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
             "seed (seeds: [0])")
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
     return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
+
+
+def _name_feet(recordings: list[RecordingSpec]) -> None:
+    """One file read once per foot (gaitmap's two sensors: ``{path: f.csv, foot: left}`` and ``foot: right``) under
+    one default name: each entry is named after its foot (``f_left``, ``f_right``); a given label is kept."""
+    counts = collections.Counter(rec.label for rec in recordings)
+    for rec in recordings:
+        foot = rec.options.get("foot")
+        if (counts[rec.label] > 1 and foot in ("left", "right") and rec.path is not None
+                and rec.label == Path(rec.path).stem):
+            rec.label = f"{rec.label}_{foot}"
 
 
 def _without_sidecars(paths: list[str]) -> list[str]:

@@ -148,3 +148,16 @@ def test_a_study_prunes_other_studies_entries_on_request(tmp_path):
     table = run_study(Study.from_dict(two), out=out, report=False, prune={"max_age_days": 0})
     assert table.attrs["pruned"]["removed"] == 1 and table.attrs["cached"] == 1
     assert len(list((out / "cache").glob("*.json"))) == 1
+
+
+def test_one_file_read_for_each_foot_is_named_after_the_foot(tmp_path):
+    both = tmp_path / "imu_sample.csv"
+    both.write_text("two feet\n")
+    feet = [{"path": str(both), "foot": "left"}, {"path": str(both), "foot": "right"}]
+    study = Study.from_dict({"name": "feet", "base": "yun2012", "recordings": feet})
+    assert [r.label for r in study.recordings] == ["imu_sample_left", "imu_sample_right"]
+    labelled = [{**feet[0], "label": "L"}, feet[1]]  # a given label is kept
+    assert [r.label for r in Study.from_dict({"name": "f", "base": "yun2012", "recordings": labelled}).recordings] \
+        == ["L", "imu_sample"]
+    with pytest.raises(ConfigError, match="both called 'imu_sample_left'"):  # the same foot twice is still refused
+        Study.from_dict({"name": "f", "base": "yun2012", "recordings": [feet[0], feet[0]]})
