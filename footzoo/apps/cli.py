@@ -265,9 +265,10 @@ def _two_feet(args: argparse.Namespace) -> bool:
 def _print_metrics(title: str, metrics: dict[str, Any], notes: dict[str, str] | None = None) -> None:
     print(title)
     notes = notes or {}
+    width = max([32, *(len(str(k)) for k in metrics)])  # one column of values, however long a name
     for key, value in metrics.items():
         why = f"   (refused: {notes[key]})" if key in notes else ""
-        print(f"  {key:32s} {value:.4f}{why}" if isinstance(value, float) else f"  {key:32s} {value}{why}")
+        print(f"  {key:{width}s} {value:.4f}{why}" if isinstance(value, float) else f"  {key:{width}s} {value}{why}")
 
 
 #: Files ``footzoo run --out DIR`` writes (a result archive with CSV tables, :mod:`footzoo.core.archive`).
@@ -315,10 +316,13 @@ def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list
     One commit: the manifest is written last, and the figures of an earlier run into the folder
     that this one does not draw are removed with it (they belong to the earlier result).
     """
+    from ..core.archive import MANIFEST
+
     figures = _figures(result, rec) if plot else {}
     files = {**figures, LOG: log_text(result.diagnostics["warnings"])}
     folder = result.save(out, backend="csv", inputs=inputs, files=files)
-    return sorted(p.name for p in folder.iterdir() if p.name in RUN_OUTPUTS) + sorted(files)
+    saved = json.loads((folder / MANIFEST).read_text(encoding="utf-8")).get("files", [])
+    return sorted({*(str(f) for f in saved if f not in files), MANIFEST}) + sorted(files)  # reference tables too
 
 
 def cmd_run(args: argparse.Namespace) -> int:

@@ -147,3 +147,17 @@ def test_steps_csv_columns_carry_units(tmp_path):
     unit = re.compile(r"_(s|m|m_s|rad|steps_min)$")
     assert all(unit.search(c) for c in cols if c != "events_from_rate"), list(cols)
     assert "fpa_rad" in cols and "heading_rad" in cols
+
+
+def test_run_names_every_file_it_wrote_and_keeps_the_values_in_one_column(walk, tmp_path, capsys):
+    data = write(walk, tmp_path / "walk.csv")  # with true steps: the result holds the reference's steps as a table
+    out = tmp_path / "out"
+    assert main(["run", "yun2012", "--data", str(data), "--out", str(out)]) == EXIT_OK
+    printed = capsys.readouterr().out
+    wrote = next(line for line in printed.splitlines() if line.startswith("wrote "))
+    listed = wrote.removeprefix("wrote ").split(" to ")[0].split(", ")
+    assert sorted(listed) == sorted(p.name for p in out.iterdir())
+    assert any(name.startswith("table_") for name in listed)
+    rows = [line for line in printed.splitlines() if line.startswith("  ")]
+    assert any(len(line.split()[0]) > 32 for line in rows)  # a name longer than the usual column
+    assert len({len(line) - len(line.lstrip()[len(line.split()[0]):].lstrip()) for line in rows}) == 1
