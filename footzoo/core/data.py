@@ -291,11 +291,12 @@ class Recording:
                             "split the file there into two recordings")
                     raise RecordingError(
                         f"column {cols[col]!r} holds the text {text[:40]!r} at row {row} (t = {float(t[row]):.6f} s), "
-                        "not a number; repair or drop that row, or pass nan_policy='interpolate'")
+                        "not a number; repair or drop that row, or interpolate it: "
+                        + option_fix("nan_policy", "interpolate"))
                 raise RecordingError(
                     f"column {cols[col]!r} has {int(bad[:, col].sum())} non-finite value(s), "
                     f"first at row {row} (t = {float(t[row]):.6f} s); drop or repair those rows, "
-                    "or pass nan_policy='interpolate'"
+                    f"or interpolate them: {option_fix('nan_policy', 'interpolate')}"
                 )
             return values
 
@@ -456,7 +457,7 @@ def validate_recording(rec: Recording) -> None:
         k = int(np.argmax(dt == 0))
         raise RecordingError(
             f"{int(np.sum(dt == 0))} duplicate time stamp(s), first at sample {k + 1} (t = {t[k]:.6f} s); "
-            "remove them, or pass duplicates='drop' to drop repeated rows (a warning gives the count)"
+            "remove them, or drop the repeated rows (a warning gives the count): " + option_fix("duplicates", "drop")
         )
     period = float(np.median(dt))
     if not RATE_RANGE[0] <= 1.0 / period <= RATE_RANGE[1]:
@@ -550,11 +551,15 @@ def _report_gaps(rec: Recording) -> None:
             f"{rec.name}: bridged {k.size} gap(s) in the time stamps (intervals over {GAP_PERIODS:g} median periods "
             f"of {period * 1e3:.2f} ms), the longest {dt[longest] * 1e3:.1f} ms at t = {rec.t[longest]:.3f} s;{lossy} "
             "the filters integrate over each sample's real interval. The list is in meta['diagnostics']['gaps']; "
-            "pass a smaller max_gap to refuse them"
+            f"to refuse them, a smaller max_gap: {option_fix('max_gap', 'SECONDS', number=True)}"
         ),
         stacklevel=4,
     )
 
+
+def option_fix(key: str, value: str, number: bool = False) -> str:
+    """How to pass a reader option, in Python and on the command line (for the messages of the data's checks)."""
+    return f"footzoo.load(path, {key}={value if number else repr(value)}), on the command line --option {key}={value}"
 
 #: How to declare a unit, in each place footzoo reads one (every reader takes ``acc_unit`` and ``gyr_unit``).
 UNIT_FIX = ("footzoo.load(path, {key}='{value}'), on the command line --option {key}={value}, "

@@ -59,7 +59,8 @@ def test_time_going_backwards():
 def test_duplicate_time_stamps_are_an_error_unless_dropped_with_a_count():
     df = frame()
     df = pd.concat([df.iloc[:30], df.iloc[[29, 29]], df.iloc[30:]]).reset_index(drop=True)
-    with pytest.raises(RecordingError, match=r"2 duplicate time stamp\(s\).*duplicates='drop'"):
+    with pytest.raises(RecordingError, match=r"2 duplicate time stamp\(s\).*duplicates='drop'\), "
+                                             "on the command line --option duplicates=drop"):
         Recording.from_dataframe(df)
     with pytest.warns(UserWarning, match=r"dropped 2 row\(s\)"):
         rec = Recording.from_dataframe(df, duplicates="drop")
