@@ -444,7 +444,10 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
 def cmd_list(args: argparse.Namespace) -> int:
     """Print every plug-in (or one kind, or one by name) with its parameters, and the config's settings."""
+    if args.plugins:
+        from ..plugins.extensions import load_plugins  # deferred: the plug-ins' imports
 
+        load_plugins(args.plugins, where="--plugins")
     if args.kind == "settings" or (args.kind is None and args.name is None):
         plugins = describe() if args.kind is None else ""
         print(plugins + ("\n" if plugins else "") + describe_settings(), end="")
@@ -853,6 +856,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="only this kind of plug-in, or the settings blocks (gravity, init, navigation, guards)")
     lst.add_argument("--compatibility", action="store_true",
                      help="print which orientation x correction combinations validate, and why not")
+    lst.add_argument("--plugins", nargs="+", metavar="FILE", default=[],
+                     help="your own plug-ins too: .py files or module names, as a config's plugins: lists them")
     lst.set_defaults(func=lambda a: cmd_list_compat(a) if a.compatibility else cmd_list(a))
 
     fmt = sub.add_parser("formats", help="list the readers (file formats) with their options, installed ones too")

@@ -50,3 +50,26 @@ def test_validate_checks_a_study_or_tune_file_without_running_it(tmp_path, capsy
                     + "tune: {objective: armse_3d_m}\n")
     assert main(["validate", str(tune)]) == 0
     assert "valid tune file: grid search, objective armse_3d_m" in capsys.readouterr().out
+
+
+def test_list_shows_a_plug_in_file_given_with_plugins(tmp_path, capsys):
+    from footzoo.plugins import registry
+
+    mine = tmp_path / "listed_detector.py"
+    mine.write_text(
+        '"""A listed detector."""\nimport numpy as np\nimport footzoo\nfrom footzoo.plugins.base import Detector\n\n\n'
+        "@footzoo.register\nclass Listed(Detector):\n"
+        '    """Stance when the rate is small.\n\n    Parameters\n    ----------\n    limit : float\n'
+        '        Largest rate in stance (rad/s).\n    """\n\n'
+        '    name = "listed_detector"\n    paper = "none"\n    units = {"limit": "rad/s"}\n\n'
+        "    def __init__(self, limit: float = 0.5):\n        self.limit = limit\n\n"
+        "    def fit_predict(self, samples):\n"
+        "        self.stance_ = np.linalg.norm(samples.gyr, axis=1) < self.limit\n        return self.stance_\n")
+    try:
+        assert main(["list", "listed_detector"]) == 2
+        assert "no plug-in named 'listed_detector'" in capsys.readouterr().err
+        assert main(["list", "listed_detector", "--plugins", str(mine)]) == 0
+        out = capsys.readouterr().out
+        assert "listed_detector — Stance when the rate is small." in out and "limit = 0.5 [rad/s]" in out
+    finally:
+        registry._REGISTRY["detector"].pop("listed_detector", None)
