@@ -53,6 +53,7 @@ class WarningLog:
         self._ctx = warnings.catch_warnings(record=True)
         self.caught: list[warnings.WarningMessage] = self._ctx.__enter__()
         self.kept: list[str] = []
+        self.unlogged: set[str] = set()
         _OPEN.log = self
         return self
 
@@ -60,15 +61,21 @@ class WarningLog:
         """Add ``"Category: message"`` texts to the log without issuing them as warnings."""
         self.kept += texts
 
+    def not_logged(self, texts: list[str]) -> None:
+        """Leave these ``"Category: message"`` texts out of the log (a summary of warnings the log lists each of);
+        they are still passed on to the caller."""
+        self.unlogged.update(texts)
+
     def texts(self) -> list[str]:
         """Every distinct warning so far, ``"Category: message"``, in order (those kept for the log last)."""
-        return list(dict.fromkeys([*warning_texts(self.caught), *self.kept]))
+        return [t for t in dict.fromkeys([*warning_texts(self.caught), *self.kept]) if t not in self.unlogged]
 
     def __exit__(self, *exc: Any) -> None:
         self._ctx.__exit__(*exc)
         _OPEN.log = self._outer
         if self._outer is not None:
             self._outer.keep(self.kept)
+            self._outer.not_logged(sorted(self.unlogged))
         for w in self.caught:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
 

@@ -407,9 +407,12 @@ def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: Warni
             replayed.append((category, f"{n} run(s): {message}" if n > 1 else message))
             continue
         log.keep([f"{name}: {n} run(s): {text.partition(': ')[2]}" if n > 1 else text for text, n in members])
-        total = sum(n for _, n in members)
-        replayed.append((category, f"{total} run(s) gave {len(members)} warnings like this one, with other numbers or "
-                                   f"recordings (each is in footzoo.log or the table's attrs['warnings']): {message}"))
+        if not quiet:  # a summary on the terminal only: the log lists each
+            total = sum(n for _, n in members)
+            summary = (f"{total} run(s) gave {len(members)} warnings like this one, with other numbers or recordings "
+                       f"(each is in footzoo.log or the table's attrs['warnings']): {message}")
+            log.not_logged([f"{category.__name__}: {summary}"])
+            replayed.append((category, summary))
     if refused:
         text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
         replayed.append((MetricWarning, f"metrics refused (NaN, see the table's note column): {text}"))
