@@ -71,7 +71,10 @@ analysed in ``benchmarks/relabel_misses.md``.
 A gyroscope in rad/s declared as deg/s reads 57.3 times too slow: the accelerometer shows a
 foot that moves (|‖f‖ − g| above :data:`MOTION_ACC` for :data:`MOTION_TIME` s) while the
 gyroscope never turns it (fewer than :data:`TURN_FRACTION` of those samples above
-:data:`TURN_RATE`); a moving foot turns at 5–20 rad/s. That is named too (and the rate is then
+:data:`TURN_RATE`); a moving foot turns at 5–20 rad/s. A recording that ends before
+:data:`MOTION_TIME` s of motion (four strides of a walk) is judged at its end, on a stricter test
+for less evidence: at least :data:`SHORT_MOTION_TIME` s of motion and a gyroscope that never
+exceeds :data:`SHORT_TURN_RATE` (20 °/s) anywhere. That is named too (and the rate is then
 not judged). An accelerometer in g or mg declared as m/s², or the reverse, and a gyroscope in
 deg/s declared as rad/s are refused when the recording is built
 (:func:`footzoo.core.data.check_units`).
@@ -153,6 +156,13 @@ MOTION_ACC = 3.0
 MOTION_TIME = 2.0
 TURN_RATE = 1.0
 TURN_FRACTION = 0.01
+#: A recording that ends before MOTION_TIME s of motion (a few strides: a simulated walk moves 0.34 s of each
+#: stride) is judged at its end if it moved at least SHORT_MOTION_TIME (s, about one stride): a gyroscope that never
+#: exceeds SHORT_TURN_RATE (rad/s) in the whole recording is then named. SHORT_TURN_RATE read as deg/s is 20 rad/s,
+#: the fastest a foot turns; a foot's peak of 3–11 rad/s (the data folder's walks and runs) declared as deg/s reads
+#: 0.05–0.19. (A crawl of the data folder moves 0.31 s in its first 12 s and peaks at 0.97 rad/s: not named.)
+SHORT_MOTION_TIME = 0.3
+SHORT_TURN_RATE = 20.0 * math.pi / 180.0
 DEG = math.pi / 180.0
 
 _WORDS = {2.0: "twice", 1.5: "1.5 times", 1.25: "1.25 times", 1.2: "1.2 times", 1.0 / 1.2: "five sixths of",
@@ -312,6 +322,7 @@ class GaitScan:
         self._motion = Motion()  # until MOTION_TIME s of motion are seen (then the gyroscope's unit is decided)
         self._unit_decided = False
         self._t_last: float | None = None
+        self._k_last = 0  # the last sample seen (where a short recording's gyroscope unit is decided)
         self._cut: int | None = None  # the first sample of a sensor dropout: the rate is judged before it
 
     def exclude_from(self, sample: int) -> None:
@@ -364,6 +375,8 @@ class GaitScan:
 
     def finish(self) -> dict[str, Any]:
         """End of the data: judge what is still pending, then every stride measured; the finding (empty: none)."""
+        if not self._unit_decided:
+            self._short_gyro_unit()
         if self._pending is not None:
             self._decide(final=True)
             self._pending = None  # judged once
@@ -410,7 +423,7 @@ class GaitScan:
     def _gyro_unit(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, w: np.ndarray) -> None:
         """Count the moving samples and how many of them turn; decide once MOTION_TIME s of motion are seen."""
         dt = np.diff(t, prepend=t[0] if self._t_last is None else self._t_last)
-        self._t_last = float(t[-1])
+        self._t_last, self._k_last = float(t[-1]), int(k[-1])
         moving = np.abs(row_norms(acc) - self.gravity) > MOTION_ACC
         if not moving.any():
             self._motion.peak_all = max(self._motion.peak_all, float(np.max(w)))
@@ -428,18 +441,34 @@ class GaitScan:
         self._unit_decided = True  # on the first MOTION_TIME s of motion
         if turning >= TURN_FRACTION * count:
             return
-        peak = self._motion.peak_moving if turning == count else self._motion.peak_all
-        self.report["gyro_unit"] = {"sample": int(k[upto - 1]), "moving_s": self._motion.seconds,
+        self._name_gyro_unit(int(k[upto - 1]), self._motion.peak_moving if turning == count else self._motion.peak_all,
+                             "")
+
+    def _short_gyro_unit(self) -> None:
+        """At the end of a recording too short for MOTION_TIME s of motion: named if it moved SHORT_MOTION_TIME s and
+        the gyroscope never exceeded TURN_RATE anywhere (a stricter test for less evidence)."""
+        self._unit_decided = True
+        m = self._motion
+        if m.seconds >= SHORT_MOTION_TIME and m.peak_all < SHORT_TURN_RATE:
+            self._name_gyro_unit(self._k_last, m.peak_all, f" (in the whole recording, which moves for less than "
+                                                           f"{MOTION_TIME:g} s: it never exceeds "
+                                                           f"{SHORT_TURN_RATE:.2f} rad/s)")
+
+    def _name_gyro_unit(self, sample: int, peak: float, short: str) -> None:
+        """Keep the finding of a gyroscope in rad/s declared as deg/s and warn with its fix."""
+        m = self._motion
+        count, turning = m.samples, m.turning
+        self.report["gyro_unit"] = {"sample": sample, "moving_s": m.seconds,
                                     "moving_samples": count, "turning_samples": turning, "peak_rate_rad_s": peak,
                                     "peak_if_rad_s": peak / DEG}
         warnings.warn(
-            f"{self.name}: the accelerometer shows {self._motion.seconds:.1f} s of motion (|‖f‖ − g| above "
+            f"{self.name}: the accelerometer shows {m.seconds:.1f} s of motion (|‖f‖ − g| above "
             f"{MOTION_ACC:g} m/s², {count} samples) but the gyroscope turns faster than {TURN_RATE:g} rad/s in "
-            f"only {turning} of them, at most {peak:.3g} rad/s: a moving foot turns at 5–20 rad/s. The gyroscope's "
-            f"values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} rad/s): declare "
-            "gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line --option gyr_unit=rad/s, "
-            "a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. Details in "
-            "diagnostics['sensor']['plausibility']",
+            f"only {turning} of them, at most {peak:.3g} rad/s{short}: a moving foot turns at 5–20 rad/s. The "
+            f"gyroscope's values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} "
+            "rad/s): declare gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line "
+            "--option gyr_unit=rad/s, a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. "
+            "Details in diagnostics['sensor']['plausibility']",
             SensorWarning, stacklevel=5,
         )
 

@@ -189,3 +189,19 @@ def test_a_wrong_rate_before_a_dropout_is_still_named(walk):
     finding = res.diagnostics["sensor"]["plausibility"]["rate"]
     assert finding["likely_rate"] == 100.0 and finding["until_sample"] < walk.n - 200
     assert sum("probably sampled at 100 Hz" in m for m in found) == 1
+
+
+def test_a_short_walk_with_its_gyroscope_in_rad_s_declared_as_deg_s_is_named_at_its_end_batch_and_live():
+    """Four strides move for 1.4 s, too little for the first test; the peak of the whole recording then decides."""
+    short = simulate(n_strides=4, rate=100.0, noise=NoiseModel(seed=3))
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(short))
+    assert "plausibility" not in res.diagnostics["sensor"] and not found  # as declared: nothing to name
+    rec = Recording(t=short.t, acc=short.acc, gyr=short.gyr * math.pi / 180.0, meta={"name": "deg"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["gyro_unit"]
+    assert 0.3 < finding["moving_s"] < 2.0  # decided on the short test, not after 2 s of motion
+    assert finding["peak_if_rad_s"] == pytest.approx(np.linalg.norm(short.gyr, axis=1).max())
+    assert len(found) == 1 and "never exceeds 0.35 rad/s" in found[0] and "gyr_unit: rad/s" in found[0]
+    stream = Stream(Pipeline.from_dict(BASE), rate=rec.rate)
+    _, live = _sensor_warnings(lambda: stream.run(rec, chunk=np.array([5, 40])))
+    assert stream.sensor["plausibility"]["gyro_unit"]["peak_if_rad_s"] == finding["peak_if_rad_s"] and len(live) == 1
