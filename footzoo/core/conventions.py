@@ -41,6 +41,8 @@ SI_UNITS: dict[str, str] = {
 ACC_UNITS: dict[str, float] = {"m/s^2": 1.0, "m/s2": 1.0, "g": GRAVITY, "mg": GRAVITY / 1000.0}
 GYR_UNITS: dict[str, float] = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 DIST_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+#: Units of a time column (seconds per unit).
+TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9, "min": 60.0, "h": 3600.0}
 
 
 def axis_map_text(rows: np.ndarray) -> str:

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from .checks import check_positive, gap_limit
-from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS
+from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS, TIME_UNITS
 from .errors import FootzooWarning, RecordingError
 from .norms import row_norms, unit_error
 from .sanity import check_impossible, scan
@@ -463,8 +463,7 @@ def validate_recording(rec: Recording) -> None:
     if not RATE_RANGE[0] <= 1.0 / period <= RATE_RANGE[1]:
         raise RecordingError(
             f"the median sampling rate is {1.0 / period:.6g} Hz (period {period:.6g}), outside the plausible "
-            f"{RATE_RANGE[0]:g}-{RATE_RANGE[1]:g} Hz of a foot-mounted IMU: are the time stamps in ms, µs or ns? "
-            "footzoo needs t in seconds (divide by 1e3, 1e6 or 1e9)"
+            f"{RATE_RANGE[0]:g}-{RATE_RANGE[1]:g} Hz of a foot-mounted IMU: {_time_unit_hint(period, t[-1] - t[0])}"
         )
     max_gap = _max_gap(rec, period)
     if np.any(dt > max_gap):
@@ -476,12 +475,31 @@ def validate_recording(rec: Recording) -> None:
         )
     duration = t[-1] - t[0]
     if duration < MIN_DURATION:
+        longer = duration * TIME_UNITS["min"] >= MIN_DURATION and RATE_RANGE[0] <= 1.0 / (period * 60.0)
         raise RecordingError(
-            f"the recording is too short to align: {duration:.3f} s; footzoo needs at least "
+            f"the recording is too short to align: {duration:.3f} s at {1.0 / period:.6g} Hz; footzoo needs at least "
             f"{MIN_DURATION} s, starting with the foot still"
+            + (f"; or {_time_unit_hint(period, duration)}" if longer else "")
         )
     _check_units(rec)
     check_impossible(t, acc, gyr)
+
+
+def _time_unit_hint(period: float, duration: float) -> str:
+    """The units of ``t`` under which a median ``period`` and a ``duration`` (both read as s) are a plausible IMU's,
+    with the fix (the time column's unit, or the factor to seconds)."""
+    fits = [(unit, scale) for unit, scale in TIME_UNITS.items() if unit != "µs" and scale != 1.0
+            and RATE_RANGE[0] <= 1.0 / (period * scale) <= RATE_RANGE[1] and duration * scale >= MIN_DURATION]
+    counter = ("if t counts samples, declare the rate instead (a sidecar's time: {rate: HZ}, or the reader's rate "
+               "option)")
+    if not fits:
+        return f"footzoo needs t in seconds; check the time column: {counter}"
+    said = "; ".join(f"in {unit}, it is {1.0 / (period * scale):.4g} Hz over {duration * scale:.4g} s "
+                     f"({'multiply' if scale > 1 else 'divide'} t by {scale if scale > 1 else 1.0 / scale:g})"
+                     for unit, scale in fits)
+    return (f"are the time stamps in {' or '.join(unit for unit, _ in fits)}? footzoo needs t in seconds: {said}; "
+            f"a sidecar declares it as time: {{column: NAME, unit: {fits[0][0]}}}"
+            + (f"; {counter}" if abs(period - 1.0) < 1e-9 else ""))
 
 
 def _check_truth(truth: Truth, n: int) -> None:

@@ -19,7 +19,7 @@ For a logger footzoo has no reader for, write ``<file>.footzoo.yaml`` next to th
     closed_loop: false                        # optional: the walk ends where it started
 
 Columns are named as in the header line, or given by position (0 is the first column) when
-``header: false`` (positions work with a header too). Units: time ``s``, ``ms``, ``us``, ``ns``, or
+``header: false`` (positions work with a header too). Units: time ``s``, ``ms``, ``us``, ``ns``, ``min``, ``h``, or
 ``datetime`` for date-time text such as ``2025-01-01T10:00:00.125`` (seconds since the Unix epoch;
 a double holds them to about 0.2 µs); acc ``m/s^2``, ``g``, ``mg``; gyr
 ``rad/s``, ``deg/s``; mag any (direction only). The axis map is a signed permutation or a
@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.conventions import ACC_UNITS, GYR_UNITS
+from ..core.conventions import TIME_UNITS as SECONDS_PER_UNIT
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError, did_you_mean
 from ..core.yamlsafe import load_file
@@ -47,7 +48,7 @@ SIDECAR_SUFFIX = ".footzoo.yaml"
 #: Keys of a description.
 KEYS = ("time", "acc", "gyr", "mag", "axes", "delimiter", "decimal", "skip_rows", "header", "comment", "meta",
         "closed_loop")
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "ns": 1e-9, "datetime": None}
+TIME_UNITS: dict[str, float | None] = {**SECONDS_PER_UNIT, "datetime": None}
 DELIMITERS = {",": ",", ";": ";", "\t": "\t", "\\t": "\t", "tab": "\t", " ": r"\s+", "whitespace": r"\s+"}
 
 #: Where the description format is documented, for the messages.
@@ -152,7 +153,7 @@ class _Spec:
             return {"rate": float(rate)}
         extra = [k for k in spec if k not in ("column", "unit")]
         if extra or "column" not in spec:
-            self.fail("time", f"expected {{column: NAME, unit: s|ms|us|ns}} or {{rate: HZ}}, got {spec!r:.80}")
+            self.fail("time", f"expected {{column: NAME, unit: s|ms|us|ns|min|h}} or {{rate: HZ}}, got {spec!r:.80}")
         unit = spec.get("unit", "s")
         if unit not in TIME_UNITS:
             self.fail("time.unit", f"{unit!r} is not a time unit; use one of {list(TIME_UNITS)}")

@@ -76,8 +76,33 @@ def test_gaps_are_reported_with_their_length_and_place():
 
 
 def test_too_short_to_align():
-    with pytest.raises(RecordingError, match="too short to align"):
+    with pytest.raises(RecordingError, match="too short to align") as err:
         Recording.from_dataframe(frame().iloc[:50])
+    assert "min" not in str(err.value)  # 0.49 s at 100 Hz: no other unit makes it a plausible recording
+
+
+@pytest.mark.parametrize("unit, seconds, fix", [
+    ("min", 60.0, "multiply t by 60"),  # 100 Hz read as 6000 Hz over 0.067 s: too short, not too fast
+    ("h", 3600.0, "multiply t by 3600"),
+    ("ms", 1e-3, "divide t by 1000"),
+    ("us", 1e-6, "divide t by 1e+06"),
+])
+def test_a_time_column_in_another_unit_is_named_with_the_unit_that_makes_it_plausible(unit, seconds, fix):
+    df = frame()
+    df["t"] = df["t"] / seconds
+    with pytest.raises(RecordingError) as err:
+        Recording.from_dataframe(df)
+    text = str(err.value)
+    assert (f"are the time stamps in {unit}?" in text and "it is 100 Hz over 3.99 s" in text and fix in text
+            and f"unit: {unit}}}" in text)
+
+
+def test_a_sample_counter_as_time_is_told_to_declare_the_rate():
+    df = frame()
+    df["t"] = np.arange(len(df), dtype=float)
+    with pytest.raises(RecordingError, match=r"the median sampling rate is 1 Hz.*if t counts samples, declare the "
+                                             r"rate instead"):
+        Recording.from_dataframe(df)
 
 
 def test_acc_in_g_is_recognised():

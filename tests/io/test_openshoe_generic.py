@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo import FormatError
+from footzoo import FormatError, RecordingError
 from footzoo.core.conventions import GRAVITY
 from footzoo.core.errors import FootzooWarning
 from footzoo.io import detect_format, load
@@ -145,6 +145,18 @@ def generic_text(rec) -> str:
     return "\n".join(lines) + "\n"
 
 
+def test_a_time_column_in_minutes_is_declared_or_named(walk, tmp_path):
+    p = tmp_path / "minutes.csv"
+    pd.DataFrame({"T": walk.t / 60.0, **{f"a{i}": walk.acc[:, i] for i in range(3)},
+                  **{f"w{i}": walk.gyr[:, i] for i in range(3)}}).to_csv(p, index=False)
+    blocks = "acc: {columns: [a0, a1, a2], unit: m/s^2}\ngyr: {columns: [w0, w1, w2], unit: rad/s}\naxes: [x, y, z]\n"
+    (tmp_path / "minutes.csv.footzoo.yaml").write_text("time: {column: T, unit: s}\n" + blocks)
+    with pytest.raises(RecordingError, match=r"are the time stamps in min\?.*multiply t by 60.*unit: min"):
+        load(p)
+    (tmp_path / "minutes.csv.footzoo.yaml").write_text("time: {column: T, unit: min}\n" + blocks)
+    np.testing.assert_allclose(load(p).t, walk.t, rtol=1e-12, atol=1e-12)
+
+
 def test_a_described_csv_comes_back_in_frd_si(walk, tmp_path):
     p = tmp_path / "walk.csv"
     p.write_text(generic_text(walk))
@@ -185,7 +197,7 @@ def test_a_rotation_matrix_and_a_shared_description_without_header(walk, tmp_pat
     ("acc: {columns: [AccX, AccY, AccZ]}", "acc.unit: missing"),
     ("time: {column: Time, unit: ms}", r"column\(s\) \['Time'\] named in walk.csv.footzoo.yaml are not in the file "
                                        r"\(did you mean 'Time \[ms\]'\?\)"),
-    ("time: {column: 'Time [ms]', unit: min}", "'min' is not a time unit"),
+    ("time: {column: 'Time [ms]', unit: minutes}", "'minutes' is not a time unit"),
     ("gyro: {columns: [GyrX, GyrY, GyrZ], unit: deg/s}", r"unknown key \(did you mean 'gyr'\?\)"),
     ("delimiter: ','", "the decimal mark cannot be the delimiter too"),
 ])
