@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import configparser
 import importlib
+import re
 import sys
 import warnings
 from importlib.metadata import PackageNotFoundError, distribution, entry_points
@@ -252,3 +253,16 @@ def test_the_installed_example_package_loads_a_file_by_footzoo_load(tmp_path, wa
     with warnings.catch_warnings():
         warnings.simplefilter("error", FootzooWarning)  # no reader skipped
         check_example_reads(data, walk)
+
+
+@pytest.mark.parametrize("first, found", [("# imulog 2.0", "'2.0'"), ("# imulog", "'(none given)'")])
+def test_the_example_reader_names_a_version_it_does_not_read_and_the_ones_it_reads(on_path, tmp_path, walk, first,
+                                                                                     found):
+    install_fake(on_path, "footzoo-imulog", None, None, {"imulog": "footzoo_imulog:ImuLogReader"})
+    on_path.joinpath("footzoo_imulog.py").write_text((EXAMPLE / "footzoo_imulog.py").read_text())
+    rediscover()
+    data = tmp_path / "walk.imulog"
+    data.write_text(imulog_text(walk).replace("# imulog 1.0", first, 1))
+    with pytest.raises(FormatError, match=rf"an imulog file of version {re.escape(found)}; this reader "
+                                          r"\(footzoo-imulog\) reads version\(s\) 1.0: update footzoo-imulog"):
+        footzoo.load(data)

@@ -26,10 +26,18 @@ from footzoo.core.conventions import GRAVITY
 from footzoo.io import Option, Reader
 from footzoo.io.base import RECORDING_OPTIONS, first_line
 
-SIGNATURE = "# imulog 1.0"
+#: The first line of every imulog file is ``# imulog VERSION``; this reader reads the versions of VERSIONS.
+SIGNATURE = ("#", "imulog")
+VERSIONS = ("1.0",)
 #: Logger axes -> FRD: strapped on the instep the logger's y points left and z up (180° about x); mounted
 #: under the sole (upside down, toe still forward) its z points down and y right already.
 AXES = {"instep": np.diag([1.0, -1.0, -1.0]), "sole": np.eye(3)}
+
+
+def version_of(path: Path) -> str | None:
+    """The version an imulog file's first line names (``""``: none named); None when it is no imulog file."""
+    words = first_line(path).split()
+    return " ".join(words[2:]) if tuple(words[:2]) == SIGNATURE else None
 
 
 class ImuLogReader(Reader):
@@ -44,11 +52,17 @@ class ImuLogReader(Reader):
     url = "https://example.org/footlogger-3"
 
     def guess_can_open(self, path: Path) -> bool:
-        """A file whose first line is ``# imulog 1.0`` (cheap: one line is read)."""
-        return Path(path).suffix.lower() in self.extensions and first_line(path).strip() == SIGNATURE
+        """A file whose first line is ``# imulog VERSION``, of any version (cheap: one line is read); :meth:`open`
+        refuses a version it does not read, by name."""
+        return Path(path).suffix.lower() in self.extensions and version_of(path) is not None
 
     def open(self, path: Path, mounting: str = "instep", max_gap: float | None = None) -> Recording:
         """Read the file into a footzoo Recording (FRD, SI)."""
+        version = version_of(path)
+        if version not in VERSIONS:
+            raise FormatError(f"{path}: an imulog file of version {version or '(none given)'!r}; this reader "
+                              f"(footzoo-imulog) reads version(s) {', '.join(VERSIONS)}: update footzoo-imulog, or "
+                              "export the file from the logger as version 1.0")
         if mounting not in AXES:
             raise FormatError(f"{path}: mounting={mounting!r}: use one of {sorted(AXES)}")
         table = pd.read_csv(path, sep=r"\s+", comment="#", header=None).to_numpy(dtype=float)
