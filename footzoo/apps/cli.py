@@ -49,7 +49,7 @@ from ..core.errors import (
     RecordingError,
     did_you_mean,
 )
-from ..core.files import why_missing
+from ..core.files import nul_in_path, why_missing
 from ..core.params import describe as describe_parameters
 from ..core.warninglog import LOG, log_text, warning_texts
 from ..io.registry import BUILTIN
@@ -94,6 +94,8 @@ def _output(text: str) -> str:
     """An argparse ``type`` for ``--out``: a non-empty path (an empty one would write nothing, silently)."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
     return text
 
 
@@ -118,12 +120,16 @@ def _input_yaml(text: str) -> str:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty name; give a shipped config's name (footzoo configs lists them) "
                                          "or the path of a YAML file")
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the name {nul_in_path(text)}")
     return text
 
 def _destination(text: str) -> str:
     """An argparse ``type`` for ``--to``: a non-empty path (an empty one would silently mean here)."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path; give a folder or file name (or leave --to out: here)")
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
     return text
 
 EXIT_OK = 0

@@ -66,6 +66,9 @@ def resolve(spec: str | Path) -> Path:
     ConfigError
         When ``spec`` is neither an existing file nor a shipped config's name.
     """
+    if not isinstance(spec, (str, os.PathLike)):
+        raise ConfigError(f"a config is a shipped config's name or the path of a YAML file, got {type(spec).__name__} "
+                          f"{spec!r:.80}; a mapping goes to Pipeline.from_dict")
     if not str(spec).strip():
         raise ConfigError("the config is an empty name; give a shipped config's name (footzoo configs lists them) "
                           "or the path of a YAML file")

@@ -109,7 +109,9 @@ def is_study_file(d: Any) -> bool:
 def top_level_errors(d: dict[str, Any]) -> list[str]:
     """Every problem with the top-level keys of a config (unknown, missing, badly typed), as messages."""
     if not isinstance(d, dict):
-        return [f"a config must be a mapping, got {type(d).__name__}"]
+        hint = (f": a shipped config's name or a YAML file goes to Pipeline.from_yaml({d!r:.60})" if isinstance(d, str)
+                else " of keys (orientation, detector, corrections, ...)")
+        return [f"a config must be a mapping, got {type(d).__name__}{hint}"]
     if is_study_file(d):
         kind = "tune" if "tune" in d else "study"
         verb = "footzoo tune" if kind == "tune" else "footzoo ablate"

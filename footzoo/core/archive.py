@@ -52,6 +52,7 @@ from .._version import __version__
 from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, json_safe, previous_marker
 from .data import Truth
 from .errors import FootzooWarning, FormatError, OutputError
+from .files import nul_in_path
 
 FORMAT = "footzoo-result"
 SESSION_FORMAT = "footzoo-session-result"
@@ -319,7 +320,8 @@ def _earlier_files(folder: Path, kind: str) -> set[str] | None:
 @contextlib.contextmanager
 def _new_folder(path: str | os.PathLike, what: str) -> Any:
     """The archive folder (created if needed); a folder created here is removed again when the save fails."""
-    existed = Path(path).is_dir() if isinstance(path, (str, os.PathLike)) and str(path).strip() else False
+    existed = (Path(path).is_dir() if isinstance(path, (str, os.PathLike)) and str(path).strip()
+               and not nul_in_path(path) else False)
     folder = _prepare_folder(path, what)
     try:
         yield folder
@@ -332,6 +334,8 @@ def _new_folder(path: str | os.PathLike, what: str) -> Any:
 def _prepare_folder(path: str | os.PathLike, what: str) -> Path:
     if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
         raise OutputError(f"{what}: give a folder path (got {path!r:.80})")
+    if nul_in_path(path):
+        raise OutputError(f"{what} {nul_in_path(path)}")
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{what} {str(folder)!r} is a file; a result is saved as a folder: choose a folder name")

@@ -50,6 +50,7 @@ from typing import IO, Any
 
 from .._version import __version__
 from .errors import FormatError, OutputError
+from .files import nul_in_path
 
 #: Infix of the temporary files (a leftover one, from a killed process, can be deleted).
 TMP_INFIX = ".footzoo-tmp-"
@@ -71,6 +72,8 @@ def check_target(path: PathLike, what: str = "output") -> Path:
         raise OutputError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
     if not str(path).strip():
         raise OutputError(f"{what} is an empty path; give a file name")
+    if nul_in_path(path):
+        raise OutputError(f"{what} {nul_in_path(path)}")
     p = Path(path)
     if p.is_dir():
         raise OutputError(f"{what} {str(p)!r} is a directory; give a file name")

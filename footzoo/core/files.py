@@ -25,6 +25,16 @@ FOREIGN_BOMS = ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32")
 SNIFF_BYTES = 4096
 
 
+def nul_in_path(path: str | os.PathLike | bytes) -> str | None:
+    """Why ``path`` cannot name a file because it holds a NUL character (no file system allows one), or None."""
+    text = os.fsdecode(path) if isinstance(path, (str, bytes, os.PathLike)) else ""
+    k = text.find("\0")
+    if k < 0:
+        return None
+    return (f"{text!r} holds a NUL character (\\x00) at position {k}, which no file name can: check how the path "
+            "was built (a C string, a padded field, a pasted value)")
+
+
 def why_missing(path: str | os.PathLike) -> str:
     """Why ``path`` cannot be opened although it was named: ``"does not exist"``, a dangling link or a link loop."""
     p = Path(path)

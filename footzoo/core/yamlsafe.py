@@ -34,7 +34,7 @@ from yaml.constructor import ConstructorError
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from .errors import ConfigError
-from .files import damaged_text, foreign_encoding, nul_padding, why_missing
+from .files import damaged_text, foreign_encoding, nul_in_path, nul_padding, why_missing
 
 #: Largest YAML file read (bytes).
 MAX_BYTES = 1 << 20
@@ -234,6 +234,8 @@ def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str 
     """
     if isinstance(path, str) and not path.strip():
         raise error(f"{what} is an empty path ('' would read the current folder); give the path of a YAML file")
+    if nul_in_path(path):
+        raise error(f"{what} {nul_in_path(path)}")
     p = Path(path)
     if p.suffix.lower() in RECORDING_SUFFIXES and p.suffix.lower() != ".txt":
         raise error(f"{str(p)!r} is a recording ({p.suffix} file), not a {what} (YAML): a recording goes to --data, "

@@ -39,7 +39,7 @@ import numpy as np
 from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
-from ..core.files import not_utf8, why_missing
+from ..core.files import not_utf8, nul_in_path, why_missing
 from . import xio
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import REQUIRED, Option, Reader
@@ -73,6 +73,8 @@ def check_input_file(path: str | Path, what: str = "recording") -> Path:
         raise FormatError(f"{what} must be a file path (str or Path), got {type(path).__name__} {path!r:.80}")
     if not str(path).strip():
         raise FormatError(f"{what} is an empty path; give the path of a recording file")
+    if nul_in_path(path):
+        raise FormatError(f"{what} {nul_in_path(path)}")
     p = Path(path)
     try:
         if not p.exists():

@@ -360,6 +360,9 @@ def returned(plugin: Any, method: str, names: list[str], args: tuple, kwargs: di
         if getattr(result, "kind", None) != plugin.kind or not hasattr(result, "get_params"):
             raise broken(plugin, method, f"returned {type(result).__name__}, not the plug-in: end {method}() with "
                                          "'return self'")
+        if result is not plugin:  # another plug-in's results would be read as this one's
+            raise broken(plugin, method, f"returned another {type(result).__name__} object, not itself: set the "
+                                         f"results on self and end {method}() with 'return self'")
         if method != "begin":
             check_attributes(result, method, _samples(names, args, kwargs))
     elif method in RETURNS_CHUNK:

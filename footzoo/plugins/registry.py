@@ -59,6 +59,9 @@ def register(cls: type[Plugin]) -> type[Plugin]:
     if source is not None:
         _load_builtin()  # a plug-in from outside may not take a built-in's name: known now, not at the first lookup
     old = _REGISTRY[cls.kind].get(cls.name)
+    if old is not None and old is not cls and old.__module__ == cls.__module__ and old.__qualname__ != cls.__qualname__:
+        raise ValueError(f"{cls.__qualname__}: a {cls.kind} plug-in named {cls.name!r} is already registered by "
+                         f"{old.__qualname__} of the same module; give each class its own name")
     if old is not None and old is not cls and old.__module__ != cls.__module__:
         # a module executed again (an edited plug-in file loaded again) replaces its own registrations
         old_source = _SOURCES.get(old)
@@ -79,7 +82,7 @@ _SOURCES: dict[type, tuple[str, str, str]] = {}
 
 def _source(cls: type) -> tuple[str, str, str] | None:
     """Where a plug-in class comes from: its resolved source file, qualified name and the file's hash."""
-    if cls.__module__.startswith("footzoo."):
+    if _builtin(cls):
         return None  # a built-in: its name is its identity
     module = sys.modules.get(cls.__module__)
     path = getattr(module, "__file__", None)
@@ -90,6 +93,11 @@ def _source(cls: type) -> tuple[str, str, str] | None:
     except OSError:
         return None
     return str(Path(path).resolve()), cls.__qualname__, digest
+
+
+def _builtin(cls: type) -> bool:
+    """Whether the class is one of footzoo's own plug-ins (a script's or a notebook's class is not, file or none)."""
+    return cls.__module__.startswith("footzoo.")
 
 
 def _by_loader(cls: type) -> bool:
@@ -160,7 +168,7 @@ def build(kind: str, spec: dict[str, Any] | str, where: str = "") -> Plugin:
     except (KeyboardInterrupt, MemoryError):
         raise
     except BaseException as err:  # noqa: BLE001 - any failure of a plug-in's own constructor is a named error
-        if _source(cls) is None:
+        if _builtin(cls):
             raise
         raise _constructor_fault(cls, err) from err
 

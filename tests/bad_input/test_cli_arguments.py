@@ -71,6 +71,13 @@ CASES = [
     ("still-text", lambda d, w: ["calibrate", "--data", str(w), "--still", "a", "b", "--out", str(d / "f.yaml")],
      EXIT_USAGE, "argument --still: 'a' is not a number"),
     ("ablate-out-empty", lambda d, w: ["ablate", str(QUICK), "--out", ""], EXIT_USAGE, "argument --out: an empty path"),
+    # a NUL character no file name can hold (was: internal error, ValueError: embedded null byte)
+    ("run-out-nul", lambda d, w: ["run", "yun2012", "--data", str(w), "--out", "o\x00ut"], EXIT_USAGE,
+     "argument --out: the path 'o\\x00ut' holds a NUL character (\\x00) at position 1, which no file name can"),
+    ("run-data-nul", lambda d, w: ["run", "yun2012", "--data", "wa\x00lk.csv"], EXIT_DATA,
+     "recording 'wa\\x00lk.csv' holds a NUL character"),
+    ("configs-to-nul", lambda d, w: ["configs", "--copy", "yun2012", "--to", "a\x00.yaml"], EXIT_USAGE,
+     "argument --to: the path 'a\\x00.yaml' holds a NUL character"),
     # a malformed scheduler address, before any work (Dask's own parser would fail late, with a bare ValueError)
     *[(f"scheduler-{i}", lambda d, w, a=a: ["ablate", str(QUICK), "--scheduler", a], EXIT_USAGE, fragment)
       for i, (a, fragment) in enumerate([

@@ -66,3 +66,30 @@ def test_an_argument_of_the_wrong_kind_is_both_the_subjects_error_and_a_type_err
             call()
         assert isinstance(info.value, subject) and isinstance(info.value, TypeError)
         assert "footzoo." in str(info.value) or "Pipeline.from_yaml" in str(info.value)
+
+
+# yun2012 fits a hard-iron calibration, which this straight simulated walk cannot give (expected warning)
+@pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)
+def test_a_path_with_a_nul_character_is_named_not_a_crash(sim_walk, tmp_path):
+    """Before: ValueError (embedded null byte) from pathlib, for a result folder; for a recording: 'no such file'."""
+    from footzoo.core.errors import OutputError
+
+    res = footzoo.Pipeline.from_yaml("yun2012").run(sim_walk)
+    with pytest.raises(OutputError, match=r"Result.save '.*r\\x00es' holds a NUL character \(\\x00\) at position"):
+        res.save(str(tmp_path / "r\x00es"))
+    with pytest.raises(footzoo.FormatError, match=r"recording 'walk\\x00.csv' holds a NUL character"):
+        footzoo.load("walk\x00.csv")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: footzoo.Pipeline.from_yaml(None), r"a config is a shipped config's name or the path of a YAML file, got "
+                                               r"NoneType None; a mapping goes to Pipeline.from_dict"),
+    (lambda: footzoo.Pipeline.from_yaml({"detector": {"type": "shoe"}}), r"got dict .*Pipeline.from_dict"),
+    (lambda: footzoo.Pipeline.from_dict("yun2012"), r"a config must be a mapping, got str: a shipped config's name or "
+                                                   r"a YAML file goes to Pipeline.from_yaml\('yun2012'\)"),
+])
+def test_a_config_of_the_wrong_kind_says_which_constructor_takes_it(call, message):
+    """Before: TypeError from pathlib for from_yaml(None)."""
+    with pytest.raises(footzoo.ConfigError, match=message):
+        call()

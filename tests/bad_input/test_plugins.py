@@ -208,6 +208,16 @@ class WrongCalibration(Calibration):
         return self
 
 
+@faulty
+class ReturnsAnother(AngularRateFSM):
+    """Returns a built-in detector it made, not itself (its results would be read as the plug-in's)."""
+
+    name = "test_fault_returns_another"
+
+    def detect(self, t, acc, gyr, ctx=None):
+        return AngularRateFSM().detect(t[:10], acc[:10], gyr[:10])
+
+
 def _config(**parts):
     base = {"name": "faulty", "orientation": {"type": "madgwick", "use_magnetometer": False},
             "detector": {"type": "angular_rate_fsm"}, "corrections": [{"type": "zvu_dedrift"}]}
@@ -218,6 +228,10 @@ BATCH = [
     ("raising", _config(detector={"type": "test_fault_raising"}), "detect", "ZeroDivisionError"),
     ("exiting", _config(detector={"type": "test_fault_exiting"}), "detect", "never exit the process"),
     ("no_return", _config(detector={"type": "test_fault_no_return"}), "detect", "return self"),
+    # before: the error named the built-in angular_rate_fsm, whose shapes were wrong, not the plug-in
+    ("returns_another", _config(detector={"type": "test_fault_returns_another"}), "detect",
+     r"returned another AngularRateFSM object, not itself: set the results on self and end detect\(\) with 'return "
+     "self'"),
     ("nan_stance", _config(detector={"type": "test_fault_nan_stance"}), "detect", "NaN is not stance"),
     ("short_stance", _config(detector={"type": "test_fault_short_stance"}), "detect", r"shape \(\d+,\)"),
     ("mutating", _config(detector={"type": "test_fault_mutating"}), "detect", "copy it first"),
@@ -426,3 +440,34 @@ def test_a_plugin_that_raises_in_its_constructor_or_takes_a_builtin_name_is_a_pl
         err = capsys.readouterr().err
         assert all(e in err for e in expected) and "internal error" not in err and "Traceback" not in err
     assert registry._REGISTRY["detector"]["shoe"].__module__ == "footzoo.detectors.shoe"
+
+
+def test_two_classes_of_one_module_under_one_name_are_refused_and_a_redefinition_replaces():
+    """A notebook or script: two classes under one name was silently the second; one class defined again replaces."""
+    namespace: dict = {}
+    source = ("import footzoo\nfrom footzoo.detectors.angular_rate_fsm import AngularRateFSM\n"
+              "@footzoo.register\nclass {cls}(AngularRateFSM):\n    '''A copy.'''\n    name = 'test_twice'\n")
+    try:
+        exec(source.format(cls="First"), namespace)
+        exec(source.format(cls="First"), namespace)  # the cell run again: the new class replaces the old
+        assert registry.get("detector", "test_twice") is namespace["First"]
+        with pytest.raises(ValueError, match="Second: a detector plug-in named 'test_twice' is already registered by "
+                                             "First of the same module; give each class its own name"):
+            exec(source.format(cls="Second"), namespace)
+    finally:
+        registry._REGISTRY["detector"].pop("test_twice", None)
+
+
+def test_a_notebook_plugin_that_raises_in_its_constructor_is_a_plugin_error(walk):
+    """A class with no source file (a notebook's, an exec'd one) was taken for a built-in: its error escaped raw."""
+    namespace: dict = {}
+    exec("import footzoo\nfrom footzoo.detectors.angular_rate_fsm import AngularRateFSM\n@footzoo.register\n"
+         "class NoLicence(AngularRateFSM):\n    '''Fails to start.'''\n    name = 'test_no_licence'\n"
+         "    def __init__(self, threshold=0.6, min_duration=0.1):\n        raise RuntimeError('no licence')\n",
+         namespace)
+    try:
+        with pytest.raises(PluginError, match=r"detector 'test_no_licence' .* failed in __init__\(\): RuntimeError: "
+                                              "no licence; fix the plug-in"):
+            Pipeline.from_dict(_config(detector={"type": "test_no_licence"}))
+    finally:
+        registry._REGISTRY["detector"].pop("test_no_licence", None)
