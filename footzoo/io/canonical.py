@@ -14,6 +14,7 @@ removes the steps sidecar of an earlier file of the same name when the new one h
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -192,8 +193,21 @@ class CanonicalReader(Reader):
         return read(path, **options)
 
 
+def written_by_footzoo(path: Path) -> bool:
+    """Whether the file ``path`` (a link: the file it names) is as :func:`write` left it: its metadata sidecar names
+    its SHA-256."""
+    side = meta_path(path.resolve())
+    try:
+        found = re.search(r"^data_sha256:\s*([0-9a-f]{64})\s*$", side.read_text(encoding="utf-8", errors="replace"),
+                          re.M)
+    except OSError:
+        return False
+    return found is not None and found.group(1) == sha256(path)
+
+
 def check_output(path: str | Path) -> Path:
-    """``path`` when :func:`write` writes its extension (``.csv``, ``.parquet``, ``.pq``), else an OutputError."""
+    """``path`` when :func:`write` writes its extension (``.csv``, ``.parquet``, ``.pq``) and may replace what is there
+    (nothing, or a recording it wrote: never a user's file), else an OutputError."""
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix not in (*CSV_SUFFIXES, *PARQUET_SUFFIXES):
@@ -203,6 +217,10 @@ def check_output(path: str | Path) -> Path:
         if not parquet_available():
             raise OutputError(f"{str(p)!r}: writing Parquet needs pyarrow (pip install 'footzoo[parquet]'); "
                               "or write .csv")
+    if p.is_file() and not written_by_footzoo(p):
+        raise OutputError(f"{str(p)!r} exists and is not a recording footzoo wrote (no {meta_path(p).name} describes "
+                          "it as it is): footzoo replaces only its own outputs; choose another name, or delete or "
+                          "move the file first")
     for side, holds in ((meta_path(p), "its metadata"), (steps_path(p), "its true strides")):
         if side.is_dir():
             raise OutputError(f"{str(p)!r}: its sidecar {side.name} ({holds}, written next to it) cannot be written: "
@@ -216,7 +234,8 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
     The data file, its metadata sidecar ``<file>.meta.yaml`` and the true-steps sidecar
     ``<file>.steps.csv`` (when the truth has steps) are written as one unit: all or nothing
     replaces an earlier version, and an earlier steps sidecar is removed when the recording has
-    none. The recording's own input files are never overwritten.
+    none. The recording's own input files are never overwritten, nor a file footzoo did not
+    write (:func:`written_by_footzoo`).
 
     Parameters
     ----------

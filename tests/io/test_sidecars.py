@@ -8,7 +8,7 @@ import shutil
 
 import pytest
 
-from footzoo.core.errors import FootzooWarning
+from footzoo.core.errors import FootzooWarning, OutputError
 from footzoo.io import builtin_sample, load
 from footzoo.io.canonical import write
 from footzoo.sim import NoiseModel, simulate
@@ -59,9 +59,15 @@ def test_stale_sidecars_of_an_earlier_file_are_never_the_reference(tmp_path):
                                             r"together with walk.csv.steps.csv"):
         rec = load(p)
     assert rec.truth.steps is None and rec.truth.stride_count is None and rec.meta["name"] == "walk"
-    # footzoo's writer replaces the data and its sidecars together, and removes a steps file the new one lacks
+    # the hand-copied file is not footzoo's to replace; once it is gone, footzoo's writer replaces the stale sidecars
+    # together with the data, and removes a steps file the new one lacks
     no_steps = simulate(n_strides=3, rate=100.0, noise=NoiseModel(seed=3))
     no_steps.truth.steps = None
+    with pytest.raises(OutputError, match=r"'.*walk.csv' exists and is not a recording footzoo wrote \(no "
+                                          r"walk.csv.meta.yaml describes it as it is\)"):
+        write(no_steps, p)
+    assert p.read_bytes() == other.read_bytes()
+    p.unlink()
     write(no_steps, p)
     assert not p.with_name("walk.csv.steps.csv").exists()
     # a steps file put next to a hashed sidecar later is not vouched for

@@ -49,3 +49,21 @@ def test_a_sidecar_that_cannot_be_written_leaves_no_data_file_without_it(tmp_pat
     with pytest.raises(OSError):
         write(old, tmp_path / "new.csv")
     assert sorted(f.name for f in tmp_path.iterdir()) == sorted(before)  # no data file without its sidecar
+
+
+def test_the_writer_replaces_its_own_recording_but_never_a_users_file(tmp_path):
+    """``footzoo simulate --out notes.csv`` replaced a user's file of that name without a word (data loss)."""
+    from footzoo.apps.cli import EXIT_DATA, main
+
+    rec = simulate(n_strides=3, rate=100.0, noise=NoiseModel(seed=1))
+    notes = tmp_path / "notes.csv"
+    notes.write_text("my notes, not a recording\n")
+    with pytest.raises(OutputError, match=r"'.*notes.csv' exists and is not a recording footzoo wrote \(no "
+                                          r"notes.csv.meta.yaml describes it as it is\): footzoo replaces only its own "
+                                          r"outputs; choose another name, or delete or move the file first"):
+        write(rec, notes)
+    assert main(["simulate", "straight", "--strides", "3", "--out", str(notes)]) == EXIT_DATA
+    assert notes.read_text() == "my notes, not a recording\n" and sorted(tmp_path.iterdir()) == [notes]
+    own = write(rec, tmp_path / "walk.csv")
+    assert write(simulate(n_strides=4, rate=100.0), own) == own  # footzoo's own recording is replaced, as before
+    assert load(own).n > rec.n
