@@ -206,7 +206,7 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
     except _LimitError as err:
         raise error(f"{source}: YAML refused: {err}") from None
     except yaml.YAMLError as err:
-        raise error(f"{source}: not valid YAML: {err}") from None
+        raise error(f"{source}: not valid YAML: {err}{_tab_hint(err)}") from None
     except (ValueError, TypeError, OverflowError) as err:
         raise error(f"{source}: not valid YAML: bad value: {err}") from None
     except RecursionError:
@@ -218,6 +218,15 @@ def load_text(text: str, source: str = "<string>", error: type[Exception] = Conf
 
 #: Extensions of recordings, named when one is given where a YAML file is expected.
 RECORDING_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq", ".mat", ".gz", ".zip", ".npz", ".h5")
+
+
+def _tab_hint(err: yaml.YAMLError) -> str:
+    """The fix of the most common YAML mistake, a tab in the indentation (YAML forbids tabs there)."""
+    mark = getattr(err, "problem_mark", None)
+    if "'\\t'" not in str(err) or mark is None:
+        return ""
+    return (f"\nYAML allows no tab there (it indents with spaces only): replace the tab at line {mark.line + 1}, "
+            f"column {mark.column + 1} by spaces")
 
 
 def load_file(path: str | Path, error: type[Exception] = ConfigError, what: str = "YAML file") -> Any:

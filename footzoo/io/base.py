@@ -22,6 +22,7 @@ too, in footzoo's ``setup.cfg``); :func:`footzoo.io.load` finds them there (see
 
 from __future__ import annotations
 
+import importlib
 import io
 import re
 import warnings
@@ -186,7 +187,7 @@ def first_line(path: str | Path) -> str:
     Leading blank lines (a logger's empty first line) are skipped; at most
     :data:`HEADER_MAX_CHARS` characters of the line are read. Bytes that are not UTF-8 are replaced.
     """
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+    with _open_text(Path(path)) as fh:
         for _ in range(MAX_BLANK_LINES):
             line = fh.readline(HEADER_MAX_CHARS)
             if not line:
@@ -194,6 +195,25 @@ def first_line(path: str | Path) -> str:
             if line.strip():
                 return line.rstrip("\r\n")
     return ""
+
+
+def _open_text(path: Path) -> Any:
+    """The text of a file for sniffing its header: decompressed for ``.gz``, ``.bz2`` and ``.xz`` (as pandas reads
+    them), as it is otherwise (a ``.zip`` or ``.zst`` shows its binary start, which no reader claims)."""
+    opener = {".gz": "gzip", ".bz2": "bz2", ".xz": "lzma"}.get(path.suffix.lower())
+    if opener is None:
+        return open(path, encoding="utf-8-sig", errors="replace")
+    module = importlib.import_module(opener)
+    return module.open(path, "rt", encoding="utf-8-sig", errors="replace")
+
+
+def data_suffix(path: str | Path) -> str:
+    """The extension of the data, lower case: that of the file, or the one before a compression suffix
+    (``walk.csv.gz``: ``.csv``), so that a reader of text tables claims their compressed copies too."""
+    p = Path(path)
+    if p.suffix.lower() in COMPRESSED and len(p.suffixes) >= 2:
+        return p.suffixes[-2].lower()
+    return p.suffix.lower()
 
 
 def has_extension(path: str | Path, *suffixes: str) -> bool:

@@ -35,6 +35,7 @@ from .base import (
     Option,
     Reader,
     check_unique_columns,
+    data_suffix,
     first_line,
     frame_options,
     input_files,
@@ -84,6 +85,8 @@ def read(path: Path, axes: Any = AXES, **options: Any) -> Recording:
         raise
     except (ValueError, OSError, pd.errors.ParserError) as err:
         raise FormatError(f"{path}: cannot read as canonical CSV/Parquet: {err}") from None
+    # a header written 't, acc_x, ...' is recognised (matches strips the names): read it with the same names
+    df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
     check_unique_columns(df, path)
     _warn_unread(df.columns, path)
     if not np.array_equal(rows, np.eye(3)):
@@ -184,7 +187,7 @@ class CanonicalReader(Reader):
     }
 
     def guess_can_open(self, path: Path) -> bool:
-        suffix = Path(path).suffix.lower()
+        suffix = data_suffix(path)
         if suffix in PARQUET_SUFFIXES:
             return True
         return suffix in (*CSV_SUFFIXES, ".txt") and matches(first_line(path))

@@ -31,7 +31,7 @@ from ..core.checks import check_positive, check_range, gap_limit
 from ..core.data import Recording, Truth
 from ..core.errors import FootzooWarning, FormatError
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, first_line, frame_options, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, data_suffix, first_line, frame_options, text_source
 from .gaitmap_reference import REFERENCE_FILES, has_reference, reference_stride_positions, reference_strides
 
 RATE_HZ = 204.8
@@ -163,7 +163,7 @@ class GaitmapReader(Reader):
     }
 
     def guess_can_open(self, path: Path) -> bool:
-        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+        return data_suffix(path) in (".csv", ".txt") and matches(first_line(path))
 
     def companions(self, path: Path, **options: Any) -> list[Path]:
         """gaitmap's motion-capture reference files in the file's folder (its truth when they are there)."""

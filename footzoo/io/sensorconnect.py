@@ -26,7 +26,16 @@ import pandas as pd
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import describe_axes, parse_axes, rotate_columns
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, frame_options, text_source
+from .base import (
+    RECORDING_OPTIONS,
+    Option,
+    Reader,
+    check_unique_columns,
+    data_suffix,
+    first_line,
+    frame_options,
+    text_source,
+)
 
 SIGNALS = {
     "scaledAccelX": "acc_x", "scaledAccelY": "acc_y", "scaledAccelZ": "acc_z",
@@ -146,7 +155,7 @@ class SensorConnectReader(Reader):
                **frame_options(AXES, ACC_UNIT, GYR_UNIT), **RECORDING_OPTIONS}
 
     def guess_can_open(self, path: Path) -> bool:
-        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+        return data_suffix(path) in (".csv", ".txt") and matches(first_line(path))
 
     def companions(self, path: Path, **options: Any) -> list[Path]:
         """Köroğlu's ground control points ``<file>.mat`` next to the export."""

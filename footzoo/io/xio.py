@@ -30,7 +30,16 @@ from ..core.checks import check_bool
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import describe_axes, parse_axes, rotate_columns
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, first_line, frame_options, text_source
+from .base import (
+    RECORDING_OPTIONS,
+    Option,
+    Reader,
+    check_unique_columns,
+    data_suffix,
+    first_line,
+    frame_options,
+    text_source,
+)
 from .metadata import read_facts, sha256
 
 COLUMNS = {
@@ -129,7 +138,7 @@ class XioReader(Reader):
     }
 
     def guess_can_open(self, path: Path) -> bool:
-        return Path(path).suffix.lower() in (".csv", ".txt") and matches(first_line(path))
+        return data_suffix(path) in (".csv", ".txt") and matches(first_line(path))
 
     def open(self, path: Path, **options: Any) -> Recording:
         return read(path, **options)

@@ -53,3 +53,13 @@ def test_a_config_named_by_a_link_in_a_loop_is_called_a_loop_not_missing(tmp_pat
     for read in (footzoo.Pipeline.from_yaml, footzoo.run_study):
         with pytest.raises(footzoo.ConfigError, match=r"'c\.yaml' is a symbolic link in a loop \(c\.yaml -> c\.yaml"):
             read("c.yaml")
+
+
+@pytest.mark.parametrize("text, line, column", [("detector:\n\ttype: shoe\n", 2, 1), ("name: a\nx:\t1\n", 2, 3)])
+def test_a_tab_in_a_yaml_file_is_named_with_its_place_and_the_fix(text, line, column):
+    """PyYAML's own message ("found character '\\t' that cannot start any token") says what, not how to fix it."""
+    from footzoo.core.yamlsafe import load_text
+
+    fix = rf"YAML allows no tab there \(it indents with spaces only\): replace the tab at line {line}, column {column}"
+    with pytest.raises(footzoo.ConfigError, match=rf"(?s)c.yaml: not valid YAML: .*{fix} by spaces"):
+        load_text(text, "c.yaml")

@@ -68,3 +68,24 @@ def test_a_truncated_matlab_file_is_called_damaged(tmp_path):
     savemat(other, {"x": np.zeros(3)})
     with pytest.raises(FormatError, match=r"variables \['x'\]; PyShoe's trials have imu and ts"):
         footzoo.load(other)
+
+
+@pytest.mark.parametrize("suffix, opener", [(".gz", "gzip"), (".bz2", "bz2"), (".xz", "lzma")])
+def test_a_compressed_recording_is_recognised_and_read_as_its_text(walk_csv, tmp_path, suffix, opener):
+    """Before: 'cannot tell the format' quoting the compressed bytes as a header (pandas reads it with format=)."""
+    import importlib
+
+    packed = tmp_path / f"walk.csv{suffix}"
+    with importlib.import_module(opener).open(packed, "wb") as fh:
+        fh.write(walk_csv.read_bytes())
+    assert footzoo.io.detect_format(packed) == "canonical"
+    plain = footzoo.load(walk_csv)
+    np.testing.assert_array_equal(footzoo.load(packed).acc, plain.acc)
+
+
+def test_a_header_with_spaces_after_the_commas_is_read_by_its_names(walk_csv, tmp_path):
+    """Recognised as canonical (its names stripped) but then read with ' acc_x': 'missing column(s)' before."""
+    lines = _lines(walk_csv)
+    spaced = tmp_path / "spaced.csv"
+    spaced.write_text("\n".join([", ".join(lines[0].split(","))] + lines[1:]) + "\n")
+    np.testing.assert_array_equal(footzoo.load(spaced).gyr, footzoo.load(walk_csv).gyr)
