@@ -32,6 +32,9 @@ TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
 MIN_DURATION = 1.0
 #: A bridged gap longer than this (s) is named in the warning: in a swing it loses motion.
 LOSSY_GAP = 0.1
+#: Largest resolution of the time stamps' float type, as a fraction of the median period (a float32 clock far from 0
+#: rounds them).
+MAX_TIME_ROUNDING = 0.01
 #: Plausible median sampling rate of a foot-mounted IMU (Hz); outside it the time stamps are not in seconds.
 RATE_RANGE = (10.0, 20_000.0)
 #: An interval longer than this many median periods is a gap (at least one sample missing).
@@ -142,6 +145,7 @@ class Recording:
     max_gap: float | None = None
 
     def __post_init__(self) -> None:
+        _check_time_precision(self.t)
         self.t = _floats("t", self.t)
         self.acc = _floats("acc", self.acc)
         self.gyr = _floats("gyr", self.gyr)
@@ -345,6 +349,26 @@ def writable_array(value: Any, dtype: Any = float) -> np.ndarray:
     """
     array = np.ascontiguousarray(value, dtype=dtype)
     return array if array.flags.writeable else array.copy()
+
+
+def _check_time_precision(t: Any) -> None:
+    """A RecordingError when ``t`` comes in a float type too coarse for its values: float32 resolves 7.8 ms at
+    10⁵ s (a day's clock), which rounds every time stamp of a 100 Hz recording to a step of 0 or 7.8 ms."""
+    if not isinstance(t, np.ndarray) or t.dtype.kind != "f" or t.dtype.itemsize >= 8 or t.ndim != 1 or len(t) < 3:
+        return
+    finite = t[np.isfinite(t)]
+    if len(finite) < 3:
+        return  # the checks of the values say what is wrong
+    step = float(np.spacing(np.max(np.abs(finite))))  # the resolution of the type where the values are largest
+    period = float(np.median(np.abs(np.diff(finite.astype(np.float64)))))
+    if step > MAX_TIME_ROUNDING * period:
+        share = "more than" if period == 0 else f"{step / period:.0%} of"
+        raise RecordingError(
+            f"t is {t.dtype} (a {8 * t.dtype.itemsize}-bit float): at t = {np.max(np.abs(finite)):.6g} s it resolves "
+            f"only {step * 1e3:.3g} ms, {share} the sampling period "
+            f"({period * 1e3:.3g} ms): the time stamps were rounded. Keep them as float64 (np.float64), or subtract "
+            "the start time before converting them to a shorter type"
+        )
 
 
 def _floats(name: str, value: Any) -> np.ndarray:

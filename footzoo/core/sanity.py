@@ -50,7 +50,7 @@ from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
 from .errors import RecordingError, SensorWarning
 from .norms import row_norms, row_norms_squared
-from .plausibility import GaitScan, RateEvidence
+from .plausibility import MOTION_ACC, GaitScan, RateEvidence
 
 #: Fewest consecutive samples at an axis's exact extreme reported as saturation.
 SATURATION_MIN_RUN = 3
@@ -338,6 +338,11 @@ STILL_MAX_DRIFT = 0.25
 STILL_STANCE_SHARE = 0.9
 #: Shortest motion after the still start (s) for which "no stance at all" is reported.
 NO_STANCE_MIN_DURATION = 5.0
+#: Share of the samples after the still start taken for stance from which, with the accelerometer showing
+#: ALL_STANCE_MOTION s of motion (|‖f‖ − g| above MOTION_ACC), "stance all along" is reported: a walk is 60 % stance,
+#: standing with a few steps less than 99 %.
+ALL_STANCE_SHARE = 0.99
+ALL_STANCE_MOTION = 1.0
 #: Shortest quiet period (s) whose specific force far from g (outside [0.5 g, 1.5 g]) is reported as a scale fault.
 SCALE_MIN_DURATION = 0.2
 #: ... when ‖f‖ is steady there: its 10th to 90th percentiles within this fraction of its level (a still sensor
@@ -587,6 +592,9 @@ class EstimateScan:
     * **no stance at all** — no stance sample after the still start, over more than
       :data:`NO_STANCE_MIN_DURATION` s of motion: the velocity was never reset and the track is
       pure strapdown drift (a detector that never fires on this motion, with the guard off).
+    * **stance all along** — at least :data:`ALL_STANCE_SHARE` of the samples after the still start
+      taken for stance while the accelerometer shows :data:`ALL_STANCE_MOTION` s of motion: the
+      velocity is held at zero through the swings (a threshold far too high).
     * **drift while still** — the data say the sensor lies still (|ω| < :data:`STILL_GYR`,
       |‖f‖ − g| < :data:`STILL_ACC`) for :data:`STILL_MIN_DURATION` s or longer, and the estimate
       moves more than :data:`STILL_MAX_DRIFT` m meanwhile: the detector misses that stillness, or
@@ -610,6 +618,9 @@ class EstimateScan:
         self.t_start, self.gravity, self.name, self.detector = t_start, gravity, name, detector
         self.report: dict[str, Any] = {}
         self._stance = 0
+        self._after = 0  # samples after the still start
+        self._moving = 0.0  # seconds of them with |‖f‖ − g| above MOTION_ACC
+        self._t_prev: float | None = None
         self._first: tuple[float, np.ndarray] | None = None  # (t, pos) of the first sample after the still start
         self._last: tuple[float, np.ndarray] | None = None
         self._run: dict[str, Any] | None = None  # the still run open at the end of the last chunk
@@ -628,6 +639,7 @@ class EstimateScan:
         self._plausibility()
         still, off_g, stances, first = _quiet_runs(t, acc, gyr, ok, float(self.t_start), float(self.gravity))
         self._stance += stances
+        self._count_motion(t, acc)
         if first >= 0 and self._first is None:
             self._first = (float(t[first]), pos[first].copy())
         self._last = (float(t[-1]), pos[-1].copy())
@@ -652,6 +664,33 @@ class EstimateScan:
                 self._close(run)
                 if s == 0:
                     self._run = None
+
+    def _count_motion(self, t: np.ndarray, acc: np.ndarray) -> None:
+        """Count the samples after the still start and the seconds of them that move (for "stance all along")."""
+        dt = np.diff(t, prepend=t[0] if self._t_prev is None else self._t_prev)
+        self._t_prev = float(t[-1])
+        after = t > self.t_start
+        self._after += int(np.count_nonzero(after))
+        moving = after & (np.abs(row_norms(acc) - self.gravity) > MOTION_ACC)
+        self._moving += float(np.sum(dt[moving]))
+
+    def _all_stance(self) -> None:
+        """Report a detector that took (nearly) every sample for stance while the foot moved."""
+        if not self._after or self._first is None or self._last is None:
+            return
+        share = self._stance / self._after
+        if share < ALL_STANCE_SHARE or self._moving < ALL_STANCE_MOTION:
+            return
+        moved = float(np.linalg.norm(self._last[1] - self._first[1]))
+        self.report["all_stance"] = {"stance_share": share, "moving_s": self._moving, "distance_m": moved}
+        warnings.warn(
+            f"{self.name}: the detector {self.detector!r} takes {share:.1%} of the samples after the still start for "
+            f"stance, while the accelerometer shows {self._moving:.1f} s of motion (|‖f‖ − g| above {MOTION_ACC:g} "
+            f"m/s²): the velocity is held at zero through the swings, so the track ({moved:.2f} m) and the strides "
+            "are not the foot's. Lower its threshold, or choose a detector made for this motion. Details in "
+            "diagnostics['sensor']",
+            SensorWarning, stacklevel=4,
+        )
 
     def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, runs: np.ndarray) -> None:
         """Report (once) a quiet gyroscope with a specific force far from g for SCALE_MIN_DURATION s.
@@ -742,6 +781,7 @@ class EstimateScan:
             self._run = None
         self.gait.finish()
         self._plausibility()
+        self._all_stance()
         if self._first is not None and self._last is not None and self._stance == 0:
             duration = self._last[0] - self._first[0]
             if duration > NO_STANCE_MIN_DURATION:

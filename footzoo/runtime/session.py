@@ -10,6 +10,7 @@ time from the other foot's initial contact to this foot's next initial contact.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -20,13 +21,15 @@ import pandas as pd
 
 from ..core.archive import read_session, save_session
 from ..core.data import Recording
-from ..core.errors import FormatError, NotARecordingError
+from ..core.errors import FootzooWarning, FormatError, NotARecordingError
 from ..evaluation.result import Result
 from ..io import detect_format, load
 from ..io.gaitmap import feet
 from .pipeline import Pipeline, require_pipeline
 
 FEET = ("left", "right")
+#: Shortest overlap of the two feet's time spans, as a fraction of the shorter span, for one clock.
+MIN_CLOCK_OVERLAP = 0.5
 #: Parameters of the bilateral table: median per foot of these stride-table columns.
 BILATERAL_COLUMNS = ["stride_time_s", "step_time_s", "stance_time_s", "swing_time_s", "cadence_steps_min",
                      "stride_length_m", "speed_m_s", "max_clearance_m"]
@@ -54,6 +57,7 @@ class Session:
                                          "build it with footzoo.load(path)")
         self.recordings = dict(recordings)
         self.name = name
+        _check_one_clock(self.recordings)
 
     def __repr__(self) -> str:
         return f"Session({self.name!r}, feet={list(self.recordings)})"
@@ -84,6 +88,23 @@ class Session:
         require_pipeline(pipeline, "Session.run")
         results = {foot: pipeline.run(rec, engine=engine) for foot, rec in self.recordings.items()}
         return SessionResult(results=results, name=self.name)
+
+
+def _check_one_clock(recordings: dict[str, Recording]) -> None:
+    """Warn when both feet are given but their time spans overlap for less than half of the shorter one: a step time
+    pairs one foot's contact with the other's, which needs one clock (two loggers' clocks started apart)."""
+    if len(recordings) < 2:
+        return
+    spans = {f: (float(r.t[0]), float(r.t[-1])) for f, r in recordings.items()}
+    (lf, (l0, l1)), (rf, (r0, r1)) = spans.items()
+    overlap = max(0.0, min(l1, r1) - max(l0, r0))
+    if overlap >= MIN_CLOCK_OVERLAP * min(l1 - l0, r1 - r0):
+        return
+    warnings.warn(FootzooWarning(
+        f"session: the {lf} foot's recording spans t = {l0:.6g}–{l1:.6g} s and the {rf} foot's {r0:.6g}–{r1:.6g} s, "
+        f"overlapping {overlap:.3g} s: the two are not on one clock, so the step times (each foot's contact after the "
+        "other's) and their symmetry come out NaN or wrong; the per-foot results are unaffected. Put both on one "
+        "clock (e.g. Recording(t=rec.t - offset, ...)) for the bilateral table"), stacklevel=3)
 
 
 def step_times(steps: dict[str, pd.DataFrame]) -> dict[str, np.ndarray]:

@@ -169,3 +169,16 @@ def test_read_only_inputs_become_writable_copies_and_the_caller_keeps_theirs():
     np.testing.assert_array_equal(rec.acc, acc)
     writable = np.zeros((n, 3))
     assert Recording(t=np.arange(n) / 100.0, acc=acc, gyr=writable).gyr is writable  # no copy when not needed
+
+
+def test_time_stamps_rounded_by_a_float32_clock_are_refused_with_the_fix():
+    """float32 at 10⁵ s resolves 7.8 ms: a 100 Hz recording's stamps rounded to steps of 0 and 7.8 ms were read as
+    hundreds of bridged gaps, with no word of the cause."""
+    df = frame()
+    t = df["t"].to_numpy()
+    acc, gyr = df[["acc_x", "acc_y", "acc_z"]].to_numpy(), df[["gyr_x", "gyr_y", "gyr_z"]].to_numpy()
+    with pytest.raises(RecordingError, match=r"t is float32 \(a 32-bit float\): at t = 100004 s it resolves only "
+                                             r"7.81 ms, .* the sampling period .*Keep them as float64"):
+        Recording(t=(t + 1e5).astype(np.float32), acc=acc, gyr=gyr)
+    rec = Recording(t=t.astype(np.float32), acc=acc, gyr=gyr)  # near 0, float32 resolves a microsecond: fine
+    assert rec.rate == pytest.approx(100.0, rel=1e-4)

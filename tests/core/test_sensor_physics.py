@@ -204,6 +204,21 @@ def test_a_detector_that_never_fires_with_the_guard_off_is_reported(walk):
     assert any("no stance from t =" in m and "'test_stance_until' never fired" in m for m in found)
 
 
+def test_a_detector_that_takes_every_sample_for_stance_is_reported_batch_and_live(walk):
+    """A threshold far too high holds the foot still through its swings: 0 m and no stride, and no word before."""
+    config = {**BASE, "detector": {"type": "angular_rate_fsm", "threshold": 10.0}}  # the simulated foot peaks at 7.5
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(config).run(walk))
+    finding = res.diagnostics["sensor"]["all_stance"]
+    assert finding["stance_share"] == 1.0 and finding["moving_s"] > 1.0
+    assert sum("the detector 'angular_rate_fsm' takes 100.0% of the samples after the still start for stance, while "
+               "the accelerometer shows" in m and "Lower its threshold" in m for m in found) == 1
+    stream = Stream(Pipeline.from_dict(config), rate=walk.rate)
+    _, live = _sensor_warnings(lambda: stream.run(walk, chunk=np.array([3, 50])))
+    assert stream.sensor["all_stance"] == finding and sum("takes 100.0%" in m for m in live) == 1
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(walk))  # its default threshold: a walk
+    assert "all_stance" not in res.diagnostics["sensor"] and not found
+
+
 # --------------------------------------------------------------------------- (f) drift while still
 def test_a_still_sensor_whose_estimate_drifts_is_reported_batch_and_live():
     rec = simulate(n_strides=4, rate=50.0, stand_end=60.0, noise=NoiseModel(seed=3))

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo import Pipeline, Session
+from footzoo import Pipeline, Recording, Session
 from footzoo.apps.cli import main
-from footzoo.core.errors import FormatError
+from footzoo.core.errors import FootzooWarning, FormatError
 from footzoo.evaluation.metrics import footprint_errors, rigid_align_2d
 from footzoo.io import load
 from footzoo.io.canonical import write
@@ -208,3 +209,15 @@ def test_short_reprs():
     assert "channels=['acc', 'gyr', 'mag']" in text and "array" not in text and len(text) < 300
     res = Pipeline.from_yaml(YUN).run(rec)
     assert "array" not in repr(res) and len(repr(res)) < 200
+
+
+def test_two_feet_on_different_clocks_are_warned_and_one_clock_is_not():
+    """Step times pair one foot's contact with the other's: an hour apart they were NaN without a word."""
+    walk = simulate(n_strides=3, rate=100.0)
+    later = Recording(t=walk.t + 3600.0, acc=walk.acc, gyr=walk.gyr)
+    with pytest.warns(FootzooWarning, match=r"session: the left foot's recording spans t = 0–5.99 s and the right "
+                                            r"foot's 3600–3605.99 s, overlapping 0 s: the two are not on one clock"):
+        Session({"left": walk, "right": later})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FootzooWarning)
+        Session({"left": walk, "right": Recording(t=walk.t + 0.5, acc=walk.acc, gyr=walk.gyr)})
