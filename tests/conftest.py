@@ -48,6 +48,8 @@ HARD_IRON_NOT_FITTED = "ignore:.*hard_iron. magnetometer left uncalibrated:footz
 GAPS_BRIDGED = "ignore:.*bridged [0-9]+ gap:footzoo.core.errors.FootzooWarning"
 #: A detector misses the stances of an unusual motion on a real trial; the stance guard marks them and says so.
 STANCES_GUARDED = "ignore:.*found no stance for:footzoo.core.errors.GuardWarning"
+#: A detector at an edge of its range takes every sample for stance, the swings included; the run says so.
+ALL_STANCE = "ignore:.*of the samples after the still start for stance, while:footzoo.core.errors.SensorWarning"
 #: PyShoe's 2018-02-22 trial has its sensor mounted upside down; the mounting report says so.
 UPSIDE_DOWN_TRIAL = "ignore:recording .2018-02-22-10-09-36.. the sensor's y axis:footzoo.core.errors.SensorWarning"
 #: The mounting report finds the x axis of Köroğlu's sensors (experiments 31-33) pointing backwards.

@@ -451,7 +451,8 @@ def validate_recording(rec: Recording) -> None:
         raise RecordingError("the recording is empty (0 samples)")
     for name, arr in (("acc", acc), ("gyr", gyr), ("mag", rec.mag)):
         if arr is not None and arr.shape != (n, 3):
-            raise RecordingError(f"{name} must have shape ({n}, 3) to match t, got {arr.shape}")
+            flipped = "; it looks transposed: pass " + name + ".T" if arr.shape == (3, n) else ""
+            raise RecordingError(f"{name} must have shape ({n}, 3) to match t, got {arr.shape}{flipped}")
     if rec.dist is not None and rec.dist.shape[0] != n:
         raise RecordingError(f"dist must have {n} rows to match t, got {rec.dist.shape[0]}")
     if n < 3:

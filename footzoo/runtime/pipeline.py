@@ -12,8 +12,10 @@ capabilities, never their names.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +62,22 @@ from .stages import CalibrationStage, detected, estimate_attitude, guarded
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
 STREAM_WARMUP = 30.0
 
+
+
+@contextlib.contextmanager
+def _read_only(rec: Any) -> Iterator[None]:
+    """The recording's arrays read-only while a run uses them: a plug-in that reaches them by another way than its
+    arguments (a global, a closure) fails in its own code, named (the contract's "writes into an input array"),
+    instead of changing the caller's recording and misleading the blocks after it."""
+    arrays = [a for a in (getattr(rec, k, None) for k in ("t", "acc", "gyr", "mag", "dist"))
+              if isinstance(a, np.ndarray) and a.flags.writeable]
+    for a in arrays:
+        a.flags.writeable = False
+    try:
+        yield
+    finally:
+        for a in arrays:
+            a.flags.writeable = True
 
 class Pipeline:
     """An orientation filter, a stance detector, corrections and analyses.
@@ -282,12 +300,14 @@ class Pipeline:
         """
         if engine not in ENGINES:
             raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
-        with inputs_checked_once():  # each array (the recording's, a block's checked output) is scanned for NaN once
+        with inputs_checked_once(), _read_only(rec):  # each array is scanned for NaN once; none is written meanwhile
             return self._run(rec, engine, covariance)
 
     def _run(self, rec: Recording, engine: str, covariance: bool) -> Result:
         if not isinstance(rec, Recording):
             hint = (f": load it first, Pipeline.run(footzoo.load({str(rec)!r}))" if isinstance(rec, (str, os.PathLike))
+                    else ": build one with footzoo.Recording.from_dataframe(df) (columns t, acc_x, ..., gyr_z)"
+                    if isinstance(rec, pd.DataFrame)
                     else ": build one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
             raise NotARecordingError(f"Pipeline.run expects a footzoo Recording, got {type(rec).__name__}{hint}")
         self._check_inputs(rec)

@@ -184,6 +184,8 @@ class Stream:
         to the same numbers); cheaper per sample.
         """
         check_open(self, "extend")
+        if all(np.size(a) == 0 for a in (t, acc, gyr)):
+            return None  # an empty packet (a read that found no new sample): nothing to add
         t, acc, gyr, mag, dist = validate_block(t, acc, gyr, mag, dist, self._t_prev, self.max_gap)
         n = t.shape[0]
         rows = {"k": np.arange(self._k, self._k + n), "t": t, "acc": acc, "gyr": gyr}

@@ -548,7 +548,14 @@ def _seeds(r: dict[str, Any], i: int) -> list[int]:
     repeats = r.get("repeats", 1)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")
-    return [s + 1000 * k for k in range(repeats if seeds else 0) for s in seeds]
+    out = [s + 1000 * k for k in range(repeats if seeds else 0) for s in seeds]
+    seen: set[int] = set()
+    twice = sorted({s for s in out if s in seen or seen.add(s)})
+    if twice:
+        raise ConfigError(f"recordings[{i}].seeds gives seed(s) {twice} more than once (seeds {seeds!r:.80}, repeats "
+                          f"{repeats}: seed s, then s + 1000, s + 2000, ...); one seed is one simulated recording, the "
+                          "same twice would be averaged as two: list each seed once")
+    return out
 
 
 def _count_recording(r: Any, i: int) -> int:

@@ -97,6 +97,22 @@ def test_closing_twice_is_harmless_and_gives_nothing_more(pipeline, walk):
     assert len(out["t"]) == walk.n and len(stream.close()["t"]) == 0
 
 
+def test_an_empty_packet_adds_nothing_and_changes_no_estimate(pipeline, walk):
+    """A read that found no new sample: was 'an empty block: give at least one sample', an error mid-recording."""
+    import numpy as np
+
+    plain = Stream(pipeline, rate=walk.rate).run(walk, chunk=100)
+    stream = Stream(pipeline, rate=walk.rate)
+    parts = []
+    for a in range(0, walk.n, 100):
+        sl = slice(a, a + 100)
+        stream.extend(walk.t[sl], walk.acc[sl], walk.gyr[sl], None if walk.mag is None else walk.mag[sl])
+        assert stream.extend(np.empty(0), np.empty((0, 3)), np.empty((0, 3))) is None
+        parts.append(stream.final())
+    parts.append(stream.close())
+    np.testing.assert_array_equal(np.concatenate([p["pos"] for p in parts]), plain["pos"])
+
+
 def _dropped(walk: Recording, sensor: str, first: int) -> Recording:
     arrays = {"acc": walk.acc.copy(), "gyr": walk.gyr.copy()}
     arrays[sensor][first:] = 0.0 if sensor == "gyr" else arrays[sensor][first - 1]  # zeros, or the last value held

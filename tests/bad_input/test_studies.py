@@ -4,6 +4,8 @@ level; each refused before any run.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 import footzoo
@@ -31,6 +33,18 @@ def test_a_study_refuses_a_bad_simulate_entry_before_running(simulate_spec, mess
 
     with pytest.raises(footzoo.ConfigError, match=message):
         Study.from_dict({"base": "yun2012", "recordings": [{"simulate": simulate_spec}]})
+
+
+@pytest.mark.parametrize("entry, twice", [({"seeds": [1, 2, 1]}, "[1]"),
+                                          ({"seeds": [0, 1000], "repeats": 2}, "[1000]")])
+def test_a_seed_given_twice_is_named_not_called_two_recordings_of_one_name(entry, twice):
+    """Before: 'both called sim_straight_s1 ... give each entry its own label', a fix that does not apply."""
+    from footzoo.studies import Study
+
+    noisy = {"path": "straight", "n_strides": 4, "noise": {"scale": 1}}
+    with pytest.raises(footzoo.ConfigError, match=rf"recordings\[0\].seeds gives seed\(s\) {re.escape(twice)} more "
+                                                  r"than once .*list each seed once"):
+        Study.from_dict({"base": "yun2012", "recordings": [{"simulate": noisy, **entry}]})
 
 
 def test_two_recordings_with_one_name_are_refused_and_labels_tell_them_apart(walk_csv, tmp_path):

@@ -182,3 +182,14 @@ def test_time_stamps_rounded_by_a_float32_clock_are_refused_with_the_fix():
         Recording(t=(t + 1e5).astype(np.float32), acc=acc, gyr=gyr)
     rec = Recording(t=t.astype(np.float32), acc=acc, gyr=gyr)  # near 0, float32 resolves a microsecond: fine
     assert rec.rate == pytest.approx(100.0, rel=1e-4)
+
+
+def test_a_transposed_array_is_named_with_its_fix():
+    df = frame()
+    t, acc = df["t"].to_numpy(), df[["acc_x", "acc_y", "acc_z"]].to_numpy()
+    gyr = df[["gyr_x", "gyr_y", "gyr_z"]].to_numpy()
+    fix = "gyr must have shape (400, 3) to match t, got (3, 400); it looks transposed: pass gyr.T"
+    with pytest.raises(RecordingError, match=re.escape(fix)):
+        Recording(t=t, acc=acc, gyr=gyr.T)
+    with pytest.raises(RecordingError, match=r"got \(400, 4\)$"):  # not transposed: no such hint
+        Recording(t=t, acc=np.c_[acc, acc[:, :1]], gyr=gyr)
