@@ -101,7 +101,7 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, axes: Any =
     Parameters
     ----------
     foot : {"left", "right"}
-        Which sensor to read (required: the file holds both feet).
+        Which sensor to read (required when the file holds both feet; a file of one foot is read as that foot).
     rate : float
         Sampling rate (Hz), 204.8 for the example data.
     axes : str or sequence
@@ -109,6 +109,8 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, axes: Any =
     acc_unit, gyr_unit : str
         The file's units (default m/s² and deg/s).
     """
+    if foot is None and len(feet(path)) == 1:
+        foot = feet(path)[0]  # a file of one foot: no choice to make
     if foot not in FEET:
         raise FormatError(
             f"{path}: a gaitmap file holds both feet; choose one with foot='left' or foot='right', "
@@ -156,7 +158,7 @@ class GaitmapReader(Reader):
     extensions = (".csv",)
     url = "https://github.com/mad-lab-fau/gaitmap"
     options = {
-        "foot": Option(None, "", "which sensor to read: 'left' or 'right' (required: the file holds both feet)"),
+        "foot": Option(None, "", "which sensor to read: 'left' or 'right' (required when the file holds both feet)"),
         "rate": Option(RATE_HZ, "Hz", "sampling rate: the time base is the sample index / rate"),
         **frame_options(AXES, ACC_UNIT, GYR_UNIT),
         **RECORDING_OPTIONS,

@@ -276,6 +276,18 @@ def test_a_gaitmap_file_with_a_sensor_besides_the_feet_says_it_is_not_read(tmp_p
     assert rec.n == walk.n
 
 
+def test_a_gaitmap_file_of_one_foot_is_read_as_that_foot(tmp_path, walk):
+    """Before: 'a gaitmap file holds both feet; choose one with foot=...' for a file that holds the left foot only."""
+    from ..io.texts import gaitmap_text
+
+    p = tmp_path / "left_only.csv"
+    p.write_text(gaitmap_text(walk))
+    rec = load(p)
+    np.testing.assert_allclose(rec.gyr, walk.gyr, atol=1e-12)
+    with pytest.raises(FormatError, match=r"no 'right_sensor' columns; found \['left_sensor'\]"):
+        load(p, foot="right")
+
+
 @pytest.mark.skipif(not KOROGLU.exists(), reason="the real recordings (../shared/data) are not here")
 def test_the_real_sensorconnect_export_reads_as_before(tmp_path):
     rec = load(KOROGLU)
