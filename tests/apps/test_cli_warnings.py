@@ -11,6 +11,8 @@ from footzoo.apps.cli import LOG, build_parser, main
 from footzoo.io.canonical import write
 from footzoo.sim import NoiseModel, simulate
 
+from ..conftest import ALL_STANCE
+
 #: A straight walk: yun2012's magnetometer calibration cannot fit it and says so (a CalibrationWarning).
 WARNING = "hard_iron: magnetometer left uncalibrated"
 
@@ -73,6 +75,8 @@ def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
     assert LOG in json.loads((tmp_path / "out" / "outputs.json").read_text())["files"]  # part of the report
 
 
+# its threshold of 10 rad/s takes every sample for stance, which the run says (expected)
+@pytest.mark.filterwarnings(ALL_STANCE)
 def test_a_quiet_tune_logs_the_runs_warnings(straight, tmp_path, capsys):
     tune_file = tmp_path / "tune.yaml"
     tune_file.write_text(f"name: t\nbase: yun2012\nfactors: {{detector.threshold: [10.0, 1.0]}}\n"

@@ -14,7 +14,7 @@ from footzoo.core.errors import FootzooWarning
 from footzoo.studies import Study, TuneSpec, cross_validate, leave_one_group_out, tune
 from footzoo.studies.tune import load_tune_file, sample_space
 
-from ..conftest import HARD_IRON_NOT_FITTED
+from ..conftest import ALL_STANCE, HARD_IRON_NOT_FITTED
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -121,6 +121,8 @@ def test_tune_chooses_the_better_threshold_and_writes_its_config(tmp_path):
     assert again.best_ == result.best_ and again.values_.equals(result.values_)  # from the cache
 
 
+# its threshold of 10 rad/s takes every sample for stance, which the run says (expected)
+@pytest.mark.filterwarnings(ALL_STANCE)
 # yun2012 fits a hard-iron calibration, which this straight simulated walk cannot give (expected warning)
 @pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)
 def test_the_tune_command(tmp_path, capsys):
