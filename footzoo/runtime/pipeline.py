@@ -63,7 +63,6 @@ from .stages import CalibrationStage, detected, estimate_attitude, guarded
 STREAM_WARMUP = 30.0
 
 
-
 @contextlib.contextmanager
 def _read_only(rec: Any) -> Iterator[None]:
     """The recording's arrays read-only while a run uses them: a plug-in that reaches them by another way than its
@@ -78,6 +77,7 @@ def _read_only(rec: Any) -> Iterator[None]:
     finally:
         for a in arrays:
             a.flags.writeable = True
+
 
 class Pipeline:
     """An orientation filter, a stance detector, corrections and analyses.
