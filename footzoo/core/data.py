@@ -9,7 +9,7 @@ with a message that names the column and the fix.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -133,6 +133,10 @@ class Recording:
         over each sample's own interval, which is what the sensor measured) and
         reported with a :class:`~footzoo.core.errors.FootzooWarning` and in
         ``meta["diagnostics"]["gaps"]``; longer gaps are refused.
+    warn : bool
+        Warn about the bridged gaps and the sensor findings (saturation, glitches, dropouts); off,
+        they are only listed in ``meta`` (for samples that were checked and warned about already, e.g.
+        the kept samples of a :class:`~footzoo.Stream`). Errors are raised either way.
     """
 
     t: np.ndarray
@@ -143,8 +147,9 @@ class Recording:
     meta: dict[str, Any] = field(default_factory=dict)
     truth: Truth | None = None
     max_gap: float | None = None
+    warn: InitVar[bool] = True
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, warn: bool = True) -> None:
         _check_time_precision(self.t)
         self.t = _floats("t", self.t)
         self.acc = _floats("acc", self.acc)
@@ -161,10 +166,10 @@ class Recording:
             raise RecordingError(f"truth must be a footzoo Truth, got {type(self.truth).__name__}")
         validate_recording(self)
         self.meta = dict(self.meta)
-        _report_gaps(self)
+        _report_gaps(self, warn)
         self.meta.setdefault("name", "recording")
         self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
-        findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]))
+        findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]), warn=warn)
         if findings:
             self.meta["sanity"] = findings
 
@@ -560,8 +565,8 @@ def _max_gap(rec: Recording, period: float) -> float:
     return gap_limit(period, rec.max_gap)
 
 
-def _report_gaps(rec: Recording) -> None:
-    """Warn about the short gaps that are bridged and list them in ``meta["diagnostics"]["gaps"]``.
+def _report_gaps(rec: Recording, warn: bool = True) -> None:
+    """Warn about the short gaps that are bridged (with ``warn``) and list them in ``meta["diagnostics"]["gaps"]``.
 
     A gap is an interval longer than ``GAP_PERIODS`` median periods. The
     samples are kept as they are: the filters integrate each sample over its
@@ -586,17 +591,33 @@ def _report_gaps(rec: Recording) -> None:
         "longest_s": float(dt[longest]),
         "max_gap_s": float(_max_gap(rec, period)),
     }
-    long_gaps = int(np.sum(dt[k] > LOSSY_GAP))
+    if warn:
+        warn_gaps(rec, stacklevel=4)  # as seen from _report_gaps: the caller of Recording(...)
+
+
+def warn_gaps(rec: Recording, fix: str | None = None, stacklevel: int = 2) -> None:
+    """The warning of the bridged gaps listed in ``rec.meta["diagnostics"]["gaps"]`` (none: no warning).
+
+    ``fix``: how to refuse them where the samples came from (default: the loader's ``max_gap`` option).
+    """
+    gaps = rec.meta.get("diagnostics", {}).get("gaps")
+    if not gaps:
+        return
+    period = float(np.median(np.diff(rec.t)))
+    durations = np.asarray(gaps["duration_s"])
+    longest = int(np.argmax(durations))
+    long_gaps = int(np.sum(durations > LOSSY_GAP))
     lossy = (f" {long_gaps} of them longer than {LOSSY_GAP:g} s: one in a swing loses part of the swing's motion, so "
              "check the strides around them;" if long_gaps else "")
     warnings.warn(
         FootzooWarning(
-            f"{rec.name}: bridged {k.size} gap(s) in the time stamps (intervals over {GAP_PERIODS:g} median periods "
-            f"of {period * 1e3:.2f} ms), the longest {dt[longest] * 1e3:.1f} ms at t = {rec.t[longest]:.3f} s;{lossy} "
-            "the filters integrate over each sample's real interval. The list is in meta['diagnostics']['gaps']; "
-            f"to refuse them, a smaller max_gap: {option_fix('max_gap', 'SECONDS', number=True)}"
+            f"{rec.name}: bridged {gaps['count']} gap(s) in the time stamps (intervals over {GAP_PERIODS:g} median "
+            f"periods of {period * 1e3:.2f} ms), the longest {durations[longest] * 1e3:.1f} ms at "
+            f"t = {gaps['start_s'][longest]:.3f} s;{lossy} the filters integrate over each sample's real interval. "
+            "The list is in meta['diagnostics']['gaps']; to refuse them, a smaller max_gap: "
+            f"{fix or option_fix('max_gap', 'SECONDS', number=True)}"
         ),
-        stacklevel=4,
+        stacklevel=stacklevel + 1,
     )
 
 

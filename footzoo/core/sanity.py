@@ -247,15 +247,17 @@ def find_acc_glitches(acc: np.ndarray) -> np.ndarray:
     return find_bursts(acc, ACC_GLITCH_JUMP)
 
 
-def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording") -> dict[str, Any]:
+def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording", warn: bool = True) -> dict[str, Any]:
     """Warn about saturation and glitches in a recording's signals (FRD, SI); return the findings.
 
-    Impossible values are checked before, by :func:`check_impossible` (an error).
+    Impossible values are checked before, by :func:`check_impossible` (an error). ``warn=False``: the findings
+    only, for signals whose findings were warned already (a stream's scans warn as the samples come).
     """
     report: dict[str, Any] = {}
     saturated = find_saturation(t, acc, gyr)
     if saturated:
         report["saturation"] = saturated
+    if saturated and warn:
         parts = [f"{s['axis']} at {s['value']:.6g} for {s['samples']} samples in {len(s['runs'])} run(s), "
                  f"first at sample {s['runs'][0][0]} (t = {s['first_t']:.3f} s)" for s in saturated]
         warnings.warn(
@@ -263,10 +265,14 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
             "underestimated there; use a sensor with a larger range. Details in meta['sanity']",
             SensorWarning, stacklevel=4,
         )
-    report.update(warn_glitches(t, acc, gyr, name, stacklevel=5))
+    glitches = _glitches(t, acc, gyr)
+    report.update(glitches)
+    if warn:
+        _warn_found(t, acc, gyr, glitches, name, 0, 5)  # the caller of the Recording, as warn_frozen's
     frozen = find_frozen(t, acc, gyr)
     if frozen:
         report["frozen"] = frozen
+    if frozen and warn:
         warn_frozen(frozen, name, stacklevel=5)
     return report
 

@@ -252,13 +252,20 @@ class Stream:
             out["consistency"] = self._axes.report
         return out
 
-    def result(self, meta: dict[str, Any] | None = None) -> Any:
+    def result(self, meta: dict[str, Any] | None = None, truth: Any = None) -> Any:
         """The whole run as a :class:`~footzoo.Result` (after :meth:`close`; needs ``keep=True``).
 
         Its samples are the final estimates, its steps and analyses computed on them as a batch
-        run computes them; ``meta`` describes the recording (``name``, ``foot``, ...).
+        run computes them; ``meta`` describes the recording (``name``, ``foot``, ...: a loaded
+        recording's ``rec.meta``). ``truth`` (a :class:`~footzoo.Truth`, e.g. ``rec.truth``, one row
+        per pushed sample) is the reference its :attr:`~footzoo.Result.metrics` are scored against,
+        as a batch run's are against its recording's.
+
+        The stream warned about its samples as they came (:attr:`sensor`); the result does not warn
+        again. Bridged gaps in the time stamps are listed in ``recording["diagnostics"]["gaps"]`` and
+        warned here unless ``meta`` already lists them (a loaded recording's meta: its loader warned).
         """
-        from ..core.data import Recording
+        from ..core.data import Recording, Truth, warn_gaps
         from ..core.table import samples_frame
         from ..evaluation.result import Result
         from .pipeline import versions
@@ -267,10 +274,22 @@ class Stream:
             raise ConfigError("Stream.result() needs the final estimates kept: Stream(..., keep=True)")
         if not self._closed:
             raise RecordingError("Stream.result(): close() the stream first (the last samples are not final yet)")
+        if truth is not None and not isinstance(truth, Truth):
+            hint = ": pass the recording's reference, truth=rec.truth" if isinstance(truth, Recording) else ""
+            raise ConfigError(f"Stream.result(truth=...) takes a footzoo Truth, got {type(truth).__name__}{hint}")
         from ..plugins.incremental import concat
 
         k = concat(self._kept)
-        rec = Recording(t=k["t"], acc=k["acc"], gyr=k["gyr"], mag=k.get("mag"), meta=dict(meta or {}))
+        given = dict(meta or {})
+        try:
+            rec = Recording(t=k["t"], acc=k["acc"], gyr=k["gyr"], mag=k.get("mag"), meta=given, truth=truth,
+                            max_gap=self.max_gap, warn=False)
+        except RecordingError as e:
+            if truth is None:
+                raise
+            raise RecordingError(f"Stream.result(truth=...): {e} (the stream was pushed {len(k['t'])} samples)") from e
+        if "gaps" not in given.get("diagnostics", {}):
+            warn_gaps(rec, fix="footzoo.Stream(pipeline, max_gap=SECONDS)")
         stance = k["stance"].astype(bool)
         steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
         config = {**self.pipeline.to_dict(), "engine": "stream"}
@@ -278,7 +297,7 @@ class Stream:
         diagnostics["sensor"] = self.sensor
         return Result(samples=samples_frame(k["t"], k["quat"], k["pos"], k["vel"], k["acc_nav"], stance),
                       steps=steps, config=config, versions=versions(), recording=dict(rec.meta),
-                      diagnostics=diagnostics)
+                      diagnostics=diagnostics, reference=truth)
 
     def run(self, rec: Any, chunk: int | np.ndarray = 1) -> dict[str, np.ndarray]:
         """Push a whole recording and close: every sample's final estimate.

@@ -1,5 +1,7 @@
 """Every pipeline runs live: provisional estimates at once, final ones equal to the batch run after the latency."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -251,6 +253,44 @@ def test_a_kept_stream_gives_the_batch_result_with_its_strides(walk):
     np.testing.assert_allclose(res.steps["stride_length_m"], batch.steps["stride_length_m"], rtol=0, atol=1e-9)
     with pytest.raises(ConfigError, match="keep=True"):
         Stream(p).result()
+
+
+def test_a_kept_stream_given_the_truth_has_the_batch_runs_metrics(walk):
+    """``result(truth=rec.truth)``: the live result is scored against the reference as the batch run is."""
+    p = Pipeline.from_yaml("nguyen2016")
+    s = Stream(p, rate=walk.rate, keep=True, guess=False)
+    s.run(walk, chunk=CHUNKS)
+    live, batch = s.result(meta=walk.meta, truth=walk.truth), p.run(walk)
+    assert live.reference is walk.truth and "armse_3d_m" in batch.metrics
+    assert live.metrics.keys() == batch.metrics.keys()
+    np.testing.assert_allclose(list(live.metrics.values()), list(batch.metrics.values()), rtol=0, atol=1e-9)
+    assert "armse_3d_m" not in s.result(meta=walk.meta).metrics  # no truth, no errors against one
+    with pytest.raises(ConfigError, match=r"truth=rec\.truth"):
+        s.result(truth=walk)  # the recording instead of its reference
+    short = footzoo.Truth(pos=walk.truth.pos[:-5])
+    with pytest.raises(RecordingError, match=r"Stream\.result\(truth=\.\.\.\).*pos has .* rows"):
+        s.result(truth=short)
+
+
+def test_a_streamed_recording_is_warned_about_its_gaps_once():
+    """The loader warned about the bridged gaps: the live result of the loaded recording does not warn again (they
+    are in its ``recording["diagnostics"]``); samples pushed live are warned about once, at ``result()``, with the
+    stream's fix."""
+    walk = simulate(n_strides=4, rate=100.0, noise=NoiseModel(seed=3))
+    keep = np.ones(walk.n, bool)
+    keep[400:403] = False  # one gap of 0.04 s
+    with pytest.warns(FootzooWarning, match="bridged 1 gap"):
+        rec = Recording(t=walk.t[keep], acc=walk.acc[keep], gyr=walk.gyr[keep], meta={"name": "gappy"})
+    pipe = Pipeline.from_yaml("nguyen2016")
+    stream = Stream(pipe, rate=rec.rate, keep=True, guess=False)
+    stream.run(rec, chunk=50)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FootzooWarning)  # any footzoo warning fails the test
+        res = stream.result(meta=rec.meta)
+    assert res.recording["diagnostics"]["gaps"]["count"] == 1
+    with pytest.warns(FootzooWarning, match=r"bridged 1 gap.*footzoo\.Stream\(pipeline, max_gap=SECONDS\)"):
+        res = stream.result(meta={"name": "live"})  # samples that no loader saw
+    assert res.recording["diagnostics"]["gaps"] == rec.meta["diagnostics"]["gaps"]
 
 
 def test_stream_is_exported_at_the_top_level():
