@@ -25,15 +25,29 @@ from .cache import HEAVY, with_heavy
 
 
 def summarise(table: pd.DataFrame, factor: str) -> pd.DataFrame:
-    """Mean, median, standard deviation and count of every metric per level of one factor.
+    """Mean, median, standard deviation and count of every metric per level of one factor, and why values are missing.
 
     The levels are the table's own values (a plug-in spec as JSON text); :func:`readable` labels them.
-    A metric NaN in every run of a level (refused, with the reason in the table's ``note``) has count 0.
+    A metric NaN in every run of a level (refused) has count 0; ``reason`` then gives the table's
+    ``note`` of those runs (each distinct one once), and ``"k of n runs: ..."`` when only some runs have
+    no value; it is empty where every run has one.
     """
     ok = table[table["metric"].notna()]
-    g = ok.groupby([factor, "metric"], dropna=False)["value"]
-    out = g.agg(["mean", "median", "std", "count"]).reset_index()
-    return out.sort_values(["metric", factor]).reset_index(drop=True)
+    if "note" not in ok.columns:  # a table written before the notes
+        ok = ok.assign(note=None)
+    g = ok.groupby([factor, "metric"], dropna=False)
+    out = g["value"].agg(["mean", "median", "std", "count"])
+    out["reason"] = [_missing_reason(d["value"], d["note"]) for _, d in g[["value", "note"]]] if len(ok) else []
+    return out.reset_index().sort_values(["metric", factor]).reset_index(drop=True)
+
+
+def _missing_reason(values: pd.Series, notes: pd.Series) -> str:
+    """Why a summary's metric lacks values in some runs: their distinct notes (empty when no value is missing)."""
+    missing = values.isna().to_numpy()
+    if not missing.any():
+        return ""
+    why = "; ".join(dict.fromkeys(str(n) for n in notes[missing] if isinstance(n, str) and n)) or "no reason recorded"
+    return why if missing.all() else f"{int(missing.sum())} of {len(values)} runs: {why}"
 
 
 def compared(table: pd.DataFrame, factors: list[str]) -> list[str]:

@@ -233,7 +233,27 @@ def test_a_metric_the_reference_cannot_give_is_nan_with_the_reason(walk, tmp_pat
     assert "no foot-progression-angle analysis" in notes["fpa_mean_deg"]
     assert all(np.isnan(rows.loc[m, "value"]) for m in asked if m != "stance_f1")
     summary = (tmp_path / "out" / "summary.md").read_text()
-    assert "| yun2012 | ic_error_median_abs_s |" in summary  # in the summary too (count 0)
+    line = next(x for x in summary.splitlines() if x.startswith("| yun2012 | ic_error_median_abs_s |"))
+    assert "| 0 | " in line and notes["ic_error_median_abs_s"] in line  # in the summary too: count 0, and why
+
+
+def test_the_summary_says_why_a_metric_has_no_value():
+    """``summarise``'s reason column: the runs' notes where a level has no value, how many runs lack one where
+    only some do, empty where every run has one."""
+    from footzoo.studies.report import summarise
+
+    table = pd.DataFrame({
+        "run": [0, 1, 2, 3, 0, 1, 2, 3], "base": ["a", "a", "b", "b"] * 2, "recording": ["x", "y"] * 4,
+        "metric": ["armse_3d_m"] * 4 + ["strides"] * 4, "value": [0.1, np.nan, np.nan, np.nan, 8, 9, 8, 9],
+        "error": None, "note": [None, "no positions in y", "no positions in x", "no positions in y"] + [None] * 4})
+    s = summarise(table, "base").set_index(["base", "metric"])
+    assert s.loc[("a", "armse_3d_m"), "count"] == 1
+    assert s.loc[("a", "armse_3d_m"), "reason"] == "1 of 2 runs: no positions in y"
+    assert s.loc[("b", "armse_3d_m"), "count"] == 0
+    assert s.loc[("b", "armse_3d_m"), "reason"] == "no positions in x; no positions in y"
+    assert s.loc[("a", "strides"), "reason"] == "" and s.loc[("b", "strides"), "mean"] == 8.5
+    unexplained = summarise(table.drop(columns="note"), "base").set_index(["base", "metric"])
+    assert unexplained.loc[("b", "armse_3d_m"), "reason"] == "no reason recorded"
 
 
 def test_the_datasets_metrics_a_study_asks_for_are_kept():
