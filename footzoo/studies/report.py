@@ -82,14 +82,19 @@ def to_markdown(df: pd.DataFrame, digits: int = 4) -> str:
     cols = [str(c) for c in df.columns]
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for row in df.itertuples(index=False):
-        lines.append("| " + " | ".join(_fmt(v, digits) for v in row) + " |")
+        lines.append("| " + " | ".join(_fmt(v, digits).replace("|", r"\|") for v in row) + " |")  # a note's "|"
     return "\n".join(lines) + "\n"
+
+
+#: The characters a LaTeX table escapes, with their escape.
+LATEX_ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",
+                 "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}"}
 
 
 def to_latex(df: pd.DataFrame, digits: int = 4) -> str:
     """A booktabs LaTeX tabular."""
-    def esc(v: Any) -> str:
-        return _fmt(v, digits).replace("_", r"\_").replace("%", r"\%").replace("&", r"\&")
+    def esc(v: Any) -> str:  # every character LaTeX gives a meaning (a reason is free text)
+        return "".join(LATEX_ESCAPES.get(c, c) for c in _fmt(v, digits))
 
     cols = list(df.columns)
     lines = [r"\begin{tabular}{" + "l" * len(cols) + "}", r"\toprule",

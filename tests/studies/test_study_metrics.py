@@ -256,6 +256,18 @@ def test_the_summary_says_why_a_metric_has_no_value():
     assert unexplained.loc[("b", "armse_3d_m"), "reason"] == "no reason recorded"
 
 
+def test_a_reason_in_free_text_keeps_the_summary_tables_valid():
+    """A note is free text: Markdown's cell separator and LaTeX's special characters are escaped."""
+    from footzoo.studies.report import to_latex, to_markdown
+
+    s = pd.DataFrame({"metric": ["fpa_mean_deg"], "reason": ["meta['foot'] {left|right} at 50% & $x_1 ~ #2^\\"]})
+    md = to_markdown(s).splitlines()[2]
+    assert md == "| fpa_mean_deg | meta['foot'] {left\\|right} at 50% & $x_1 ~ #2^\\ |"
+    row = to_latex(s).splitlines()[4]
+    assert row == (r"fpa\_mean\_deg & meta['foot'] \{left|right\} at 50\% \& \$x\_1 \textasciitilde{} \#2"
+                   r"\textasciicircum{}\textbackslash{} \\")
+
+
 def test_the_datasets_metrics_a_study_asks_for_are_kept():
     """The issue's cases: IC timing on PyShoe (no stride events), stance F1 on gaitmap (no stance mask)."""
     from ..conftest import data_file
