@@ -71,6 +71,11 @@ def resolve_specs(specs: Any, base_dir: str | Path | None = None, where: str = "
             p = Path(spec).expanduser()
             if not p.is_absolute():
                 p = Path(base_dir if base_dir is not None else ".") / p
+                if not p.exists():  # say where the relative path was read from: a YAML file's folder, or here
+                    folder = (f"the folder of the file that lists it, {str(base_dir)!r}" if base_dir is not None
+                              else f"the current folder, {str(Path.cwd())!r}")
+                    raise ConfigError(f"{where}[{i}]: plug-in file {spec!r} {why_missing(p)}: a relative path is "
+                                      f"read from {folder}; give the path from there, or an absolute one")
             out.append(str(p.resolve()))
         else:
             out.append(spec)
@@ -191,8 +196,7 @@ def _source_files(spec: str, label: str) -> list[Path]:
 
 def _check_file(p: Path, label: str) -> None:
     if not p.exists():
-        raise ConfigError(f"{label}: plug-in file {str(p)!r} {why_missing(p)}; paths are relative to the "
-                          f"YAML file's folder")
+        raise ConfigError(f"{label}: plug-in file {str(p)!r} {why_missing(p)}; give the path to an existing .py file")
     if not p.is_file():
         raise ConfigError(f"{label}: plug-in path {str(p)!r} is not a file; give the path to a .py file")
     if p.suffix != ".py":

@@ -1,6 +1,7 @@
 """External plug-ins: loading (files, modules, entry points), errors, pipelines and studies in every back end."""
 
 import hashlib
+import re
 import sys
 
 import numpy as np
@@ -96,7 +97,8 @@ def test_a_builtin_name_cannot_be_taken(tmp_path):
 
 
 @pytest.mark.parametrize(("source", "message"), [
-    (None, r"plugins\[0\]: plug-in file '.*missing.py' does not exist; paths are relative to the YAML file's folder"),
+    (None, r"plugins\[0\]: plug-in file 'missing.py' does not exist: a relative path is read from the folder of the "
+           r"file that lists it, '.*'; give the path from there, or an absolute one"),
     ("def broken(:\n    pass\n", r"plugins\[0\]: syntax error in plug-in file .*bad.py, line 1: .*; fix the file"),
     ("import numpy\nimport not_a_module_xyz\n",
      r"plugins\[0\]: importing plug-in file '.*bad.py' failed at line 2: ModuleNotFoundError: .*not_a_module_xyz"),
@@ -110,6 +112,25 @@ def test_plugin_file_errors_name_file_line_and_fix(tmp_path, source, message):
     with pytest.raises(ConfigError, match=message):
         ext.load_plugins([name], base_dir=tmp_path)
     assert not {m for m in set(sys.modules) - before if m.startswith("footzoo_plugin_")}  # a failed import leaves none
+
+
+def test_a_missing_plugin_file_says_where_its_relative_path_was_read_from(tmp_path, monkeypatch, capsys):
+    """A YAML file's plug-in paths are read from its folder; ``--plugins`` and Python's from the current folder."""
+    from footzoo.apps.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ConfigError, match=rf"--plugins\[0\]: plug-in file 'mine.py' does not exist: a relative path is "
+                                          rf"read from the current folder, '{re.escape(str(tmp_path))}'"):
+        ext.load_plugins(["mine.py"], where="--plugins")
+    with pytest.raises(ConfigError, match=rf"read from the folder of the file that lists it, "
+                                          rf"'{re.escape(str(tmp_path / 'configs'))}'"):
+        ext.load_plugins(["mine.py"], base_dir=tmp_path / "configs")
+    with pytest.raises(ConfigError, match=r"plug-in file '/nowhere/mine.py' does not exist; give the path to an "
+                                          r"existing .py file"):
+        ext.load_plugins(["/nowhere/mine.py"])  # absolute: read from nowhere else
+    capsys.readouterr()
+    assert main(["list", "--plugins", "mine.py"]) != 0
+    assert "a relative path is read from the current folder" in capsys.readouterr().err
 
 
 def test_plugin_module_names_and_bad_specs(tmp_path, monkeypatch):
