@@ -9,12 +9,21 @@ import numpy as np
 import pandas as pd
 
 from ..core.errors import ConfigError, FootzooWarning
+from ..core.usage import fix
 from ..evaluation.metrics import intervals, nearest_index
 from ..kernels.jit import njit
 from ..plugins.base import Analysis, Choice, File, Real, Vector
 from ..plugins.registry import register
 from .foot_side import infer_foot
 from .foot_vector import FootVector
+
+
+def foot_fix() -> str:
+    """How to declare the foot the sensor is on, where footzoo is used from (:mod:`footzoo.core.usage`)."""
+    config = "or foot: right|left in the analysis config (every recording the config runs on)"
+    return fix(python=f"footzoo.load(path, foot='right'|'left') (meta['foot']), {config}",
+               command_line=f"--foot right|left, {config}",
+               study="the recording entry's foot: key in the study (recordings: [{path: ..., foot: right}])")
 
 
 @register
@@ -114,7 +123,7 @@ class HuangFPA(Analysis):
         foot = meta.get("foot")
         if foot is not None and foot not in ("right", "left"):
             raise ConfigError(f"huang_fpa: the recording says the sensor is on the foot {foot!r}; it must be 'left' or "
-                              "'right' (meta['foot']), or set foot: right or foot: left in the analysis config")
+                              f"'right': {foot_fix()}")
         return foot, "recording"
 
     def check(self, meta: dict) -> None:
@@ -145,7 +154,7 @@ class HuangFPA(Analysis):
         """The side read from the walk (:func:`footzoo.analysis.foot_side.infer_foot`), with a warning either way."""
         found = infer_foot(pos, stance)
         self.foot_evidence_ = found.as_dict()
-        declare = "declare the foot: --foot right|left, footzoo.load(path, foot=...), or foot: in the analysis config"
+        declare = "declare the foot: " + foot_fix()
         if found.side is None:
             self.foot_source_ = "unknown"
             self.note_ = (f"the foot side is unknown (the recording does not name it, and {found.reason}); the foot "

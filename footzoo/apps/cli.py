@@ -51,6 +51,7 @@ from ..core.errors import (
 )
 from ..core.files import nul_in_path, why_missing
 from ..core.params import describe as describe_parameters
+from ..core.usage import used_from
 from ..core.warninglog import LOG, log_text, warning_texts
 from ..io.registry import BUILTIN
 from ..plugins.base import BASES
@@ -938,6 +939,12 @@ def main(argv: list[str] | None = None) -> int:
     debug = bool(getattr(args, "debug", False))
     if not debug:
         warnings.showwarning = _show_warning
+    with used_from("command line"):  # a message names the command line's fix (an option, not a keyword)
+        return _run_command(args, debug)
+
+
+def _run_command(args: argparse.Namespace, debug: bool) -> int:
+    """Run the parsed command; its exit code (an error is printed, with a traceback only with ``--debug``)."""
     try:
         if not getattr(args, "quiet", False):
             return args.func(args)

@@ -40,6 +40,7 @@ import pandas as pd
 from ..core import errors
 from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
 from ..core.errors import ConfigError, FootzooWarning
+from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
 from ..evaluation.metrics import reference_steps, run_metrics
 from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
@@ -138,7 +139,7 @@ def _recording(cell: Cell, identity: str) -> tuple[Any, list[str]]:
         if got is not None:
             _RECORDINGS.move_to_end(identity)
             return got
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True) as caught, used_from("study"):
         warnings.simplefilter("always")
         rec = _read_only(cell.recording.load())
     if rec.truth is not None and rec.truth.steps is not None:  # footzoo's column names once, not per run
@@ -181,8 +182,8 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
     out = _new_record(cell, key)
     caught: list[warnings.WarningMessage] = []
     try:
-        with warnings.catch_warnings(record=True) as caught:  # sent back with the record (see _replay_warnings)
-            warnings.simplefilter("always")
+        with warnings.catch_warnings(record=True) as caught, used_from("study"):  # caught: sent back with the record
+            warnings.simplefilter("always")  # (see _replay_warnings); a message names the study's fix
             # wall and CPU seconds of the pipeline itself and of its metrics (benchmarks/study_scaling.py)
             start, cpu = time.perf_counter(), time.process_time()
             res = Pipeline.from_dict(cell.config).run(rec)

@@ -146,3 +146,42 @@ def test_pyshoe_circling_is_left_undecided_not_guessed():
         res = Pipeline.from_yaml("recommended").run(rec)
     found = infer_foot(res.pos, res.stance)
     assert found.side is None and found.strides < MIN_STRIDES
+
+
+def test_the_foot_side_fix_is_the_one_that_applies_where_the_user_is(tmp_path):
+    """In Python the loader's ``foot=``, on the command line ``--foot``, in a study the recording entry's ``foot:``."""
+    from footzoo.analysis.fpa import HuangFPA
+    from footzoo.core.usage import used_from
+
+    pos, stance = walk([0.02, -0.02] * 5)  # half each way: the walk does not tell the side
+    t, quat = np.arange(len(pos)) / 100.0, np.tile([1.0, 0.0, 0.0, 0.0], (len(pos), 1))
+    fixes = {}
+    for place in ("python", "command line", "study"):
+        with used_from(place), pytest.warns(FootzooWarning, match="every FPA is NaN") as warned:
+            HuangFPA().analyze(t, quat, pos, stance, {"name": "hand-made"})
+        fixes[place] = str(warned[0].message)
+    assert "footzoo.load(path, foot='right'|'left')" in fixes["python"] and "--foot" not in fixes["python"]
+    assert "--foot right|left" in fixes["command line"] and "footzoo.load" not in fixes["command line"]
+    assert "the recording entry's foot: key in the study" in fixes["study"]
+    assert "--foot" not in fixes["study"] and "footzoo.load" not in fixes["study"]
+
+
+@pytest.mark.slow
+def test_a_study_names_the_recording_entrys_foot_key(tmp_path):
+    import yaml
+
+    from footzoo.io.canonical import write
+    from footzoo.studies import run_study
+
+    rec = simulate(n_strides=8, rate=100.0, noise=NoiseModel(seed=1))
+    rec.meta.pop("foot", None)
+    cfg = Pipeline.from_yaml("recommended").to_dict()
+    cfg["analysis"] = [{"type": "huang_fpa"}]
+    (tmp_path / "fpa.yaml").write_text(yaml.safe_dump(cfg))
+    write(rec, tmp_path / "walk.csv")
+    study = {"base": str(tmp_path / "fpa.yaml"), "recordings": [{"path": str(tmp_path / "walk.csv")}],
+             "metrics": ["fpa_mean_deg"]}
+    with pytest.warns(FootzooWarning) as warned:
+        run_study(study, out=tmp_path / "out")
+    assert any("the recording entry's foot: key in the study" in str(w.message) for w in warned)
+    assert not any("--foot" in str(w.message) for w in warned)
