@@ -20,6 +20,7 @@ from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS, TIME_UNITS
 from .errors import FootzooWarning, RecordingError
 from .norms import row_norms, unit_error
 from .sanity import check_impossible, scan
+from .usage import fix
 
 ACC_COLS = ["acc_x", "acc_y", "acc_z"]
 GYR_COLS = ["gyr_x", "gyr_y", "gyr_z"]
@@ -622,12 +623,21 @@ def warn_gaps(rec: Recording, fix: str | None = None, stacklevel: int = 2) -> No
 
 
 def option_fix(key: str, value: str, number: bool = False) -> str:
-    """How to pass a reader option, in Python and on the command line (for the messages of the data's checks)."""
-    return f"footzoo.load(path, {key}={value if number else repr(value)}), on the command line --option {key}={value}"
+    """How to pass a reader option, in Python and on the command line, or in a study (for the messages of the data's
+    checks; :mod:`footzoo.core.usage`)."""
+    return fix(python=f"footzoo.load(path, {key}={value if number else repr(value)}), on the command line "
+                      f"--option {key}={value}", study=_entry_fix(key, value))
 
-#: How to declare a unit, in each place footzoo reads one (every reader takes ``acc_unit`` and ``gyr_unit``).
-UNIT_FIX = ("footzoo.load(path, {key}='{value}'), on the command line --option {key}={value}, "
-            "Recording.from_dataframe(..., {key}='{value}')")
+
+def unit_fix(key: str, value: str) -> str:
+    """How to declare a unit, in each place footzoo reads one (every reader takes ``acc_unit`` and ``gyr_unit``)."""
+    return fix(python=f"footzoo.load(path, {key}='{value}'), on the command line --option {key}={value}, "
+                      f"Recording.from_dataframe(..., {key}='{value}')", study=_entry_fix(key, value))
+
+
+def _entry_fix(key: str, value: str) -> str:
+    """A reader option in a study: a key of the recording's entry."""
+    return f"the recording entry's {key}: {value} key in the study (recordings: [{{path: ..., {key}: {value}}}])"
 
 
 def _check_units(rec: Recording) -> None:
@@ -653,12 +663,12 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
     if 0.5 < rest < 2.0:
         raise RecordingError(
             f"accelerometer magnitude at rest is {rest:.3f}: this looks like g, not m/s²; "
-            f"declare acc_unit: g ({UNIT_FIX.format(key='acc_unit', value='g')})"
+            f"declare acc_unit: g ({unit_fix('acc_unit', 'g')})"
         )
     if 500.0 < rest < 2000.0:
         raise RecordingError(
             f"accelerometer magnitude at rest is {rest:.1f}: this looks like mg; declare acc_unit: mg "
-            f"({UNIT_FIX.format(key='acc_unit', value='mg')})"
+            f"({unit_fix('acc_unit', 'mg')})"
         )
     if not 0.5 * GRAVITY < rest < 1.5 * GRAVITY:
         for true, declared in (("m/s^2", "g"), ("m/s^2", "mg"), ("g", "mg"), ("mg", "g")):
@@ -667,7 +677,7 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
                 raise RecordingError(
                     f"accelerometer magnitude at rest is {rest:.4g} m/s² as declared, {rest / GRAVITY:.4g} g: this "
                     f"is what g reads in {true} declared as {declared}; declare acc_unit: {true} "
-                    f"({UNIT_FIX.format(key='acc_unit', value=true)})"
+                    f"({unit_fix('acc_unit', true)})"
                 )
         raise RecordingError(
             f"accelerometer magnitude at rest is {rest:.3f} m/s², far from g = {GRAVITY}; "
@@ -678,5 +688,5 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
     if peak > GYRO_DEG_S_SUSPICION:
         raise RecordingError(
             f"gyroscope 99th-percentile rate is {peak:.1f}, too fast for rad/s (a foot turns below ~20 rad/s): "
-            f"this looks like deg/s; declare gyr_unit: deg/s ({UNIT_FIX.format(key='gyr_unit', value='deg/s')})"
+            f"this looks like deg/s; declare gyr_unit: deg/s ({unit_fix('gyr_unit', 'deg/s')})"
         )

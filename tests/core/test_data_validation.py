@@ -193,3 +193,22 @@ def test_a_transposed_array_is_named_with_its_fix():
         Recording(t=t, acc=acc, gyr=gyr.T)
     with pytest.raises(RecordingError, match=r"got \(400, 4\)$"):  # not transposed: no such hint
         Recording(t=t, acc=np.c_[acc, acc[:, :1]], gyr=gyr)
+
+
+def test_in_a_study_the_data_checks_name_the_recording_entrys_key():
+    """A study reads its recordings with the options of their entries: that is the fix a message names there."""
+    from footzoo.core.usage import used_from
+
+    with used_from("study"), pytest.raises(RecordingError) as err:
+        Recording.from_dataframe(frame(gyr_scale=180 / np.pi))
+    assert "the recording entry's gyr_unit: deg/s key in the study" in str(err.value)
+    assert "footzoo.load" not in str(err.value) and "--option" not in str(err.value)
+    df = frame()
+    df = pd.concat([df.iloc[:30], df.iloc[[29]], df.iloc[30:]]).reset_index(drop=True)
+    with used_from("study"), pytest.raises(RecordingError, match=r"the recording entry's duplicates: drop key"):
+        Recording.from_dataframe(df)
+    with pytest.raises(RecordingError, match=r"footzoo\.load\(path, duplicates='drop'\)"):  # in Python, as before
+        Recording.from_dataframe(df)
+    with pytest.raises(ValueError, match="place must be one of"):
+        with used_from("notebook"):
+            pass
