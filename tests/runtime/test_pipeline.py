@@ -144,5 +144,6 @@ def test_an_analysis_refuses_a_recording_it_cannot_use_before_the_run_starts(mon
 
     monkeypatch.setattr(type(pipe), "detect", no_detection)
     with pytest.raises(ConfigError, match=r"the recording says the sensor is on the foot 'both'; it must be 'left' or "
-                                          r"'right'.*or set foot: right or foot: left"):
+                                          r"'right': footzoo\.load\(path, foot='right'\|'left'\).*"
+                                          r"or foot: right\|left in the analysis config"):
         pipe.run(rec)
