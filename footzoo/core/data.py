@@ -596,10 +596,10 @@ def _report_gaps(rec: Recording, warn: bool = True) -> None:
         warn_gaps(rec, stacklevel=4)  # as seen from _report_gaps: the caller of Recording(...)
 
 
-def warn_gaps(rec: Recording, fix: str | None = None, stacklevel: int = 2) -> None:
+def warn_gaps(rec: Recording, refuse: str | None = None, stacklevel: int = 2) -> None:
     """The warning of the bridged gaps listed in ``rec.meta["diagnostics"]["gaps"]`` (none: no warning).
 
-    ``fix``: how to refuse them where the samples came from (default: the loader's ``max_gap`` option).
+    ``refuse``: how to refuse them where the samples came from (default: the loader's ``max_gap`` option).
     """
     gaps = rec.meta.get("diagnostics", {}).get("gaps")
     if not gaps:
@@ -616,7 +616,7 @@ def warn_gaps(rec: Recording, fix: str | None = None, stacklevel: int = 2) -> No
             f"periods of {period * 1e3:.2f} ms), the longest {durations[longest] * 1e3:.1f} ms at "
             f"t = {gaps['start_s'][longest]:.3f} s;{lossy} the filters integrate over each sample's real interval. "
             "The list is in meta['diagnostics']['gaps']; to refuse them, a smaller max_gap: "
-            f"{fix or option_fix('max_gap', 'SECONDS', number=True)}"
+            f"{refuse or option_fix('max_gap', 'SECONDS', number=True)}"
         ),
         stacklevel=stacklevel + 1,
     )

@@ -289,7 +289,7 @@ class Stream:
                 raise
             raise RecordingError(f"Stream.result(truth=...): {e} (the stream was pushed {len(k['t'])} samples)") from e
         if "gaps" not in given.get("diagnostics", {}):
-            warn_gaps(rec, fix="footzoo.Stream(pipeline, max_gap=SECONDS)")
+            warn_gaps(rec, refuse="footzoo.Stream(pipeline, max_gap=SECONDS)")
         stance = k["stance"].astype(bool)
         steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
         config = {**self.pipeline.to_dict(), "engine": "stream"}
