@@ -139,6 +139,7 @@ class Stream:
         self._scan_raw = Blocks(self._signals.push)
         self._scan_final: Blocks | None = None
         self.log: list[dict[str, Any]] | None = None
+        self._given: tuple[dict[str, Any], Any] | None = None  # meta and truth of the recording run() pushed
 
     # ------------------------------------------------------------------ public
     @property
@@ -259,7 +260,8 @@ class Stream:
         run computes them; ``meta`` describes the recording (``name``, ``foot``, ...: a loaded
         recording's ``rec.meta``). ``truth`` (a :class:`~footzoo.Truth`, e.g. ``rec.truth``, one row
         per pushed sample) is the reference its :attr:`~footzoo.Result.metrics` are scored against,
-        as a batch run's are against its recording's.
+        as a batch run's are against its recording's. After :meth:`run`, both default to the
+        recording's: the result is then the batch run's (``Pipeline.run(rec)``), computed live.
 
         The stream warned about its samples as they came (:attr:`sensor`); the result does not warn
         again. Bridged gaps in the time stamps are listed in ``recording["diagnostics"]["gaps"]`` and
@@ -280,6 +282,9 @@ class Stream:
         from ..plugins.incremental import concat
 
         k = concat(self._kept)
+        if self._given is not None:  # the defaults of a recording pushed by run()
+            meta = self._given[0] if meta is None else meta
+            truth = self._given[1] if truth is None else truth
         given = dict(meta or {})
         try:
             rec = Recording(t=k["t"], acc=k["acc"], gyr=k["gyr"], mag=k.get("mag"), meta=given, truth=truth,
@@ -305,9 +310,12 @@ class Stream:
         ``chunk`` samples at a time (1: :meth:`push`, sample by sample; more: :meth:`extend`), or
         blocks of the sizes in an array (e.g. random ones, in the tests). Uses the recording's rate
         (:attr:`Recording.rate`) when the stream was made without one, as the batch run does. With
-        ``log`` set to a list, each call's returned estimate is appended.
+        ``log`` set to a list, each call's returned estimate is appended. With ``keep``, :meth:`result`
+        then describes and scores the run with the recording's ``meta`` and ``truth``.
         """
         check_unused(self)
+        if self.keep:  # result()'s defaults: the recording's description and reference
+            self._given = (rec.meta, rec.truth)
         if self.rate is None and self.ctx is None:
             self.rate = rec.rate
         sizes = np.asarray(chunk, dtype=int).reshape(-1)

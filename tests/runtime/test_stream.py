@@ -256,20 +256,33 @@ def test_a_kept_stream_gives_the_batch_result_with_its_strides(walk):
 
 
 def test_a_kept_stream_given_the_truth_has_the_batch_runs_metrics(walk):
-    """``result(truth=rec.truth)``: the live result is scored against the reference as the batch run is."""
+    """``result(truth=rec.truth)``: the live result is scored against the reference as the batch run is; after
+    ``run(rec)`` the recording's meta and truth are the defaults."""
     p = Pipeline.from_yaml("nguyen2016")
-    s = Stream(p, rate=walk.rate, keep=True, guess=False)
-    s.run(walk, chunk=CHUNKS)
-    live, batch = s.result(meta=walk.meta, truth=walk.truth), p.run(walk)
-    assert live.reference is walk.truth and "armse_3d_m" in batch.metrics
-    assert live.metrics.keys() == batch.metrics.keys()
-    np.testing.assert_allclose(list(live.metrics.values()), list(batch.metrics.values()), rtol=0, atol=1e-9)
-    assert "armse_3d_m" not in s.result(meta=walk.meta).metrics  # no truth, no errors against one
+    batch = p.run(walk)
+    assert "armse_3d_m" in batch.metrics
+
+    def same_metrics(live):
+        assert live.metrics.keys() == batch.metrics.keys()
+        np.testing.assert_allclose(list(live.metrics.values()), list(batch.metrics.values()), rtol=0, atol=1e-9)
+
+    ran = Stream(p, rate=walk.rate, keep=True, guess=False)
+    ran.run(walk, chunk=CHUNKS)
+    default = ran.result()
+    assert default.reference is walk.truth and default.recording["name"] == walk.name
+    same_metrics(default)
+    pushed = Stream(p, rate=walk.rate, keep=True, guess=False)  # samples as a sensor delivers them
+    for k in range(0, walk.n, 37):
+        sl = slice(k, k + 37)
+        pushed.extend(walk.t[sl], walk.acc[sl], walk.gyr[sl], walk.mag[sl], walk.dist[sl])
+    pushed.close()
+    assert "armse_3d_m" not in pushed.result(meta=walk.meta).metrics  # no truth, no errors against one
+    same_metrics(pushed.result(meta=walk.meta, truth=walk.truth))
     with pytest.raises(ConfigError, match=r"truth=rec\.truth"):
-        s.result(truth=walk)  # the recording instead of its reference
+        pushed.result(truth=walk)  # the recording instead of its reference
     short = footzoo.Truth(pos=walk.truth.pos[:-5])
     with pytest.raises(RecordingError, match=r"Stream\.result\(truth=\.\.\.\).*pos has .* rows"):
-        s.result(truth=short)
+        pushed.result(truth=short)
 
 
 def test_a_streamed_recording_is_warned_about_its_gaps_once():
