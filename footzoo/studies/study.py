@@ -452,7 +452,7 @@ class Study:
             if problem:
                 problems.setdefault(problem, []).append({"recording": rec.label})
         if problems:
-            lines = [f"- {e} (e.g. {_levels_text(where[0])}; {len(where)} case(s))"
+            lines = [f"- {e} ({len(where)} case(s), the first: {_levels_text(where[0])})"
                      for e, where in list(problems.items())[:5]]
             more = f"\n... and {len(problems) - 5} more distinct problem(s)" if len(problems) > 5 else ""
             raise ConfigError(f"study {self.name!r}: {bad} of {len(configs)} config(s) invalid or recordings "

@@ -41,7 +41,7 @@ def test_a_misspelt_parameter_stops_the_study_before_any_run(tmp_path):
     with pytest.raises(ConfigError, match=r"(?s)2 of 2 config\(s\) invalid.*nothing was run.*"
                        r"unknown parameter 'treshold'.*did you mean 'threshold'") as err:
         run_study(study, out=tmp_path / "out")
-    assert "detector.treshold=0.5" in str(err.value)  # the levels that lead to it
+    assert "(2 case(s), the first: base='yun2012', detector.treshold=0.5)" in str(err.value)  # the levels
     assert not list((tmp_path / "out").glob("cache/*.json"))
 
 
