@@ -17,6 +17,47 @@ from ..plugins.registry import register
 from .foot_side import infer_foot
 from .foot_vector import FootVector
 
+#: Largest angle (rad) between the heading vector and the line of progression for which an FPA is kept: 15°.
+MAX_HEADING_OFFSET = math.radians(15.0)
+
+
+#: Largest magnitude (rad) of the median FPA of a recording's straight strides read as the foot's: 35°. Human FPA
+#: lies about −10° to +25° (toe-out positive); beyond 35° the sensor's x axis is turned on the foot.
+MAX_PLAUSIBLE_FPA = math.radians(35.0)
+#: Fewest straight strides for that judgement.
+MIN_STRAIGHT_STRIDES = 5
+
+
+def heading_offsets(pos: np.ndarray, heel_strikes: np.ndarray, heading: np.ndarray) -> np.ndarray:
+    """The heading vector's angle from the line of progression at each footprint (M,) (rad; NaN where undefined).
+
+    The line of progression at footprint ``i`` is the horizontal direction from the previous footprint of
+    the same foot to the next one, ``p_{i+1} − p_{i−1}`` (the last footprint: ``p_i − p_{i−1}``), with
+    ``p_i`` the position at heel strike ``i``. Walking straight the two agree to a few degrees; on a turn
+    the heading vector, built from the stride before the footprint and smoothed over the strides before
+    it (eqs. 13–14), lags the walk by half the turn and more.
+
+    Parameters
+    ----------
+    pos : (N, 3) ndarray
+        Position in NED (m).
+    heel_strikes : (M,) int ndarray
+        Sample index of each heel strike.
+    heading : (M,) ndarray
+        Direction of the heading vector at each heel strike (rad, from north toward east).
+    """
+    p = pos[np.asarray(heel_strikes, dtype=np.int64), :2]
+    m = len(p)
+    out = np.full(m, np.nan)
+    if m < 2:
+        return out
+    after = np.vstack([p[2:], p[-1:]])  # p_{i+1}, the last footprint's own
+    chord = after - p[:-1]  # rows i = 1 .. m-1
+    moved = np.hypot(chord[:, 0], chord[:, 1]) > 1e-3
+    travel = np.arctan2(chord[:, 1], chord[:, 0])
+    out[1:] = np.where(moved, (heading[1:] - travel + np.pi) % (2 * np.pi) - np.pi, np.nan)
+    return out
+
 
 def foot_fix() -> str:
     """How to declare the foot the sensor is on, where footzoo is used from (:mod:`footzoo.core.usage`)."""
@@ -62,6 +103,13 @@ class HuangFPA(Analysis):
         YAML file from ``footzoo calibrate`` (replaces ``foot_vector``).
     foot : {"auto", "right", "left"}
         Which foot the sensor is on.
+    max_heading_offset : float
+        Largest angle (rad) between the heading vector and the line of progression (the previous
+        footprint to the next) for which the FPA is kept; beyond it the footprint is on a turn and its
+        FPA is NaN (default 15°). The paper walked on a treadmill: "FPA is only valid clinically during
+        straight line walking", and its heading vector, slow to follow a turn, gives "invalid FPA
+        estimates" after one (Sec. IV). When most footprints of a recording are on turns, a warning
+        says so.
 
     Attributes
     ----------
@@ -75,8 +123,13 @@ class HuangFPA(Analysis):
         Where the side came from.
     foot_evidence_ : dict or None
         What the walk said (:meth:`footzoo.analysis.foot_side.FootSide.as_dict`) when the side was read from it.
+    heading_offset_ : (M,) ndarray
+        Angle of the heading vector from the line of progression at each footprint
+        (:func:`heading_offsets`, rad; NaN where undefined).
+    turning_ : (M,) bool ndarray
+        Footprints on a turn (``|heading_offset_| > max_heading_offset``): their FPA is NaN.
     note_ : str
-        Why the FPA is NaN ("" when it is not).
+        Why every FPA is NaN ("" when one is not).
     """
 
     name = "huang_fpa"
@@ -94,6 +147,9 @@ class HuangFPA(Analysis):
                             source="none: use foot_vector"),
         "foot": Choice(("auto", "right", "left"), "which foot the sensor is on (auto: the recording's meta['foot'])",
                        source="footzoo's: from the recording"),
+        "max_heading_offset": Real("rad", "(0, pi]", "largest angle between the heading vector (eq. 14) and the "
+                                   "line of progression at a footprint for which the FPA is kept (a turn: NaN)",
+                                   source="footzoo's: measured on the visible recordings (docs/gait.md)"),
     }
 
     def __init__(
@@ -104,6 +160,7 @@ class HuangFPA(Analysis):
         foot_vector: list[float] | tuple[float, float, float] = (1.0, 0.0, 0.0),
         calibration: str | None = None,
         foot: str = "auto",
+        max_heading_offset: float = MAX_HEADING_OFFSET,
     ):
         if not window[0] < window[1]:
             raise ConfigError(f"window must be [start, end] fractions of the stance with start < end, got {window}")
@@ -115,6 +172,7 @@ class HuangFPA(Analysis):
         self.foot_vector = foot_vector
         self.calibration = calibration
         self.foot = foot
+        self.max_heading_offset = max_heading_offset
 
     def _declared(self, meta: dict) -> tuple[str | None, str]:
         """The side the config or the recording names, and which one named it."""
@@ -144,10 +202,16 @@ class HuangFPA(Analysis):
             return self
         f_s = FootVector.load(self.calibration).vector if self.calibration else np.asarray(self.foot_vector, float)
         f_s = f_s / np.linalg.norm(f_s)
-        self.fpa_ = _fpa_kernel(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(quat, dtype=float),
-                                np.ascontiguousarray(pos, dtype=float), self.heel_strikes_.astype(np.int64),
-                                f_s, float(self.alpha), self.window[0], self.window[1], float(self.stance_fraction),
-                                1.0 if foot == "right" else -1.0)
+        fpa, heading = _fpa_kernel(np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(quat, dtype=float),
+                                   np.ascontiguousarray(pos, dtype=float), self.heel_strikes_.astype(np.int64),
+                                   f_s, float(self.alpha), self.window[0], self.window[1], float(self.stance_fraction),
+                                   1.0 if foot == "right" else -1.0)
+        self.heading_offset_ = heading_offsets(np.asarray(pos, dtype=float), self.heel_strikes_, heading)
+        self.turning_ = np.abs(self.heading_offset_) > self.max_heading_offset  # NaN compares False
+        self.fpa_ = np.where(self.turning_, np.nan, fpa)
+        name = str(meta.get("name", "recording"))
+        if not self._say_turning(np.isfinite(fpa), name):  # a walk of turns says nothing of the mounting
+            self._say_implausible(name)
         return self
 
     def _side_from_walk(self, pos: np.ndarray, stance: np.ndarray, name: str) -> str | None:
@@ -167,6 +231,41 @@ class HuangFPA(Analysis):
             f"huang_fpa: recording {name!r} does not say which foot the sensor is on; read as the {found.side} foot "
             f"from the walk: {found.reason}. To be sure, {declare}"), stacklevel=3)
         return found.side
+
+    def _say_turning(self, had: np.ndarray, name: str) -> bool:
+        """Warn when most FPAs are dropped for a turn (and say so: True), and say why the column is NaN when every
+        one is."""
+        turned = int(np.count_nonzero(self.turning_ & had))
+        total = int(np.count_nonzero(had))
+        if total == 0 or 2 * turned <= total:
+            return False
+        offsets = np.degrees(np.abs(self.heading_offset_[self.turning_ & had]))
+        why = (f"the walk turns at {turned} of {total} footprints (the heading vector, eq. 14, is "
+               f"{np.median(offsets):.0f}° (median) from the line of progression there, more than "
+               f"{math.degrees(self.max_heading_offset):.0f}°): the FPA is defined on straight walking (Huang et al. "
+               "2016, Sec. IV), on a turn it measures the turn, not the foot")
+        if turned == total:
+            self.note_ = why
+        warnings.warn(FootzooWarning(
+            f"huang_fpa: recording {name!r}: {why}; those FPAs are NaN, the rest of the run is unaffected. For a "
+            "foot progression angle, record straight walking (a walkway or a treadmill, turns apart)"), stacklevel=3)
+        return True
+
+    def _say_implausible(self, name: str) -> None:
+        """Warn when the straight strides' median FPA is beyond :data:`MAX_PLAUSIBLE_FPA`: it measures the sensor."""
+        kept = self.fpa_[np.isfinite(self.fpa_)]
+        if len(kept) < MIN_STRAIGHT_STRIDES or abs(np.median(kept)) <= MAX_PLAUSIBLE_FPA:
+            return
+        angle = math.degrees(float(np.median(kept)))
+        vector = ("the calibrated foot vector" if self.calibration
+                  else f"the foot vector {list(self.foot_vector)} (sensor axes)")
+        warnings.warn(FootzooWarning(
+            f"huang_fpa: recording {name!r}: the foot progression angle is {angle:+.0f}° (median of {len(kept)} "
+            f"straight strides), far outside a human's (about −10° to +25°, toe-out positive): it is the angle of "
+            f"{vector} from the line of progression, and that axis is not along the foot. The FPA measures the "
+            "sensor, not the foot: mount the sensor with its x axis along the foot, or give the foot's long axis "
+            "in sensor axes: calibrate it (footzoo calibrate --data CALIBRATION_RECORDING --out foot.yaml, then "
+            "calibration: foot.yaml in the analysis config) or set foot_vector"), stacklevel=3)
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
         """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.
@@ -188,11 +287,14 @@ class HuangFPA(Analysis):
 
 @njit
 def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray, f_s: np.ndarray, alpha: float,
-                w0: float, w1: float, stance_fraction: float, side: float) -> np.ndarray:
-    """Eqs. 12–16 for every heel strike ``hs[i]`` (sample indices); NaN where undefined."""
+                w0: float, w1: float, stance_fraction: float, side: float) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs. 12–16 for every heel strike ``hs[i]`` (sample indices): the FPA and the heading vector's
+    direction ``ψ_h`` (rad, from north toward east); NaN where undefined."""
     m = hs.shape[0]
     fpa = np.empty(m)
     fpa[:] = np.nan
+    heading = np.empty(m)
+    heading[:] = np.nan
     hx, hy = 0.0, 0.0
     for i in range(1, m):
         rx = pos[hs[i], 0] - pos[hs[i - 1], 0]  # eq. 13
@@ -203,13 +305,14 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
             hx, hy = alpha * rx + (1 - alpha) * hx, alpha * ry + (1 - alpha) * hy
         if hx == 0.0 and hy == 0.0:
             continue
+        heading[i] = math.atan2(hy, hx)
         stride = t[hs[i + 1]] - t[hs[i]] if i + 1 < m else t[hs[i]] - t[hs[i - 1]]
         stance_time = stance_fraction * stride
         lo = _bisect(t, t[hs[i]] + w0 * stance_time, False)
         hi = _bisect(t, t[hs[i]] + w1 * stance_time, True)
         if hi <= lo:
             continue
-        psi_h = math.atan2(hy, hx)
+        psi_h = heading[i]
         total = 0.0
         for k in range(lo, hi):
             w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
@@ -219,7 +322,7 @@ def _fpa_kernel(t: np.ndarray, quat: np.ndarray, pos: np.ndarray, hs: np.ndarray
             d = math.atan2(fy, fx) - psi_h
             total += side * -((-d + math.pi) % (2 * math.pi) - math.pi)  # eq. 15, wrapped to (-π, π]
         fpa[i] = total / (hi - lo)  # eq. 16
-    return fpa
+    return fpa, heading
 
 
 @njit(inline=True)  # inlined: no compilation per constant value of right
