@@ -9,10 +9,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo.analysis.fpa import MAX_HEADING_OFFSET, HuangFPA, heading_offsets
+from footzoo import Pipeline
+from footzoo.analysis.fpa import MAX_HEADING_OFFSET, MAX_PLAUSIBLE_FPA, HuangFPA, heading_offsets
 from footzoo.core.conventions import quat_from_euler
 from footzoo.core.errors import FootzooWarning
+from footzoo.io import load
 from footzoo.sim import remount, simulate
+
+from ..conftest import data_file
 
 STANCE, SWING, RATE = 60, 40, 100.0  # samples, samples, Hz
 LENGTH = 1.3  # m
@@ -91,7 +95,7 @@ def test_a_walk_that_turns_at_every_footprint_has_no_fpa_and_says_why():
 
 
 def test_a_corner_drops_only_the_footprints_on_it_quietly():
-    """12 straight strides, a 90° corner over three footprints, 12 straight: the corner's FPAs are NaN, the rest exact."""
+    """12 straight strides, a 90° corner over three footprints, 12 straight: the corner's FPAs NaN, the rest kept."""
     corner = math.radians(30.0)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -138,3 +142,28 @@ def test_a_sensor_turned_on_the_foot_is_named_with_its_fix(simulated):
         b = HuangFPA(foot="right", foot_vector=[math.cos(yaw), -math.sin(yaw), 0.0]).analyze(
             simulated.t, remount(simulated, m).truth.quat, simulated.truth.pos, simulated.truth.stance, {})
     np.testing.assert_allclose(np.degrees(b.fpa_[np.isfinite(b.fpa_)]), 8.0, atol=0.05)
+
+
+def _run_with_fpa(rec):
+    cfg = Pipeline.from_yaml("recommended").to_dict()
+    cfg["analysis"] = [{"type": "huang_fpa"}]
+    return Pipeline.from_dict(cfg).run(rec)
+
+
+def test_pyshoes_room_walk_turns_at_every_footprint_and_says_so():
+    """The trial that read 28°–129° without a word: it circles the room, turning 36°–95° at each stride."""
+    rec = load(data_file("pyshoe_vicon", "2017-11-22-11-22-03.mat"))
+    with pytest.warns(FootzooWarning, match=r"huang_fpa: recording '2017-11-22-11-22-03': the walk turns at"):
+        res = _run_with_fpa(rec)
+    assert res.steps["fpa_rad"].isna().all()
+    assert "turns" in res.metric_notes["fpa_mean_deg"]
+
+
+def test_gaitmaps_straight_walk_keeps_its_fpa_quietly():
+    rec = load(data_file("gaitmap_example", "imu_sample.csv"), foot="left")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FootzooWarning)
+        res = _run_with_fpa(rec)
+    fpa = res.steps["fpa_rad"].to_numpy()
+    assert np.isfinite(fpa).sum() >= 25  # the turn's strides dropped, the straight ones kept
+    assert abs(np.degrees(np.nanmedian(fpa))) < math.degrees(MAX_PLAUSIBLE_FPA)
