@@ -55,6 +55,10 @@ UPSIDE_DOWN_TRIAL = "ignore:recording .2018-02-22-10-09-36.. the sensor's y axis
 #: The mounting report finds the x axis of Köroğlu's sensors (experiments 31-33) pointing backwards.
 KOROGLU_MOUNTING = ("ignore:recording .SensorConnectData_3[1-3].. the foot walks backwards:"
                     "footzoo.core.errors.SensorWarning")
+#: PyShoe's walking trials circle a small room: huang_fpa finds most footprints on turns and says so.
+FPA_ON_TURNS = "ignore:huang_fpa. recording .* the walk turns at:footzoo.core.errors.FootzooWarning"
+#: A sensor turned on the foot on purpose: huang_fpa's straight-walk FPA is no foot's, and it says so.
+FPA_OF_THE_SENSOR = "ignore:huang_fpa. recording .* not along the foot:footzoo.core.errors.FootzooWarning"
 
 #: The shared recordings: ../shared/data next to the checkout, or the folder named by FOOTZOO_DATA.
 DATA = Path(os.environ.get("FOOTZOO_DATA") or Path(__file__).resolve().parents[1].parent / "shared" / "data")

@@ -14,6 +14,8 @@ from footzoo.runtime.alignment import initial_attitude
 from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import simulate
 
+from ..conftest import FPA_OF_THE_SENSOR
+
 #: The mounting report of a sensor turned on purpose (this module's subject).
 TURNED = "ignore:recording .sim_rectangle.. the sensor's y axis points left:footzoo.core.errors.SensorWarning"
 
@@ -69,8 +71,9 @@ def test_the_inverted_sensor_reads_plus_g_at_rest(walk):
     assert rec.acc[0, 2] == pytest.approx(GRAVITY)
 
 
-# the sensor is turned on purpose: the mounting report names it (expected warning)
+# the sensor is turned on purpose: the mounting report names it, and huang2016's FPA too (expected warnings)
 @pytest.mark.filterwarnings(TURNED)
+@pytest.mark.filterwarnings(FPA_OF_THE_SENSOR)
 @pytest.mark.parametrize("config", ["yun2012", "huang2016", "nguyen2016", "duong2015_zupt"])
 @pytest.mark.parametrize("mounting", ["inverted", "on_its_side", "arbitrary"])
 def test_every_orientation_filter_starts_right_on_a_turned_sensor(walk, config, mounting):
