@@ -59,8 +59,9 @@ def test_block_extraction():
     assert python_blocks('```python\n--8<-- "pyproject.toml"\n```\n')[0][1] == (ROOT / "pyproject.toml").read_text()
 
 
-#: The pages whose code takes longest (a study, the tutorial's several runs: about 10 s each): with the slow tests.
-SLOW_PAGES = ("docs/getting-started.md", "docs/studies.md")
+#: The pages whose code takes longest (a study, the tutorial's several runs: about 10 s each; a live run kept and
+#: scored, the uncertainty page's runs: 5-6 s each): with the slow tests.
+SLOW_PAGES = ("docs/getting-started.md", "docs/studies.md", "docs/live.md", "docs/uncertainty.md")
 
 
 def _page(path: Path) -> object:

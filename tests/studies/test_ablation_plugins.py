@@ -245,6 +245,7 @@ def test_editing_the_plugin_reruns_its_cells_only(tmp_path):
     assert third.attrs["computed"] == 0 and third.equals(second)
 
 
+@pytest.mark.slow  # two worker processes (about 6 s)
 def test_a_base_config_with_plugins_is_resolved_against_its_own_folder(tmp_path):
     configs = tmp_path / "configs"
     configs.mkdir()
