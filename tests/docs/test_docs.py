@@ -60,8 +60,9 @@ def test_block_extraction():
 
 
 #: The pages whose code takes longest (a study, the tutorial's several runs: about 10 s each; a live run kept and
-#: scored, the uncertainty page's runs: 5-6 s each): with the slow tests.
-SLOW_PAGES = ("docs/getting-started.md", "docs/studies.md", "docs/live.md", "docs/uncertainty.md")
+#: scored, the uncertainty page's runs, the guards' and the generic reader's: 4-6 s each): with the slow tests.
+SLOW_PAGES = ("docs/getting-started.md", "docs/studies.md", "docs/live.md", "docs/uncertainty.md", "docs/guards.md",
+              "docs/readers/generic.md")
 
 
 def _page(path: Path) -> object:

@@ -173,6 +173,7 @@ def test_an_unmarked_function_is_called_in_python_through_the_same_convention():
         calling(_velocity_rows, "measure")  # the context form warns about nothing
 
 
+@pytest.mark.slow  # two new processes (about 4 s)
 def test_a_plugins_compiled_convention_is_cached_and_a_new_process_compiles_nothing(tmp_path):
     if not _jit.HAVE_NUMBA:
         pytest.skip("numba not installed")

@@ -83,6 +83,7 @@ def test_import_footzoo_loads_no_heavy_dependency():
     assert "Pipeline" in out["all"] and "load" in out["all"]
 
 
+@pytest.mark.slow  # a new process importing footzoo (about 4 s)
 def test_pipeline_and_readers_load_no_compiler_until_a_kernel_runs():
     """``from footzoo import Pipeline, load`` and building every plug-in import neither numba, scipy nor filterpy.
 
