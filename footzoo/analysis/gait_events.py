@@ -33,9 +33,11 @@ Checked against three references (docs/gait-events.md, ``benchmarks/accuracy.py 
 events``): the simulator's truth (the toe leaving the floor, the heel touching it;
 :mod:`footzoo.sim.gait`), gaitmap's motion-capture events (``stride_events_sample.csv``) and the
 hand-checked IMU events of Voisard et al.'s data set (:mod:`footzoo.io.xsens`). For TO they agree
-(the half point lies 5 to 9 ms after each one's toe-off); for IC the motion capture puts the
-contact at the zero crossing and the hand-checked events put it a median 23 ms later, at the
-impact, so IC follows the motion capture.
+(the half point lies 5 to 9 ms after each one's toe-off). For IC the simulator and the motion
+capture's events sit at the zero crossing, the foot's largest pitch; the hand-checked events a
+median 23 ms later, at the impact, where the motion capture's heel marker touches down. IC stays
+at the zero crossing, a landmark of every swing at every rate: about 20 ms before the heel's
+touch-down.
 
 **Independent of the mounting** (footzoo's choice, :func:`sagittal_rate`): ``ω_ml`` is
 not a sensor axis but the angular rate rotated into the navigation frame with the
