@@ -461,7 +461,28 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "",
         if identity is None or _try_lock(fh) is True:  # the last holder: no other process holds this file
             with contextlib.suppress(OSError):
                 os.unlink(p / LOCK_NAME)
-        fh.close()  # closing releases the lock
+            fh.close()  # closing releases the lock
+        else:
+            fh.close()
+            _remove_if_unheld(p / LOCK_NAME)  # the others may have left while this one looked
+
+
+def _remove_if_unheld(lock: Path) -> None:
+    """Remove the lock file ``lock`` if no holder is left (two holders of one study leaving at once).
+
+    Each of them may see the other still holding it; each then closes its own handle and looks once more
+    with a fresh one, so the last to look finds it free and removes it.
+    """
+    try:
+        fh = open(lock, "r+", encoding="utf-8")  # noqa: SIM115 (closed below, after the removal)
+    except OSError:
+        return  # already removed
+    try:
+        if _try_lock(fh) is True and _same_file(fh, lock):
+            with contextlib.suppress(OSError):
+                os.unlink(lock)
+    finally:
+        fh.close()
 
 
 def lock_holder(folder: PathLike) -> dict[str, Any] | None:

@@ -232,6 +232,36 @@ def test_the_same_study_twice_shares_the_folder_and_another_is_refused(tmp_path)
     assert len(errors) == 1 and not (folder / LOCK_NAME).exists()  # the same one joined; the last removed the file
 
 
+def test_two_holders_of_one_study_leaving_at_once_remove_the_lock_file(tmp_path, monkeypatch):
+    """Each leaver may see the other still holding the file; the last to look again removes it."""
+    import threading
+
+    folder, inside = tmp_path / "study", threading.Barrier(2, timeout=30)
+    seen_by_both = threading.Barrier(2, timeout=30)  # both leavers test the lock before either closes
+    real, leaving = atomic._try_lock, threading.local()
+
+    def try_lock(fh, exclusive=True, wait=False):
+        if exclusive and not wait and getattr(leaving, "first", False):  # each leaver's first look
+            leaving.first = False
+            seen_by_both.wait()
+            return False  # as when both look at the same instant, each still seeing the other's lock
+        return real(fh, exclusive, wait)
+
+    monkeypatch.setattr(atomic, "_try_lock", try_lock)
+
+    def hold():
+        with folder_lock(folder, owner="study 'a'", identity="study-A"):
+            inside.wait()
+            leaving.first = True
+
+    threads = [threading.Thread(target=hold) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert not (folder / LOCK_NAME).exists()
+
+
 def test_a_lock_held_by_another_process_is_refused_and_released_when_it_dies(tmp_path):
     folder = tmp_path / "out"
     code = ("import sys, time\nfrom footzoo.core.atomic import folder_lock\n"
