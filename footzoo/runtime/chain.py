@@ -148,25 +148,47 @@ def build_chain(pipeline: Any, ctx: RunContext, start: Chunk, engine: str = "aut
     whole : bool
         ``start`` is the whole recording (a batch run): every calibration is fitted on it.
     """
-    stages: list[Stage] = []
-    calibrated = start
-    gain = accelerometer_gain(start["t"], start["acc"], start["gyr"], pipeline.gravity, name=ctx.name, **pipeline.init)
-    if gain != 1.0:
-        stage = GainStage(gain, pipeline.gravity / gain, pipeline.gravity)
-        calibrated = stage.whole(start)
-        stages.append(stage)
-    if pipeline.calibration:
-        cal = CalibrationStage(pipeline.calibration if calibrations is None else calibrations, ctx)
-        calibrated = cal.fit(calibrated, whole=whole)
-        stages.append(cal)
-    use_mag = "mag" in calibrated and bool(getattr(pipeline.orientation, "use_magnetometer", False))
-    q0 = initial_attitude(calibrated["t"], calibrated["acc"], calibrated["gyr"],
-                          calibrated["mag"] if use_mag else None, **pipeline.init)
+    stages, calibrated = input_stages(pipeline, ctx, start, calibrations, whole)
+    q0, use_mag = aligned(pipeline, calibrated)
     stages.append(DetectorStage(pipeline.detector, pipeline.guards, ctx, truth))
     if not (pipeline.filter_corrections and pipeline.orientation.carried_by_filter):
         stages.append(OrientationStage(pipeline.orientation, ctx, q0, use_mag))
     stages.append(navigation_stage(pipeline, ctx, calibrated, q0, engine, covariance))
     return Chain(stages)
+
+
+def input_stages(pipeline: Any, ctx: RunContext, start: Chunk, calibrations: list[Calibration] | None = None,
+                 whole: bool = False) -> tuple[list[Stage], Chunk]:
+    """The stages that prepare the signals, before the detector, made on the run's start, and ``start`` as they
+    give it.
+
+    The accelerometer's gain (:class:`GainStage`, when the still start reads more than
+    :data:`~footzoo.runtime.alignment.ACC_GAIN_TOLERANCE` off g: a ``SensorWarning``), then the
+    pipeline's calibrations (:class:`CalibrationStage`, fitted on ``start``). A batch run, a stream
+    and :meth:`footzoo.Pipeline.prepare` (the step-by-step API) all prepare the signals here.
+    ``calibrations`` and ``whole`` as in :func:`build_chain`.
+    """
+    stages: list[Stage] = []
+    out = start
+    gain = accelerometer_gain(start["t"], start["acc"], start["gyr"], pipeline.gravity, name=ctx.name, **pipeline.init)
+    if gain != 1.0:
+        stage = GainStage(gain, pipeline.gravity / gain, pipeline.gravity)
+        out = stage.whole(start)
+        stages.append(stage)
+    if pipeline.calibration:
+        cal = CalibrationStage(pipeline.calibration if calibrations is None else calibrations, ctx)
+        out = cal.fit(out, whole=whole)
+        stages.append(cal)
+    return stages, out
+
+
+def aligned(pipeline: Any, prepared: Chunk) -> tuple[np.ndarray, bool]:
+    """The initial attitude (body -> NED quaternion) of a run from its prepared start, and whether the orientation
+    reads the magnetometer (then the heading is the magnetometer's, else north)."""
+    use_mag = "mag" in prepared and bool(getattr(pipeline.orientation, "use_magnetometer", False))
+    q0 = initial_attitude(prepared["t"], prepared["acc"], prepared["gyr"], prepared["mag"] if use_mag else None,
+                          **pipeline.init)
+    return q0, use_mag
 
 
 def navigation_stage(pipeline: Any, ctx: RunContext, start: Chunk, q0: np.ndarray, engine: str = "auto",

@@ -1,12 +1,14 @@
 """Compose plug-ins into a pipeline and run it on a recording.
 
 ``Pipeline.run`` pushes the whole recording, as one finished chunk, through the chain of stages
-a live :class:`footzoo.Stream` runs (:func:`footzoo.runtime.chain.build_chain`: calibrations,
-detector and guard, orientation unless the Kalman filter carries it, the Kalman engine or batch
-navigation), then adds the steps and analyses (:meth:`~Pipeline.analyse`) and the checks of the
-estimate. Each stage alone is a public method: :meth:`~Pipeline.calibrate`,
-:meth:`~Pipeline.detect` and :meth:`~Pipeline.guard`, :meth:`~Pipeline.orient`,
-:meth:`~Pipeline.navigate`. The stages read the plug-ins' base classes and declared
+a live :class:`footzoo.Stream` runs (:func:`footzoo.runtime.chain.build_chain`: the
+accelerometer's gain and the calibrations, detector and guard, orientation unless the Kalman
+filter carries it, the Kalman engine or batch navigation), then adds the steps and analyses
+(:meth:`~Pipeline.analyse`) and the checks of the estimate. Each stage alone is a public method:
+:meth:`~Pipeline.prepare` (the gain, the calibrations and the initial attitude, through the same
+stage code as ``run``), :meth:`~Pipeline.detect` and :meth:`~Pipeline.guard`,
+:meth:`~Pipeline.orient`, :meth:`~Pipeline.navigate`, which prepare a raw recording the same way
+first: on the same recording they give what ``run`` gives. The stages read the plug-ins' base classes and declared
 capabilities, never their names.
 """
 
@@ -17,7 +19,7 @@ import copy
 import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -55,12 +57,23 @@ from ..plugins.base import (
 from ..plugins.extensions import load_plugins
 from ..plugins.incremental import WHOLE_RECORDING, Chunk, Latency, total
 from ..plugins.registry import build
-from .chain import Chain, build_chain, navigation_stage, recording_chunk, with_signals
+from .chain import Chain, aligned, build_chain, input_stages, navigation_stage, recording_chunk, with_signals
 from .guards import StanceGuard, check_speed
-from .stages import CalibrationStage, detected, estimate_attitude, guarded
+from .stages import detected, estimate_attitude, guarded
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
 STREAM_WARMUP = 30.0
+
+#: The ``meta`` key of a recording :meth:`Pipeline.prepare` made: what its preparation depended on.
+PREPARED = "prepared"
+
+
+class Prepared(NamedTuple):
+    """A recording as :meth:`Pipeline.prepare` gives it (see there): ``recording``, ``q0``, ``diagnostics``."""
+
+    recording: Recording
+    q0: np.ndarray
+    diagnostics: dict[str, Any]
 
 
 @contextlib.contextmanager
@@ -368,29 +381,84 @@ class Pipeline:
             checked(a.check, dict(rec.meta))
 
     # ------------------------------------------------------- the stages alone
-    def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
-        """Stage 0: the recording with the calibrations applied in order (a copy; ``rec`` stays), and their reports."""
-        if not self.calibration:
-            return rec, []
+    def prepare(self, rec: Recording) -> Prepared:
+        """Stage 0: the recording as :meth:`run` prepares it for the other stages, its initial attitude and reports.
+
+        The same stages as :meth:`run` (:func:`footzoo.runtime.chain.input_stages`): the
+        accelerometer's gain, when the still start reads more than 3 % off g (scaled back to g, with a
+        :class:`~footzoo.core.errors.SensorWarning`), then the calibrations, fitted on the whole
+        recording. The step-by-step methods (:meth:`detect`, :meth:`guard`, :meth:`orient`,
+        :meth:`navigate`) prepare a raw recording themselves (each call again, with its warning) and
+        take one from here as it is: prepare once and pass the prepared recording on::
+
+            rec, q0, diagnostics = pipe.prepare(raw)
+            stance, _ = pipe.guard(rec, pipe.detect(rec))
+            nav = pipe.navigate(rec, stance, q0, pipe.orient(rec, stance, q0))  # nav["pos"] == pipe.run(raw).pos
+
+        Returns
+        -------
+        Prepared
+            ``recording``: a copy of ``rec`` with the prepared signals (``rec`` stays; its arrays are
+            shared when nothing changes them); ``q0``: the attitude at the first sample (body -> NED
+            quaternion), aligned on the prepared still start as :meth:`run` aligns it (heading from the
+            magnetometer when the orientation reads it); ``diagnostics``: the entries :meth:`run` puts in
+            ``Result.diagnostics`` for these stages, ``acc_gain`` (when scaled) and ``calibration`` (with
+            calibrations).
+        """
+        if not isinstance(rec, Recording):
+            raise NotARecordingError(f"Pipeline.prepare expects a footzoo Recording, got {type(rec).__name__}: build "
+                                     "one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
         ctx = self.context(rec)
-        stage = CalibrationStage(self.calibration, ctx)
-        out = stage.fit(recording_chunk(rec, ctx, self.init["duration"]), whole=True)
-        return with_signals(rec, out), stage.reports
+        stages, out = input_stages(self, ctx, recording_chunk(rec, ctx, self.init["duration"]), whole=True)
+        q0, _ = aligned(self, out)
+        prepared = with_signals(rec, out)
+        prepared.meta = {**rec.meta, PREPARED: self._preparation()}
+        return Prepared(prepared, q0, Chain(stages).report())
+
+    def _preparation(self) -> dict[str, Any]:
+        """What the preparation of a recording depends on (a prepared recording's ``meta["prepared"]``)."""
+        return {"gravity": self.gravity, "init": dict(self.init), "calibration": [c.spec() for c in self.calibration]}
+
+    def _prepared(self, rec: Recording) -> Recording:
+        """``rec`` when this pipeline's :meth:`prepare` made it (or one prepared alike), else ``rec`` prepared."""
+        if isinstance(rec, Recording) and rec.meta.get(PREPARED) == self._preparation():
+            return rec
+        return self.prepare(rec).recording
+
+    def calibrate(self, rec: Recording) -> tuple[Recording, list[dict[str, Any]]]:
+        """The recording as :meth:`prepare` gives it (the gain and the calibrations applied) and the calibrations'
+        reports (``Result.diagnostics["calibration"]``; empty without calibrations)."""
+        prepared = self.prepare(rec)
+        return prepared.recording, prepared.diagnostics.get("calibration", [])
 
     def detect(self, rec: Recording, ctx: RunContext | None = None) -> Detector:
-        """Stage 1: the fitted detector (``stance_``, ``statistic_``)."""
+        """Stage 1: the fitted detector (``stance_``, ``statistic_``) on the recording as :meth:`run` prepares it.
+
+        ``rec``: the recording, raw or from :meth:`prepare` (a raw one is prepared here: the same
+        stance as :meth:`run`'s detector stage, and the same ``SensorWarning`` for a gain error).
+        """
+        rec = self._prepared(rec)
         return detected(self.detector, rec.t, rec.acc, rec.gyr, ctx or self.context(rec), rec.truth)
 
     def guard(self, rec: Recording, detector: Detector,
               ctx: RunContext | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report."""
+        """Stage 1b: the stance mask the rest of the run uses, after the maximum-swing guard, and its report.
+
+        ``rec``: raw or from :meth:`prepare` (see :meth:`detect`).
+        """
+        rec = self._prepared(rec)
         return guarded(self.guards, rec.t, rec.gyr, detector, ctx or self.context(rec), rec.name)
 
     def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray,
                ctx: RunContext | None = None) -> np.ndarray | None:
-        """Stage 2: the attitude (N, 4), or None when the Kalman filter carries it."""
+        """Stage 2: the attitude (N, 4), or None when the Kalman filter carries it.
+
+        ``rec``: raw or from :meth:`prepare` (see :meth:`detect`); ``q0``: the initial attitude, as
+        :meth:`prepare` gives it for the result of :meth:`run`.
+        """
         if self.orientation.carried_by_filter and self.filter_corrections:
             return None
+        rec = self._prepared(rec)
         mag = rec.mag if self._use_mag(rec) else None
         return estimate_attitude(self.orientation, rec.t, rec.acc, rec.gyr, mag, stance, q0, ctx or self.context(rec))
 
@@ -398,8 +466,11 @@ class Pipeline:
                  engine: str = "auto", covariance: bool = False, ctx: RunContext | None = None) -> dict[str, Any]:
         """Stage 3: velocity and position (and the filter's attitude): the Kalman engine or batch corrections.
 
+        ``rec``: raw or from :meth:`prepare` (see :meth:`detect`); ``q0``: the initial attitude, as
+        :meth:`prepare` gives it for the result of :meth:`run`.
         A dict of ``quat``, ``vel``, ``pos``, ``acc_nav`` (the samples'), ``diagnostics`` and ``engine``.
         """
+        rec = self._prepared(rec)
         ctx = ctx or self.context(rec)
         chunk = {**recording_chunk(rec, ctx, self.init["duration"]), "stance": stance}
         if quat is not None:
