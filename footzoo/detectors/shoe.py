@@ -7,7 +7,6 @@ import math
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.conventions import GRAVITY
 from ..plugins.base import Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave
 from ..plugins.registry import register
@@ -59,7 +58,8 @@ class SHOE(SkogTest):
 
         ``(1/W) Σ ‖y_a − g u‖² = mean ‖y_a‖² − 2 g ‖ȳ_a‖ + g²`` for the unit vector ``u = ȳ_a/‖ȳ_a‖``.
         """
-        acc_term = m[:, 3] - 2.0 * GRAVITY * np.linalg.norm(m[:, :3], axis=1) + GRAVITY**2
+        g = self.gravity_
+        acc_term = m[:, 3] - 2.0 * g * np.linalg.norm(m[:, :3], axis=1) + g**2
         return np.maximum(acc_term, 0.0) / self.sigma_a**2 + m[:, 4] / self.sigma_g**2
 
 

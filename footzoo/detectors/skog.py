@@ -48,6 +48,11 @@ class SkogTest(Detector):
         Stance flag.
     window_samples_ : int
         W in samples at the recording's median rate.
+    gravity_ : float
+        g (m/s²) the tests compare the specific force with: the run's gravity (the pipeline's
+        ``gravity``, which the accelerometer-gain stage scales a still start to), so the detector and
+        the rest of the run agree on what a still sensor reads. Skog et al. take g as the known local
+        gravity (OpenShoe computes it from latitude and altitude), not a fixed constant.
     """
 
     parameters = {
@@ -80,11 +85,18 @@ class SkogTest(Detector):
         self.window_samples_ = self.window_samples(self.ctx_)
         acc = np.ascontiguousarray(acc, dtype=float)
         gyr = np.ascontiguousarray(gyr, dtype=float)
+        g = self.gravity_
         fused = FUSED_TESTS.get(type(self).test)
         if fused is not None:  # the same numbers as test(window_moments(...)), without the (N, 6) moments
-            return window_statistic(acc, gyr, self.window_samples_, GRAVITY, GRAVITY**2, fused, self.sigma_a**2,
-                                    self.sigma_g**2)
-        return self.test(window_moments(acc, gyr, self.window_samples_, GRAVITY))
+            return window_statistic(acc, gyr, self.window_samples_, g, g**2, fused, self.sigma_a**2, self.sigma_g**2)
+        return self.test(window_moments(acc, gyr, self.window_samples_, g))
+
+    @property
+    def gravity_(self) -> float:
+        """g (m/s²) of the tests: the run's (:attr:`RunContext.gravity`, the pipeline's ``gravity``), the paper's
+        "magnitude of the local gravity vector"; 9.81 before a run (:data:`~footzoo.core.conventions.GRAVITY`)."""
+        ctx = getattr(self, "ctx_", None)
+        return GRAVITY if ctx is None else ctx.gravity
 
     def _compute(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> Chunk:
         """The batch test over arrays: ``stance`` and ``statistic``."""

@@ -208,8 +208,9 @@ def recorded_forward(pipeline: Any, rec: Recording, engine: str = "fast") -> tup
     """The Kalman filter of ``pipeline`` run forward over ``rec`` alone, with a record of every sample: for a smoother
     applied by hand (:mod:`footzoo.filters.smoother`, :mod:`footzoo.filters.stepwise`) in a test or a benchmark.
 
-    No calibration or orientation stage runs (the filter carries the attitude, from the initial
-    attitude of ``rec``'s still start); the positions are in the engine's frame (NED, m), before a
+    ``rec`` is prepared as a run prepares it (:meth:`~footzoo.Pipeline.prepare`: the accelerometer's
+    gain, the calibrations); no orientation stage runs (the filter carries the attitude, from the
+    initial attitude of the still start, heading north); the positions are in the engine's frame (NED, m), before a
     run's output frame is applied.
 
     Returns
@@ -222,6 +223,7 @@ def recorded_forward(pipeline: Any, rec: Recording, engine: str = "fast") -> tup
         :meth:`~footzoo.filters.engine.KalmanEngine.advance` with ``record=True``: the trajectory
         (``quat``, ``vel``, ``pos``, biases) and each sample's record.
     """
+    rec = pipeline.prepare(rec).recording
     stance = pipeline.detect(rec).stance_
     q0 = initial_attitude(rec.t, rec.acc, rec.gyr, None, **pipeline.init)
     samples = Samples(rec.t, rec.acc, rec.gyr, rec.mag, rec.dist, rec.t <= rec.t[0] + pipeline.init["duration"])

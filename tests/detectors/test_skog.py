@@ -3,9 +3,12 @@
 import numpy as np
 import pytest
 
+from footzoo import Pipeline, Recording
+from footzoo.core.context import RunContext
 from footzoo.core.conventions import GRAVITY
 from footzoo.detectors import AMVD, ARED, MBGTD, SHOE
 from footzoo.evaluation.metrics import stance_scores
+from footzoo.orientation.madgwick import Madgwick
 
 from ..conftest import data_file
 from .sims import GAITS, RATES, walk
@@ -25,6 +28,20 @@ def test_a_still_sensor_gives_zero_statistics():
         d = cls().detect(t, acc, gyr)
         np.testing.assert_allclose(d.statistic_, 0.0, atol=1e-6)
         assert d.stance_.all()
+
+
+def test_the_tests_compare_with_the_runs_gravity():
+    """A still sensor reading g = 9.78 m/s² (a pipeline's ``gravity: 9.78``): zero against the run's g; against
+    9.81 the SHOE and MBGTD terms are (0.03 m/s²)²/σ_a² = 9 (hand-derived)."""
+    t, acc, gyr = still()
+    acc *= 9.78 / GRAVITY
+    ctx = RunContext(rate=100.0, gravity=9.78)
+    for cls in (SHOE, MBGTD):
+        assert cls().detect(t, acc, gyr, ctx=ctx).gravity_ == 9.78
+        np.testing.assert_allclose(cls().detect(t, acc, gyr, ctx=ctx).statistic_, 0.0, atol=1e-6)
+        np.testing.assert_allclose(cls().detect(t, acc, gyr).statistic_, 0.03**2 / SIGMA_A**2, rtol=1e-6)
+    rec = Recording(t=t, acc=acc, gyr=gyr)
+    assert Pipeline(orientation=Madgwick(), detector=SHOE(), gravity=9.78).detect(rec).gravity_ == 9.78
 
 
 def test_constant_rotation_gives_rate_squared_over_sigma():

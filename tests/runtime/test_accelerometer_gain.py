@@ -108,3 +108,26 @@ def test_a_start_whose_foot_accelerates_is_no_measure_of_the_gain(walk, recwarn)
     acc[start:stop:2, 0] += 3.0  # a 3 m/s² forward jolt every other sample: ‖f‖ scatters by about 1.5 m/s²
     assert alignment.accelerometer_gain(walk.t, acc, walk.gyr, 9.81) == 1.0
     assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
+
+
+def test_the_step_by_step_api_prepares_a_walk_read_5_percent_high_as_run_does(walk, pipe, recwarn):
+    """prepare, detect, guard, orient and navigate give run's stance, attitude and track, through run's own stages:
+    the same warning, the same acc_gain entry; a raw recording given to a step is prepared the same way."""
+    hot = _hot(walk)
+    with pytest.warns(SensorWarning, match="gain"):
+        res = pipe.run(hot)
+    with pytest.warns(SensorWarning, match="gain"):
+        rec, q0, diagnostics = pipe.prepare(hot)
+    assert diagnostics == {"acc_gain": res.diagnostics["acc_gain"]}
+    np.testing.assert_array_equal(hot.acc, walk.acc * 1.05)  # the caller's recording stays
+    recwarn.clear()
+    stance, _ = pipe.guard(rec, pipe.detect(rec))  # a prepared recording is taken as it is: no second warning
+    nav = pipe.navigate(rec, stance, q0, pipe.orient(rec, stance, q0))
+    assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
+    np.testing.assert_array_equal(stance, res.stance)
+    np.testing.assert_array_equal(nav["quat"], res.quat)
+    np.testing.assert_array_equal(nav["pos"], res.pos)
+    assert np.abs(_end_error(res, walk)).max() < 0.01
+    with pytest.warns(SensorWarning, match="gain"):
+        raw = pipe.guard(hot, pipe.detect(hot))[0]
+    np.testing.assert_array_equal(raw, res.stance)
