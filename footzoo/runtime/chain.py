@@ -124,7 +124,8 @@ def with_signals(rec: Recording, out: Chunk) -> Recording:
 
 
 def build_chain(pipeline: Any, ctx: RunContext, start: Chunk, engine: str = "auto", covariance: bool = False,
-                truth: Any = None, calibrations: list[Calibration] | None = None, whole: bool = False) -> Chain:
+                truth: Any = None, calibrations: list[Calibration] | None = None, whole: bool = False,
+                prepared: bool = False) -> Chain:
     """The stages of ``pipeline`` (a :class:`footzoo.Pipeline`) for a run that starts with ``start``.
 
     Parameters
@@ -147,8 +148,10 @@ def build_chain(pipeline: Any, ctx: RunContext, start: Chunk, engine: str = "aut
         The calibrations to fit (default: the pipeline's; a stream passes them with given fits).
     whole : bool
         ``start`` is the whole recording (a batch run): every calibration is fitted on it.
+    prepared : bool
+        The signals are already prepared (:meth:`footzoo.Pipeline.prepare`): no input stage runs again.
     """
-    stages, calibrated = input_stages(pipeline, ctx, start, calibrations, whole)
+    stages, calibrated = ([], start) if prepared else input_stages(pipeline, ctx, start, calibrations, whole)
     q0, use_mag = aligned(pipeline, calibrated)
     stages.append(DetectorStage(pipeline.detector, pipeline.guards, ctx, truth))
     if not (pipeline.filter_corrections and pipeline.orientation.carried_by_filter):

@@ -326,7 +326,8 @@ class Pipeline:
         self._check_inputs(rec)
         ctx = self.context(rec)
         chunk = recording_chunk(rec, ctx, self.init["duration"])
-        chain = build_chain(self, ctx, chunk, engine, covariance, truth=rec.truth, whole=True)
+        prepared = rec.meta.get(PREPARED) == self._preparation()  # from prepare(): its gain and calibrations hold
+        chain = build_chain(self, ctx, chunk, engine, covariance, truth=rec.truth, whole=True, prepared=prepared)
         out = chain.push(chunk, finish=True)  # the whole recording, in one finished chunk
         if self.calibration:
             rec = with_signals(rec, out)
@@ -389,7 +390,8 @@ class Pipeline:
         :class:`~footzoo.core.errors.SensorWarning`), then the calibrations, fitted on the whole
         recording. The step-by-step methods (:meth:`detect`, :meth:`guard`, :meth:`orient`,
         :meth:`navigate`) prepare a raw recording themselves (each call again, with its warning) and
-        take one from here as it is: prepare once and pass the prepared recording on::
+        take one from here as it is, as :meth:`run` does (its result's diagnostics then lack this
+        preparation's, which are here): prepare once and pass the prepared recording on::
 
             rec, q0, diagnostics = pipe.prepare(raw)
             stance, _ = pipe.guard(rec, pipe.detect(rec))

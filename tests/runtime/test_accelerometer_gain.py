@@ -131,3 +131,7 @@ def test_the_step_by_step_api_prepares_a_walk_read_5_percent_high_as_run_does(wa
     with pytest.warns(SensorWarning, match="gain"):
         raw = pipe.guard(hot, pipe.detect(hot))[0]
     np.testing.assert_array_equal(raw, res.stance)
+    recwarn.clear()
+    again = pipe.run(rec)  # run takes a prepared recording as it is too: not scaled twice, no second warning
+    assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
+    np.testing.assert_array_equal(again.pos, res.pos)

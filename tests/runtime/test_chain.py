@@ -150,3 +150,7 @@ def test_the_calibration_stage_reports_its_fit_as_the_calibration_does():
     # the alignment sees the calibrated magnetometer: the chain's initial attitude is the one of the calibrated start
     q0 = initial_attitude(loop.t, loop.acc, loop.gyr, fitted.mag_, **p.init)
     np.testing.assert_array_equal(res.quat[0], p.orient(calibrated, res.stance, q0)[0])
+    # run takes the calibrated recording as it is: not calibrated a second time (a refit on calibrated signals)
+    again = p.run(calibrated)
+    np.testing.assert_array_equal(again.pos, res.pos)
+    assert "calibration" not in again.diagnostics
