@@ -165,6 +165,8 @@ SHORT_MOTION_TIME = 0.3
 SHORT_TURN_RATE = 20.0 * math.pi / 180.0
 DEG = math.pi / 180.0
 
+#: How the message names swings anchored at a running foot's quietest instants (the foot is never still).
+_RUNNING = " (anchored at its quietest instants by a running foot's bounds: it is never quite still)"
 _WORDS = {2.0: "twice", 1.5: "1.5 times", 1.25: "1.25 times", 1.2: "1.2 times", 1.0 / 1.2: "five sixths of",
           0.8: "0.8 times", 2.0 / 3.0: "two thirds of", 0.5: "half"}
 
@@ -542,7 +544,8 @@ class GaitScan:
                                         np.log([residual[s] for s in sorted(residual)]))))
             parts.append(
                 f"the gyroscope and the accelerometer agree best with the time scaled by about {f:.3g}: integrated "
-                f"over {evidence['swings']} swings, the gyroscope's attitude leaves a speed of {residual[1.0]:.2f} g "
+                f"over {evidence['swings']} swings{_RUNNING if evidence.get('anchors') == 'running' else ''}, the "
+                f"gyroscope's attitude leaves a speed of {residual[1.0]:.2f} g "
                 f"× the swing's duration where the foot stops as declared, and {at:.2f} with the time × {f:.3g}")
         also = (f" (or {finding['alternative_rate']:g} Hz)" if "alternative_rate" in finding else "")
         return (

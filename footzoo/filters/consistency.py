@@ -83,6 +83,15 @@ BATCH_BLOCK = 4096
 STATIC_GYR = 0.8
 STATIC_ACC = 2.0
 STATIC_MIN = 0.02
+#: A running foot's bounds (rad/s, m/s²), for the rate's evidence when the walking bounds above find fewer than
+#: :data:`MIN_RATE_SWINGS` swings: a foot that lands at several m/s is on the ground for 0.2–0.3 s and its quietest
+#: instants still turn at about 1 rad/s and read 2–3 m/s² off g (PyShoe's fastest run, 2017-12-15-18-03-05: one or
+#: two swings within the walking bounds, 19 within these). Their tilt is off by up to atan(3 / g) = 0.3 rad, a floor
+#: under every time scale's residual (0.13 on that run as recorded, 0.5–1.3 relabelled at ×2, ×½ or ×1.5), so they
+#: serve the rate only, never the axis map, and only where the walking bounds leave the rate unjudged: on a walk they
+#: start swings on a rising heel again (``benchmarks/relabel_misses.md``).
+RUNNING_STATIC_GYR = 1.2
+RUNNING_STATIC_ACC = 3.0
 #: A swing starts at the stillest sample (lowest (|ω| / STATIC_GYR)² + ((‖f‖ − g) / STATIC_ACC)²) of the last
 #: ANCHOR_WINDOW s of its quasi-static run, not at the run's last sample: there a walking foot's heel already rises,
 #: and the tilt the accelerometer gives is off by the heel's acceleration (1.5 m/s² forward: 0.15 rad, which the
@@ -186,6 +195,13 @@ _RATE_COLUMNS = (0, *range(1 + len(CANDIDATES), len(_SCALE)))
 _RATE_SCALES = _SCALE[list(_RATE_COLUMNS)]
 
 
+def _explaining_fault(r: np.ndarray) -> int | None:
+    """The column of the axis fault that, undone, divides the median residual ``r[0]`` by :data:`EXPLAINED_RATIO`
+    (``r``: one median per column of the residuals); None when none does or a time scale explains it better."""
+    best = int(np.argmin(r[1:])) + 1
+    return None if best > len(CANDIDATES) or r[best] * EXPLAINED_RATIO > r[0] else best
+
+
 class ConsistencyScan:
     """Gyroscope–accelerometer consistency over the swings, fed chunk by chunk (see the module docstring).
 
@@ -197,10 +213,18 @@ class ConsistencyScan:
         g (m/s²).
     name : str
         The recording's name, for the warning.
+    running : bool
+        Quasi-static within a running foot's bounds (:data:`RUNNING_STATIC_GYR`, :data:`RUNNING_STATIC_ACC`) instead of
+        a walking foot's (:data:`STATIC_GYR`, :data:`STATIC_ACC`): the evidence of the rate only, no axis fault is
+        named. A walking scan feeds one such scan (:attr:`running_scan`) until it has :data:`MIN_RATE_SWINGS` swings
+        of its own, and gives its evidence where it has fewer (:meth:`time_scales`).
     """
 
-    def __init__(self, rate: float, gravity: float = GRAVITY, name: str = "recording"):
+    def __init__(self, rate: float, gravity: float = GRAVITY, name: str = "recording", running: bool = False):
         self.gravity, self.name, self.rate = gravity, name, float(rate)
+        self.running = running
+        self.bounds = (RUNNING_STATIC_GYR, RUNNING_STATIC_ACC) if running else (STATIC_GYR, STATIC_ACC)
+        self.running_scan = None if running else ConsistencyScan(rate, gravity, name, running=True)
         self.min_static = max(3, int(math.ceil(STATIC_MIN * rate)))
         self.anchor_window = max(self.min_static, round(ANCHOR_WINDOW * rate))  # samples
         self.residuals: list[np.ndarray] = []
@@ -221,7 +245,10 @@ class ConsistencyScan:
         if not len(t) or self.done:
             return
         self.seen = int(k[-1]) + 1
-        turn, off_g = row_norms_squared(gyr) / STATIC_GYR**2, ((row_norms(acc) - self.gravity) / STATIC_ACC) ** 2
+        if self.running_scan is not None and len(self.residuals) < MIN_RATE_SWINGS:
+            self.running_scan.push(k, t, acc, gyr)  # the rate's evidence while this scan has too few swings
+        gyr_bound, acc_bound = self.bounds
+        turn, off_g = row_norms_squared(gyr) / gyr_bound**2, ((row_norms(acc) - self.gravity) / acc_bound) ** 2
         static, stillness = (turn < 1.0) & (off_g < 1.0), turn + off_g
         new = {"k": np.asarray(k), "t": t, "acc": acc, "gyr": gyr, "static": static, "stillness": stillness}
         self._buf = new if self._buf is None else {n: np.concatenate([self._buf[n], v]) for n, v in new.items()}
@@ -273,7 +300,7 @@ class ConsistencyScan:
         self.residuals.extend(out)
         self.swings.extend(zip(buf["k"][first].tolist(), buf["k"][last].tolist(), strict=True))
         for m in range((before // MIN_SWINGS + 1) * MIN_SWINGS, len(self.residuals) + 1, MIN_SWINGS):
-            if not self.report:  # the same swings decide, batch and live
+            if not self.report and not self.running:  # the same swings decide, batch and live
                 self._decide(m)
 
     def _decide(self, m: int) -> None:
@@ -283,8 +310,8 @@ class ConsistencyScan:
         if 2 * len(bad) <= len(residuals):
             return
         r = np.median(bad, axis=0)  # the median swing is inconsistent: which fault, undone, explains it?
-        best = int(np.argmin(r[1:])) + 1
-        if best > len(CANDIDATES) or r[best] * EXPLAINED_RATIO > r[0]:
+        best = _explaining_fault(r)
+        if best is None:
             return  # a time scale explains it best (the rate: core.plausibility), or nothing does
         self.report = {"cause": CANDIDATES[best - 1][0], "residual": float(r[0]),
                        "explained_residual": float(r[best]), "swings": len(residuals),
@@ -316,34 +343,48 @@ class ConsistencyScan:
         -------
         dict or None
             ``scales`` (1 first, then :data:`TIME_SCALES`: the factor by which the time is scaled),
-            ``residual`` (the median residual at each, same order), ``swings`` (how many); None
+            ``residual`` (the median residual at each, same order), ``swings`` (how many), ``anchors``
+            (``"walking"``, or ``"running"``: the swings of :attr:`running_scan`, where this scan has
+            fewer than :data:`MIN_RATE_SWINGS` by ``until`` and that one at least as many); None
             without any swing, or after a gyroscope axis fault (the residuals then say nothing
             about the rate).
         """
-        if self.report or not self.residuals:
+        if self.report:
             return None
-        ends = np.array([b for _, b in self.swings])
-        rows = np.asarray(self.residuals)[ends <= until] if until is not None else np.asarray(self.residuals)
+        rows = np.asarray(self.residuals).reshape(-1, len(_SCALE))
+        if until is not None:
+            rows = rows[np.array([b for _, b in self.swings], dtype=np.int64) <= until]
+        if len(rows) < MIN_RATE_SWINGS and self.running_scan is not None:
+            running = self.running_scan.time_scales(until)
+            if running is not None and running["swings"] >= MIN_RATE_SWINGS:
+                return running
         if not len(rows):
             return None
+        if self.running and _explaining_fault(np.median(rows, axis=0)) is not None:
+            return None  # an axis fault explains these swings (named by a walking scan, if it has the swings)
         return {"scales": _RATE_SCALES, "residual": np.median(rows[:, list(_RATE_COLUMNS)], axis=0),
-                "swings": len(rows)}
+                "swings": len(rows), "anchors": "running" if self.running else "walking"}
 
     def push_recording(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, block: int = BATCH_BLOCK) -> None:
         """A whole recording, pushed ``block`` samples at a time until the scan is :attr:`done`.
 
         The same finding as one push of everything (the scan is the live one, fed chunk by chunk), at
-        the cost of the samples that decide it rather than of the recording's length.
+        the cost of the samples that decide it rather than of the recording's length. While
+        :attr:`running_scan` is fed (this scan has fewer than :data:`MIN_RATE_SWINGS` swings), ``block`` / 8
+        samples at a time, so that it stops soon after this scan's fourth swing.
         """
-        for lo in range(0, len(t), block):
-            if self.done:
-                return
-            hi = min(lo + block, len(t))
+        lo = 0
+        while lo < len(t) and not self.done:
+            feeding = self.running_scan is not None and len(self.residuals) < MIN_RATE_SWINGS
+            hi = min(lo + (max(1, block // 8) if feeding else block), len(t))
             self.push(np.arange(lo, hi), t[lo:hi], acc[lo:hi], gyr[lo:hi])
+            lo = hi
 
     def finish(self) -> dict[str, Any]:
         """End of the data: decide on every swing seen, from :data:`MIN_RATE_SWINGS` on; the finding (empty: none)."""
         self._closed = True
-        if not self.report and len(self.residuals) >= MIN_RATE_SWINGS:
+        if self.running_scan is not None:
+            self.running_scan.finish()
+        if not self.report and not self.running and len(self.residuals) >= MIN_RATE_SWINGS:
             self._decide(len(self.residuals))
         return self.report

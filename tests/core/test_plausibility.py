@@ -139,6 +139,33 @@ def test_a_simulated_run_or_slow_walk_is_named_only_when_relabelled_and_then_wit
         assert sum(f"probably sampled at {rate:g} Hz" in m for m in found) == 1
 
 
+def test_a_run_whose_foot_is_never_still_is_named_from_its_quietest_instants_batch_and_live():
+    """The simulator's run with a 25 Hz vibration of 1 rad/s on its gyroscope from the first step on: no instant of it
+    is as still as a walking foot's, so only a running foot's bounds give the gyroscope-accelerometer evidence."""
+    from ..filters.test_consistency_scan import vibrating
+
+    rec = simulate(path="run", n_strides=16, rate=100.0, profile="physical", noise=NoiseModel(seed=2),
+                   magnetometer=False)
+    gyr = vibrating(rec)
+    for f in (1.0, 2.0):
+        relabelled = Recording(t=rec.t / f, acc=rec.acc, gyr=gyr, meta={"name": "relabelled"})
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = Pipeline.from_dict(BASE).run(relabelled)
+            stream = Stream(Pipeline.from_dict(BASE), rate=relabelled.rate)
+            stream.run(relabelled, chunk=np.array([1, 23, 7, 64]))
+        found = [str(w.message) for w in caught]
+        # expected besides: the detector's stance guard (its angular-rate threshold finds no stance in the vibration)
+        assert all("found no stance" in m or "probably sampled at" in m for m in found), found
+        named = [m for m in found if "probably sampled at" in m]
+        if f == 1.0:
+            assert "plausibility" not in res.diagnostics["sensor"] and not named
+            continue
+        assert res.diagnostics["sensor"]["plausibility"]["rate"]["likely_rate"] == 100.0
+        assert stream.sensor["plausibility"]["rate"]["likely_rate"] == 100.0
+        assert len(named) == 2 and all("by a running foot's bounds" in m for m in named)  # batch, then live
+
+
 def test_the_same_walk_at_its_real_rate_is_not_named(walk):
     res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(walk))
     assert "plausibility" not in res.diagnostics["sensor"] and not found

@@ -1,5 +1,6 @@
 """The gyroscope–accelerometer consistency scan (footzoo.filters.consistency): where each swing is anchored, batch and
-live alike, and the time scale its residuals point to on real walks."""
+live alike, the time scale its residuals point to on real walks, and a running foot's quietest instants where a walking
+foot's bounds find no swing."""
 
 from __future__ import annotations
 
@@ -104,3 +105,61 @@ def test_the_stillest_sample_of_each_run_is_the_first_lowest_one():
         expected = [a + int(np.argmin(values[a:b])) for a, b in zip(lo, hi, strict=True)]
         assert _stillest(values, lo, hi).tolist() == expected
     assert _stillest(stillness, lo[:0], hi[:0]).size == 0
+
+
+# --------------------------------------------------------------------------- a foot that is never still
+def vibrating(rec: footzoo.Recording) -> np.ndarray:
+    """``rec``'s gyroscope with, from its first step on, a 25 Hz vibration of 1 rad/s: a rate vector turning in the
+    x–y plane (constant norm; the attitude it turns swings by 1 / (2π · 25) = 6 mrad). No sample of the steps is then
+    within a walking foot's bounds (0.8 rad/s); the stances are within a running foot's (1.2 rad/s)."""
+    first = int(np.argmax(row_norms(rec.gyr) > 1.0))
+    phase = 2.0 * math.pi * 25.0 * rec.t
+    shake = np.column_stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)])
+    return rec.gyr + shake * (np.arange(rec.n) >= first)[:, None]
+
+
+@pytest.fixture(scope="module")
+def vibrating_run():
+    rec = simulate(path="run", n_strides=16, rate=100.0, profile="physical", noise=NoiseModel(seed=2),
+                   magnetometer=False)
+    return rec, vibrating(rec)
+
+
+@pytest.mark.parametrize("factor", [1.0, 2.0, 0.5, 1.5])
+def test_a_foot_never_still_is_timed_between_its_quietest_instants(vibrating_run, factor):
+    rec, gyr = vibrating_run
+    scan = ConsistencyScan(rec.rate * factor)  # declared at factor times the real rate
+    scan.push_recording(rec.t / factor, rec.acc, gyr)
+    assert not scan.residuals  # no swing within a walking foot's bounds
+    evidence = scan.time_scales()
+    assert evidence["anchors"] == "running" and evidence["swings"] >= 12
+    lowest = float(evidence["scales"][np.argmin(evidence["residual"])])
+    assert abs(math.log2(lowest / factor)) <= 1.0 / 8.0 + 1e-9  # the scale that undoes the factor, within a step
+    assert scan.time_scales(until=int(rec.n / 2))["swings"] < evidence["swings"]  # the swings ended by a sample
+
+
+def test_without_a_running_foot_s_bounds_the_foot_never_still_gives_no_evidence(vibrating_run, monkeypatch):
+    rec, gyr = vibrating_run
+    monkeypatch.setattr(consistency, "RUNNING_STATIC_GYR", STATIC_GYR)
+    monkeypatch.setattr(consistency, "RUNNING_STATIC_ACC", STATIC_ACC)
+    scan = ConsistencyScan(rec.rate * 2.0)
+    scan.push_recording(rec.t / 2.0, rec.acc, gyr)
+    assert scan.time_scales() is None
+
+
+def test_a_negated_axis_withholds_the_running_foot_s_evidence(vibrating_run):
+    rec, gyr = vibrating_run
+    flipped = gyr * np.array([1.0, -1.0, 1.0])  # the simulated foot turns about its pitch axis
+    scan = ConsistencyScan(rec.rate)
+    scan.push_recording(rec.t, rec.acc, flipped)
+    # the running foot's swings are inconsistent, and negating gyr_y explains it: no evidence of the rate (and no axis
+    # named from them: only a walking foot's swings name an axis map)
+    assert scan.running_scan.residuals and scan.time_scales() is None and not scan.finish()
+
+
+def test_a_walk_feeds_the_running_foot_s_scan_only_until_its_own_fourth_swing():
+    walk = simulate("rectangle", n_strides=24, rate=100.0, noise=NoiseModel(seed=4))
+    scan = ConsistencyScan(walk.rate)
+    scan.push_recording(walk.t, walk.acc, walk.gyr)
+    assert scan.time_scales()["anchors"] == "walking" and len(scan.residuals) == consistency.MAX_SWINGS
+    assert scan.running_scan.seen <= consistency.BATCH_BLOCK // 4  # two pushes of an eighth of a block
