@@ -503,6 +503,9 @@ class GaitScan:
         evidence = self.evidence.time_scales(last) if self.evidence is not None else None
         if evidence is not None and evidence["swings"] < MIN_SWINGS:
             evidence = None
+        quiet = gait is None and evidence is not None and len(evidence.get("strides", ())) >= MIN_STRIDES
+        if quiet:  # too few strides from the detector: the strides between the foot's quiet instants
+            gait = {**stride_summary(evidence["strides"]), "between": "quiet instants"}
         if gait is None and evidence is None:
             return False
         verdict = judge_rate(gait, evidence)
@@ -533,8 +536,10 @@ class GaitScan:
         kind = "run" if g and g["cadence_steps_min"] / f > 140.0 and g["speed_m_s"] * f > 2.0 else "walk"
         parts = []
         if g and verdict["gait_informative"]:
+            between = (f" (between the foot's quiet instants: the detector found fewer than {MIN_STRIDES} strides)"
+                       if "between" in g else "")
             parts.append(
-                f"strides of {g['stride_length_m']:.2f} m at {g['cadence_steps_min']:.0f} steps/min, "
+                f"strides{between} of {g['stride_length_m']:.2f} m at {g['cadence_steps_min']:.0f} steps/min, "
                 f"{g['clearance_m'] * 1e3:.0f} mm of foot clearance and {g['rolling_m_rad']:.2f} m per radian the "
                 f"foot turns are what a {kind} of {g['stride_length_m'] * f * f:.2f} m strides at "
                 f"{g['cadence_steps_min'] / f:.0f} steps/min gives when read at {words} its rate")

@@ -49,6 +49,7 @@ import numpy as np
 from ..core.conventions import GRAVITY
 from ..core.errors import SensorWarning
 from ..core.norms import row_norms, row_norms_squared
+from ..core.plausibility import MAX_STRIDE_TIME
 from ..kernels.jit import njit
 from .strapdown import quat_product, rotate, rotvec_quat, series_rotvec_quat
 
@@ -174,6 +175,46 @@ def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarra
             out[s, c] = v / (g * (t[b] - t[a]) * scale[c])
 
 
+@njit
+def _swing_gait(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray, g: float,
+                out: np.ndarray) -> None:
+    """``out[s]`` = (length (m, horizontal), clearance (m), rotation ∫|ω| dt (rad), peak |ω| (rad/s)) of swing ``s``:
+    strapdown from sample ``first[s]`` (tilt from its ``acc``) to ``last[s]`` with the signals as given, its velocity
+    error taken to grow linearly from zero to what is left at the end (the foot stops there), as a zero-velocity update
+    takes it: the position is corrected by ``v_end τ² / (2 T)`` at the time ``τ`` into the swing of duration ``T``."""
+    for s in range(first.shape[0]):
+        a, b = first[s], last[s]
+        fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
+        roll = math.atan2(-fy, -fz)
+        pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
+        cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+        w, x, y, z = cp * cr, cp * sr, sp * cr, -sp * sr
+        vx = vy = vz = px = py = pz = 0.0
+        turned = peak = 0.0
+        heights = np.empty(b - a)  # the height (m, up) after each sample, before the correction
+        for i in range(a, b):
+            dt = t[i + 1] - t[i]
+            nx, ny, nz = rotate(w, x, y, z, acc[i, 0], acc[i, 1], acc[i, 2])
+            vx, vy, vz = vx + nx * dt, vy + ny * dt, vz + (nz + g) * dt
+            px, py, pz = px + vx * dt, py + vy * dt, pz + vz * dt
+            heights[i - a] = -pz
+            rate = math.sqrt(gyr[i, 0] ** 2 + gyr[i, 1] ** 2 + gyr[i, 2] ** 2)
+            turned += rate * dt
+            peak = max(peak, rate)
+            d0, d1, d2, d3 = rotvec_quat(gyr[i, 0] * dt, gyr[i, 1] * dt, gyr[i, 2] * dt)
+            w, x, y, z = quat_product(w, x, y, z, d0, d1, d2, d3)
+            m = 1.0 / math.sqrt(w * w + x * x + y * y + z * z)
+            w, x, y, z = w * m, x * m, y * m, z * m
+        duration = t[b] - t[a]
+        half = 0.5 * duration  # the correction at the end: v_end T / 2
+        clearance = 0.0
+        for i in range(a, b):
+            tau = t[i + 1] - t[a]
+            clearance = max(clearance, heights[i - a] + vz * tau * tau / (2.0 * duration))
+        out[s, 0] = math.hypot(px - vx * half, py - vy * half)
+        out[s, 1], out[s, 2], out[s, 3] = clearance, turned, peak
+
+
 def _stillest(stillness: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """The index of the lowest ``stillness`` in each range ``[lo[i], hi[i])`` (the first of equal ones); the ranges
     are disjoint, in order and not empty."""
@@ -229,6 +270,10 @@ class ConsistencyScan:
         self.anchor_window = max(self.min_static, round(ANCHOR_WINDOW * rate))  # samples
         self.residuals: list[np.ndarray] = []
         self.swings: list[tuple[int, int]] = []
+        #: per swing: its start (s, as declared), duration (s), length (m), clearance (m), rotation (rad), peak (rad/s)
+        self.gait_rows: list[np.ndarray] = []
+        self._chained: list[bool] = []  # per swing: it starts in the quasi-static run the swing before it ends in
+        self._open = False  # the last swing measured ends in the run the buffer starts with
         self.report: dict[str, Any] = {}
         self._buf: dict[str, np.ndarray] | None = None
         self._anchored = False  # the buffer starts with a confirmed quasi-static run
@@ -264,19 +309,19 @@ class ConsistencyScan:
         cut = 0
         if len(starts):
             if not self._anchored:
-                self._anchored, cut = True, int(starts[0])
+                self._anchored, cut, self._open = True, int(starts[0]), False
                 starts, ends = starts - cut, ends - cut
                 buf = {n: v[cut:] for n, v in buf.items()}
             elif starts[0] != 0:  # the anchor's run was shorter than it looked: start from this run
-                cut = int(starts[0])
+                cut, self._open = int(starts[0]), False
                 starts, ends = starts - cut, ends - cut
                 buf = {n: v[cut:] for n, v in buf.items()}
             # the swings: from the stillest of the last samples of each run to the sample after the first of the next
             first = _stillest(buf["stillness"], np.maximum(starts[:-1], ends[:-1] - self.anchor_window), ends[:-1])
             self._swings(buf, first, np.minimum(starts[1:] + 1, len(buf["t"]) - 1))
-            last = int(starts[-1])
-            if ends[-1] == len(buf["t"]):  # the last run is still open: keep its last samples only
-                last = max(last, len(buf["t"]) - self.anchor_window)
+            # keep the last run's last samples only (the next swing's anchor is among them, open or closed): a long
+            # stillness kept whole would make the buffer look too long to be a swing, and lose the swing after it
+            last = max(int(starts[-1]), int(ends[-1]) - self.anchor_window)
             buf = {n: v[last:] for n, v in buf.items()}
         elif not self._anchored:  # no quasi-static run yet: only the samples a run could start with
             buf = {n: v[-self.min_static:] for n, v in buf.items()}
@@ -290,14 +335,21 @@ class ConsistencyScan:
         """The residuals of the swings ``first[i]``–``last[i]`` of ``buf``, every candidate on every swing."""
         duration = buf["t"][last] - buf["t"][first]
         ok = (duration >= SWING_RANGE[0]) & (duration <= SWING_RANGE[1])
+        chained = (ok & np.concatenate([[self._open], ok[:-1]]))[ok]  # each swing's start run ends the one before
+        if len(ok):
+            self._open = bool(ok[-1])
         first, last = first[ok].astype(np.int64), last[ok].astype(np.int64)
         first, last = first[:MAX_SWINGS - len(self.residuals)], last[:MAX_SWINGS - len(self.residuals)]
         if not len(first):
             return
         out = np.empty((len(first), len(_SCALE)))
         _residuals(buf["t"], buf["acc"], buf["gyr"], first, last, _SCALE, _SIGNS, self.gravity, out)
+        gait = np.empty((len(first), 4))
+        _swing_gait(buf["t"], buf["acc"], buf["gyr"], first, last, self.gravity, gait)
         before = len(self.residuals)
         self.residuals.extend(out)
+        self.gait_rows.extend(np.column_stack([buf["t"][first], buf["t"][last] - buf["t"][first], gait]))
+        self._chained.extend(chained[:len(first)].tolist())
         self.swings.extend(zip(buf["k"][first].tolist(), buf["k"][last].tolist(), strict=True))
         for m in range((before // MIN_SWINGS + 1) * MIN_SWINGS, len(self.residuals) + 1, MIN_SWINGS):
             if not self.report and not self.running:  # the same swings decide, batch and live
@@ -363,7 +415,20 @@ class ConsistencyScan:
         if self.running and _explaining_fault(np.median(rows, axis=0)) is not None:
             return None  # an axis fault explains these swings (named by a walking scan, if it has the swings)
         return {"scales": _RATE_SCALES, "residual": np.median(rows[:, list(_RATE_COLUMNS)], axis=0),
-                "swings": len(rows), "anchors": "running" if self.running else "walking"}
+                "swings": len(rows), "anchors": "running" if self.running else "walking",
+                "strides": self._strides(len(rows))}
+
+    def _strides(self, m: int) -> np.ndarray:
+        """The strides between the quiet instants of the first ``m`` swings, as
+        :attr:`footzoo.core.plausibility.GaitScan.strides` gives the detector's (n, 6): T (s, from the start of a swing
+        to the start of the next, when that one starts in the quasi-static run this one ends in), the swing's L (m),
+        h (m), θ (rad), peak |ω| (rad/s) and duration (s)."""
+        if m < 2:
+            return np.empty((0, 6))
+        rows = np.asarray(self.gait_rows[:m])
+        period = np.diff(rows[:, 0])
+        ok = np.asarray(self._chained[1:m]) & (period <= MAX_STRIDE_TIME)
+        return np.column_stack([period, rows[:-1, 2:6], rows[:-1, 1]])[ok]
 
     def push_recording(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, block: int = BATCH_BLOCK) -> None:
         """A whole recording, pushed ``block`` samples at a time until the scan is :attr:`done`.

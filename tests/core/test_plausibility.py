@@ -166,6 +166,25 @@ def test_a_run_whose_foot_is_never_still_is_named_from_its_quietest_instants_bat
         assert len(named) == 2 and all("by a running foot's bounds" in m for m in named)  # batch, then live
 
 
+def test_with_too_few_strides_from_the_detector_the_gait_is_measured_between_quiet_instants(walk):
+    """A detector that found no stance at all in the simulated walk read at 1.5 times its rate: the strides between the
+    foot's quiet instants (the gyroscope-accelerometer scan's swings) are the gait weighed."""
+    from footzoo.core.plausibility import GaitScan
+    from footzoo.filters.consistency import ConsistencyScan
+
+    t = walk.t / 1.5
+    evidence = ConsistencyScan(walk.rate * 1.5)
+    evidence.push_recording(t, walk.acc, walk.gyr)
+    scan = GaitScan("relabelled", evidence=evidence)
+    scan.push(np.arange(walk.n), t, walk.acc, walk.gyr, np.zeros(walk.n, dtype=bool), np.zeros((walk.n, 3)))
+    with pytest.warns(SensorWarning, match="between the foot's quiet instants") as caught:
+        finding = scan.finish()["rate"]
+    assert len(caught) == 1 and "probably sampled at 100 Hz, not 150 Hz" in str(caught[0].message)
+    gait = finding["strides"]
+    assert gait["between"] == "quiet instants" and finding["until_sample"] is None
+    assert gait["cadence_steps_min"] == pytest.approx(120.0 * 1.5, rel=0.02)  # the simulator's 120, read 1.5× fast
+
+
 def test_the_same_walk_at_its_real_rate_is_not_named(walk):
     res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(walk))
     assert "plausibility" not in res.diagnostics["sensor"] and not found

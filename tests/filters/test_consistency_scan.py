@@ -163,3 +163,16 @@ def test_a_walk_feeds_the_running_foot_s_scan_only_until_its_own_fourth_swing():
     scan.push_recording(walk.t, walk.acc, walk.gyr)
     assert scan.time_scales()["anchors"] == "walking" and len(scan.residuals) == consistency.MAX_SWINGS
     assert scan.running_scan.seen <= consistency.BATCH_BLOCK // 4  # two pushes of an eighth of a block
+
+
+def test_a_long_stillness_before_the_first_step_loses_no_swing_in_any_chunking():
+    """Six seconds still, then a walk: chunks that hold the whole stillness and a little of the first swing used to
+    make the buffer look too long to be a swing (from the stillness's start), and the first swing was lost."""
+    walk = simulate(n_strides=8, rate=100.0, stand_start=6.0, noise=NoiseModel(seed=3))
+    one = ConsistencyScan(walk.rate)
+    one.push(np.arange(walk.n), walk.t, walk.acc, walk.gyr)
+    assert len(one.swings) >= 8
+    for block in (512, 640, 700, 64):  # 5.1–7 s chunks at 100 Hz: the stillness and the first swing in the first one
+        chunked = ConsistencyScan(walk.rate)
+        chunked.push_recording(walk.t, walk.acc, walk.gyr, block=block)
+        assert chunked.swings == one.swings, block
