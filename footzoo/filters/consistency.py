@@ -289,9 +289,13 @@ class ConsistencyScan:
         """The next samples (absolute indices ``k``, time (s), FRD specific force (m/s²), rate (rad/s))."""
         if not len(t) or self.done:
             return
-        self.seen = int(k[-1]) + 1
         if self.running_scan is not None and len(self.residuals) < MIN_RATE_SWINGS:
             self.running_scan.push(k, t, acc, gyr)  # the rate's evidence while this scan has too few swings
+        self._push(k, t, acc, gyr)
+
+    def _push(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> None:
+        """:meth:`push` to this scan alone."""
+        self.seen = int(k[-1]) + 1
         gyr_bound, acc_bound = self.bounds
         turn, off_g = row_norms_squared(gyr) / gyr_bound**2, ((row_norms(acc) - self.gravity) / acc_bound) ** 2
         static, stillness = (turn < 1.0) & (off_g < 1.0), turn + off_g
@@ -434,16 +438,20 @@ class ConsistencyScan:
         """A whole recording, pushed ``block`` samples at a time until the scan is :attr:`done`.
 
         The same finding as one push of everything (the scan is the live one, fed chunk by chunk), at
-        the cost of the samples that decide it rather than of the recording's length. While
-        :attr:`running_scan` is fed (this scan has fewer than :data:`MIN_RATE_SWINGS` swings), ``block`` / 8
-        samples at a time, so that it stops soon after this scan's fourth swing.
+        the cost of the samples that decide it rather than of the recording's length. :attr:`running_scan`
+        is then given what a stream would have given it and :meth:`time_scales` may ask of it: the samples up to
+        this scan's fourth swing (all of them if it has fewer).
         """
-        lo = 0
-        while lo < len(t) and not self.done:
-            feeding = self.running_scan is not None and len(self.residuals) < MIN_RATE_SWINGS
-            hi = min(lo + (max(1, block // 8) if feeding else block), len(t))
-            self.push(np.arange(lo, hi), t[lo:hi], acc[lo:hi], gyr[lo:hi])
-            lo = hi
+        for lo in range(0, len(t), block):
+            if self.done:
+                break
+            hi = min(lo + block, len(t))
+            self._push(np.arange(lo, hi), t[lo:hi], acc[lo:hi], gyr[lo:hi])
+        if self.running_scan is not None:
+            stop = self.seen
+            if len(self.swings) >= MIN_RATE_SWINGS:  # a stream feeds it until that swing is confirmed
+                stop = min(stop, self.swings[MIN_RATE_SWINGS - 1][1] + self.min_static + 1)
+            self.running_scan.push_recording(t[:stop], acc[:stop], gyr[:stop], block)
 
     def finish(self) -> dict[str, Any]:
         """End of the data: decide on every swing seen, from :data:`MIN_RATE_SWINGS` on; the finding (empty: none)."""

@@ -67,9 +67,9 @@ def test_a_batch_run_scans_in_blocks_until_decided_with_the_finding_of_one_push(
     from footzoo.filters.consistency import ConsistencyScan
 
     class Counted(ConsistencyScan):
-        def push(self, k, t, acc, gyr):
+        def _push(self, k, t, acc, gyr):  # what the scan itself reads (push_recording: not through push)
             self.last_pushed = int(k[-1])
-            super().push(k, t, acc, gyr)
+            super()._push(k, t, acc, gyr)
 
     walk = simulate(n_strides=80, rate=100.0, noise=NoiseModel(seed=3))
     for r in (walk, _restamped(walk, 2.0)):
