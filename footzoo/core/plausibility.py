@@ -60,12 +60,17 @@ steps/min), so a rate is named only if the residuals prefer it by :data:`SUPPORT
 named is the one, on that side of 1, whose residual is lowest (the gait's ranges tell that the
 rate is wrong more than by how much; they name one of the 42 real walks relabelled at ×2 and
 one at ×1.5 that the residuals alone leave below the margin).
+When the detector gives fewer than :data:`MIN_STRIDES` strides (a detector tuned in seconds merges
+a run's strides when the rate is wrong), the gait weighed is the strides between the foot's quiet
+instants, measured by the gyroscope–accelerometer scan itself (the finding's ``strides`` then say
+``between: quiet instants``); and a foot never as still as a walking one (a fast run) is timed
+between its quietest instants (:mod:`footzoo.filters.consistency`).
 As recorded, none of the 78 real recordings of the data folder is named (the 42 the checks were
 designed on and IPOL's 36, held out), nor any of 18 simulated walks, runs, a shuffle and stairs
-at 100, 250 and 400 Hz; relabelled at ×2, ×½ or ×1.5 (time stamps divided by the factor), 40,
-38 and 38 of the 42 are named with the real rate, all 36 of IPOL's, and 16, 18 and 15 of the 18
-simulated ones (``recommended``; ``benchmarks/relabel.md``). What is left — a fast run with
-hardly a still instant, a crawl, a slow walk whose foot hardly turns, the simulated shuffle — is
+at 100, 250 and 400 Hz; relabelled at ×2, ×½ or ×1.5 (time stamps divided by the factor), 41,
+39 and 40 of the 42 are named with the real rate, all 36 of IPOL's, and 16, 18 and 15 of the 18
+simulated ones (``recommended``; ``benchmarks/relabel.md``). What is left — a crawl, a slow walk
+whose foot hardly turns, the shortest-stepped walk at half its rate, the simulated shuffle — is
 analysed in ``benchmarks/relabel_misses.md``.
 
 A gyroscope in rad/s declared as deg/s reads 57.3 times too slow: the accelerometer shows a

@@ -32,10 +32,30 @@ the real recordings in the data folder (IPOL's included) the median residual is 
 within a step (2^(1/8)) of the factor that undoes it on 218 of 231 (walks, runs and stairs with
 a residual), 4.7–13× below the declared one in the median (``benchmarks/relabel.md``,
 ``benchmarks/relabel_misses.md``). Slow, short-stepped walks turn the foot little, and their
-residuals depend little on the scale; a fast run has few quasi-static instants. So the rate is
-not named here but by :mod:`footzoo.core.plausibility`, which weighs this evidence with the gait
-the run estimated (cadence, stride length, clearance, the foot's rotation per metre) and names
-one corrected rate.
+residuals depend little on the scale. So the rate is not named here but by
+:mod:`footzoo.core.plausibility`, which weighs this evidence with the gait the run estimated
+(cadence, stride length, clearance, the foot's rotation per metre) and names one corrected rate.
+
+A fast run's foot is hardly ever that still (PyShoe's fastest run: one or two swings within the
+walking foot's bounds). Until a scan has :data:`MIN_RATE_SWINGS` swings of its own it also feeds
+a second one (:attr:`ConsistencyScan.running_scan`) whose quasi-static bounds are a running
+foot's (:data:`RUNNING_STATIC_GYR`, :data:`RUNNING_STATIC_ACC`), and where it has fewer swings its
+rate evidence is that scan's: a tilt up to 0.3 rad off at each start raises the floor of every
+time scale's residual (0.13 on that run as recorded), far below what a wrong scale leaves
+(0.5–1.3 at ×2, ×½ or ×1.5 there). Those swings never name an axis map, and their evidence is
+withheld when a negated axis explains them.
+
+Each swing also gives the gait between the foot's quiet instants, without the stance detector
+(:func:`_swing_gait`): its horizontal length and clearance, by the same strapdown with its
+velocity error taken to grow linearly from zero to what is left at the end (as a zero-velocity
+update takes it), the foot's rotation ∫|ω| dt and its peak rate; two swings that share a
+quasi-static run make a stride (the time between their starts). On the recordings of the data
+folder as recorded these strides are human: 0.23–0.40 m per radian the foot turns on the 42 of
+PyShoe, gaitmap, x-io and Köroğlu but the crawl (0.06), 0.23–0.40 on IPOL's; quiet instants can
+split a stride (the shortest-stepped PyShoe walk: 171 steps/min where its detector counts 139;
+``benchmarks/relabel_misses.md``). :mod:`footzoo.core.plausibility` weighs
+them only when the detector gives too few strides (a detector tuned in seconds merges a run's
+strides when the rate is wrong).
 """
 
 from __future__ import annotations

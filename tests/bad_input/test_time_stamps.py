@@ -104,6 +104,6 @@ def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_ar
                     total += 1
                     named += row["right"] or row["alternative"]
                     wrong += row["caught"] and not (row["right"] or row["alternative"])
-    # 84 restamped files (benchmarks/relabel.md): 78 named with the real rate, none with another; not the fast run
-    # and the crawl (×2, ×½), the upside-down slow walk and the shortest-stepped walk (×½): benchmarks/relabel_misses.md
-    assert total == 84 and named >= 77 and wrong == 0
+    # 84 restamped files (benchmarks/relabel.md): 80 named with the real rate, none with another; not the crawl (×2,
+    # ×½), the upside-down slow walk and the shortest-stepped walk (×½): benchmarks/relabel_misses.md
+    assert total == 84 and named >= 80 and wrong == 0
