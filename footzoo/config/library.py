@@ -79,6 +79,10 @@ def resolve(spec: str | Path) -> Path:
                           "(Pipeline.from_dict({...}))")
     if p.is_symlink() and not p.exists():
         return p  # a link in a loop or to nothing: the file's reader names why
+    if not p.exists() and p.suffix in ("", ".yaml", ".yml") and p.parent != Path(".") and is_name(p.name):
+        # e.g. configs/study_quick.yaml from a source checkout, run where footzoo is installed
+        raise ConfigError(f"{str(spec)!r}: no such file; footzoo ships a config named {p.stem!r}: give its name "
+                          f"alone ('{p.stem}'), which works from any folder, or the path of your own copy")
     if p.exists() or not is_name(spec):
         if not p.exists() and "/" not in str(spec) and "\\" not in str(spec) and p.suffix in ("", ".yaml", ".yml"):
             if p.suffix:  # a file name: say that the file is missing, then which names are shipped

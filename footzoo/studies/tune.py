@@ -424,6 +424,23 @@ def recording_groups(study: Study, group_by: str | None = None) -> pd.Series:
     return pd.Series(out, name="group")
 
 
+def check_groups(groups: pd.Series, group_by: str | None = None) -> None:
+    """Refuse, before any run, recordings that fall in fewer than two groups (nothing to hold out).
+
+    Raises
+    ------
+    ConfigError
+        Naming the single group, its recordings and how to split them.
+    """
+    names = list(pd.unique(groups.to_numpy()))
+    if len(names) < 2:
+        how = (f"tune.group_by {group_by!r} puts all {len(groups)} recording(s) in one group {names[0]!r}"
+               if group_by is not None else f"all {len(groups)} recording(s) are in group {names[0]!r}")
+        raise ConfigError(f"cross-validation needs at least two groups of recordings; {how} "
+                          f"(e.g. {list(groups.index[:3])}): make the first (group) of group_by take different "
+                          "values on different recordings, or give the recordings entries different 'group:' values")
+
+
 def tune(study: Study | dict[str, Any] | str | Path, spec: TuneSpec | dict[str, Any] | None = None,
          score: Score | None = None, eligible: Callable[[str], bool] | None = None,
          groups: Callable[[str], str] | None = None,
@@ -470,6 +487,7 @@ def tune(study: Study | dict[str, Any] | str | Path, spec: TuneSpec | dict[str, 
             groups = recording_groups(study, spec.group_by)
         else:
             groups = pd.Series({r.label: str(groups(r.label)) for r in study.recordings}, name="group")
+        check_groups(groups, spec.group_by)
         score = score or spec.score_function()
         options = dict(jobs=jobs, scheduler=scheduler, out=out, progress=progress, quiet=quiet)
         if out is None:

@@ -38,6 +38,17 @@ def test_a_missing_yaml_file_is_called_missing_not_an_unknown_shipped_name(tmp_p
         resolve("recomended")
 
 
+def test_a_shipped_configs_source_path_where_there_is_none_names_the_shipped_name(tmp_path, monkeypatch):
+    """``configs/study_quick.yaml`` (a source checkout's path) run where footzoo is only installed."""
+    from footzoo.apps.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    for read in (footzoo.Pipeline.from_yaml, footzoo.run_study):
+        with pytest.raises(footzoo.ConfigError, match=r"ships a config named 'study_quick': give its name alone"):
+            read("configs/study_quick.yaml")
+    assert main(["ablate", "configs/study_quick.yaml", "--out", str(tmp_path / "o")]) == 2
+
+
 def test_yaml_text_given_as_a_configs_name_says_what_it_is(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for text in ("detector: {type: shoe}", "name: x\norientation: {type: ins}\n"):

@@ -109,6 +109,15 @@ STUDY = {"name": "tuned", "base": "yun2012",
                         {"simulate": SIM, "seeds": [2, 3], "group": "day2", "label": "other"}]}
 
 
+def test_one_group_is_refused_before_any_run(tmp_path):
+    """A group_by that puts every recording in one group is named at once: no run, no cache folder."""
+    study = {"name": "one_group", "base": "yun2012", "factors": {"detector.threshold": [0.5, 1.0]},
+             "recordings": [{"simulate": SIM, "seeds": [0, 1]}]}
+    with pytest.raises(ConfigError, match=r"group_by '\^\(\.\)' puts all 2 recording\(s\) in one group"):
+        tune(study, {"objective": "armse_3d_m", "group_by": r"^(.)"}, out=tmp_path / "out")
+    assert not (tmp_path / "out" / "cache").exists()
+
+
 def test_tune_chooses_the_better_threshold_and_writes_its_config(tmp_path):
     result = tune(Study.from_dict(STUDY), {"objective": "armse_3d_m"}, out=tmp_path, quiet=True)
     assert result.best_ == "detector.threshold=1" and list(result.folds_["chosen"]) == [result.best_] * 2
