@@ -83,6 +83,18 @@ class GainStage(Stage):
         return {"acc_gain": {"gain": self.gain, "still_m_s2": self.still, "gravity_m_s2": self.gravity}}
 
 
+def _reissue_naming(caught: list[warnings.WarningMessage], name: str | None) -> None:
+    """Issue the warnings a plug-in gave again, each prefixed with the recording's ``name`` (a plug-in sees only
+    arrays: in a study or a session, a warning without the recording's name cannot be traced)."""
+    for w in caught:
+        text = str(w.message)
+        try:
+            message = w.category(f"{name}: {text}") if name and not text.startswith(f"{name}:") else w.message
+        except Exception:  # a warning class with another constructor: as it was
+            message = w.message
+        warnings.warn(message, stacklevel=4)
+
+
 class CalibrationStage(Stage):
     """In-situ calibrations, applied in order before every other stage.
 
@@ -112,7 +124,10 @@ class CalibrationStage(Stage):
                 self.reports.append({"type": c.name, "applied": True, "given": True, **_fit_of(c)})
                 out.update(_applied(c, out))
                 continue
-            fitted = checked(c.clone().calibrate, out["t"], out["acc"], out["gyr"], out.get("mag"))
+            with warnings.catch_warnings(record=True) as caught:  # re-issued below, naming the recording
+                warnings.simplefilter("always")
+                fitted = checked(c.clone().calibrate, out["t"], out["acc"], out["gyr"], out.get("mag"))
+            _reissue_naming(caught, self.ctx.name)
             out.update(calibrated_signals(c, out, fitted, self.ctx.name))
             self.reports.append({"type": c.name, **fitted.report_})
             if not whole:

@@ -44,7 +44,7 @@ def test_run_quiet_shows_no_warning_and_keeps_them_in_the_result_and_the_log(str
     captured = capsys.readouterr()
     assert "warning" not in captured.err and "strides" in captured.out
     log = (out / LOG).read_text()
-    assert f"CalibrationWarning: {WARNING}" in log
+    assert f"CalibrationWarning: sim_straight: {WARNING}" in log  # the warning names the recording
     kept = Result.load(out).diagnostics["warnings"]
     assert any(WARNING in w for w in kept) and log.splitlines() == kept
 
@@ -52,7 +52,7 @@ def test_run_quiet_shows_no_warning_and_keeps_them_in_the_result_and_the_log(str
 def test_run_without_quiet_shows_the_warnings_and_logs_them_too(straight, tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["run", "yun2012", "--data", str(straight), "--out", str(out)]) == 0
-    assert f"footzoo: warning: {WARNING}" in capsys.readouterr().err
+    assert f"footzoo: warning: sim_straight: {WARNING}" in capsys.readouterr().err
     assert WARNING in (out / LOG).read_text()
     # a run with no warning leaves a log that says so, not the previous run's
     write(simulate(path="rectangle", n_strides=10, rate=100.0, noise=NoiseModel(seed=0)), tmp_path / "loop.csv")
@@ -85,7 +85,7 @@ def test_a_quiet_tune_logs_the_runs_warnings(straight, tmp_path, capsys):
     assert main(["tune", str(tune_file), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert WARNING not in capsys.readouterr().err
     # one walk (read twice) and two settings: the same warning from 4 runs, once
-    assert f"CalibrationWarning: 4 run(s): {WARNING}" in (tmp_path / "out" / LOG).read_text()
+    assert f"CalibrationWarning: 4 run(s): sim_straight: {WARNING}" in (tmp_path / "out" / LOG).read_text()
 
 
 # the unknown foot's warning and the refused metrics' are this test's subject: let through, counted below

@@ -93,6 +93,14 @@ def test_a_straight_walk_is_left_uncalibrated_with_the_reason():
     assert np.shares_memory(out.mag_, rec.mag) and np.array_equal(out.mag_, rec.mag)
 
 
+def test_a_pipelines_calibration_warning_names_the_recording():
+    """In a run (a study, a session) the warning says which recording was left uncalibrated."""
+    rec = simulate(n_strides=4, profile="physical", noise={"scale": 1}, rate=100)
+    rec.meta["name"] = "subject7_walk"
+    with pytest.warns(CalibrationWarning, match=r"^subject7_walk: hard_iron: magnetometer left uncalibrated"):
+        footzoo.Pipeline.from_yaml("yun2012").calibrate(rec)
+
+
 def test_readings_turned_about_one_axis_only_are_refused_not_a_crash():
     ang = np.linspace(0, 4 * np.pi, 500)  # yaw only, noise-free: the readings lie on one circle
     c, s_ = np.cos(ang), np.sin(ang)

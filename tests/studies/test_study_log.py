@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import warnings
 
 import pytest
@@ -42,8 +43,8 @@ def test_the_log_lists_the_warnings_the_runs_gave_in_their_workers(tmp_path, job
         run_study(Study.from_dict(WARNS), out=tmp_path, jobs=jobs)
     log = (tmp_path / LOG).read_text().splitlines()
     # one distinct warning per walk (their direction spreads differ), each given by one run
-    assert len(log) == 2 and all(line.startswith(f"CalibrationWarning: {UNCALIBRATED}: the sensor turned too "
-                                                 "little") for line in log)
+    named = rf"CalibrationWarning: \S+: {UNCALIBRATED}: the sensor turned too little"  # each names its recording
+    assert len(log) == 2 and all(re.match(named, line) for line in log)
     # the caller gets them as one, alike but for their numbers, with the first as the example
     (shown,) = texts(caught)
     assert shown.startswith("CalibrationWarning: 2 run(s) gave 2 warnings like this one")
@@ -103,7 +104,7 @@ def test_a_tune_writes_its_log_with_its_tables_inside_its_lock(tmp_path, monkeyp
     assert not [w for w in caught if UNCALIBRATED in str(w.message)]  # quiet: the runs' warnings in the log only
     assert commits[-1] == ("tune 'tuned'", False)  # the log comes with the tune's last commit, the lock held
     log = (tmp_path / LOG).read_text().splitlines()  # each walk's warning, given by the runs of both settings
-    calibration = [line for line in log if line.startswith(f"CalibrationWarning: 2 run(s): {UNCALIBRATED}")]
+    calibration = [line for line in log if re.match(rf"CalibrationWarning: 2 run\(s\): \S+: {UNCALIBRATED}", line)]
     # and the 10 rad/s threshold's: it takes every sample of both walks for stance
     stance = [line for line in log if line not in calibration]
     assert len(calibration) == 2 and len(stance) == 1 and "the detector 'angular_rate_fsm' takes 100.0%" in stance[0]
