@@ -606,7 +606,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     from ..studies import run_study
     from ..studies.report import compared, readable, summarise, to_markdown
 
-    out = args.out or f"ablation_{Path(args.study).stem}"
+    out = Path(args.out or f"ablation_{Path(args.study).stem}")  # printed as 'results in study/', not 'study//'
     prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
              "max_bytes": None if args.cache_max_size is None else int(args.cache_max_size * 1e6)}
     with kept_warnings(args):  # and in OUT/footzoo.log, written with the study's report

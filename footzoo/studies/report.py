@@ -264,9 +264,12 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
                   step: Callable[[int], Any]) -> None:
     """The tidy table, the trajectories and sweeps, the summaries (``step(1)`` after each)."""
     table.to_csv(out / "results.csv", index=False)
-    _to_parquet(table, out / "results.parquet")
+    skipped = _to_parquet(table, out / "results.parquet")
     step(1)
-    _write_frames(runs, out)
+    skipped += _write_frames(runs, out)
+    if skipped:  # one warning for the missing package, naming every file it costs
+        warnings.warn(f"pyarrow is not installed: {', '.join(skipped)} not written (results.csv has the table; "
+                      "pip install 'footzoo[parquet]' or pyarrow to get them)", FootzooWarning, stacklevel=3)
     step(1)
     md, tex = [], []
     for f in ["base", *factors]:
@@ -285,20 +288,18 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
 FRAME_BATCH = 200
 
 
-def _write_frames(runs: list[dict[str, Any]], out: Path) -> None:
-    """``trajectories.parquet`` and ``roc.parquet``, written :data:`FRAME_BATCH` runs at a time."""
+def _write_frames(runs: list[dict[str, Any]], out: Path) -> list[str]:
+    """``trajectories.parquet`` and ``roc.parquet``, written :data:`FRAME_BATCH` runs at a time; the names of
+    those not written (no pyarrow)."""
     if len(runs) <= FRAME_BATCH:
         trajectories, roc = run_frames(with_heavy(runs, HEAVY))
-        _to_parquet(trajectories, out / "trajectories.parquet")
-        _to_parquet(roc, out / "roc.parquet")
-        return
+        return _to_parquet(trajectories, out / "trajectories.parquet") + _to_parquet(roc, out / "roc.parquet")
     try:
         # deferred: pyarrow, an optional extra (footzoo[parquet])
         import pyarrow as pa
         import pyarrow.parquet as pq
     except ImportError:
-        _to_parquet(pd.DataFrame(), out / "trajectories.parquet")  # the warning only
-        return
+        return ["trajectories.parquet", "roc.parquet"]
     writers: dict[str, Any] = {}
     try:
         for k in range(0, len(runs), FRAME_BATCH):
@@ -313,6 +314,7 @@ def _write_frames(runs: list[dict[str, Any]], out: Path) -> None:
     finally:
         for w in writers.values():
             w.close()
+    return []
 
 
 def run_frames(runs: list[dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -346,12 +348,13 @@ def _has(record: dict[str, Any], field: str) -> bool:
     return value is not None and len(value) > 0
 
 
-def _to_parquet(df: pd.DataFrame, path: Path) -> None:
+def _to_parquet(df: pd.DataFrame, path: Path) -> list[str]:
+    """Write ``df`` as Parquet; ``[path.name]`` when pyarrow is not installed (the caller says so), else ``[]``."""
     try:
         df.to_parquet(path, index=False)
-    except ImportError:  # pyarrow not installed: CSV only, and say so
-        warnings.warn(f"pyarrow is not installed: {path.name} was not written (results.csv has the table; "
-                      "pip install 'footzoo[parquet]' or pyarrow to get it)", FootzooWarning, stacklevel=2)
+    except ImportError:  # pyarrow not installed: CSV only
+        return [path.name]
+    return []
 
 
 # --------------------------------------------------------------------------- human labels

@@ -69,8 +69,9 @@ def test_run_quiet_without_a_folder_says_how_many_it_did_not_show(straight, caps
 def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
     study = tmp_path / "study.yaml"
     study.write_text(f"name: s\nbase: yun2012\nrecordings: [{{path: {straight}}}]\nmetrics: [strides]\n")
-    assert main(["ablate", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert WARNING not in capsys.readouterr().err
+    assert main(["ablate", str(study), "--out", f"{tmp_path / 'out'}/", "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert WARNING not in captured.err and f"results in {tmp_path / 'out'}/\n" in captured.out  # not 'out//'
     assert WARNING in (tmp_path / "out" / LOG).read_text()
     assert LOG in json.loads((tmp_path / "out" / "outputs.json").read_text())["files"]  # part of the report
 
