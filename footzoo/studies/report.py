@@ -6,12 +6,13 @@ import contextlib
 import itertools
 import json
 import os
+import re
 import shutil
 import tempfile
 import textwrap
 import threading
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -41,12 +42,35 @@ def summarise(table: pd.DataFrame, factor: str) -> pd.DataFrame:
     return out.reset_index().sort_values(["metric", factor]).reset_index(drop=True)
 
 
+#: A number in a message (``12``, ``-0.77``, ``1e+06``): messages that differ only in these are alike.
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
+def alike(text: str, labels: Iterable[str] = ()) -> str:
+    """The shape of a message: its text with the recordings' names (``labels``) and every number blanked."""
+    for label in labels:
+        text = text.replace(label, "<recording>")
+    return _NUMBER.sub("#", text)
+
+
+def grouped(counts: dict[str, int]) -> list[tuple[str, int, int]]:
+    """Distinct messages with their counts, those alike but for their numbers merged: ``(first, total count,
+    how many distinct messages it stands for)``, in the order of their first appearance."""
+    groups: dict[str, list[tuple[str, int]]] = {}
+    for text, n in counts.items():
+        groups.setdefault(alike(text), []).append((text, n))
+    return [(members[0][0], sum(n for _, n in members), len(members)) for members in groups.values()]
+
+
 def _missing_reason(values: pd.Series, notes: pd.Series) -> str:
-    """Why a summary's metric lacks values in some runs: their distinct notes (empty when no value is missing)."""
+    """Why a summary's metric lacks values in some runs: their distinct notes, those alike but for their numbers
+    given once with how many more there are (empty when no value is missing)."""
     missing = values.isna().to_numpy()
     if not missing.any():
         return ""
-    why = "; ".join(dict.fromkeys(str(n) for n in notes[missing] if isinstance(n, str) and n)) or "no reason recorded"
+    distinct = dict.fromkeys((str(n) for n in notes[missing] if isinstance(n, str) and n), 1)
+    why = "; ".join(text if k == 1 else f"{text} (and {k - 1} alike, with other numbers)"
+                    for text, _, k in grouped(distinct)) or "no reason recorded"
     return why if missing.all() else f"{int(missing.sum())} of {len(values)} runs: {why}"
 
 

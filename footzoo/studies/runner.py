@@ -57,7 +57,7 @@ from .cache import (
     touch,
     write_entry,
 )
-from .report import write_outputs
+from .report import alike, grouped, write_outputs
 from .study import Cell, Study, check_jobs, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
@@ -374,17 +374,6 @@ def study_identity(study: Study) -> str:
     return hashlib.sha256(json.dumps(spec, sort_keys=True, default=str).encode()).hexdigest()
 
 
-#: A number in a warning's text (``12``, ``-0.77``, ``1e+06``): warnings that differ only in these are alike.
-_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
-
-
-def _alike(text: str, labels: list[str]) -> str:
-    """The shape of a warning: its text with the recordings' names and every number blanked."""
-    for label in labels:
-        text = text.replace(label, "<recording>")
-    return _NUMBER.sub("#", text)
-
-
 def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: WarningLog, quiet: bool,
                      labels: list[str] = ()) -> None:
     """Issue each distinct warning of the runs once, with the number of runs that gave it (``quiet``: into the
@@ -395,7 +384,7 @@ def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: Warni
     labels = sorted({str(x) for x in labels if str(x)}, key=len, reverse=True)
     groups: dict[str, list[tuple[str, int]]] = {}
     for text, n in worker.items():
-        groups.setdefault(_alike(text, labels), []).append((text, n))
+        groups.setdefault(alike(text, labels), []).append((text, n))
     replayed = []
     for members in groups.values():
         name, _, message = members[0][0].partition(": ")
@@ -415,7 +404,8 @@ def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: Warni
             log.not_logged([f"{category.__name__}: {summary}"])
             replayed.append((category, summary))
     if refused:
-        text = "; ".join(f"{why} ({n} run(s))" for why, n in refused.items())
+        text = "; ".join(f"{why} ({n} run(s))" if k == 1 else f"{why} ({n} run(s), with {k - 1} alike reasons: other "
+                         "numbers)" for why, n, k in grouped(refused))
         replayed.append((MetricWarning, f"metrics refused (NaN, see the table's note column): {text}"))
     for category, message in replayed:
         if quiet:

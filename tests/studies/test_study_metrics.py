@@ -256,6 +256,18 @@ def test_the_summary_says_why_a_metric_has_no_value():
     assert unexplained.loc[("b", "armse_3d_m"), "reason"] == "no reason recorded"
 
 
+def test_reasons_alike_but_for_their_numbers_are_given_once_with_their_count():
+    """Nine PyShoe trials' fragmented stance references: one reason and how many more, not nine sentences."""
+    from footzoo.studies.report import summarise
+
+    notes = [f"fragmented stance reference: {k} of its {k + 20} stance phases last under 100 ms" for k in (16, 45, 24)]
+    table = pd.DataFrame({"run": [0, 1, 2, 3], "base": ["a"] * 4, "recording": ["p1", "p2", "p3", "g"],
+                          "metric": ["step_count_error"] * 4, "value": [np.nan] * 4, "error": None,
+                          "note": [*notes, "the reference has no stance mask"]})
+    reason = summarise(table, "base").set_index(["base", "metric"]).loc[("a", "step_count_error"), "reason"]
+    assert reason == f"{notes[0]} (and 2 alike, with other numbers); the reference has no stance mask"
+
+
 def test_a_reason_in_free_text_keeps_the_summary_tables_valid():
     """A note is free text: Markdown's cell separator and LaTeX's special characters are escaped."""
     from footzoo.studies.report import to_latex, to_markdown
