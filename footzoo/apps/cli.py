@@ -502,13 +502,15 @@ def _validate_study(name: str, path: Path, tune: bool) -> int:
     """Check a study (or tune) file as ``footzoo ablate`` (``tune``) does before its first run, without running it."""
     # deferred: the study runner: the command line starts without it
     from ..studies import Study
-    from ..studies.tune import load_tune_file
+    from ..studies.tune import check_groups, load_tune_file, recording_groups
 
     if tune:
         study, spec = load_tune_file(path)
         study.check()
+        groups = recording_groups(study, spec.group_by)
+        check_groups(groups, spec.group_by)
         what = (f"tune file: {spec.search} search, objective {spec.objective} ({spec.direction}); "
-                f"{len(study.recordings)} recording(s)")
+                f"{len(study.recordings)} recording(s) in {groups.nunique()} groups")
     else:
         study = Study.from_yaml(path)
         study.check()

@@ -116,6 +116,9 @@ def test_one_group_is_refused_before_any_run(tmp_path):
     with pytest.raises(ConfigError, match=r"group_by '\^\(\.\)' puts all 2 recording\(s\) in one group"):
         tune(study, {"objective": "armse_3d_m", "group_by": r"^(.)"}, out=tmp_path / "out")
     assert not (tmp_path / "out" / "cache").exists()
+    (tmp_path / "tune.yaml").write_text(yaml.safe_dump({**study, "tune": {"objective": "armse_3d_m",
+                                                                          "group_by": "^(.)"}}))
+    assert main(["validate", str(tmp_path / "tune.yaml")]) == 2  # footzoo validate says it too
 
 
 def test_tune_chooses_the_better_threshold_and_writes_its_config(tmp_path):
