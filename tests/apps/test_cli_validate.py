@@ -48,8 +48,14 @@ def test_validate_checks_a_study_or_tune_file_without_running_it(tmp_path, capsy
     tune = tmp_path / "tune.yaml"
     tune.write_text("name: t\nbase: yun2012\nfactors: {detector.threshold: [0.4, 0.6]}\n" + sim
                     + "tune: {objective: armse_3d_m}\n")
+    assert main(["validate", str(tune)]) == 2  # recordings without a group: tune would refuse them
+    assert "has no group" in capsys.readouterr().err
+    walk = "{path: straight, n_strides: 4, rate: 50, noise: {scale: 1}}"
+    tune.write_text("name: t\nbase: yun2012\nfactors: {detector.threshold: [0.4, 0.6]}\n"
+                    f"recordings: [{{simulate: {walk}, seeds: [0], group: a}}, "
+                    f"{{simulate: {walk}, seeds: [1], group: b, label: other}}]\ntune: {{objective: armse_3d_m}}\n")
     assert main(["validate", str(tune)]) == 0
-    assert "valid tune file: grid search, objective armse_3d_m" in capsys.readouterr().out
+    assert "valid tune file: grid search, objective armse_3d_m; 2 recording(s) in 2 groups" in capsys.readouterr().out
 
 
 def test_list_shows_a_plug_in_file_given_with_plugins(tmp_path, capsys):
