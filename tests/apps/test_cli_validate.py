@@ -55,7 +55,8 @@ def test_validate_checks_a_study_or_tune_file_without_running_it(tmp_path, capsy
                     f"recordings: [{{simulate: {walk}, seeds: [0], group: a}}, "
                     f"{{simulate: {walk}, seeds: [1], group: b, label: other}}]\ntune: {{objective: armse_3d_m}}\n")
     assert main(["validate", str(tune)]) == 0
-    assert "valid tune file: grid search, objective armse_3d_m; 2 recording(s) in 2 groups" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "valid tune file: grid search, objective armse_3d_m (minimize); 2 recording(s) in 2 groups" in out
 
 
 def test_list_shows_a_plug_in_file_given_with_plugins(tmp_path, capsys):
