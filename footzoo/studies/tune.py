@@ -433,6 +433,9 @@ def check_groups(groups: pd.Series, group_by: str | None = None) -> None:
         Naming the single group, its recordings and how to split them.
     """
     names = list(pd.unique(groups.to_numpy()))
+    if not names:
+        raise ConfigError("cross-validation needs at least two groups of recordings; there are no recordings: list "
+                          "them under 'recordings:'")
     if len(names) < 2:
         how = (f"tune.group_by {group_by!r} puts all {len(groups)} recording(s) in one group {names[0]!r}"
                if group_by is not None else f"all {len(groups)} recording(s) are in group {names[0]!r}")

@@ -121,6 +121,13 @@ def test_one_group_is_refused_before_any_run(tmp_path):
     assert main(["validate", str(tmp_path / "tune.yaml")]) == 2  # footzoo validate says it too
 
 
+def test_no_recordings_at_all_are_refused_by_the_group_check():
+    from footzoo.studies.tune import check_groups
+
+    with pytest.raises(ConfigError, match="there are no recordings"):
+        check_groups(pd.Series([], dtype=object, name="group"))
+
+
 def test_tune_chooses_the_better_threshold_and_writes_its_config(tmp_path):
     result = tune(Study.from_dict(STUDY), {"objective": "armse_3d_m"}, out=tmp_path, quiet=True)
     assert result.best_ == "detector.threshold=1" and list(result.folds_["chosen"]) == [result.best_] * 2
