@@ -162,6 +162,16 @@ def _integrate(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, a: int, b: int, 
 
 
 @njit
+def _tilt(fx: float, fy: float, fz: float) -> tuple[float, float, float, float]:
+    """The attitude (scalar-first quaternion, body to NED, heading 0) whose roll and pitch make the still
+    specific force ``(fx, fy, fz)`` (FRD, m/s²) point up."""
+    roll = math.atan2(-fy, -fz)
+    pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
+    cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+    return cp * cr, cp * sr, sp * cr, -sp * sr
+
+
+@njit
 def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarray, last: np.ndarray,
                scale: np.ndarray, signs: np.ndarray, g: float, out: np.ndarray) -> None:
     """``out[s, c] = |v| / (g T)`` of swing ``s``: strapdown from sample ``first[s]`` (tilt from its ``acc``) to
@@ -177,11 +187,8 @@ def _residuals(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarra
     reach = np.max(np.abs(scale))
     for s in range(first.shape[0]):
         a, b = first[s], last[s]
-        fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
-        roll = math.atan2(-fy, -fz)
-        pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
-        cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
-        state[0], state[1], state[2], state[3], state[4:] = cp * cr, cp * sr, sp * cr, -sp * sr, 0.0
+        state[0], state[1], state[2], state[3] = _tilt(acc[a, 0], acc[a, 1], acc[a, 2])
+        state[4:] = 0.0
         turn = 0.0
         for i in range(a, b):
             turn = max(turn, (gyr[i, 0] ** 2 + gyr[i, 1] ** 2 + gyr[i, 2] ** 2) * (t[i + 1] - t[i]) ** 2)
@@ -204,11 +211,7 @@ def _swing_gait(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, first: np.ndarr
     takes it: the position is corrected by ``v_end τ² / (2 T)`` at the time ``τ`` into the swing of duration ``T``."""
     for s in range(first.shape[0]):
         a, b = first[s], last[s]
-        fx, fy, fz = acc[a, 0], acc[a, 1], acc[a, 2]
-        roll = math.atan2(-fy, -fz)
-        pitch = math.atan2(fx, math.sqrt(fy * fy + fz * fz))
-        cr, sr, cp, sp = math.cos(roll / 2), math.sin(roll / 2), math.cos(pitch / 2), math.sin(pitch / 2)
-        w, x, y, z = cp * cr, cp * sr, sp * cr, -sp * sr
+        w, x, y, z = _tilt(acc[a, 0], acc[a, 1], acc[a, 2])
         vx = vy = vz = px = py = pz = 0.0
         turned = peak = 0.0
         heights = np.empty(b - a)  # the height (m, up) after each sample, before the correction
