@@ -96,6 +96,11 @@ def find_header(path: Path) -> tuple[int, str, float | None] | None:
             text = line.strip()
             found = _RATE.search(text)
             if found:
+                if rate is not None and float(found.group(1)) != rate:
+                    raise FormatError(f"{path}: the header says two sampling rates, {rate:g} Hz and "
+                                      f"{float(found.group(1)):g} Hz (line {k + 1}); footzoo cannot tell which one "
+                                      "timed the packets: pass the true one, e.g. rate=100 (command line: --option "
+                                      "rate=100)")
                 rate = float(found.group(1))
             if text.startswith("PacketCounter"):
                 names = re.split(r"[\t,;]|\s+", text)
@@ -142,8 +147,20 @@ def trial_annotations(path: Path) -> Path | None:
     return candidate if candidate.exists() else None
 
 
+def _bounds(annotations: dict[str, Any], key: str, default: tuple[float, float]) -> tuple[float, float]:
+    """``annotations[key]`` as two packet counts ``(first, last)``; the default when it is absent."""
+    if key not in annotations:
+        return default
+    try:
+        lo, hi = (float(v) for v in annotations[key])
+    except (TypeError, ValueError):
+        raise FormatError(f"{key} must be two packet counts [first, last], got {annotations[key]!r:.80}; repair the "
+                          "annotations") from None
+    return lo, hi
+
+
 def reference_events(annotations: dict[str, Any], foot: str, first: float, rate: float,
-                     uturn: bool = False) -> pd.DataFrame:
+                     uturn: bool = False, packets: float | None = None) -> pd.DataFrame:
     """The reference strides (``start_s``, ``to_s``, ``end_s``, ``turn``) of one foot from IPOL annotations.
 
     Parameters
@@ -158,14 +175,24 @@ def reference_events(annotations: dict[str, Any], foot: str, first: float, rate:
         Sampling rate (Hz).
     uturn : bool
         Keep the swings in the U-turn (``turn`` true); by default they are left out.
+    packets : float, optional
+        The packets the file spans (last − first); an event beyond them is a :class:`FormatError`.
     """
     key = "LeftFootEvents" if foot == "left" else "RightFootEvents"
     try:
         pairs = np.asarray(annotations[key], dtype=float).reshape(-1, 2)
     except (KeyError, TypeError, ValueError):
         raise FormatError(f"the annotations have no readable {key} (a list of [toe-off, heel-strike] pairs)") from None
-    lo, hi = annotations.get("TrialBoundaries", [-np.inf, np.inf])
-    u0, u1 = annotations.get("UTurnBoundaries", [np.inf, -np.inf])
+    lo, hi = _bounds(annotations, "TrialBoundaries", (-np.inf, np.inf))
+    u0, u1 = _bounds(annotations, "UTurnBoundaries", (np.inf, -np.inf))
+    bad = np.flatnonzero(~np.isfinite(pairs).all(axis=1) | (pairs[:, 0] >= pairs[:, 1]))
+    if bad.size:
+        raise FormatError(f"{key}[{bad[0]}] = {pairs[bad[0]].tolist()}: a swing is [toe-off, heel-strike] packet "
+                          f"counts with the toe-off first ({bad.size} pair(s) are not); repair the annotations")
+    if packets is not None and pairs.size and (pairs.min() < 0 or pairs.max() > packets):
+        raise FormatError(f"{key} names packets {pairs.min():.0f}-{pairs.max():.0f}, but the file holds packets 0-"
+                          f"{packets:.0f} from its first: these annotations belong to another trial or file; "
+                          "check the pairing of the .json and .txt files")
     times = (first + pairs - 0.5) / rate  # the middle of the annotated sample's interval
     start = np.concatenate([[np.nan], times[:-1, 1]])
     turn = (pairs[:, 0] <= u1) & (pairs[:, 1] >= u0)
@@ -199,6 +226,9 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
     if rate is None and file_rate is None:
         raise FormatError(f"{path}: the file does not say its sampling rate (no 'Acquisition frequency: ... Hz' or "
                           "'Update Rate: ...Hz' line); pass it, e.g. rate=100 (command line: --option rate=100)")
+    if rate is None and not 0.0 < file_rate <= 100_000.0:
+        raise FormatError(f"{path}: the header says a sampling rate of {file_rate:g} Hz, which no sensor has; pass the "
+                          "true one, e.g. rate=100 (command line: --option rate=100)")
     rate = check_range("rate", rate if rate is not None else file_rate, 0.0, 100_000.0, "Hz", lo_open=True)
     magnetometer = check_bool("magnetometer", magnetometer)
     uturn = check_bool("uturn", uturn)
@@ -233,7 +263,10 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
             raise FormatError(f"{notes}: the annotation file cannot be read as JSON ({err}); repair or move "
                               "it") from None
         first = float(np.round(t[0] * rate))
-        steps = reference_events(annotations, foot, first, rate, uturn)
+        try:
+            steps = reference_events(annotations, foot, first, rate, uturn, packets=float(np.round(t[-1] * rate)) - first)
+        except FormatError as err:
+            raise FormatError(f"{notes}: {err}") from None
         meta["input_files"].append(str(notes))
         for key, name in (("TrialBoundaries", "trial_s"), ("UTurnBoundaries", "uturn_s")):
             if key in annotations:

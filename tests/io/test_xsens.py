@@ -135,6 +135,32 @@ def test_an_annotation_file_that_is_not_json_is_named(walk, tmp_path):
         load(path)
 
 
+
+@pytest.mark.parametrize("rate_line, match", [
+    ("Acquisition frequency: 100 Hz\n// Update Rate: 60.00Hz", r"two sampling rates, 100 Hz and 60 Hz.*rate=100"),
+    ("Acquisition frequency: 0 Hz", r"9-3_lf\.txt: the header says a sampling rate of 0 Hz.*rate=100"),
+])
+def test_a_header_whose_rate_is_impossible_or_contradicts_itself_is_refused(walk, tmp_path, rate_line, match):
+    path = tmp_path / "9-3_lf.txt"
+    path.write_text(xsens_text(walk, rate_line=rate_line))
+    with pytest.raises(FormatError, match=match):
+        load(path)
+
+
+@pytest.mark.parametrize("notes, match", [
+    ({"LeftFootEvents": [[150, 100]]}, r"LeftFootEvents\[0\] = \[150.0, 100.0\].*toe-off first"),
+    ({"LeftFootEvents": [[100000, 100050]], "TrialBoundaries": [0, 200000]}, r"packets 100000-100050.*another trial"),
+    ({"LeftFootEvents": [[10, 50]], "TrialBoundaries": "all"}, r"TrialBoundaries must be two packet counts"),
+    ({"LeftFootEvents": "none"}, r"no readable LeftFootEvents"),
+])
+def test_annotations_that_cannot_describe_this_file_are_refused_with_the_file_named(walk, tmp_path, notes, match):
+    path = tmp_path / "9-4_lf.txt"
+    path.write_text(xsens_text(walk))
+    (tmp_path / "9-4.json").write_text(json.dumps(notes))
+    with pytest.raises(FormatError, match=r"9-4\.json: .*" + match):
+        load(path)
+
+
 # ------------------------------------------------------------------------------- real recordings
 
 
