@@ -59,7 +59,7 @@ from ..plugins.incremental import WHOLE_RECORDING, Chunk, Latency, total
 from ..plugins.registry import build
 from .chain import Chain, aligned, build_chain, input_stages, navigation_stage, recording_chunk, with_signals
 from .guards import StanceGuard, check_speed
-from .stages import detected, estimate_attitude, guarded
+from .stages import GainStage, detected, estimate_attitude, guarded
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
 STREAM_WARMUP = 30.0
@@ -329,8 +329,8 @@ class Pipeline:
         prepared = rec.meta.get(PREPARED) == self._preparation()  # from prepare(): its gain and calibrations hold
         chain = build_chain(self, ctx, chunk, engine, covariance, truth=rec.truth, whole=True, prepared=prepared)
         out = chain.push(chunk, finish=True)  # the whole recording, in one finished chunk
-        if self.calibration:
-            rec = with_signals(rec, out)
+        if self.calibration or any(isinstance(stage, GainStage) for stage in chain.stages):
+            rec = with_signals(rec, out)  # the checks of the estimate read the signals the run used, as a stream's do
         return self._result(rec, ctx, out, chain.report(), chain.engine)
 
     def _result(self, rec: Recording, ctx: RunContext, out: Chunk, reports: dict[str, Any], engine: str) -> Result:

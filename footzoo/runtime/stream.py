@@ -44,6 +44,7 @@ from .alignment import first_still_window
 from .chain import Chain, build_chain, with_init
 from .pipeline import STREAM_WARMUP, require_pipeline
 from .stage import Queue, Stage
+from .stages import GainStage
 from .stream_state import check_channel, check_open, check_unused
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
@@ -299,6 +300,9 @@ class Stream:
         steps = self.pipeline.analyse(rec, stance, k["quat"], k["pos"])
         config = {**self.pipeline.to_dict(), "engine": "stream"}
         diagnostics = {"calibration": self.fits} if self.fits is not None else {}
+        for stage in self._stages:  # the gain the stream applied to the specific force, as a batch run reports it
+            if isinstance(stage, GainStage):
+                diagnostics.update(stage.report())
         diagnostics["sensor"] = self.sensor
         return Result(samples=samples_frame(k["t"], k["quat"], k["pos"], k["vel"], k["acc_nav"], stance),
                       steps=steps, config=config, versions=versions(), recording=dict(rec.meta),

@@ -680,6 +680,10 @@ def _connect(address: Any) -> Any:
         raise ConfigError(f"scheduler {address}: no Dask scheduler answers there ({err}); start one (dask scheduler, "
                           "then dask worker ADDRESS on each machine), check the address and the firewall, or leave "
                           "the scheduler out to run on this machine") from None
+    except Exception as err:  # something answers, but not in Dask's protocol (a web server, a proxy): garbage frames
+        raise ConfigError(f"scheduler {address}: what answers there is not a Dask scheduler ({type(err).__name__}: "
+                          f"{str(err)[:120]}); check the address and the port (a scheduler listens on 8786 by default, "
+                          "its dashboard on 8787), or leave the scheduler out to run on this machine") from None
 
 
 def _indexed(k: int, *args: Any) -> tuple[int, list[dict[str, Any]]]:

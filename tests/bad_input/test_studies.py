@@ -99,3 +99,33 @@ def test_a_study_given_as_a_mapping_runs(walk_csv, tmp_path, monkeypatch):
              "recordings": [{"path": walk_csv.name}]}
     table = footzoo.run_study(study, out=tmp_path / "s", quiet=True)
     assert set(table["detector.threshold"]) == {0.5, 0.6} and table.attrs["failed"] == 0
+
+
+@pytest.mark.slow  # importing dask.distributed takes about 2 s
+def test_a_scheduler_address_where_something_else_answers_is_named_not_a_raw_error():
+    # a web server or a proxy at the address sends bytes that Dask reads as a huge frame size (a ValueError or a
+    # MemoryError inside Dask, before the fix): a ConfigError that names the address and the usual ports
+    import socket
+    import threading
+
+    pytest.importorskip("dask.distributed")
+    from footzoo.studies.runner import _connect
+
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+
+    def answer():
+        with server:
+            for _ in range(8):  # Dask may retry; each connection gets bytes that are not Dask's protocol
+                try:
+                    conn, _ = server.accept()
+                except OSError:
+                    return
+                with conn:
+                    conn.sendall(b"\xff" * 64)
+
+    threading.Thread(target=answer, daemon=True).start()
+    with pytest.raises(footzoo.ConfigError, match=rf"scheduler tcp://127\.0\.0\.1:{port}: what answers there is not "
+                                                  r"a Dask scheduler.*8786"):
+        _connect(f"tcp://127.0.0.1:{port}")
+    server.close()
