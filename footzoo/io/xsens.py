@@ -263,8 +263,9 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
             raise FormatError(f"{notes}: the annotation file cannot be read as JSON ({err}); repair or move "
                               "it") from None
         first = float(np.round(t[0] * rate))
+        packets = float(np.round(t[-1] * rate)) - first
         try:
-            steps = reference_events(annotations, foot, first, rate, uturn, packets=float(np.round(t[-1] * rate)) - first)
+            steps = reference_events(annotations, foot, first, rate, uturn, packets=packets)
         except FormatError as err:
             raise FormatError(f"{notes}: {err}") from None
         meta["input_files"].append(str(notes))

@@ -53,7 +53,6 @@ def test_a_stream_reports_the_accelerometer_gain_it_applied_as_the_batch_run_doe
     from dataclasses import replace
 
     from footzoo import Pipeline, Result, Stream
-    from footzoo.core.errors import SensorWarning
 
     off = replace(sim_walk, acc=sim_walk.acc * 1.2)  # a still start 20 % off g: a gain error, corrected
     pipeline = Pipeline.from_yaml("nguyen2016")
