@@ -43,6 +43,7 @@ from ..core.conventions import ACC_UNITS, GYR_UNITS
 from ..core.errors import (
     ConfigError,
     FootzooError,
+    FootzooWarning,
     FormatError,
     OutputError,
     PluginError,
@@ -55,7 +56,7 @@ from ..core.usage import used_from
 from ..core.warninglog import LOG, log_text, warning_texts
 from ..io.registry import BUILTIN
 from ..plugins.base import BASES
-from ..plugins.registry import describe
+from ..plugins.registry import describe, registered_by
 
 
 def _reader_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -454,7 +455,11 @@ def cmd_list(args: argparse.Namespace) -> int:
     if args.plugins:
         from ..plugins.extensions import load_plugins  # deferred: the plug-ins' imports
 
-        load_plugins(args.plugins, where="--plugins")
+        for i, loaded in enumerate(load_plugins(args.plugins, where="--plugins")):
+            if not registered_by(loaded["module"]):
+                warnings.warn(FootzooWarning(
+                    f"--plugins[{i}]: {loaded['path']} registers no plug-in, so nothing of it is listed: decorate "
+                    "each plug-in class with @footzoo.register (a subclass of a footzoo kind, e.g. Detector)"))
     if args.kind == "settings" or (args.kind is None and args.name is None):
         plugins = describe() if args.kind is None else ""
         print(plugins + ("\n" if plugins else "") + describe_settings(), end="")

@@ -113,6 +113,11 @@ def same_plugin(a: type, b: type) -> bool:
     return sa is not None and sb is not None and sa[:2] == sb[:2]
 
 
+def registered_by(module: str) -> list[str]:
+    """The names of the plug-ins (every kind) whose class the module named ``module`` defines."""
+    return sorted(name for kind in KINDS for name, cls in _REGISTRY[kind].items() if cls.__module__ == module)
+
+
 def available(kind: str) -> dict[str, type[Plugin]]:
     """Registered plug-ins of one kind, by name."""
     _load_builtin()

@@ -9,7 +9,9 @@ and on the command line (exit code 4, never "internal error"); in a study only i
 
 from __future__ import annotations
 
+import re
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
@@ -291,6 +293,19 @@ def test_a_plugin_file_that_exits_on_import_is_a_plugin_error(tmp_path):
         load_plugins([str(bad)])
     assert isinstance(info.value, ConfigError) and info.value.method == "import"
 
+
+
+def test_listing_a_plugin_file_that_registers_nothing_says_so(tmp_path, capsys):
+    # e.g. the @footzoo.register decorator forgotten: the listing would silently lack the plug-in
+    empty = tmp_path / "forgot_register.py"
+    empty.write_text("from footzoo.plugins.base import Detector\n\nclass Forgot(Detector):\n    name = 'forgot'\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")  # the command prints its warnings (checked below)
+        assert main(["list", "--kind", "detector", "--plugins", str(empty)]) == 0
+    out, err = capsys.readouterr()
+    assert re.search(r"footzoo: warning: --plugins\[0\]: .*forgot_register\.py registers no plug-in.*"
+                     r"@footzoo\.register", err), err
+    assert "forgot" not in out
 
 def test_cli_a_faulty_plugin_exits_4_without_traceback_and_names_it(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
