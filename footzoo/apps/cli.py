@@ -459,7 +459,8 @@ def cmd_list(args: argparse.Namespace) -> int:
             if not registered_by(loaded["module"]):
                 warnings.warn(FootzooWarning(
                     f"--plugins[{i}]: {loaded['path']} registers no plug-in, so nothing of it is listed: decorate "
-                    "each plug-in class with @footzoo.register (a subclass of a footzoo kind, e.g. Detector)"), stacklevel=2)
+                    "each plug-in class with @footzoo.register (a subclass of a footzoo kind, e.g. Detector)"),
+                    stacklevel=2)
     if args.kind == "settings" or (args.kind is None and args.name is None):
         plugins = describe() if args.kind is None else ""
         print(plugins + ("\n" if plugins else "") + describe_settings(), end="")
