@@ -221,6 +221,17 @@ def has_extension(path: str | Path, *suffixes: str) -> bool:
     return Path(path).suffix.lower() in suffixes
 
 
+def check_encoding(path: Path, what: str = "") -> None:
+    """A :class:`FormatError` naming the conversion when a text file is UTF-16 or UTF-32 or starts with NUL bytes
+    (:func:`footzoo.core.files.foreign_encoding`); a compressed file is left to its reader."""
+    if Path(path).suffix.lower() in COMPRESSED:
+        return
+    with open(path, "rb") as fh:
+        problem = foreign_encoding(fh.read(SNIFF_BYTES))
+    if problem:
+        raise FormatError(f"{what or path}: {problem}")
+
+
 def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
     """``path``, or its content without a last line that was cut short or NUL padding, for ``pandas.read_csv``.
 
@@ -236,10 +247,8 @@ def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
     if Path(path).suffix.lower() in COMPRESSED:
         return path
     name = what or str(path)
+    check_encoding(path, name)
     with open(path, "rb") as fh:
-        problem = foreign_encoding(fh.read(SNIFF_BYTES))
-        if problem:
-            raise FormatError(f"{name}: {problem}")
         fh.seek(0, 2)
         size = fh.tell()
         if size == 0:

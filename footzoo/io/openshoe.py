@@ -46,7 +46,7 @@ from ..core.checks import check_bool, check_range
 from ..core.data import Recording
 from ..core.errors import FootzooWarning, FormatError
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, frame_options, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_encoding, frame_options, text_source
 
 #: Ticks per second of the MicroStrain 3DM-GX3 timer in the ``Counter`` column.
 TIMER_HZ = 19_660_800.0
@@ -136,6 +136,7 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
     acc_unit, gyr_unit : str, optional
         The file's units; default: those its header names.
     """
+    check_encoding(path)  # a UTF-16 export is named as such, not as another format
     found = find_header(path)
     if found is None:
         raise FormatError(f"{path}: not an OpenShoe data_inert.txt (no 'Header: a_x [...]' or dummy_header line in "

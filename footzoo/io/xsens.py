@@ -70,7 +70,7 @@ from ..core.checks import check_bool, check_range
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import apply_axes, describe_axes, parse_axes
-from .base import RECORDING_OPTIONS, Option, Reader, check_unique_columns, frame_options, text_source
+from .base import RECORDING_OPTIONS, Option, Reader, check_encoding, check_unique_columns, frame_options, text_source
 
 #: Default axis map: the IPOL data set's MTw on the dorsum of the foot, x to the heel, z up (180° about y).
 DEFAULT_AXES = "[-x, y, -z]"
@@ -218,6 +218,7 @@ def read(path: Path, rate: float | None = None, axes: Any = DEFAULT_AXES, magnet
     acc_unit, gyr_unit : str, optional
         The file's units; default MT Manager's, m/s² and rad/s.
     """
+    check_encoding(path)  # a UTF-16 export is named as such, not as another format
     found = find_header(path)
     if found is None:
         raise FormatError(f"{path}: not an Xsens text export (no header line starting with PacketCounter and naming "

@@ -136,15 +136,18 @@ def test_an_annotation_file_that_is_not_json_is_named(walk, tmp_path):
 
 
 
-@pytest.mark.parametrize("rate_line, match", [
-    ("Acquisition frequency: 100 Hz\n// Update Rate: 60.00Hz", r"two sampling rates, 100 Hz and 60 Hz.*rate=100"),
-    ("Acquisition frequency: 0 Hz", r"9-3_lf\.txt: the header says a sampling rate of 0 Hz.*rate=100"),
+@pytest.mark.parametrize("rate_line, encoding, match", [
+    ("Acquisition frequency: 100 Hz\n// Update Rate: 60.00Hz", "utf-8",
+     r"two sampling rates, 100 Hz and 60 Hz.*rate=100"),
+    ("Acquisition frequency: 0 Hz", "utf-8", r"9-3_lf\.txt: the header says a sampling rate of 0 Hz.*rate=100"),
+    ("Acquisition frequency: 100 Hz", "utf-16", r"9-3_lf\.txt: .*UTF-16"),  # named as such, not "not an Xsens export"
 ])
-def test_a_header_whose_rate_is_impossible_or_contradicts_itself_is_refused(walk, tmp_path, rate_line, match):
+def test_a_header_with_an_impossible_or_contradicting_rate_or_a_foreign_encoding_is_refused(walk, tmp_path, rate_line,
+                                                                                            encoding, match):
     path = tmp_path / "9-3_lf.txt"
-    path.write_text(xsens_text(walk, rate_line=rate_line))
+    path.write_text(xsens_text(walk, rate_line=rate_line), encoding=encoding)
     with pytest.raises(FormatError, match=match):
-        load(path)
+        load(path, format="xsens")
 
 
 @pytest.mark.parametrize("notes, match", [
