@@ -27,7 +27,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .errors import ConfigError, RecordingError, did_you_mean
+from .errors import ConfigError, RecordingError, did_you_mean, shown
 from .params import Boolean, Declared, Interval, Param, Real, Vector, declared
 
 #: Plausible gravity magnitude g on the Earth's surface (m/s²), inclusive bounds.
@@ -102,7 +102,8 @@ def check_vector(name: str, value: Any, size: int = 3, nonzero: bool = False, un
 
 def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: str) -> np.ndarray:
     if value is None:  # a channel that dropped out: said so, not as a shape
-        raise RecordingError(f"{name} is missing (None) at t = {t!r}: every sample needs {name} ({unit}, 3 numbers); "
+        raise RecordingError(f"{name} is missing (None) at t = {shown(t)}: "
+                             f"every sample needs {name} ({unit}, 3 numbers); "
                              "a sensor that dropped out cannot be bridged: repair the gap or end the stream there")
     raw = value if isinstance(value, np.ndarray) else None
     if raw is None and isinstance(value, (list, tuple)):
@@ -110,23 +111,24 @@ def _sample_vector(name: str, value: Any, t: float, bound: float | None, unit: s
     if raw is not None and (np.iscomplexobj(raw) or raw.dtype == bool
                             or (raw.dtype == object and any(isinstance(v, (bool, complex, np.bool_, np.complexfloating))
                                                             for v in raw.ravel().tolist()))):
-        raise RecordingError(f"{name} at t = {t!r} must be 3 real numbers ({unit}), got {value!r} "
+        raise RecordingError(f"{name} at t = {shown(t)} must be 3 real numbers ({unit}), got {value!r} "
                              "(booleans or complex numbers are not samples)")
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise RecordingError(f"{name} at t = {t!r} must be 3 numbers ({unit}), got {value!r}") from None
+        raise RecordingError(f"{name} at t = {shown(t)} must be 3 numbers ({unit}), got {value!r}") from None
     if arr.shape != (3,):
         extra = ""
         if arr.ndim == 2 and arr.shape[-1] == 3:
             extra = (f": that is {arr.shape[0]} samples; push them one at a time "
                      "(for k in range(n): stream.push(t[k], acc[k], gyr[k])) or use Stream.run(recording)")
-        raise RecordingError(f"{name} at t = {t!r} must have shape (3,), got {arr.shape}{extra}")
+        raise RecordingError(f"{name} at t = {shown(t)} must have shape (3,), got {arr.shape}{extra}")
     if not np.isfinite(arr).all():
-        raise RecordingError(f"non-finite sample at t = {t!r}: {name} = {arr.tolist()}; repair or drop the sample")
+        raise RecordingError(f"non-finite sample at t = {shown(t)}: {name} = {arr.tolist()}; repair or drop the sample")
     if bound is not None and np.abs(arr).max() > bound:
         raise RecordingError(
-            f"{name} at t = {t!r} is {arr.tolist()} {unit}: beyond any body-worn IMU (|value| <= {bound:g} {unit}); "
+            f"{name} at t = {shown(t)} is {arr.tolist()} {unit}: "
+            f"beyond any body-worn IMU (|value| <= {bound:g} {unit}); "
             "the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)"
         )
     return arr
@@ -167,22 +169,22 @@ def validate_sample(
         a block of samples (shape ``(n, 3)``) is rejected with how to push it.
     """
     if isinstance(t, (bool, str)) or np.ndim(t) != 0:
-        raise RecordingError(f"t must be one time stamp in s (a number), got {t!r}; push one sample per call")
+        raise RecordingError(f"t must be one time stamp in s (a number), got {shown(t)}; push one sample per call")
     try:
         tf = float(t)
     except (TypeError, ValueError):
-        raise RecordingError(f"t must be a time stamp in s, got {t!r}") from None
+        raise RecordingError(f"t must be a time stamp in s, got {shown(t)}") from None
     if not math.isfinite(tf):
-        raise RecordingError(f"time stamp t = {t!r} is not finite; give each sample its real time in s")
+        raise RecordingError(f"time stamp t = {shown(t)} is not finite; give each sample its real time in s")
     if previous_t is not None:
         if tf <= previous_t:
             raise RecordingError(
-                f"time went from {previous_t!r} s to {tf!r} s: samples must arrive in order (increasing time)"
+                f"time went from {shown(previous_t)} s to {shown(tf)} s: samples must arrive in order (increasing time)"
             )
         gap = DEFAULT_MAX_GAP if max_gap is None else max_gap
         if tf - previous_t > gap:
             raise RecordingError(
-                f"gap of {tf - previous_t:.6g} s before t = {tf!r} s exceeds the stream's limit of {gap:g} s: "
+                f"gap of {tf - previous_t:.6g} s before t = {shown(tf)} s exceeds the stream's limit of {gap:g} s: "
                 "the filter cannot bridge it; start a new Stream after the gap"
             )
     a = _sample_vector("acc", acc, tf, ACC_MAX, "m/s^2")
@@ -194,10 +196,11 @@ def validate_sample(
             d = np.asarray(dist, dtype=float).reshape(-1)
         except (TypeError, ValueError):
             raise RecordingError(
-                f"dist at t = {tf!r} must be numbers in m (NaN for no reading), got {dist!r}"
+                f"dist at t = {shown(tf)} must be numbers in m (NaN for no reading), got {dist!r}"
             ) from None
         if np.isinf(d).any():
-            raise RecordingError(f"dist at t = {tf!r} is infinite ({d.tolist()}); use NaN where there is no reading")
+            raise RecordingError(f"dist at t = {shown(tf)} is infinite ({d.tolist()}); "
+                                 f"use NaN where there is no reading")
     return tf, a, g, m, d
 
 
@@ -241,22 +244,24 @@ def validate_block(
         bad = ~np.isfinite(arr).all(axis=1)
         if bad.any():
             k = int(np.argmax(bad))
-            raise RecordingError(f"non-finite sample at t = {tf[k]!r}: {name} = {arr[k].tolist()}; repair or drop it")
+            raise RecordingError(f"non-finite sample at t = {shown(tf[k])}: {name} = {arr[k].tolist()}; "
+                                 f"repair or drop it")
         if bound is not None and (np.abs(arr) > bound).any():
             k = int(np.argmax((np.abs(arr) > bound).any(axis=1)))
             raise RecordingError(
-                f"{name} at t = {tf[k]!r} is {arr[k].tolist()} {unit}: beyond any body-worn IMU (|value| <= "
+                f"{name} at t = {shown(tf[k])} is {arr[k].tolist()} {unit}: beyond any body-worn IMU (|value| <= "
                 f"{bound:g} {unit}); the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)")
         arrays.append(arr)
     if not np.isfinite(tf).all():
         k = int(np.argmax(~np.isfinite(tf)))
-        raise RecordingError(f"time stamp {k} of the block is {tf[k]!r}: give each sample its real time in s")
+        raise RecordingError(f"time stamp {k} of the block is {shown(tf[k])}: give each sample its real time in s")
     steps = np.diff(np.concatenate([[previous_t], tf])) if previous_t is not None else np.diff(tf)
     first = tf[0] if previous_t is None else previous_t
     if (steps <= 0).any():
         k = int(np.argmax(steps <= 0))
         before = (np.concatenate([[first], tf]) if previous_t is not None else tf)[k]
-        raise RecordingError(f"time went from {before!r} s to {before + steps[k]!r} s: samples must arrive in order "
+        raise RecordingError(f"time went from {shown(before)} s to {shown(before + steps[k])} s: "
+                             f"samples must arrive in order "
                              "(increasing time)")
     gap = DEFAULT_MAX_GAP if max_gap is None else max_gap
     if (steps > gap).any():

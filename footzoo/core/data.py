@@ -17,7 +17,7 @@ import pandas as pd
 
 from .checks import check_positive, gap_limit
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS, TIME_UNITS
-from .errors import FootzooWarning, RecordingError
+from .errors import FootzooWarning, RecordingError, shown
 from .norms import row_norms, unit_error
 from .sanity import check_impossible, scan
 from .usage import fix
@@ -282,7 +282,8 @@ class Recording:
                 row, col = np.argwhere(bad)[0]
                 if bad[:, col].all():
                     raise RecordingError(
-                        f"column {cols[col]!r} holds no numbers (first value {df[cols[col]].iloc[0]!r}); check the "
+                        f"column {cols[col]!r} holds no numbers (first value {shown(df[cols[col]].iloc[0])}); "
+                        f"check the "
                         "file's delimiter and decimal separator (footzoo reads ',' between values and '.' in numbers)"
                     )
                 empty = df.iloc[row].isna().to_numpy()

@@ -82,6 +82,15 @@ class GuardWarning(FootzooWarning):
     """A pipeline guard fired: the detector missed stances, or the estimate diverged (:mod:`footzoo.runtime.guards`)."""
 
 
+def shown(value: object) -> str:
+    """``value`` as a message quotes it: a NumPy number as the plain Python number (``2.99``, not
+    ``np.float64(2.99)``), anything else as its ``repr``."""
+    item = getattr(value, "item", None)
+    if callable(item) and getattr(value, "ndim", None) == 0:
+        value = item()
+    return repr(value)
+
+
 def did_you_mean(word: str, options: list[str]) -> str:
     """`` (did you mean 'x'?)`` when a close option exists, else an empty string."""
     close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)

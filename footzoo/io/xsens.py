@@ -68,7 +68,7 @@ import pandas as pd
 
 from ..core.checks import check_bool, check_range
 from ..core.data import Recording, Truth
-from ..core.errors import FormatError
+from ..core.errors import FormatError, shown
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import RECORDING_OPTIONS, Option, Reader, check_encoding, check_unique_columns, frame_options, text_source
 
@@ -124,7 +124,8 @@ def packet_times(counter: np.ndarray, rate: float, path: Path) -> np.ndarray:
     bad = ~np.isfinite(pc) | (pc != np.round(pc)) | (pc < 0)
     if bad.any():
         k = int(np.argmax(bad))
-        raise FormatError(f"{path}: PacketCounter must hold whole numbers >= 0; data row {k} holds {counter[k]!r}; "
+        raise FormatError(f"{path}: PacketCounter must hold whole numbers >= 0; "
+                          f"data row {k} holds {shown(counter[k])}; "
                           "repair the file (footzoo reads t = PacketCounter / rate)")
     step = np.diff(pc)
     wrap = (step < 0) & (pc[:-1] - pc[1:] > COUNTER_WRAP / 2) & (pc[:-1] < COUNTER_WRAP)

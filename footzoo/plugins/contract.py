@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.errors import FootzooError, PluginError, RecordingError
+from ..core.errors import FootzooError, PluginError, RecordingError, shown
 from ..core.norms import unit_error
 from ..filters.measurement import MeasurementModel
 
@@ -434,7 +434,8 @@ def check_array(plugin: Any, method: str, label: str, value: Any, spec: Output, 
         if kind != "b" and not np.isin(arr, (0, 1)).all():
             bad = np.flatnonzero(~np.isin(arr, (0, 1)))
             raise broken(plugin, method, f"set {label} with {len(bad)} value(s) that are neither 0 nor 1 (first "
-                                         f"{arr[bad[0]]!r} at sample {int(bad[0])}): a stance mask is bool; NaN is "
+                                         f"{shown(arr[bad[0]])} at sample {int(bad[0])}): "
+                                         f"a stance mask is bool; NaN is "
                                          "not stance — decide each sample (stance_ = statistic < threshold)")
         return
     if kind != "f" or not len(arr):

@@ -77,3 +77,21 @@ def _sensor_warnings(fn, *args):
         warnings.simplefilter("always")
         out = fn(*args)
     return out, [str(w.message) for w in caught if issubclass(w.category, SensorWarning)]
+
+
+@pytest.mark.parametrize("second, match", [
+    (slice(5, 8), r"time went from 0\.09 s to 0\.05 s: samples must arrive in order"),  # back in time
+    ("nan", r"non-finite sample at t = 0\.1: acc = \[nan, nan, nan\]"),
+])
+def test_a_stream_error_quotes_numpy_time_stamps_as_plain_numbers(sim_walk, second, match):
+    from footzoo import Pipeline, Stream
+
+    t, acc, gyr = sim_walk.t, sim_walk.acc.copy(), sim_walk.gyr
+    stream = Stream(Pipeline.from_yaml("nguyen2016"), rate=sim_walk.rate)
+    stream.extend(t[:10], acc[:10], gyr[:10])
+    if second == "nan":
+        acc[10] = np.nan
+        second = slice(10, 20)
+    with pytest.raises(RecordingError, match=match) as info:
+        stream.extend(t[second], acc[second], gyr[second])
+    assert "np.float64" not in str(info.value)
