@@ -221,12 +221,14 @@ def missing_reason(name: str, reference: Any = None, steps: Any = None) -> str:
     return "the run did not compute it (no reference or analysis gives it)"
 
 
-def checked_metrics(values: dict[str, float], problems: dict[str, str],
-                    reference: Any = None) -> tuple[dict[str, float], dict[str, str]]:
+def checked_metrics(values: dict[str, float], problems: dict[str, str], reference: Any = None,
+                    t: np.ndarray | None = None) -> tuple[dict[str, float], dict[str, str]]:
     """``values`` with every refused metric NaN, and the reasons (metric -> reason) of the NaN ones.
 
     A metric of ``problems`` becomes NaN whether or not it was computed. With a reference stride
-    table that has strides and none matched, the per-stride comparisons are NaN too.
+    table that has strides and none matched, the per-stride comparisons are NaN too; with the
+    recording's time stamps ``t`` (s), a reference whose strides all lie outside them is named as
+    such (another clock or time origin).
     """
     out, notes = dict(values), {}
     for name, why in problems.items():
@@ -234,11 +236,25 @@ def checked_metrics(values: dict[str, float], problems: dict[str, str],
         notes[name] = why
     if (reference is not None and getattr(reference, "steps", None) is not None and len(reference.steps)
             and values.get("matched_strides", 1.0) == 0.0):
+        why = "no estimated stride matched a reference stride" + _outside(reference.steps, t)
         for name in STRIDE_COMPARISONS:
             if name not in notes:
                 out[name] = float("nan")
-                notes[name] = "no estimated stride matched a reference stride"
+                notes[name] = why
     return out, notes
+
+
+def _outside(steps: Any, t: np.ndarray | None) -> str:
+    """``": the reference's strides ... lie outside the recording ..."`` when they all do, else ``""``."""
+    steps = reference_steps(steps)  # the simulator's older column names too
+    times = np.concatenate([np.asarray(steps[c], dtype=float) for c in ("start_s", "to_s", "end_s")
+                            if c in steps.columns] or [np.array([])])
+    times = times[np.isfinite(times)]
+    if t is None or not len(t) or not times.size or ((times >= t[0]) & (times <= t[-1])).any():
+        return ""
+    return (f": the reference's strides (t = {times.min():.2f}-{times.max():.2f} s) all lie outside the recording "
+            f"(t = {float(t[0]):.2f}-{float(t[-1]):.2f} s); the reference and the samples are stamped by different "
+            "clocks or from different origins: give both the same time base")
 
 
 def result_metrics_checked(t: np.ndarray, pos: np.ndarray, steps: Any,
@@ -252,7 +268,7 @@ def result_metrics_checked(t: np.ndarray, pos: np.ndarray, steps: Any,
     values = result_metrics(t, pos, steps, reference)
     found = {**reference_problems(t, reference), **estimate_problems(steps, reference)}
     problems = {k: why for k, why in found.items() if k in values}
-    return checked_metrics(values, problems, reference)
+    return checked_metrics(values, problems, reference, t)
 
 
 def warn_refused(label: str, notes: dict[str, str]) -> None:

@@ -90,7 +90,8 @@ def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple
     """Every metric of a run (the names of ``footzoo run``), the refused ones NaN, and the reasons of those."""
 
     m = run_metrics(rec.t, pos, res.steps, res.stance, rec.truth)
-    m, notes = checked_metrics(m, {**_reference_problems(rec), **estimate_problems(res.steps, rec.truth)}, rec.truth)
+    m, notes = checked_metrics(m, {**_reference_problems(rec), **estimate_problems(res.steps, rec.truth)}, rec.truth,
+                               rec.t)
     if metric_names:
         m = {k: v for k, v in m.items() if k in metric_names}
         notes = {k: v for k, v in notes.items() if k in metric_names}

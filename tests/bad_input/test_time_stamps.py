@@ -107,3 +107,22 @@ def test_no_real_recording_is_said_to_be_at_the_wrong_rate_and_restamped_ones_ar
     # 84 restamped files (benchmarks/relabel.md): 80 named with the real rate, none with another; not the crawl (×2,
     # ×½), the upside-down slow walk and the shortest-stepped walk (×½): benchmarks/relabel_misses.md
     assert total == 84 and named >= 80 and wrong == 0
+
+
+@pytest.mark.parametrize("shift, outside", [(100.0, True), (0.0, False)])
+def test_a_reference_on_another_clock_is_named_as_the_reason_no_stride_matched(shift, outside):
+    # the samples stamped from another origin than the reference strides (e.g. a stream's clock, truth=rec.truth)
+    import pandas as pd
+
+    from footzoo.core.data import Truth
+    from footzoo.evaluation.validity import checked_metrics
+
+    t = np.arange(0.0, 15.0, 0.01) + shift
+    truth = Truth(steps=pd.DataFrame({"start_s": [np.nan, 2.6], "to_s": [2.1, 3.1], "end_s": [2.6, 3.6]}))
+    values = {"matched_strides": 0.0, "ic_error_median_abs_s": 0.0}
+    out, notes = checked_metrics(values, {}, truth, t)
+    assert np.isnan(out["ic_error_median_abs_s"])
+    said = notes["ic_error_median_abs_s"]
+    assert said.startswith("no estimated stride matched a reference stride")
+    assert (("the reference's strides (t = 2.10-3.60 s) all lie outside the recording (t = 100.00-114.99 s)" in said)
+            == outside), said
