@@ -349,7 +349,7 @@ class Study:
             if not v:
                 raise ConfigError(f"factor {k!r} has no levels: give it a list of values, e.g. {k}: [a, b], "
                                   "or remove it")
-            keys = [json.dumps(level, sort_keys=True, default=str) for level in v]
+            keys = [json.dumps(_numbers_as_float(level), sort_keys=True, default=str) for level in v]  # 1 == 1.0
             counts = collections.Counter(keys)
             twice = next((level for level, key in zip(v, keys, strict=True) if counts[key] > 1), None)
             if twice is not None:  # it would run every cell of that level twice under one name
@@ -687,3 +687,16 @@ def _file_digest(path: str) -> str:
                 h.update(block)
         _FILE_DIGESTS[memo] = h.hexdigest()
     return _FILE_DIGESTS[memo]
+
+
+def _numbers_as_float(value: Any) -> Any:
+    """``value`` with every number (not a bool) as a float, in lists and mappings too: the levels 1 and 1.0 are one."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, list):
+        return [_numbers_as_float(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _numbers_as_float(v) for k, v in value.items()}
+    return value

@@ -66,6 +66,9 @@ def test_two_recordings_with_one_name_are_refused_and_labels_tell_them_apart(wal
 @pytest.mark.parametrize("factors, message", [
     ({"detector.threshold.x": [1, 2]}, r"'detector\.threshold' is a value .* one level too deep"),
     ({"detector.threshold": [0.5, 0.5]}, r"lists the level 0\.5 more than once"),
+    ({"detector.threshold": [1, 1.0]}, r"lists the level 1 more than once"),  # one number, written twice
+    ({"corrections": [[{"type": "zvu_dedrift"}], [{"type": "ekf_zupt", "gyro_bias": False}],
+                      [{"type": "ekf_zupt", "gyro_bias": False}]]}, r"lists the level .*ekf_zupt.* more than once"),
 ])
 def test_a_factor_that_cannot_be_set_or_repeats_a_level_is_refused(factors, message, tmp_path):
     from footzoo.studies import Study, run_study
