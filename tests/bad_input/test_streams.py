@@ -49,6 +49,7 @@ def test_an_accelerometer_unit_that_changes_mid_stream_is_warned_where_it_change
     assert "acc_scale" not in res.diagnostics["sensor"]
 
 
+@pytest.mark.slow  # a batch run and a stream of a 10-stride walk: 2-3 s
 def test_a_stream_reports_the_accelerometer_gain_it_applied_as_the_batch_run_does(sim_walk, tmp_path):
     from dataclasses import replace
 
