@@ -520,6 +520,11 @@ def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], 
             f"tune: {len(left_out)} of {len(run.all_groups)} recording(s) gave no {spec.objective} in any setting "
             f"and are left out of the cross-validation: {left_out[:5]}; the study's note column and {LOG} say why "
             "(e.g. no reference that can score it)"), stacklevel=2)
+    if len(values.columns) == 1:
+        warnings.warn(FootzooWarning(
+            f"tune: only one setting was scored ({best}): nothing was compared, so it is 'chosen' by default and the "
+            "cross-validation only scores it; give a factor two or more values (or search a space) to choose"),
+            stacklevel=2)
     settings = run.settings
     scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
     config = run.configs[best]

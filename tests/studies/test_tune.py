@@ -217,6 +217,14 @@ def test_tune_says_when_the_chosen_value_is_the_grid_s_edge(tmp_path):
     assert "# at the edge: detector.threshold = 10 is the largest value" in (tmp_path / "best.yaml").read_text()
 
 
+
+def test_a_grid_of_one_value_is_said_to_compare_nothing(tmp_path):
+    study = Study.from_dict({**STUDY, "factors": {"detector.threshold": [3.0]}})
+    with pytest.warns(FootzooWarning, match=r"tune: only one setting was scored \(detector.threshold=3\): nothing was "
+                                            r"compared.*two or more values"):
+        result = tune(study, {"objective": "armse_3d_m"}, out=tmp_path, quiet=True)
+    assert result.best_ == "detector.threshold=3"
+
 def test_a_recording_that_cannot_give_the_objective_is_named_as_left_out(tmp_path):
     """A recording without a reference gives no ``armse_3d_m``: the tune says it is left out, not just fewer rows."""
     from footzoo.io.canonical import write
