@@ -515,6 +515,10 @@ def _acquire(folder: Path, what: str, owner: str, identity: str | None) -> IO[An
             fh.close()
             raise OutputError(_in_use(folder, what, holder, flock=False))
         if state is False:
+            if holder is None and identity is not None:  # the holder is starting: its description is not written yet
+                fh.close()
+                time.sleep(0.05)
+                continue
             if not shared:
                 fh.close()
                 raise OutputError(_in_use(folder, what, holder, flock=True))

@@ -249,17 +249,51 @@ def test_two_holders_of_one_study_leaving_at_once_remove_the_lock_file(tmp_path,
 
     monkeypatch.setattr(atomic, "_try_lock", try_lock)
 
+    errors = []
+
     def hold():
-        with folder_lock(folder, owner="study 'a'", identity="study-A"):
-            inside.wait()
-            leaving.first = True
+        try:
+            with folder_lock(folder, owner="study 'a'", identity="study-A"):
+                inside.wait()
+                leaving.first = True
+        except Exception as err:  # noqa: BLE001 (reported below)
+            errors.append(err)
 
     threads = [threading.Thread(target=hold) for _ in range(2)]
     for t in threads:
         t.start()
     for t in threads:
         t.join(30)
-    assert not (folder / LOCK_NAME).exists()
+    assert errors == [] and not (folder / LOCK_NAME).exists()
+
+
+def test_the_same_study_started_while_the_first_writes_its_description_joins_it(tmp_path):
+    """Between taking the lock and describing itself the first holder's file is empty: the second one waits and
+    joins (it was refused as if another study held the folder)."""
+    import fcntl
+    import threading
+
+    folder = tmp_path / "study"
+    folder.mkdir()
+    with open(folder / LOCK_NAME, "w", encoding="utf-8") as first:  # the first holder, not described yet
+        fcntl.flock(first.fileno(), fcntl.LOCK_EX)
+        joined, errors = threading.Event(), []
+
+        def second():
+            try:
+                with folder_lock(folder, owner="study 'a'", identity="study-A"):
+                    joined.set()
+            except OutputError as err:
+                errors.append(str(err))
+
+        thread = threading.Thread(target=second)
+        thread.start()
+        assert not joined.wait(0.2)  # waiting for the description
+        first.write(json.dumps({"owner": "study 'a'", "pid": os.getpid(), "identity": "study-A"}) + "\n")
+        first.flush()
+        fcntl.flock(first.fileno(), fcntl.LOCK_SH)  # described: the same study may join
+        thread.join(10)
+    assert errors == [] and joined.is_set()
 
 
 def test_a_lock_held_by_another_process_is_refused_and_released_when_it_dies(tmp_path):
