@@ -23,7 +23,7 @@ import numpy as np
 
 import footzoo
 from footzoo.filters.measurement import ATT, MeasurementModel, Q, measurement_function
-from footzoo.plugins.base import KalmanCorrection, Samples
+from footzoo.plugins.base import KalmanCorrection, Real, Samples
 
 #: Positions in ``par``: σ_ψ (rad), the field magnitude's tolerance (a fraction), the dip's tolerance (rad).
 HEADING_STD, NORM_TOLERANCE, DIP_TOLERANCE = 0, 1, 2
@@ -94,19 +94,22 @@ class MagnetometerHeadingUpdate(KalmanCorrection):
 
     name = "magnetometer_heading"
     paper = "Jiménez, Seco, Prieto & Guevara 2010, WPNC (MAGU)"
-    units = {"heading_std": "rad", "norm_tolerance": "1", "dip_tolerance": "rad"}
+    # one declaration per parameter: unit, accepted range, meaning, source of the default
+    parameters = {
+        "heading_std": Real("rad", "(0, pi]", "σ of the magnetic heading", source="chosen: 0.1 rad (5.7°)"),
+        "norm_tolerance": Real("1", "(0, 1]", "rejects a reading whose |m| differs from the start's by more",
+                               source="chosen: 5 %"),
+        "dip_tolerance": Real("rad", "(0, pi/2]", "rejects a reading whose dip differs from the start's by more",
+                              source="chosen: 0.05 rad (2.9°)"),
+    }
     needs_magnetometer = True
     observes = ("magnetic_heading",)
 
     def __init__(self, heading_std: float = 0.1, norm_tolerance: float = 0.05, dip_tolerance: float = 0.05):
-        for name, value in (("heading_std", heading_std), ("norm_tolerance", norm_tolerance),
-                            ("dip_tolerance", dip_tolerance)):
-            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
-                    and value > 0):
-                raise footzoo.ConfigError(f"{name} must be a positive number ({self.units[name]}), got {value!r}")
-        self.heading_std = float(heading_std)
-        self.norm_tolerance = float(norm_tolerance)
-        self.dip_tolerance = float(dip_tolerance)
+        # footzoo has checked each value against its declaration before this runs
+        self.heading_std = heading_std
+        self.norm_tolerance = norm_tolerance
+        self.dip_tolerance = dip_tolerance
 
     def requires_attitude_state(self) -> bool:
         """The heading error is the attitude error's z component."""
