@@ -29,6 +29,8 @@ TRUTH_POS_COLS = ["true_pos_n", "true_pos_e", "true_pos_d"]
 TRUTH_VEL_COLS = ["true_vel_n", "true_vel_e", "true_vel_d"]
 TRUTH_QUAT_COLS = ["true_qw", "true_qx", "true_qy", "true_qz"]
 
+#: The name of a recording given none (``footzoo.load`` names it after its file instead).
+DEFAULT_NAME = "recording"
 #: Shortest recording footzoo accepts (s): the initial alignment needs still samples.
 MIN_DURATION = 1.0
 #: A bridged gap longer than this (s) is named in the warning: in a swing it loses motion.
@@ -168,7 +170,7 @@ class Recording:
         validate_recording(self)
         self.meta = dict(self.meta)
         _report_gaps(self, warn)
-        self.meta.setdefault("name", "recording")
+        self.meta.setdefault("name", DEFAULT_NAME)
         self.meta["rate"] = float(1.0 / np.median(np.diff(self.t)))
         findings = scan(self.t, self.acc, self.gyr, str(self.meta["name"]), warn=warn)
         if findings:
@@ -193,7 +195,7 @@ class Recording:
     @property
     def name(self) -> str:
         """The recording's name (file stem or given)."""
-        return str(self.meta.get("name", "recording"))
+        return str(self.meta.get("name", DEFAULT_NAME))
 
     @classmethod
     def from_dataframe(

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
-from ..core.data import Recording, Truth
+from ..core.data import DEFAULT_NAME, Recording, Truth
 from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
 from ..core.files import not_utf8, nul_in_path, why_missing
 from . import xio
@@ -249,6 +249,8 @@ def _rotate(rec: Recording, rows: Any) -> None:
 
 def _complete_meta(rec: Recording, path: Path, fmt: str, reader: Any) -> None:
     """Name, source, format and input files in ``rec.meta``; a metadata sidecar's facts for readers that ignore it."""
+    if rec.meta.get("name", DEFAULT_NAME) == DEFAULT_NAME:  # a reader that names nothing: the file's stem
+        rec.meta["name"] = path.stem
     rec.meta.setdefault("source", str(path))
     rec.meta.setdefault("format", fmt)
     files = [str(f) for f in rec.meta.get("input_files") or []]

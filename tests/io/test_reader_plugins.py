@@ -55,6 +55,19 @@ class TsvReader(Reader):
         return Recording(t=d[:, 0], acc=d[:, 1:4] * scale, gyr=d[:, 4:7], meta={"name": "tsv"})
 
 
+class NamelessReader(Reader):
+    """The same files, read without naming the recording."""
+
+    description = "sets no name"
+
+    def guess_can_open(self, path):
+        return False
+
+    def open(self, path):
+        d = pd.read_csv(path, sep="\\t", comment="#", header=None).to_numpy(float)
+        return Recording(t=d[:, 0], acc=d[:, 1:4], gyr=d[:, 4:7])
+
+
 class GreedyReader(Reader):
     """Claims every .csv file (a badly written reader)."""
 
@@ -164,6 +177,17 @@ def test_a_reader_from_an_installed_package_loads_a_file_by_footzoo_load(on_path
     assert turned.meta["axes"] == "[x, -y, -z]" and "axes" not in rec.meta
     with pytest.raises(FormatError, match=r"axes: the axis map \[x, y, -z\] is left-handed"):
         footzoo.load(data, axes="[x, y, -z]")
+
+
+def test_a_recording_its_reader_does_not_name_is_named_after_its_file(on_path, tmp_path, walk):
+    install_fake(on_path, "fake-readers", "fake_readers", FAKE_READERS,
+                 {"faketsv": "fake_readers:TsvReader", "nameless": "fake_readers:NamelessReader"})
+    rediscover()
+    data = tmp_path / "walk_07.tsv"
+    rows = np.column_stack([walk.t, walk.acc, walk.gyr])
+    data.write_text("#tsv\n" + "\n".join("\t".join(repr(float(v)) for v in r) for r in rows) + "\n")
+    assert footzoo.load(data, format="nameless").name == "walk_07"  # not the default "recording"
+    assert footzoo.load(data, format="faketsv").name == "tsv"  # a name the reader gives is kept
 
 
 def test_broken_or_clashing_readers_are_skipped_with_the_reason_and_builtins_keep_working(on_path, walk, tmp_path):
