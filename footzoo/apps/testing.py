@@ -57,6 +57,7 @@ from ..core.context import RunContext
 from ..core.errors import ConfigError, FootzooError, PluginError
 from ..core.params import Real
 from ..filters.strapdown import motion_acceleration
+from ..io import Reader
 from ..plugins.base import (
     AccelerationCorrection,
     Analysis,
@@ -492,8 +493,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     found = [c for k in KINDS for c in available(k).values() if c.__module__ in modules]
     if not found:
-        print(f"no plug-in is registered by {', '.join(argv)} (decorate the classes with @footzoo.register)",
-              file=sys.stderr)
+        readers = _readers_in(modules)
+        if readers:
+            print(f"{', '.join(argv)} defines the reader {', '.join(readers)} and no pipeline plug-in: check_plugin "
+                  "checks calibrations, orientations, detectors, corrections and analyses. A reader is registered by "
+                  "an entry point of the group footzoo.readers (see 'Bring your own format' in the docs); try it on a "
+                  "file with footzoo.load(FILE, format=NAME) and `footzoo formats`", file=sys.stderr)
+        else:
+            print(f"no plug-in is registered by {', '.join(argv)} (decorate the classes with @footzoo.register)",
+                  file=sys.stderr)
         return 2
     failed = 0
     for cls in found:
@@ -503,6 +511,13 @@ def main(argv: list[str] | None = None) -> int:
             failed += 1
             print(f"check_plugin: {cls.kind} {cls.name!r} FAILED: {err}", file=sys.stderr)
     return 1 if failed else 0
+
+
+def _readers_in(modules: set[str]) -> list[str]:
+    """The reader classes (:class:`footzoo.io.Reader` subclasses) the modules define."""
+    return sorted(obj.__name__ for name in modules for obj in vars(sys.modules[name]).values()
+                  if isinstance(obj, type) and issubclass(obj, Reader) and obj is not Reader
+                  and obj.__module__ == name)
 
 
 if __name__ == "__main__":

@@ -284,6 +284,22 @@ def test_check_plugin_from_the_command_line(tmp_path, capsys):
     assert main([str(tmp_path / "none.py")]) == 2 and "does not exist" in capsys.readouterr().err
 
 
+def test_check_plugin_on_a_reader_file_says_how_readers_are_registered_and_tried(tmp_path, capsys):
+    from footzoo.apps.testing import main
+
+    reader = tmp_path / "my_format_reader.py"
+    reader.write_text("from footzoo.io import Reader\n\n\nclass MyFormatReader(Reader):\n"
+                      "    def guess_can_open(self, path):\n        return False\n\n"
+                      "    def open(self, path):\n        raise NotImplementedError\n")
+    assert main([str(reader)]) == 2
+    err = capsys.readouterr().err
+    assert "defines the reader MyFormatReader" in err and "footzoo.readers" in err and "footzoo.load(" in err
+    assert "@footzoo.register" not in err  # the fix for a pipeline plug-in, wrong for a reader
+    empty = tmp_path / "empty_module.py"
+    empty.write_text("X = 1\n")
+    assert main([str(empty)]) == 2 and "decorate the classes with @footzoo.register" in capsys.readouterr().err
+
+
 def test_the_testing_module_runs_as_a_script():
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", "--help"], capture_output=True, text=True,
