@@ -111,11 +111,13 @@ def _interrupt(proc: subprocess.Popen) -> tuple[int, str]:
     return proc.returncode, err
 
 
-@pytest.fixture(autouse=True, scope="module")
+@pytest.fixture(autouse=True)
 def _unregistered():
-    """The slow detector, loaded here by the studies run in this process, leaves the registry with the module."""
+    """The slow detector, loaded by a test's studies in this process from that test's own folder, leaves the registry
+    with the test: the next test's copy (another file, another module) registers the name again."""
     from footzoo.plugins import registry
 
+    registry._REGISTRY["detector"].pop("test_slow_fsm", None)
     yield
     registry._REGISTRY["detector"].pop("test_slow_fsm", None)
 
