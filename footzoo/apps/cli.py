@@ -879,7 +879,7 @@ def build_parser() -> argparse.ArgumentParser:
     fmt.set_defaults(func=cmd_formats)
 
     cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
-    cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")
+    cfg.add_argument("--copy", metavar="NAME", type=_input_yaml, help="the shipped config to copy (e.g. recommended)")
     cfg.add_argument("--to", default=None, metavar="DEST", type=_destination,
                      help="folder or file name of the copy (default: here)")
     cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
