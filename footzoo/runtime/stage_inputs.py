@@ -64,8 +64,8 @@ def stance(where: str, value: Any, rec: Recording) -> np.ndarray:
     _samples(where, "stance", arr, rec, FIX_STANCE)
     bad = np.flatnonzero((arr != 0) & (arr != 1))
     if bad.size:
-        raise RecordingError(f"{where}: stance must be True/False (or 1/0) per sample, got {arr[bad[0]]!r} at sample "
-                             f"{bad[0]} ({bad.size} such); {FIX_STANCE}")
+        raise RecordingError(f"{where}: stance must be True/False (or 1/0) per sample, got {float(arr[bad[0]]):g} at "
+                             f"sample {bad[0]} ({bad.size} such); {FIX_STANCE}")
     return arr.astype(bool)
 
 

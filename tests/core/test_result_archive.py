@@ -53,7 +53,8 @@ def tricky() -> Result:
                    "series": pd.Series([1, 2, 3], name="s"), "path": Path("/tmp/x"), "text": "1e3", "int": 3,
                    "flt": 0.1 + 0.2, "i8": np.int8(-3), "b": np.bool_(True), "matrix": np.eye(3)[None],
                    "words": np.array(["a", "bc"])}
-    recording = {"name": "1e3", "place": "Gång 走路", "subject": "007", "rate": 100.0, "flag": True, "gaps": {"start_s": [0.1, 0.2]},
+    recording = {"name": "1e3", "place": "Gång 走路", "subject": "007", "rate": 100.0, "flag": True,
+                 "gaps": {"start_s": [0.1, 0.2]},
                  "started": dt.datetime(2026, 1, 2, 3, 4, 5, 6, tzinfo=dt.timezone(dt.timedelta(hours=1))),
                  "day": dt.date(2026, 1, 2), "clock": dt.time(23, 59, 1), "raw": b"\xff\x00id",
                  "stamp": np.datetime64("2026-01-02T03:04:05.123456789")}
