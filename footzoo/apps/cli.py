@@ -27,6 +27,7 @@ code  meaning
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -187,7 +188,10 @@ def _jobs(text: str) -> int:
 
 def _biases(text: str) -> tuple[str, ...]:
     """An argparse ``type`` for ``--biases``: ``none`` or a comma-separated subset of acc, gyr, mag."""
-    if text.strip() in ("", "none"):
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty list; give a comma-separated list of acc, gyr, mag (e.g. acc,gyr), "
+                                         "or none")
+    if text.strip() == "none":
         return ()
     names = tuple(b.strip() for b in text.split(","))
     unknown = [b for b in names if b not in ("acc", "gyr", "mag")]
@@ -937,6 +941,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    _printable_output()
     parser = build_parser()
     try:
         args, extras = parser.parse_known_args(argv)
@@ -949,6 +954,14 @@ def main(argv: list[str] | None = None) -> int:
         warnings.showwarning = _show_warning
     with used_from("command line"):  # a message names the command line's fix (an option, not a keyword)
         return _run_command(args, debug)
+
+
+def _printable_output() -> None:
+    """Let stdout and stderr write any text: a name or path the terminal's encoding (``LC_ALL=C``, an ASCII
+    ``PYTHONIOENCODING``) cannot show is printed with backslash escapes instead of failing the command."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, ValueError, OSError):  # not a text file (e.g. replaced, closed)
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _run_command(args: argparse.Namespace, debug: bool) -> int:
