@@ -135,6 +135,19 @@ def _destination(text: str) -> str:
         raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
     return text
 
+
+def _folder(text: str) -> str:
+    """An argparse ``type`` for an output folder (``compile --ship``): non-empty, and not an existing file."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder name")
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
+    if Path(text).exists() and not Path(text).is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder; give a folder name (it is created if "
+                                         "missing)")
+    return text
+
+
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
@@ -786,8 +799,8 @@ def build_parser() -> argparse.ArgumentParser:
     comp.add_argument("configs", nargs="+", type=_input_yaml,
                       help="pipeline YAML files or study files (every config of the grid), "
                            "e.g. configs/*.yaml")
-    comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
-                      "(what setup.py does for a wheel's footzoo/_compiled)")
+    comp.add_argument("--ship", metavar="DIR", type=_folder, help="write the machine code into DIR instead of "
+                      "numba's cache (what setup.py does for a wheel's footzoo/_compiled)")
     comp.add_argument("--no-smoothed-live", action="store_true", help="leave out the live runs of step-wise "
                       "smoothed configs (their live loop: about 14 s more each; what setup.py does for a wheel)")
     comp.set_defaults(func=cmd_compile)

@@ -98,6 +98,9 @@ CASES = [
      "no orientation plug-in named 'shoe': 'shoe' is a detector plug-in; leave out --kind orientation"),
     ("show-unknown-metric", lambda d, w: ["ablate", str(QUICK), "--show", "strides,armse_3d"], EXIT_USAGE,
      "argument --show: 'armse_3d' is not a metric (did you mean 'armse_3d_m'?)"),
+    ("compile-ship-a-file", lambda d, w: [(d / "k.txt").write_text("x"), "compile"][1:] + [
+        "yun2012", "--ship", "k.txt"], EXIT_USAGE,
+     "argument --ship: 'k.txt' is a file, not a folder; give a folder name"),
     ("configs-copy-empty", lambda d, w: ["configs", "--copy", ""], EXIT_USAGE, "argument --copy: an empty name"),
     ("simulate-biases-empty", lambda d, w: ["simulate", "straight", "--out", "s.csv", "--biases", ""], EXIT_USAGE,
      "argument --biases: an empty list; give a comma-separated list of acc, gyr, mag"),
