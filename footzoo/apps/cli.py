@@ -27,6 +27,7 @@ code  meaning
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -134,6 +135,19 @@ def _destination(text: str) -> str:
         raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
     return text
 
+
+def _folder(text: str) -> str:
+    """An argparse ``type`` for an output folder (``compile --ship``): non-empty, and not an existing file."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder name")
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
+    if Path(text).exists() and not Path(text).is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder; give a folder name (it is created if "
+                                         "missing)")
+    return text
+
+
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_USAGE = 2
@@ -187,7 +201,10 @@ def _jobs(text: str) -> int:
 
 def _biases(text: str) -> tuple[str, ...]:
     """An argparse ``type`` for ``--biases``: ``none`` or a comma-separated subset of acc, gyr, mag."""
-    if text.strip() in ("", "none"):
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty list; give a comma-separated list of acc, gyr, mag (e.g. acc,gyr), "
+                                         "or none")
+    if text.strip() == "none":
         return ()
     names = tuple(b.strip() for b in text.split(","))
     unknown = [b for b in names if b not in ("acc", "gyr", "mag")]
@@ -782,8 +799,8 @@ def build_parser() -> argparse.ArgumentParser:
     comp.add_argument("configs", nargs="+", type=_input_yaml,
                       help="pipeline YAML files or study files (every config of the grid), "
                            "e.g. configs/*.yaml")
-    comp.add_argument("--ship", metavar="DIR", help="write the machine code into DIR instead of numba's cache "
-                      "(what setup.py does for a wheel's footzoo/_compiled)")
+    comp.add_argument("--ship", metavar="DIR", type=_folder, help="write the machine code into DIR instead of "
+                      "numba's cache (what setup.py does for a wheel's footzoo/_compiled)")
     comp.add_argument("--no-smoothed-live", action="store_true", help="leave out the live runs of step-wise "
                       "smoothed configs (their live loop: about 14 s more each; what setup.py does for a wheel)")
     comp.set_defaults(func=cmd_compile)
@@ -879,7 +896,7 @@ def build_parser() -> argparse.ArgumentParser:
     fmt.set_defaults(func=cmd_formats)
 
     cfg = sub.add_parser("configs", help="list the shipped configs, or copy one next to your data to edit it")
-    cfg.add_argument("--copy", metavar="NAME", help="the shipped config to copy (e.g. recommended)")
+    cfg.add_argument("--copy", metavar="NAME", type=_input_yaml, help="the shipped config to copy (e.g. recommended)")
     cfg.add_argument("--to", default=None, metavar="DEST", type=_destination,
                      help="folder or file name of the copy (default: here)")
     cfg.add_argument("--force", action="store_true", help="overwrite an existing file")
@@ -937,6 +954,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``footzoo`` console script; returns the exit code (see the module docstring)."""
+    _printable_output()
     parser = build_parser()
     try:
         args, extras = parser.parse_known_args(argv)
@@ -949,6 +967,14 @@ def main(argv: list[str] | None = None) -> int:
         warnings.showwarning = _show_warning
     with used_from("command line"):  # a message names the command line's fix (an option, not a keyword)
         return _run_command(args, debug)
+
+
+def _printable_output() -> None:
+    """Let stdout and stderr write any text: a name or path the terminal's encoding (``LC_ALL=C``, an ASCII
+    ``PYTHONIOENCODING``) cannot show is printed with backslash escapes instead of failing the command."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, ValueError, OSError):  # not a text file (e.g. replaced, closed)
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _run_command(args: argparse.Namespace, debug: bool) -> int:

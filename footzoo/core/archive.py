@@ -32,6 +32,7 @@ feet) is saved the same way, with one result folder per foot (:func:`save_sessio
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import datetime as _dt
 import importlib.util
@@ -265,6 +266,13 @@ class _Packer:
             return {"$table": key, **({"series": str(value.name)} if isinstance(value, pd.Series) else {})}
         if isinstance(value, os.PathLike):
             return {"$path": os.fspath(value)}
+        if isinstance(value, (bytes, bytearray)):
+            return {"$bytes": base64.b64encode(bytes(value)).decode("ascii")}
+        for kind in (_dt.datetime, _dt.date, _dt.time):  # a recording's date and time (pd.Timestamp is a datetime)
+            if isinstance(value, kind):
+                return {f"${kind.__name__}": value.isoformat()}
+        if isinstance(value, np.datetime64):
+            return {"$datetime64": str(value)}
         self.dropped.append(f"{where}: {type(value).__name__}")
         return {"$dropped": type(value).__name__}
 
@@ -293,6 +301,12 @@ class _Unpacker:
                 return np.array(self.arrays[inner])
             if key == "$path":
                 return Path(inner)
+            if key == "$bytes":
+                return base64.b64decode(inner)
+            if key in ("$datetime", "$date", "$time"):
+                return getattr(_dt, key[1:]).fromisoformat(inner)
+            if key == "$datetime64":
+                return np.datetime64(inner)
             if key == "$dropped":
                 return None
             if key == "$table":
@@ -514,8 +528,12 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     return folder
 
 
-def _read_manifest(folder: Path, kind: str) -> dict[str, Any]:
+def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
     what = "a result" if kind == FORMAT else "a session result"
+    loader = "Result.load" if kind == FORMAT else "SessionResult.load"
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise FormatError(f"{loader}: give the path of the folder {loader.split('.')[0]}.save wrote (got {path!r:.80})")
+    folder = Path(path)
     if not folder.is_dir():
         raise FormatError(f"{str(folder)!r} is not a folder; {what} is loaded from the folder Result.save wrote")
     manifest = folder / MANIFEST
@@ -578,8 +596,8 @@ def read_result(path: str | os.PathLike) -> dict[str, Any]:
     A file of the archive that is truncated, overwritten or otherwise damaged is a FormatError
     naming the folder and the cause (never a raw parser error).
     """
+    data = _read_manifest(path, FORMAT)
     folder = Path(path)
-    data = _read_manifest(folder, FORMAT)
     try:
         return _result_fields(folder, data["files"])
     except FormatError:
@@ -628,8 +646,8 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
 
 def read_session(path: str | os.PathLike) -> tuple[str, dict[str, dict[str, Any]]]:
     """``(name, {foot: the fields of its Result})`` of a session saved by :func:`save_session` (:func:`read_result`)."""
+    data = _read_manifest(path, SESSION_FORMAT)
     folder = Path(path)
-    data = _read_manifest(folder, SESSION_FORMAT)
     results = {str(foot): read_result(folder / str(foot)) for foot in data.get("feet") or []}
     return str(data.get("name", folder.name)), results
 

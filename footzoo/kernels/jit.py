@@ -2,7 +2,7 @@
 
 ``njit`` marks a plain-array function for compilation with numba when numba is
 installed and returns it unchanged otherwise, or when the environment variable
-``FOOTZOO_DISABLE_JIT=1`` is set. Both paths run the same source, so they give
+``FOOTZOO_DISABLE_JIT=1`` (or numba's ``NUMBA_DISABLE_JIT=1``) is set. Both paths run the same source, so they give
 the same numbers; the tests run both.
 
 Nothing is imported or compiled when footzoo is imported: numba itself is
@@ -27,7 +27,18 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-ENABLED = os.environ.get("FOOTZOO_DISABLE_JIT", "").strip() not in ("1", "true", "yes")
+
+def jit_enabled(environ: Any = os.environ) -> bool:
+    """False when ``FOOTZOO_DISABLE_JIT`` or numba's own ``NUMBA_DISABLE_JIT`` is set (to anything but 0/false/no).
+
+    numba's switch turns its ``njit`` into the identity, which footzoo's compiled paths (kernel caching,
+    compiled models) cannot use; either switch runs the plain-Python path instead, as without numba.
+    """
+    return not any(str(environ.get(name, "")).strip().lower() not in ("", "0", "false", "no")
+                   for name in ("FOOTZOO_DISABLE_JIT", "NUMBA_DISABLE_JIT"))
+
+
+ENABLED = jit_enabled()
 HAVE_NUMBA = ENABLED and importlib.util.find_spec("numba") is not None
 
 _pending: list[_Kernel | _Lazy] = []

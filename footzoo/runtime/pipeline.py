@@ -38,7 +38,7 @@ from ..core.sanity import EstimateScan
 from ..core.table import samples_frame
 from ..evaluation.result import Result
 from ..filters.consistency import ConsistencyScan
-from ..filters.engine import ENGINES, KalmanEngine, NavigationNoise
+from ..filters.engine import KalmanEngine, NavigationNoise
 from ..filters.stepwise import WAITS_FOR as STEPWISE_WAIT
 from ..plugins.base import (
     AccelerationCorrection,
@@ -57,8 +57,10 @@ from ..plugins.base import (
 from ..plugins.extensions import load_plugins
 from ..plugins.incremental import WHOLE_RECORDING, Chunk, Latency, total
 from ..plugins.registry import build
+from . import stage_inputs as inputs
 from .chain import Chain, aligned, build_chain, input_stages, navigation_stage, recording_chunk, with_signals
 from .guards import StanceGuard, check_speed
+from .stage_inputs import engine as checked_engine
 from .stages import GainStage, detected, estimate_attitude, guarded
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
@@ -311,8 +313,7 @@ class Pipeline:
             in ``diagnostics['nis_rows']``) and their summary ``diagnostics['consistency']``
             (:func:`footzoo.evaluation.metrics.nis_summary`: 1 per row for a consistent filter).
         """
-        if engine not in ENGINES:
-            raise ConfigError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+        checked_engine("Pipeline.run", engine)
         with inputs_checked_once(), _read_only(rec):  # each array is scanned for NaN once; none is written meanwhile
             return self._run(rec, engine, covariance)
 
@@ -439,6 +440,7 @@ class Pipeline:
         ``rec``: the recording, raw or from :meth:`prepare` (a raw one is prepared here: the same
         stance as :meth:`run`'s detector stage, and the same ``SensorWarning`` for a gain error).
         """
+        ctx = inputs.context("Pipeline.detect", ctx)
         rec = self._prepared(rec)
         return detected(self.detector, rec.t, rec.acc, rec.gyr, ctx or self.context(rec), rec.truth)
 
@@ -448,7 +450,9 @@ class Pipeline:
 
         ``rec``: raw or from :meth:`prepare` (see :meth:`detect`).
         """
+        ctx = inputs.context("Pipeline.guard", ctx)
         rec = self._prepared(rec)
+        detector = inputs.fitted_detector("Pipeline.guard", detector, rec)
         return guarded(self.guards, rec.t, rec.gyr, detector, ctx or self.context(rec), rec.name)
 
     def orient(self, rec: Recording, stance: np.ndarray, q0: np.ndarray,
@@ -458,6 +462,10 @@ class Pipeline:
         ``rec``: raw or from :meth:`prepare` (see :meth:`detect`); ``q0``: the initial attitude, as
         :meth:`prepare` gives it for the result of :meth:`run`.
         """
+        where = "Pipeline.orient"
+        stance = inputs.stance(where, stance, inputs.recording(where, rec))
+        q0 = inputs.initial_attitude(where, q0)
+        ctx = inputs.context(where, ctx)
         if self.orientation.carried_by_filter and self.filter_corrections:
             return None
         rec = self._prepared(rec)
@@ -472,6 +480,14 @@ class Pipeline:
         :meth:`prepare` gives it for the result of :meth:`run`.
         A dict of ``quat``, ``vel``, ``pos``, ``acc_nav`` (the samples'), ``diagnostics`` and ``engine``.
         """
+        where = "Pipeline.navigate"
+        stance = inputs.stance(where, stance, inputs.recording(where, rec))
+        q0 = inputs.initial_attitude(where, q0)
+        if quat is not None:
+            quat = inputs.attitude(where, quat, rec, "pipe.orient(rec, stance, q0) gives it (None when the filter "
+                                   "carries the attitude)")
+        checked_engine(where, engine)
+        ctx = inputs.context(where, ctx)
         rec = self._prepared(rec)
         ctx = ctx or self.context(rec)
         chunk = {**recording_chunk(rec, ctx, self.init["duration"]), "stance": stance}
@@ -500,6 +516,11 @@ class Pipeline:
         ``stances`` and ``sagittal``: the real stances and the sagittal rate when the caller has them
         (:func:`footzoo.analysis.strides.segment_steps`).
         """
+        where = "Pipeline.analyse"
+        rec = inputs.recording(where, rec)
+        stance = inputs.stance(where, stance, rec)
+        quat = inputs.attitude(where, quat, rec, "pipe.navigate(...)['quat'] gives it")
+        pos = inputs.positions(where, pos, rec)
         steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat, stances=stances, sagittal=sagittal)
         for a in self.analysis:
             steps = checked(checked(a.clone().analyze, rec.t, quat, pos, stance, rec.meta).annotate, steps, rec.t)

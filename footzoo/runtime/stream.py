@@ -38,14 +38,16 @@ from ..core.data import check_units
 from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
 from ..core.sanity import EstimateScan, SignalScan
 from ..filters.consistency import ConsistencyScan
+from ..filters.engine import ENGINES
 from ..plugins.base import checked
 from ..plugins.incremental import Chunk, Latency, length, take
+from . import stage_inputs as inputs
 from .alignment import first_still_window
 from .chain import Chain, build_chain, with_init
 from .pipeline import STREAM_WARMUP, require_pipeline
 from .stage import Queue, Stage
 from .stages import GainStage
-from .stream_state import check_channel, check_open, check_unused
+from .stream_state import check_channel, check_open, check_unused, chunk_sizes
 
 #: Samples the sensor and physics scans are fed at a time, live (a finding comes at most this many samples late).
 SCAN_BLOCK = 128
@@ -110,6 +112,8 @@ class Stream:
                 continue
             if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < np.inf):
                 reasons.append(f"{label} must be a positive number of seconds, got {value!r}")
+        if engine not in ENGINES:
+            reasons.append(f"engine must be one of {list(ENGINES)}, got {engine!r}")
         if reasons:
             raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
         self.pipeline = pipeline
@@ -317,15 +321,16 @@ class Stream:
         ``log`` set to a list, each call's returned estimate is appended. With ``keep``, :meth:`result`
         then describes and scores the run with the recording's ``meta`` and ``truth``.
         """
+        rec = inputs.recording("Stream.run", rec)
+        sizes = chunk_sizes(chunk)
         check_unused(self)
         if self.keep:  # result()'s defaults: the recording's description and reference
             self._given = (rec.meta, rec.truth)
         if self.rate is None and self.ctx is None:
             self.rate = rec.rate
-        sizes = np.asarray(chunk, dtype=int).reshape(-1)
         parts, k, i = [], 0, 0
         while k < rec.n:
-            m = max(int(sizes[i % sizes.size]), 1)
+            m = int(sizes[i % sizes.size])
             i += 1
             if m == 1:
                 est = self.push(rec.t[k], rec.acc[k], rec.gyr[k], None if rec.mag is None else rec.mag[k],

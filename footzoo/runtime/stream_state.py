@@ -11,7 +11,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..core.errors import RecordingError
+import numpy as np
+
+from ..core.errors import ConfigError, RecordingError
 
 
 def check_open(stream: Any, call: str) -> None:
@@ -44,3 +46,16 @@ def check_channel(stream: Any, name: str, present: bool, t: Any) -> None:
     raise RecordingError(f"{what}: a channel must come with every sample or with none (the first sample decides); "
                          f"a sensor that drops out mid-stream cannot be bridged: push {name} with every sample (repair "
                          "the gap), or start a new Stream without it")
+
+
+def chunk_sizes(chunk: Any) -> np.ndarray:
+    """The block sizes of :meth:`~footzoo.Stream.run`: a whole number of samples >= 1, or a non-empty array of them."""
+    problem = f"Stream.run(): chunk must be a number of samples >= 1 or a non-empty list of them, got {chunk!r:.80}"
+    try:
+        sizes = np.asarray(chunk).reshape(-1)
+    except (TypeError, ValueError):
+        raise ConfigError(problem) from None
+    if (sizes.size == 0 or sizes.dtype.kind not in "iuf" or sizes.dtype == bool
+            or not np.all(np.isfinite(sizes)) or np.any(sizes < 1) or np.any(sizes != np.round(sizes))):
+        raise ConfigError(f"{problem}; e.g. chunk=1 (push() sample by sample) or chunk=50 (extend() 50 at a time)")
+    return sizes.astype(int)

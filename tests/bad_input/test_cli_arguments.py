@@ -98,6 +98,12 @@ CASES = [
      "no orientation plug-in named 'shoe': 'shoe' is a detector plug-in; leave out --kind orientation"),
     ("show-unknown-metric", lambda d, w: ["ablate", str(QUICK), "--show", "strides,armse_3d"], EXIT_USAGE,
      "argument --show: 'armse_3d' is not a metric (did you mean 'armse_3d_m'?)"),
+    ("compile-ship-a-file", lambda d, w: [(d / "k.txt").write_text("x"), "compile"][1:] + [
+        "yun2012", "--ship", "k.txt"], EXIT_USAGE,
+     "argument --ship: 'k.txt' is a file, not a folder; give a folder name"),
+    ("configs-copy-empty", lambda d, w: ["configs", "--copy", ""], EXIT_USAGE, "argument --copy: an empty name"),
+    ("simulate-biases-empty", lambda d, w: ["simulate", "straight", "--out", "s.csv", "--biases", ""], EXIT_USAGE,
+     "argument --biases: an empty list; give a comma-separated list of acc, gyr, mag"),
     ("configs-to-without-copy", lambda d, w: ["configs", "--to", str(d / "mine")], EXIT_USAGE,
      "--to goes with --copy NAME"),
     ("configs-to-not-yaml", lambda d, w: ["configs", "--copy", "yun2012", "--to", str(d / "mine.txt")], EXIT_USAGE,
@@ -179,3 +185,16 @@ def test_property_a_scheduler_address_is_normalised_or_refused(address):
     scheme, _, rest = out.partition("://")
     host, _, port = rest.rpartition(":")
     assert scheme in ("tcp", "tls", "ws", "wss", "ucx") and host and 1 <= int(port) <= 65535
+
+
+def test_a_name_the_terminal_cannot_show_is_escaped_not_a_crash(tmp_path, monkeypatch):
+    """With an ASCII-only terminal (LC_ALL=C, PYTHONIOENCODING=ascii) a non-ASCII name is printed escaped."""
+    import io
+    import sys
+
+    monkeypatch.chdir(tmp_path)
+    err = io.TextIOWrapper(io.BytesIO(), encoding="ascii")
+    monkeypatch.setattr(sys, "stderr", err)
+    assert main(["validate", "gång.yaml"]) == EXIT_USAGE
+    err.flush()
+    assert "g\\xe5ng.yaml" in err.buffer.getvalue().decode("ascii")

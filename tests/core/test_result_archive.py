@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import math
 import warnings
@@ -52,7 +53,11 @@ def tricky() -> Result:
                    "series": pd.Series([1, 2, 3], name="s"), "path": Path("/tmp/x"), "text": "1e3", "int": 3,
                    "flt": 0.1 + 0.2, "i8": np.int8(-3), "b": np.bool_(True), "matrix": np.eye(3)[None],
                    "words": np.array(["a", "bc"])}
-    recording = {"name": "1e3", "subject": "007", "rate": 100.0, "flag": True, "gaps": {"start_s": [0.1, 0.2]}}
+    recording = {"name": "1e3", "place": "Gång 走路", "subject": "007", "rate": 100.0, "flag": True,
+                 "gaps": {"start_s": [0.1, 0.2]},
+                 "started": dt.datetime(2026, 1, 2, 3, 4, 5, 6, tzinfo=dt.timezone(dt.timedelta(hours=1))),
+                 "day": dt.date(2026, 1, 2), "clock": dt.time(23, 59, 1), "raw": b"\xff\x00id",
+                 "stamp": np.datetime64("2026-01-02T03:04:05.123456789")}
     ref = footzoo.Truth(pos=np.arange(15.0).reshape(n, 3), stance=np.array([1, 0, 1, 1, 0], dtype=bool),
                         steps=steps[["start_s", "turn"]], closed_loop=True, stride_count=3,
                         footprints=np.ones((2, 2)), source="hand-made")
@@ -115,6 +120,7 @@ def test_every_dtype_nan_boolean_and_number_like_text_survive(tmp_path, backend)
     assert back.steps["label"].dtype == res.steps["label"].dtype
     assert back.steps["code"][2] == "ünïcode, \"quoted\"\n"
     assert back.recording["name"] == "1e3" and back.recording["subject"] == "007"
+    assert_same_value(res.recording, back.recording, "recording")  # dates, times and bytes too, not dropped
     d = back.diagnostics
     assert d["nested"]["tuple"] == (1, 2.5, "3") and math.isnan(d["nested"]["nan"]) and d["nested"]["inf"] == -math.inf
     assert d["nested"]["$weird"] == 1 and d["nested"][7] == "int key" and d["nested"]["none"] is None
@@ -194,6 +200,7 @@ def test_a_failure_while_saving_keeps_the_earlier_result(result, tmp_path, monke
 
 @pytest.mark.parametrize("make, fragment", [
     (lambda d: d / "none", "is not a folder"),
+    (lambda d: "", "give the path of the folder Result.save wrote"),
     (lambda d: d, "holds no manifest.json"),
     (lambda d: (d / "manifest.json").write_text('{"format": "footzoo-session-result"}') and d,
      "use SessionResult.load"),

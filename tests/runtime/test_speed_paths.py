@@ -45,6 +45,18 @@ def test_a_kalman_config_with_an_external_attitude_matches_too(walk):
     np.testing.assert_allclose(b.pos, a.pos, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("environ, enabled", [
+    ({}, True), ({"FOOTZOO_DISABLE_JIT": "1"}, False), ({"NUMBA_DISABLE_JIT": "1"}, False),
+    ({"NUMBA_DISABLE_JIT": "0"}, True), ({"FOOTZOO_DISABLE_JIT": "yes", "NUMBA_DISABLE_JIT": ""}, False),
+])
+def test_numbas_own_switch_also_selects_the_plain_python_path(environ, enabled):
+    """NUMBA_DISABLE_JIT=1 makes numba's njit the identity, which footzoo's compiled paths cannot use (every run
+    failed reading the recording): it selects the plain-Python path, as FOOTZOO_DISABLE_JIT does."""
+    from footzoo.kernels.jit import jit_enabled
+
+    assert jit_enabled(environ) is enabled
+
+
 @pytest.mark.slow
 def test_without_a_compiler_the_same_code_gives_the_same_numbers(tmp_path):
     """FOOTZOO_DISABLE_JIT=1 runs the kernels as plain Python (an install without numba)."""
