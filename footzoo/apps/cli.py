@@ -94,11 +94,22 @@ def _reader_option(text: str) -> tuple[str, Any]:
 
 
 def _output(text: str) -> str:
-    """An argparse ``type`` for ``--out``: a non-empty path (an empty one would write nothing, silently)."""
+    """An argparse ``type`` for ``--out``: a non-empty path (an empty one would write nothing, silently), not ``-``."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
+    if text.strip() == "-":
+        raise argparse.ArgumentTypeError("'-' (standard output): footzoo writes its outputs to files, not to a "
+                                         "stream; give a name")
     if nul_in_path(text):
         raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
+    return text
+
+
+def _recording_path(text: str) -> str:
+    """An argparse ``type`` for ``--data``: a path, not ``-`` (a recording is not read from standard input)."""
+    if text.strip() == "-":
+        raise argparse.ArgumentTypeError("'-' (standard input): footzoo reads a recording from a file, not from a "
+                                         "stream; save it to a file and give its path")
     return text
 
 
@@ -777,7 +788,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
     run.add_argument("config", type=_input_yaml, help="pipeline YAML, e.g. yun2012")
-    run.add_argument("--data", help="recording file (default: built-in x-io short walk)")
+    run.add_argument("--data", type=_recording_path, help="recording file (default: built-in x-io short walk)")
     run.add_argument("--format", help=f"reader name: {', '.join(BUILTIN)} or an installed one "
                      "(footzoo formats lists them; default: detect)")
     run.add_argument("--foot", choices=["left", "right", "both"],
@@ -834,7 +845,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.set_defaults(func=cmd_simulate)
 
     cal = sub.add_parser("calibrate", help="foot vector from a still period and slow dorsi-/plantar-flexions")
-    cal.add_argument("--data", required=True, help="calibration recording")
+    cal.add_argument("--data", required=True, type=_recording_path, help="calibration recording")
     cal.add_argument("--format", help="reader format (default: detect)")
     cal.add_argument("--foot", choices=["left", "right"], help="foot to read from a two-foot file (gaitmap)")
     cal.add_argument("--acc-unit", choices=list(ACC_UNITS), help="accelerometer unit (default: the format's)")
