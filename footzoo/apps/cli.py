@@ -93,15 +93,22 @@ def _reader_option(text: str) -> tuple[str, Any]:
     return name.strip(), parsed
 
 
+def _named(text: str, empty: str, what: str = "path") -> str:
+    """``text`` if it names something: not empty or blank (``empty`` says what to give instead) and without a NUL
+    (``what`` it is, for the message); the checks every path or name argument shares."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(empty)
+    if nul_in_path(text):
+        raise argparse.ArgumentTypeError(f"the {what} {nul_in_path(text)}")
+    return text
+
+
 def _output(text: str) -> str:
     """An argparse ``type`` for ``--out``: a non-empty path (an empty one would write nothing, silently), not ``-``."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; give the output's name (or leave --out out)")
+    _named(text, "an empty path; give the output's name (or leave --out out)")
     if text.strip() == "-":
         raise argparse.ArgumentTypeError("'-' (standard output): footzoo writes its outputs to files, not to a "
                                          "stream; give a name")
-    if nul_in_path(text):
-        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
     return text
 
 
@@ -131,28 +138,18 @@ def _metric_names(text: str) -> list[str]:
 
 def _input_yaml(text: str) -> str:
     """An argparse ``type`` for a config or study argument: a shipped name or a path, never empty ('' is not '.')."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty name; give a shipped config's name (footzoo configs lists them) "
-                                         "or the path of a YAML file")
-    if nul_in_path(text):
-        raise argparse.ArgumentTypeError(f"the name {nul_in_path(text)}")
-    return text
+    return _named(text, "an empty name; give a shipped config's name (footzoo configs lists them) or the path of a "
+                  "YAML file", what="name")
+
 
 def _destination(text: str) -> str:
     """An argparse ``type`` for ``--to``: a non-empty path (an empty one would silently mean here)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; give a folder or file name (or leave --to out: here)")
-    if nul_in_path(text):
-        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
-    return text
+    return _named(text, "an empty path; give a folder or file name (or leave --to out: here)")
 
 
 def _folder(text: str) -> str:
     """An argparse ``type`` for an output folder (``compile --ship``): non-empty, and not an existing file."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; give a folder name")
-    if nul_in_path(text):
-        raise argparse.ArgumentTypeError(f"the path {nul_in_path(text)}")
+    _named(text, "an empty path; give a folder name")
     if Path(text).exists() and not Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder; give a folder name (it is created if "
                                          "missing)")
