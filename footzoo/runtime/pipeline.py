@@ -408,9 +408,7 @@ class Pipeline:
             ``Result.diagnostics`` for these stages, ``acc_gain`` (when scaled) and ``calibration`` (with
             calibrations).
         """
-        if not isinstance(rec, Recording):
-            raise NotARecordingError(f"Pipeline.prepare expects a footzoo Recording, got {type(rec).__name__}: build "
-                                     "one with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
+        rec = inputs.recording("Pipeline.prepare", rec)
         ctx = self.context(rec)
         stages, out = input_stages(self, ctx, recording_chunk(rec, ctx, self.init["duration"]), whole=True)
         q0, _ = aligned(self, out)
