@@ -528,6 +528,7 @@ def main(argv: list[str] | None = None) -> int:
         head = summary.read_text().partition(FLAGSHIP_MARK)[0] if summary.exists() else ""
         merged = {**accuracy_parts.read_parts(kept), **blocks}  # the parts not rerun keep their blocks
         section = "\n".join(accuracy_parts.flagship_section(merged))
+        summary.parent.mkdir(parents=True, exist_ok=True)
         summary.write_text(f"{head.rstrip()}\n\n{FLAGSHIP_MARK}\n\n{section.rstrip()}\n")
         print(f"flagship parts {flagship} in {summary}")
     return 0

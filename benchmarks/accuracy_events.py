@@ -2,7 +2,8 @@
 
 * the simulator's truth (the toe leaving the floor, the heel touching it): a 10 m × 5 m rectangle walk
   (physical foot model, Table II noise, seed 0) at 100, 250 and 400 Hz;
-* gaitmap's motion-capture events (``stride_events_sample.csv``), both feet;
+* gaitmap's motion-capture events (``stride_events_sample.csv``), both feet, and its heel marker's touch-down
+  (:func:`heel_touchdowns`), since the event file's IC marks the foot's largest pitch, about 20 ms before it;
 * the hand-checked IMU events of Voisard et al.'s IPOL data set (``ipol_gait``, 18 trials, both feet),
   compared inside the trial and outside the U-turn (:mod:`footzoo.io.xsens`).
 
@@ -20,8 +21,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from footzoo.analysis.gait_events import sagittal_rate, segment_argext
+from footzoo.analysis.gait_events import contact_times, sagittal_rate, segment_argext
 from footzoo.analysis.strides import real_stances
+from footzoo.core.conventions import quat_rotate
 from footzoo.evaluation.metrics import gait_phase_errors, match_strides, reference_steps, stride_errors
 from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import NoiseModel, simulate
@@ -79,9 +81,8 @@ def _crossing(t: np.ndarray, w: np.ndarray, lo: int, hi: int, level: float, up: 
 def landmarks(rec, res) -> pd.DataFrame:
     """Per swing, landmarks of the navigation-frame sagittal rate (s): the push-off peak, half-way back from it
     (footzoo's TO), its zero crossing (Rampp et al.'s terminal contact), the zero crossing after the mid-swing
-    peak (footzoo's IC) and the rate's minimum after that (Rampp et al.'s IC, before their refinement); and the
-    impact's onset in the accelerometer: where the change of the specific force between two samples, |Δf|/Δt,
-    first exceeds 30 % of its largest value from 0.1 s before to 0.12 s after the IC zero crossing."""
+    peak (the foot's largest pitch) and the rate's minimum after that (Rampp et al.'s IC, before their
+    refinement); and footzoo's IC, the heel's impact after the largest pitch (``contact_times``)."""
     q = res.samples[["qw", "qx", "qy", "qz"]].to_numpy()
     pos = res.samples[["pos_n", "pos_e", "pos_d"]].to_numpy()
     st = real_stances(res.samples["stance"].to_numpy(bool), pos)
@@ -94,28 +95,21 @@ def landmarks(rec, res) -> pd.DataFrame:
     lo = np.minimum(mid[:-1], p)
     j = segment_argext(w, lo, np.maximum(p, lo + 1), largest=False)
     mids = _mid(t, np.arange(n))
-    jerk = np.concatenate([[0.0], np.linalg.norm(np.diff(rec.acc, axis=0), axis=1) / np.diff(t)])  # at (k−1, k)
+    f_n = quat_rotate(q, rec.acc)  # the specific force in NED, as the library's steps table takes it
     rows = []
     for i in range(len(p)):
         if not (w[p[i]] > 0 > w[j[i]]):
             continue
         ic = _crossing(t, w, p[i], mid[i + 1], 0.0, up=False)
-        k = int(np.searchsorted(_mid(t, np.arange(n)), ic)) if np.isfinite(ic) else mid[i + 1]
+        k = int(np.searchsorted(mids, ic)) if np.isfinite(ic) else mid[i + 1]
         m = k + int(np.argmin(w[k:min(k + int(0.15 * rec.rate), mid[i + 1]) + 1])) if k < mid[i + 1] else k
-        onset = np.nan
-        if np.isfinite(ic):
-            a, b = max(int(np.searchsorted(mids, ic - 0.1)), p[i] + 1), min(int(np.searchsorted(mids, ic + 0.12)), n)
-            if b > a:
-                top = a + int(np.argmax(jerk[a:b]))
-                first = top
-                while first > a and jerk[first - 1] > 0.3 * jerk[top]:
-                    first -= 1
-                onset = float((mids[first - 1] + mids[first]) / 2)  # between the two samples that differ
+        contact = float(contact_times(t, f_n, np.array([ic]), mid[i + 1:i + 2], np.array([True]))[0]) \
+            if np.isfinite(ic) else np.nan
         rows.append({"push-off peak": float(_mid(t, np.array([j[i]]))[0]),
                      "half-way back (TO)": _crossing(t, w, j[i], p[i], 0.5 * w[j[i]], up=True),
                      "zero crossing after it": _crossing(t, w, j[i], p[i], 0.0, up=True),
-                     "zero crossing (IC)": ic, "minimum after it": float(_mid(t, np.array([m]))[0]),
-                     "impact onset": onset})
+                     "largest pitch (zero crossing)": ic, "minimum after it": float(_mid(t, np.array([m]))[0]),
+                     "contact (IC)": contact})
     return pd.DataFrame(rows)
 
 
@@ -123,8 +117,8 @@ def _offsets(marks: pd.DataFrame, ref: pd.DataFrame) -> dict[str, np.ndarray]:
     """Reference event − landmark (s) for each landmark, paired with the nearest reference event within PAIR_S."""
     out = {}
     for col in marks.columns:
-        events = ref["end_s" if col in ("zero crossing (IC)", "minimum after it", "impact onset") else "to_s"]\
-            .to_numpy(float)
+        ic_like = ("largest pitch (zero crossing)", "minimum after it", "contact (IC)")
+        events = ref["end_s" if col in ic_like else "to_s"].to_numpy(float)
         x = marks[col].to_numpy(float)
         x = x[np.isfinite(x)]
         if not len(x) or not len(events):
@@ -146,6 +140,12 @@ def event_cell(reference: str, group: str, spec: dict[str, Any], config: str) ->
     m = match_strides(res.steps, ref)
     out = {"reference": reference, "group": group, "config": config, "strides": len(ref), "paired": len(m),
            "ic": (m["est_end_s"] - m["end_s"]).to_numpy(float), "to": (m["est_to_s"] - m["to_s"]).to_numpy(float)}
+    if reference.startswith("motion"):  # IC against the heel marker's touch-down as well as the file's IC
+        touch = heel_touchdowns(Path(spec["path"]).parent.parent, group)
+        est = res.steps["end_s"].to_numpy(float)
+        d = est[None, :] - touch[:, None] if len(touch) and len(est) else np.zeros((0, 1))
+        best = d[np.arange(len(d)), np.argmin(np.abs(d), axis=1)] if len(d) else np.zeros(0)
+        out["ic_touchdown"] = best[np.abs(best) <= PAIR_S]
     if config == EVENT_CONFIGS[0]:
         out["offsets"] = _offsets(landmarks(rec, res), ref)
         if reference.startswith("motion"):
@@ -171,8 +171,27 @@ def _summary(cells: list[dict[str, Any]], by_group: bool) -> pd.DataFrame:
                     "TO median abs (ms)": 1e3 * np.median(np.abs(to)),
                     "paired": f"{int(part['paired'].sum())}/{int(part['strides'].sum())}",
                     "paired (%)": 100.0 * part["paired"].sum() / max(part["strides"].sum(), 1)})
+        touch = [x for x in part.get("ic_touchdown", pd.Series(dtype=object)).tolist() if isinstance(x, np.ndarray)]
+        d = np.concatenate(touch) if touch else np.zeros(0)
+        row["IC − heel touch-down, median (ms)"] = 1e3 * np.median(d) if len(d) else np.nan
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def heel_touchdowns(data: Path, foot: str) -> np.ndarray:
+    """When gaitmap's heel marker touches down after each motion-capture IC of ``foot`` (s, the IMU's clock).
+
+    The touch-down is where the heel marker's descent stops (:func:`heel_marker`, "stopped"): a kinematic
+    contact from the markers themselves, independent of the event file's own definition.
+    """
+    from footzoo.io.gaitmap_reference import IMU_RATE
+
+    table = heel_marker(data)
+    if not len(table):
+        return np.zeros(0)
+    events = pd.read_csv(data / "gaitmap_example" / "stride_events_sample.csv")
+    ic = events.loc[events.foot == foot, "ic"].to_numpy(float) / IMU_RATE
+    return ic + 1e-3 * table.loc[table.foot == foot, "stopped (ms)"].to_numpy(float)
 
 
 def heel_marker(data: Path) -> pd.DataFrame:
@@ -242,6 +261,10 @@ def events(data: Path, jobs: int = 1) -> list[str]:
                 v = r[f"{ev} median abs (ms)"]
                 _target(tg, f"motion capture, {r['group']} foot: {ev} median abs error (ms)",
                         f"≤ {1e3 * TARGETS['mocap_s']:.0f} ms", v, v <= 1e3 * TARGETS["mocap_s"])
+            cell = next(c for c in flagship if c["reference"] == r["reference"] and c["group"] == r["group"])
+            v = 1e3 * np.median(np.abs(cell["ic_touchdown"]))
+            _target(tg, f"motion capture, {r['group']} foot: IC median abs error against the heel marker's "
+                    "touch-down (ms)", f"≤ {1e3 * TARGETS['mocap_s']:.0f} ms", v, v <= 1e3 * TARGETS["mocap_s"])
         else:
             for ev in ("IC", "TO"):
                 v = r[f"{ev} bias (ms)"]
@@ -260,16 +283,17 @@ def events(data: Path, jobs: int = 1) -> list[str]:
         row: dict[str, Any] = {"reference": reference if reference != "simulator" else f"simulator {SIM_RATES[0]:g} Hz"}
         for col in offsets[0]:
             d = np.concatenate([o[col] for o in offsets])
-            row[col] = 1e3 * np.median(d) if len(d) and not (reference == "simulator" and col == "impact onset") \
-                else np.nan  # the simulated foot lands without an impact
+            row[col] = 1e3 * np.median(d) if len(d) else np.nan
         marks.append(row)
     lines = [
         "### Gait events against three references", "",
-        "Events from the navigation-frame sagittal rate (docs/gait-events.md): TO where the rate, recovering from "
-        "its push-off peak, is back at half of it; IC at its zero crossing after the mid-swing peak. References: "
-        "the simulator's truth (the toe leaving the floor, the heel touching it; a 10 m × 5 m rectangle, physical "
-        "foot model, Table II noise), gaitmap's motion-capture events, and the hand-checked IMU events of Voisard "
-        "et al.'s IPOL data set (18 trials, both feet, inside the trial and outside the U-turn). Errors are "
+        "Events from the navigation-frame sagittal rate and the specific force (docs/gait-events.md): TO where "
+        "the rate, recovering from its push-off peak, is back at half of it; IC at the heel's impact after the "
+        "foot's largest pitch (the rate's zero crossing after the mid-swing peak). References: the simulator's "
+        "truth (the toe leaving the floor, the heel touching it; a 10 m × 5 m rectangle, physical foot model, "
+        "Table II noise), gaitmap's motion-capture events and its heel marker's touch-down, and the "
+        "hand-checked IMU events of Voisard et al.'s IPOL data set (18 trials, both feet, inside the trial and "
+        "outside the U-turn). Errors are "
         "estimate − reference; strides pair when both their TO and IC agree within 0.3 s.", "",
         f"`{EVENT_CONFIGS[0]}` against the targets:", "", to_markdown(pd.DataFrame(tg)), "",
         "#### Per reference and group", "", to_markdown(per_group.drop(columns="config"), digits=3), "",
@@ -279,29 +303,27 @@ def events(data: Path, jobs: int = 1) -> list[str]:
         "Median of reference event − landmark (ms; positive: the reference is later), landmarks of the rate "
         f"`{EVENT_CONFIGS[0]}` estimates: TO against the push-off peak, the half-way point (footzoo's TO) and "
         "the zero crossing after it (Rampp et al.'s terminal contact); IC against the zero crossing after the "
-        "mid-swing peak (footzoo's IC) and the rate's minimum after it (Rampp et al.'s IC before its "
-        "acceleration refinement); and against the onset of the impact in the accelerometer (|Δf|/Δt above "
-        "30 % of its peak around IC; the simulator has no impact). The simulated push-off holds its peak rate "
-        "over the last 60 % of the pre-swing, so its peak sample falls anywhere in it. The references agree on "
-        "TO. On IC they do not: the simulator and the motion capture put it at the zero crossing, the foot's "
-        "largest pitch, before the impact; the hand-checked events about 23 ms later, at the impact. The motion "
-        "capture's own heel marker (below) touches down about 20 ms after its IC, with the hand-checked events. "
-        "footzoo's IC stays at the zero crossing, a landmark every swing has at every rate; the impact's onset "
-        "is a jump between two samples that the simulated foot does not make (docs/gait-events.md).", "",
+        "mid-swing peak (the foot's largest pitch), the rate's minimum after it (Rampp et al.'s IC before its "
+        "acceleration refinement) and the heel's impact (footzoo's IC). The simulated push-off holds its peak "
+        "rate over the last 60 % of the pre-swing, so its peak sample falls anywhere in it. The references "
+        "agree on TO. On IC, gaitmap's event file marks the largest pitch; the hand-checked events, and the "
+        "motion capture's own heel marker (below), put the touch-down about 20 ms later, at the impact. The "
+        "simulated foot touches down at its largest pitch and lands without an impact, so footzoo's IC "
+        "finds the loading response's onset a few milliseconds after it.", "",
         to_markdown(pd.DataFrame(marks), digits=3), ""]
     heel = heel_marker(data)
     if len(heel):
         med = heel.median(numeric_only=True)
         lines += ["#### gaitmap's foot markers at the motion-capture IC", "",
                   f"Median over {len(heel)} initial contacts (`heel_marker`): the foot's pitch is largest "
-                  f"{med['largest pitch (ms)']:+.0f} ms from the motion-capture IC (the instant footzoo's zero "
-                  f"crossing marks); there the heel marker still moves forward at "
+                  f"{med['largest pitch (ms)']:+.0f} ms from the motion-capture IC (the rate's zero crossing); "
+                  f"there the heel marker still moves forward at "
                   f"{med['horizontal speed at IC (m/s)']:.1f} m/s and goes down, fastest "
                   f"{med['fastest descent (ms)']:.0f} ms after the IC ({med['speed (m/s)']:.2f} m/s); its descent "
                   f"stops {med['stopped (ms)']:.0f} ms after it, and its horizontal speed falls below 0.5 m/s "
                   f"{med['below 0.5 m/s (ms)']:.0f} ms after it. The motion capture's IC marks the end of the "
                   "swing's dorsi-flexion, not the heel's touch-down: the markers put the touch-down about 20 ms "
-                  "later, where the hand-checked events and the accelerometer's impact put it.", ""]
+                  "later, where the hand-checked events and footzoo's IC (the impact) put it.", ""]
     if gm:
         lines += ["#### gaitmap's walk: strides and gait phases", "",
                   "Gait phases: stance IC → TO, scored from 0.3 s before the first reference toe-off to 0.3 s after "

@@ -25,19 +25,28 @@ landmarks:
   the zero crossing (Rampp et al.'s toe-off, gaitmap's ``RamppEventDetection`` terminal contact:
   the change from plantar flexion to dorsal extension). The half-amplitude point times that edge
   independently of the sampling rate and of the peak's size.
-* **IC** is the first downward zero crossing of ``ω_ml`` after ``p`` (Sabatini et al. 2005's
-  landmark; Rampp et al. take the ``ω_ml`` minimum right after it, refined by the acceleration
-  peak of the impact).
+* **IC** is the heel's touch-down: its impact after the foot's largest pitch. The largest pitch is
+  the first downward zero crossing of ``ω_ml`` after ``p`` (Sabatini et al. 2005's IC landmark,
+  where the swing's dorsi-flexion ends); the heel is then still in the air and touches the floor
+  about 20 ms later (on gaitmap's example walk, its heel marker's descent stops a median 22 ms
+  after it). IC is the instant the foot's acceleration, the specific force in the navigation frame
+  ``f_n = C_b^n f_b``, has changed from its value at the largest pitch by :data:`CONTACT_LEVEL`
+  (30 %) of its largest change within :data:`CONTACT_WINDOW` (60 ms) after it: the onset of the
+  impact (Rampp et al. likewise refine their IC with the acceleration of the impact). In the
+  navigation frame the turning of gravity's projection does not count; a largest change below
+  :data:`CONTACT_MIN_CHANGE` (2 m/s²) is no impact, and IC is then the largest pitch itself (a
+  foot put down softly, or the simulator's idealised ``"paper"`` foot). Without the specific
+  force (:func:`detect_gait_events` without ``acc``), IC is the largest pitch.
 
-Checked against three references (docs/gait-events.md, ``benchmarks/accuracy.py --parts
+Checked against four references (docs/gait-events.md, ``benchmarks/accuracy.py --parts
 events``): the simulator's truth (the toe leaving the floor, the heel touching it;
-:mod:`footzoo.sim.gait`), gaitmap's motion-capture events (``stride_events_sample.csv``) and the
-hand-checked IMU events of Voisard et al.'s data set (:mod:`footzoo.io.xsens`). For TO they agree
-(the half point lies 5 to 9 ms after each one's toe-off). For IC the simulator and the motion
-capture's events sit at the zero crossing, the foot's largest pitch; the hand-checked events a
-median 23 ms later, at the impact, where the motion capture's heel marker touches down. IC stays
-at the zero crossing, a landmark of every swing at every rate: about 20 ms before the heel's
-touch-down.
+:mod:`footzoo.sim.gait`), gaitmap's motion-capture events (``stride_events_sample.csv``) and its
+heel marker's touch-down, and the hand-checked IMU events of Voisard et al.'s data set
+(:mod:`footzoo.io.xsens`). For TO they agree (the half point lies 5 to 9 ms after each one's
+toe-off). For IC, gaitmap's event file marks the largest pitch; its heel marker, the
+hand-checked events and the impact put the touch-down about 20 ms later. The simulated foot
+touches down at its largest pitch without an impact, so IC finds its loading response's onset
+about 5 ms after it.
 
 **Independent of the mounting** (footzoo's choice, :func:`sagittal_rate`): ``ω_ml`` is
 not a sensor axis but the angular rate rotated into the navigation frame with the
@@ -51,14 +60,14 @@ that body-frame signal when no attitude is given.
 
 footzoo's other choices (not fixed by the papers): the stances come from the pipeline's
 stance detector instead of Rampp's DTW stride segmentation; the push-off peak is searched from
-the middle of the stance before the swing to ``p``, IC from ``p`` to the middle of the next
-stance; the push-off peak's value is refined with a parabola through its three samples (so the
-half level does not depend on where the samples fall), both crossings are interpolated linearly
-between two samples; a sample stands for the middle of its interval ``(t[k-1], t[k]]``
-(footzoo's interval-average convention), so event times are half a period before the sample
-times. Where a swing lacks the pattern (no positive ``ω_ml`` after the push-off, e.g. a
-shuffle), the events fall back to the detector's stance edges and ``from_rate`` (the steps
-table's ``events_from_rate``) says so.
+the middle of the stance before the swing to ``p``, the largest pitch from ``p`` to the middle of
+the next stance, and the impact no later than that middle either; the push-off peak's value is
+refined with a parabola through its three samples (so the half level does not depend on where
+the samples fall), all three crossings are interpolated linearly between two samples; a sample
+stands for the middle of its interval ``(t[k-1], t[k]]`` (footzoo's interval-average convention),
+so event times are half a period before the sample times. Where a swing lacks the pattern (no
+positive ``ω_ml`` after the push-off, e.g. a shuffle), the events fall back to the detector's
+stance edges and ``from_rate`` (the steps table's ``events_from_rate``) says so.
 """
 
 from __future__ import annotations
@@ -71,6 +80,12 @@ from ..kernels.jit import njit
 
 #: Toe-off: the fraction of the push-off peak of ``ω_ml`` to which the rate has recovered (half).
 TO_LEVEL = 0.5
+#: Initial contact: the heel's impact is searched for this long after the foot's largest pitch (s).
+CONTACT_WINDOW = 0.06
+#: Initial contact: the fraction of the specific force's largest change in the window it has reached.
+CONTACT_LEVEL = 0.3
+#: Initial contact: a smaller largest change of the acceleration in the window is no impact (m/s²).
+CONTACT_MIN_CHANGE = 2.0
 
 
 @dataclass
@@ -86,11 +101,15 @@ class GaitEvents:
     from_rate : (K,) bool ndarray
         True where both events come from the angular rate, False where they fell
         back to the detector's stance edges.
+    largest_pitch : (K,) ndarray
+        The foot's largest pitch before the contact: the downward zero crossing of
+        ``ω_ml`` after the mid-swing peak (s; the stance edge where ``from_rate`` is False).
     """
 
     to: np.ndarray
     ic: np.ndarray
     from_rate: np.ndarray
+    largest_pitch: np.ndarray | None = None
 
 
 def segment_ranges(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,7 +260,71 @@ def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: n
     return out
 
 
-def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> GaitEvents:
+@njit
+def _contact_kernel(mids: np.ndarray, acc: np.ndarray, pitch: np.ndarray, first: np.ndarray, stop: np.ndarray,
+                    level: float, least: float, out: np.ndarray) -> None:
+    """``out[i]``: when ``‖f_k − f_{first−1}‖`` first reaches ``level`` of its largest value in ``[first_i, stop_i)``.
+
+    Walks back from the largest change to the first sample of the run at or above the level and
+    interpolates linearly between the interval middles ``mids`` (the change is 0 at ``first − 1``);
+    never before ``pitch[i]``. ``out[i] = pitch[i]`` where the window has fewer than two samples.
+    """
+    for i in range(pitch.shape[0]):
+        out[i] = pitch[i]
+        a, b = first[i], stop[i]
+        if a < 1 or b - a < 2:
+            continue
+        e = np.empty(b - a)
+        for k in range(a, b):
+            s = 0.0
+            for j in range(acc.shape[1]):
+                s += (acc[k, j] - acc[a - 1, j]) ** 2
+            e[k - a] = np.sqrt(s)
+        top = int(np.argmax(e))
+        lev = level * e[top]
+        if e[top] < least:
+            continue
+        k = top
+        while k > 0 and e[k - 1] >= lev:
+            k -= 1
+        prev = e[k - 1] if k > 0 else 0.0
+        frac = (lev - prev) / (e[k] - prev) if e[k] > prev else 1.0
+        when = mids[a + k - 1] + frac * (mids[a + k] - mids[a + k - 1])
+        out[i] = max(pitch[i], when)
+
+
+def contact_times(t: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.ndarray,
+                  ok: np.ndarray) -> np.ndarray:
+    """Initial contacts (s): the heel's impact after each swing's largest pitch (see the module docstring).
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Time (s).
+    acc : (N, 3) ndarray
+        Specific force in the sensor frame (m/s²); only the norm of its changes is used, so any
+        frame and mounting give the same contacts.
+    pitch : (K,) ndarray
+        Each swing's largest pitch, the zero crossing of ``ω_ml`` (s).
+    stop : (K,) int ndarray
+        The search ends before this sample at the latest (the middle of the next stance).
+    ok : (K,) bool ndarray
+        Swings whose largest pitch was found; the others keep ``pitch``.
+    """
+    ts = np.asarray(t, dtype=float)
+    mids = ts - 0.5 * np.diff(ts, prepend=ts[0] - (np.median(np.diff(ts)) if len(ts) > 1 else 0.0))
+    first = np.searchsorted(mids, pitch, side="left").astype(np.int64)
+    end = np.searchsorted(mids, pitch + CONTACT_WINDOW, side="left").astype(np.int64)
+    end = np.minimum(np.minimum(end, np.asarray(stop, dtype=np.int64)), len(ts))
+    first = np.where(ok, first, 0)
+    out = np.empty(len(pitch))
+    _contact_kernel(mids, np.ascontiguousarray(acc, dtype=float), np.asarray(pitch, dtype=float), first, end,
+                    CONTACT_LEVEL, CONTACT_MIN_CHANGE, out)
+    return out
+
+
+def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
+                       acc: np.ndarray | None = None) -> GaitEvents:
     """TO and IC of each swing between consecutive stances (see the module docstring for the definitions).
 
     Parameters
@@ -254,6 +337,10 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
         is then taken as ``ω_ml``.
     stances : (K + 1, 2) int ndarray
         ``(start, stop)`` sample indices (stop exclusive) of the stances, in order.
+    acc : (N, 3) ndarray, optional
+        Specific force in the sensor frame (m/s²). IC is the heel's impact after the largest
+        pitch (:func:`contact_times`); without it, the largest pitch itself (about 20 ms early
+        on real walks).
 
     Returns
     -------
@@ -296,8 +383,9 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray) -> G
     ic = _crossing_times(ts, w, c, np.zeros(k), ok)
     to = _crossing_times(ts, w, r, level, ok)
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
-    ic = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
-    return GaitEvents(to=to, ic=ic, from_rate=ok)
+    pitch = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
+    ic = pitch if acc is None else np.where(ok, contact_times(ts, acc, pitch, mid[1:], ok), pitch)
+    return GaitEvents(to=to, ic=ic, from_rate=ok, largest_pitch=pitch)
 
 
 def _crossing_times(ts: np.ndarray, w: np.ndarray, c: np.ndarray, level: np.ndarray, ok: np.ndarray) -> np.ndarray:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..core.conventions import quat_rotate
 from ..evaluation.metrics import intervals
 from .gait_events import detect_gait_events, sagittal_rate, segment_argext
 
@@ -43,7 +44,7 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
 def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.ndarray | None = None,
                   min_stride_length: float = 0.1, max_stance_time: float = 2.0,
                   quat: np.ndarray | None = None, stances: np.ndarray | None = None,
-                  sagittal: np.ndarray | None = None) -> pd.DataFrame:
+                  sagittal: np.ndarray | None = None, acc: np.ndarray | None = None) -> pd.DataFrame:
     """One row per stride: the stance from its initial contact, its toe-off, the swing to the next contact.
 
     Strides start at the first real step: the standing before the first toe-off
@@ -77,6 +78,10 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
         ``real_stances(stance, pos, min_stride_length)`` when the caller has it already.
     sagittal : (N,) ndarray, optional
         ``sagittal_rate(quat, gyr, pos, stances)`` (rad/s) when the caller has it already.
+    acc : (N, 3) ndarray, optional
+        Specific force in the sensor frame (m/s²): with it, IC is the heel's impact after the
+        foot's largest pitch (:func:`footzoo.analysis.gait_events.contact_times`); without it,
+        the largest pitch.
 
     Returns
     -------
@@ -104,7 +109,9 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     mid = (a + b - 1) // 2
     if gyr is not None:
         rate = gyr if quat is None else sagittal if sagittal is not None else sagittal_rate(quat, gyr, pos, st)
-        ev = detect_gait_events(t, rate, st)
+        # the impact in the navigation frame: the foot's acceleration, without the turning of gravity's projection
+        f = acc if acc is None or quat is None else quat_rotate(quat, acc)
+        ev = detect_gait_events(t, rate, st, f)
         to, ic, from_rate = ev.to, ev.ic, ev.from_rate
     else:
         to, ic, from_rate = t[np.minimum(b[:-1], n - 1)], t[a[1:]], np.zeros(len(st) - 1, bool)

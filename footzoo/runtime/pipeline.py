@@ -519,7 +519,8 @@ class Pipeline:
         stance = inputs.stance(where, stance, rec)
         quat = inputs.attitude(where, quat, rec, "pipe.navigate(...)['quat'] gives it")
         pos = inputs.positions(where, pos, rec)
-        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat, stances=stances, sagittal=sagittal)
+        steps = segment_steps(rec.t, stance, pos, rec.gyr, quat=quat, stances=stances, sagittal=sagittal,
+                              acc=rec.acc)
         for a in self.analysis:
             steps = checked(checked(a.clone().analyze, rec.t, quat, pos, stance, rec.meta).annotate, steps, rec.t)
         return steps

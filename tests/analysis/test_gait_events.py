@@ -94,15 +94,18 @@ def test_simulated_walk_events_stance_and_swing(rate):
                   SWING_DECLINE * swing)
     delay = np.arccos(1 - f.w / (f.w + f.p)) / np.pi * f.turn  # 8.0 ms
     period = 1.0 / rate
-    # measured: IC within 0.1 period, TO within 0.05 period of the model's half point
-    np.testing.assert_allclose(m["est_end_s"], m["end_s"], atol=0.25 * period)
+    # the simulated heel touches down at the largest pitch, without an impact: IC (the impact rule) finds the
+    # loading response's onset a few milliseconds later (measured 5.3–5.5 ms); TO within 0.05 period of the
+    # model's half point
+    late = (m["est_end_s"] - m["end_s"]).to_numpy()
+    assert (late >= 0).all() and (late <= 0.010).all()
     np.testing.assert_allclose(m["est_to_s"], m["to_s"] + delay, atol=0.25 * period)
     # the first row is the first step: no stride time (standing before it), all others one cycle
     assert np.isnan(steps["start_s"].iloc[0]) and np.isnan(steps["cadence_steps_min"].iloc[0])
     np.testing.assert_allclose(steps["stride_time_s"].iloc[1:], cycle, atol=0.5 * period)
     np.testing.assert_allclose(steps["cadence_steps_min"].iloc[1:], 120.0 / cycle, rtol=0.01)
-    np.testing.assert_allclose(steps["swing_time_s"], swing - delay, atol=0.5 * period)
-    np.testing.assert_allclose(steps["stance_time_s"].iloc[1:], cycle - swing + delay, atol=0.5 * period)
+    np.testing.assert_allclose(steps["swing_time_s"], swing - delay + late, atol=0.5 * period)
+    np.testing.assert_allclose(steps["stance_time_s"].iloc[1:], cycle - swing + delay - late[:-1], atol=0.5 * period)
 
 
 @pytest.mark.parametrize("rate", [100.0, 250.0, 400.0])
@@ -233,8 +236,11 @@ def test_gaitmap_events_and_stride_length_against_motion_capture(foot):
     # every reference stride pairs but the left foot's 180° turn, which the reference takes as one
     # stride over two steps (see test_a_reference_stride_over_two_steps_stays_unpaired)
     assert m["ref_strides"] >= 28 and m["matched_strides"] == m["ref_strides"] - (foot == "left")
-    # measured: IC 3.0 / 4.8 ms, TO 5.6 / 4.9 ms (left / right; navigation-frame sagittal rate); target 10 ms
-    assert m["ic_error_median_abs_s"] <= 0.010
+    # TO: measured 5.6 / 4.9 ms (left / right; navigation-frame sagittal rate); target 10 ms. IC: the event file
+    # marks the foot's largest pitch, the heel marker touches down about 20 ms later, at the impact footzoo's IC
+    # marks (measured 18.7 / 18.4 ms after the file's; tests/benchmarks/test_accuracy_events.py checks IC against
+    # the heel marker's touch-down)
+    assert 0.010 <= m["ic_error_median_abs_s"] <= 0.030
     assert m["to_error_median_abs_s"] <= 0.010
     # straight strides: measured 0.043 m (left), 0.046 m (right); target 0.05 m
     assert m["stride_length_rms_error_straight_m"] <= 0.05
@@ -342,3 +348,29 @@ def test_ipol_hand_checked_events_agree_on_toe_off_and_mark_the_contact_later():
     assert paired / strides > 0.95  # measured 558 of 567
     assert abs(np.median(to)) <= 0.015  # measured +9.2 ms
     assert -0.030 < np.median(ic) < -0.015  # measured −22.8 ms
+
+
+def test_contact_is_the_impacts_onset_hand_derived():
+    """A step of the acceleration inside one sample's interval: the contact where the change reaches 30 % of it.
+
+    At 100 Hz the step of 20 m/s² starts half-way through sample 52's interval (0.515 s), so that sample holds half
+    of it (10 m/s², the interval's mean) and the next ones all of it. 30 % of the largest change, 6 m/s², is reached
+    between the middles of samples 51 (0) and 52 (10): 0.6 of the way from 0.505 s to 0.515 s, at 0.511 s.
+    Without an impact (a change below 2 m/s²) the contact is the largest pitch itself.
+    """
+    from footzoo.analysis.gait_events import contact_times
+
+    t = np.arange(100) * 0.01
+    acc = np.zeros((100, 3))
+    acc[52, 0], acc[53:, 0] = 10.0, 20.0
+    ok = np.array([True])
+    got = contact_times(t, acc, np.array([0.49]), np.array([90]), ok)
+    assert got[0] == pytest.approx(0.511, abs=1e-12)
+    # the window ends 60 ms after the largest pitch: an impact after it is not this contact
+    assert contact_times(t, acc, np.array([0.44]), np.array([90]), ok)[0] == pytest.approx(0.44)
+    # the search stops at the next stance's middle, and a change of 1.5 m/s² is no impact
+    assert contact_times(t, acc, np.array([0.49]), np.array([52]), ok)[0] == pytest.approx(0.49)
+    assert contact_times(t, 0.075 * acc, np.array([0.49]), np.array([90]), ok)[0] == pytest.approx(0.49)
+    # the impact is never before the largest pitch, and a swing without one keeps its pitch
+    assert contact_times(t, acc, np.array([0.512]), np.array([90]), ok)[0] >= 0.512
+    assert contact_times(t, acc, np.array([0.49]), np.array([90]), np.array([False]))[0] == pytest.approx(0.49)
