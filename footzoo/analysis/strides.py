@@ -14,8 +14,8 @@ from .gait_events import detect_gait_events, sagittal_rate, segment_argext
 
 #: Columns of :func:`segment_steps`, units in the names.
 STEP_COLUMNS = [
-    "start_s", "to_s", "end_s", "stride_time_s", "stance_time_s", "swing_time_s", "cadence_steps_min",
-    "stride_length_m", "speed_m_s", "heading_rad", "start_n_m", "start_e_m", "end_n_m", "end_e_m",
+    "start_s", "to_s", "end_s", "largest_pitch_s", "stride_time_s", "stance_time_s", "swing_time_s",
+    "cadence_steps_min", "stride_length_m", "speed_m_s", "heading_rad", "start_n_m", "start_e_m", "end_n_m", "end_e_m",
     "max_clearance_m", "events_from_rate",
 ]
 
@@ -79,16 +79,17 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     sagittal : (N,) ndarray, optional
         ``sagittal_rate(quat, gyr, pos, stances)`` (rad/s) when the caller has it already.
     acc : (N, 3) ndarray, optional
-        Specific force in the sensor frame (m/s²): with it, IC is the heel's impact after the
-        foot's largest pitch (:func:`footzoo.analysis.gait_events.contact_times`); without it,
-        the largest pitch.
+        Specific force in the sensor frame (m/s²): with it and ``quat``, IC is the heel's impact
+        after the foot's largest pitch (:func:`footzoo.analysis.gait_events.contact_times`, in the
+        navigation frame); otherwise IC is the largest pitch.
 
     Returns
     -------
     DataFrame
         Row i is the gait cycle around swing i: ``start_s`` (IC beginning the
         stance, s; NaN after standing), ``to_s`` (toe-off, s), ``end_s`` (IC ending
-        the swing, s), ``stride_time_s`` = end − start, ``stance_time_s`` = TO −
+        the swing, s), ``largest_pitch_s`` (the foot's largest pitch before that IC, s;
+        NaN without ``gyr``), ``stride_time_s`` = end − start, ``stance_time_s`` = TO −
         start, ``swing_time_s`` = end − TO, ``cadence_steps_min`` (two steps per
         stride of one foot: 120 / stride time), ``stride_length_m`` (horizontal
         displacement between the middles of the stances before and after the
@@ -110,11 +111,12 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     if gyr is not None:
         rate = gyr if quat is None else sagittal if sagittal is not None else sagittal_rate(quat, gyr, pos, st)
         # the impact in the navigation frame: the foot's acceleration, without the turning of gravity's projection
-        f = acc if acc is None or quat is None else quat_rotate(quat, acc)
+        f = None if acc is None or quat is None else quat_rotate(quat, acc)
         ev = detect_gait_events(t, rate, st, f)
-        to, ic, from_rate = ev.to, ev.ic, ev.from_rate
+        to, ic, pitch, from_rate = ev.to, ev.ic, ev.largest_pitch, ev.from_rate
     else:
         to, ic, from_rate = t[np.minimum(b[:-1], n - 1)], t[a[1:]], np.zeros(len(st) - 1, bool)
+        pitch = np.full(len(ic), np.nan)
     start = np.concatenate([[np.nan], ic[:-1]])
     stance_time = to - start
     start[stance_time > max_stance_time] = np.nan
@@ -124,7 +126,8 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     # highest point (up = −d): the first minimum of pos_d, as the first maximum of −pos_d
     top = segment_argext(pos[:, 2], np.maximum(b[:-1] - 1, 0), np.minimum(a[1:] + 1, n), largest=False)
     return pd.DataFrame({
-        "start_s": start, "to_s": to, "end_s": ic, "stride_time_s": stride_time, "stance_time_s": to - start,
+        "start_s": start, "to_s": to, "end_s": ic, "largest_pitch_s": pitch, "stride_time_s": stride_time,
+        "stance_time_s": to - start,
         "swing_time_s": ic - to, "cadence_steps_min": 120.0 / stride_time, "stride_length_m": length,
         "speed_m_s": length / stride_time, "heading_rad": np.arctan2(d[:, 1], d[:, 0]),
         "start_n_m": pos[mid[:-1], 0], "start_e_m": pos[mid[:-1], 1], "end_n_m": pos[mid[1:], 0],
