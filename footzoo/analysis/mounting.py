@@ -32,7 +32,7 @@ symptoms are flagged:
   because a sensor turned on the foot by a few tens of degrees sees a scaled pitch rate with the
   same shape (correlation ±0.6 on gaitmap's example turned 90° about z).
 
-The fix is the signed permutation nearest to ``A`` (its largest entry per row): the axis map
+The fix is the proper signed permutation nearest to ``A`` (:func:`nearest_axis_map`): the axis map
 that, applied on top of the one used, makes the sensor's axes the foot's FRD axes. A sensor
 mounted upside down on purpose (PyShoe's 2018-02-22 trial) shows the same symptom as a map that
 flips y and z: the warning says so.
@@ -50,6 +50,7 @@ from ..core.conventions import axis_map_text, quat_to_matrix
 from ..core.errors import FormatError, SensorWarning
 from ..io.axes import axes_fix, parse_axes
 from ..kernels.jit import njit
+from ..sim.mounting import proper_axis_permutations
 from .gait_events import sagittal_rate, stride_directions
 
 #: Fewest strides for a mounting estimate.
@@ -62,6 +63,9 @@ REVERSED_COS = -0.5
 ACROSS_COS = math.cos(math.radians(75.0))
 #: ``|corr(gyr_y, ω_ml)|`` at or above this: ``gyr_y`` is the foot's pitch rate, so the map's y axis is right.
 PITCH_AXIS_CORRELATION = 0.8
+#: ``trace(Pᵀ A)`` of the nearest axis map at least this far ahead of the runner-up, else no map is named (0.1:
+#: about 4° nearer, for maps 40-60° away; ``d trace / dθ = 2 sin θ``).
+AMBIGUOUS_TRACE = 0.1
 
 
 def nearest_rotation(a: np.ndarray) -> np.ndarray:
@@ -72,13 +76,23 @@ def nearest_rotation(a: np.ndarray) -> np.ndarray:
 
 
 def nearest_axis_map(a: np.ndarray) -> np.ndarray | None:
-    """The proper signed permutation nearest to the rotation ``a``: each row's largest entry, or None if ambiguous."""
+    """The proper signed permutation nearest to the rotation ``a`` (3, 3), or None if two are about as near.
+
+    Nearest in the Frobenius norm among the 24 (:func:`footzoo.sim.mounting.proper_axis_permutations`): the
+    largest ``trace(Pᵀ a) = 1 + 2 cos θ``, ``θ`` the angle between them. A sensor tilted on the foot by a few tens
+    of degrees (the IPOL set's MTw sits 30-45° pitched) may have two axes nearest the same foot axis; the
+    permutation nearest as a whole then still names its map, unless the runner-up is less than
+    :data:`AMBIGUOUS_TRACE` behind (a sensor turned about 45°, halfway between two maps): None. When each row's
+    largest entry is in its own column, that permutation is the nearest.
+    """
+    maps = proper_axis_permutations()
+    score = np.array([float(np.sum(p * a)) for p in maps])
+    order = np.argsort(score)[::-1]
+    best = maps[order[0]]
     k = np.argmax(np.abs(a), axis=1)
-    if len(set(k.tolist())) < 3:
-        return None
-    p = np.zeros((3, 3))
-    p[np.arange(3), k] = np.sign(a[np.arange(3), k])
-    return p if np.linalg.det(p) > 0 else None
+    if np.array_equal(np.abs(best).argmax(axis=1), k):  # each row's largest entry: no axis is in doubt
+        return best
+    return best if score[order[0]] - score[order[1]] >= AMBIGUOUS_TRACE else None
 
 
 @njit

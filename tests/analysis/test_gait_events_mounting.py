@@ -262,3 +262,40 @@ def test_a_track_across_x_with_the_pitch_axis_right_is_not_blamed_on_the_map():
     assert abs(rep["x_forward"]) < 0.26 and rep["pitch_rate_correlation"] > 0.8  # measured 0.06 and 0.92
     assert not rep["x_across"] and not rep["walks_backwards"] and not rep["pitch_reversed"]
     assert not [w for w in caught if "mounting" in str(w.message)]
+
+
+def _turned(axis: int, deg: float) -> np.ndarray:
+    """The rotation by ``deg`` degrees about sensor axis ``axis`` (rows: FRD axes in sensor coordinates)."""
+    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m = np.eye(3)
+    m[i, i] = m[j, j] = c
+    m[i, j], m[j, i] = s, -s
+    return m
+
+
+def test_a_tilted_sensor_still_gets_its_nearest_axis_map():
+    # hand-derived: a sensor turned 180° about z ([-x, -y, z]) and tilted 40° about x, then 40° about y. Rows y
+    # and z both peak in the sensor's y column (0.766, 0.643), yet trace(Pᵀ A) = 2.119 for [-x, -y, z] against
+    # 1.901 for the next map
+    flip = np.diag([-1.0, -1.0, 1.0])
+    a = flip @ _turned(0, 40.0) @ _turned(1, 40.0)
+    assert np.argmax(np.abs(a[1])) == np.argmax(np.abs(a[2])) == 1
+    assert np.sum(flip * a) == pytest.approx(2.119, abs=1e-3)
+    assert np.array_equal(nearest_axis_map(a), flip)
+    assert np.array_equal(nearest_axis_map(_turned(1, 20.0)), np.eye(3))
+    assert nearest_axis_map(_turned(1, 45.0)) is None  # halfway between [x, y, z] and [z, y, -x]: no map named
+
+
+def test_ipol_trial_read_upside_down_is_named_with_its_fix():
+    """A tilted MTw (IPOL, about 30° pitched on the foot) read as if turned 180° about z: the warning names the map."""
+    from footzoo.io import load
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the file's own gaps and spikes (tested with the reader)
+        rec = remount(load(data_file("ipol_gait", "7-2_lf.txt")), np.diag([-1.0, -1.0, 1.0]))
+    res, warned = _run(rec)
+    rep = res.diagnostics["mounting"]
+    assert rep["walks_backwards"] and rep["pitch_reversed"] and rep["suggested_axes"] == "[-x, -y, z]"
+    text = str(next(w for w in warned if "mounting" in str(w.message)).message)
+    assert "--option 'axes=[-x, -y, z]'" in text
