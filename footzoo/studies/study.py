@@ -568,8 +568,12 @@ def _count_recording(r: Any, i: int) -> int:
 
 
 def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
+    if isinstance(r, str):  # a file path or glob alone: {path: GLOB}, its format found as footzoo.load finds it
+        r = {"path": r}
     if not isinstance(r, dict) or not ({"path", "simulate"} & set(r)):
-        raise ConfigError(f"recordings[{i}] must be {{path: GLOB, format: F}} or {{simulate: {{...}}, seeds: [...]}}")
+        raise ConfigError(f"recordings[{i}] must be a file path or glob, {{path: GLOB}} with optional format:, label:, "
+                          f"group: and reader options (foot:, axes:, sidecar: ...), or {{simulate: {{...}}, seeds: "
+                          f"[...]}}; got {r!r:.80}")
     group = r.get("group")
     if group is not None and not isinstance(group, (str, int)):
         raise ConfigError(f"recordings[{i}].group must be a group name (text), got {group!r}")

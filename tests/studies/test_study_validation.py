@@ -161,3 +161,15 @@ def test_one_file_read_for_each_foot_is_named_after_the_foot(tmp_path):
         == ["L", "imu_sample"]
     with pytest.raises(ConfigError, match="both called 'imu_sample_left'"):  # the same foot twice is still refused
         Study.from_dict({"name": "f", "base": "yun2012", "recordings": [feet[0], feet[0]]})
+
+
+def test_a_recording_given_as_a_path_alone_is_read_as_that_file(tmp_path):
+    for name in ("a.csv", "b.csv"):
+        (tmp_path / name).write_text("t\n")
+    study = Study.from_dict({"name": "p", "base": "yun2012", "recordings": [str(tmp_path / "a.csv"), "b.csv"]},
+                            root=tmp_path)  # an absolute path, and one relative to the study file
+    assert [(r.label, r.path, r.format) for r in study.recordings] == [
+        ("a", str(tmp_path / "a.csv"), None), ("b", str(tmp_path / "b.csv"), None)]
+    with pytest.raises(ConfigError, match=r"recordings\[0\] must be a file path or glob, \{path: GLOB\} with optional "
+                                          r"format:.*got 3"):
+        Study.from_dict({"name": "p", "base": "yun2012", "recordings": [3]})
