@@ -206,6 +206,7 @@ class Recording:
         gyr_unit: str = "rad/s",
         dist_unit: str = "m",
         time_col: str = "t",
+        rate: float | None = None,
         duplicates: str = "error",
         nan_policy: str = "error",
         max_gap: float | None = None,
@@ -227,6 +228,11 @@ class Recording:
             Unit of the gyr columns.
         dist_unit : {"m", "cm", "mm"}
             Unit of the dist columns.
+        time_col : str
+            The time column (s).
+        rate : float, optional
+            Sampling rate (Hz) of a table with no time column: ``t = row / rate`` (a logger that writes no time
+            stamps). Refused when the table has the time column too.
         duplicates : {"error", "drop"}
             What to do with rows whose time stamp repeats the previous one.
             ``"drop"`` keeps the first and warns with the count.
@@ -244,12 +250,20 @@ class Recording:
         _check_choice("nan_policy", nan_policy, ("error", "interpolate"))
         if len(df) == 0:
             raise RecordingError("the recording is empty (0 rows); check the file and its header")
+        if rate is not None:
+            rate = check_positive("rate", rate, unit="Hz")
+            if time_col in df.columns:
+                raise RecordingError(f"the table has a time column {time_col!r} and rate={rate:g} Hz is given too: "
+                                     "give rate only for a table with no time column (t = row / rate)")
+            df = df.assign(**{time_col: np.arange(len(df)) / rate})
         required = [time_col, *ACC_COLS, *GYR_COLS]
         missing = [c for c in required if c not in df.columns]
         if missing:
             raise RecordingError(
                 f"missing column(s) {missing}; a recording needs {required} "
                 f"(found {list(df.columns)[:12]}). Rename the columns or use a reader from footzoo.io"
+                + (f"; a table with no time column: Recording.from_dataframe(..., rate=HZ) makes {time_col!r} = row / "
+                   "rate" if time_col in missing else "")
             )
         has_mag = all(c in df.columns for c in MAG_COLS)
         partial_mag = [c for c in MAG_COLS if c in df.columns]

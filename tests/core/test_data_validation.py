@@ -6,9 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo import Recording, RecordingError
-from footzoo.core.data import Truth
+from footzoo import ConfigError, Recording, RecordingError
+from footzoo.core.data import ACC_COLS, GYR_COLS, Truth
 from footzoo.core.errors import FootzooWarning
+from footzoo.sim import simulate
 
 
 def frame(n=400, rate=100.0, acc_scale=1.0, gyr_scale=1.0):
@@ -212,3 +213,17 @@ def test_in_a_study_the_data_checks_name_the_recording_entrys_key():
     with pytest.raises(ValueError, match="place must be one of"):
         with used_from("notebook"):
             pass
+
+
+def test_a_table_with_no_time_column_takes_its_rate():
+    walk = simulate(n_strides=2, rate=50.0)
+    df = pd.DataFrame(np.column_stack([walk.acc, walk.gyr]), columns=[*ACC_COLS, *GYR_COLS])
+    rec = Recording.from_dataframe(df, rate=50.0)
+    np.testing.assert_allclose(rec.t, walk.t - walk.t[0], rtol=0, atol=1e-12)  # the simulator's clock, from 0
+    assert rec.rate == pytest.approx(50.0)
+    with pytest.raises(RecordingError, match=r"no time column: Recording.from_dataframe\(\.\.\., rate=HZ\)"):
+        Recording.from_dataframe(df)
+    with pytest.raises(RecordingError, match=r"has a time column 't' and rate=50 Hz is given too"):
+        Recording.from_dataframe(df.assign(t=walk.t), rate=50.0)
+    with pytest.raises(ConfigError, match="rate"):
+        Recording.from_dataframe(df, rate=-5)
