@@ -46,11 +46,10 @@ from typing import Any
 
 import numpy as np
 
-from ..core.conventions import axis_map_text, quat_to_matrix
+from ..core.conventions import axis_map_text, proper_axis_maps, quat_to_matrix
 from ..core.errors import FormatError, SensorWarning
 from ..io.axes import axes_fix, parse_axes
 from ..kernels.jit import njit
-from ..sim.mounting import proper_axis_permutations
 from .gait_events import sagittal_rate, stride_directions
 
 #: Fewest strides for a mounting estimate.
@@ -78,14 +77,14 @@ def nearest_rotation(a: np.ndarray) -> np.ndarray:
 def nearest_axis_map(a: np.ndarray) -> np.ndarray | None:
     """The proper signed permutation nearest to the rotation ``a`` (3, 3), or None if two are about as near.
 
-    Nearest in the Frobenius norm among the 24 (:func:`footzoo.sim.mounting.proper_axis_permutations`): the
+    Nearest in the Frobenius norm among the 24 (:func:`footzoo.core.conventions.proper_axis_maps`): the
     largest ``trace(Pᵀ a) = 1 + 2 cos θ``, ``θ`` the angle between them. A sensor tilted on the foot by a few tens
     of degrees (the IPOL set's MTw sits 30-45° pitched) may have two axes nearest the same foot axis; the
     permutation nearest as a whole then still names its map, unless the runner-up is less than
     :data:`AMBIGUOUS_TRACE` behind (a sensor turned about 45°, halfway between two maps): None. When each row's
     largest entry is in its own column, that permutation is the nearest.
     """
-    maps = proper_axis_permutations()
+    maps = proper_axis_maps()
     score = np.array([float(np.sum(p * a)) for p in maps])
     order = np.argsort(score)[::-1]
     best = maps[order[0]]

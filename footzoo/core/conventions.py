@@ -21,6 +21,8 @@ axes broadcast) and never modify their inputs.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 #: Standard gravity used by default (m/s²).
@@ -62,6 +64,18 @@ def axis_map_text(rows: np.ndarray) -> str:
             return "[" + ", ".join("[" + ", ".join(f"{v:.6g}" if v else "0" for v in r) + "]" for r in m) + "]"
         names.append(("-" if row[k] < 0 else "") + "xyz"[k])
     return "[" + ", ".join(names) + "]"
+
+
+def proper_axis_maps() -> list[np.ndarray]:
+    """The 24 axis maps that are rotations (signed permutations with determinant +1), ``[x, y, z]`` first."""
+    out = []
+    for perm in itertools.permutations(range(3)):
+        for signs in itertools.product((1.0, -1.0), repeat=3):
+            m = np.zeros((3, 3))
+            m[np.arange(3), perm] = signs
+            if np.linalg.det(m) > 0:
+                out.append(m)
+    return out
 
 
 def gravity_ned(g: float = GRAVITY) -> np.ndarray:

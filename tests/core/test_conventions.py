@@ -5,6 +5,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from footzoo.core.conventions import (
+    axis_map_text,
+    proper_axis_maps,
     quat_conj,
     quat_from_euler,
     quat_from_matrix,
@@ -106,3 +108,11 @@ def test_skew_and_wrap():
     np.testing.assert_allclose(skew(a) @ b, np.cross(a, b))
     assert wrap_angle(3 * np.pi) == pytest.approx(np.pi)
     assert wrap_angle(-3 * np.pi / 2) == pytest.approx(np.pi / 2)
+
+
+def test_the_proper_axis_maps_are_the_24_rotations_of_a_cube():
+    maps = proper_axis_maps()
+    assert len({axis_map_text(m) for m in maps}) == 24 and axis_map_text(maps[0]) == "[x, y, z]"
+    for m in maps:  # each a rotation: orthonormal, determinant +1, one ±1 per row
+        np.testing.assert_allclose(m @ m.T, np.eye(3), atol=0)
+        assert np.linalg.det(m) == pytest.approx(1.0) and np.all(np.count_nonzero(m, axis=1) == 1)
