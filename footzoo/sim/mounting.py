@@ -8,24 +8,17 @@ recording with a wrong but right-handed axis map is the same thing: the data of 
 from __future__ import annotations
 
 from dataclasses import replace
-from itertools import permutations, product
 
 import numpy as np
 
-from ..core.conventions import axis_map_text, quat_from_matrix, quat_mul
+from ..core.conventions import axis_map_text, proper_axis_maps, quat_from_matrix, quat_mul
 from ..core.data import Recording
 
 
 def proper_axis_permutations() -> list[np.ndarray]:
-    """The 24 signed permutation matrices with determinant +1 (the rotations of a cube), identity first."""
-    out = []
-    for perm in permutations(range(3)):
-        for signs in product((1.0, -1.0), repeat=3):
-            m = np.zeros((3, 3))
-            m[np.arange(3), perm] = signs
-            if np.linalg.det(m) > 0:
-                out.append(m)
-    return out
+    """The 24 signed permutation matrices with determinant +1 (the rotations of a cube), identity first
+    (:func:`footzoo.core.conventions.proper_axis_maps`)."""
+    return proper_axis_maps()
 
 
 def axis_map_name(m: np.ndarray) -> str:
