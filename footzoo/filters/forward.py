@@ -39,7 +39,7 @@ from __future__ import annotations
 from ..kernels.dispatch import by_type
 from ..kernels.jit import njit
 from ..kernels.views import unowned
-from .measurement import BA, BG, P, Q, V
+from .measurement import BA, BG, P, Q, V, row_fault, row_problem
 from .process_noise import add_process_noise, unowned_noise
 from .recorders import before, begin, end, row, transition, updated, views
 from .smoother import feed_back_attitude, unowned_trajectory
@@ -289,7 +289,8 @@ def measure(measures, arrays, k, t_k, state, w, st, data_k):
     """The corrections' measurement rows of sample ``k`` (``data_k``: its row of inputs), stacked; returns their count.
 
     Each model gets ``z``, ``H`` and ``R`` cut at the rows it declared. A model whose ``measure``
-    returns fewer rows than it was given or more than it declared is refused: the rows before it
+    returns fewer rows than it was given or more than it declared, or writes a row no update can use
+    (:func:`~footzoo.filters.measurement.row_problem`), is refused: the rows before it
     are kept, the first such fault is written to ``w.fault`` (the loop runs on, cheaper than a loop
     that can stop early; the engine then raises it).
     """
@@ -304,6 +305,11 @@ def measure(measures, arrays, k, t_k, state, w, st, data_k):
         if m_new < m or m_new > top:  # refused; the first such fault is kept for the engine to raise
             if fault.model[0] < 0:
                 fault.model[0], fault.rows[0], fault.sample[0] = j, m_new - m, k
+            return m
+        problem, row = row_problem(z, H, R, m, m_new)
+        if problem:  # a row no update can use (R not positive, NaN): refused the same way
+            if fault.model[0] < 0:
+                fault.model[0], fault.rows[0], fault.sample[0] = j, row_fault(problem, row - m), k
             return m
         m = m_new
     return m

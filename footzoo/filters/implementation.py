@@ -19,7 +19,7 @@ import numpy as np
 from ..core.errors import PluginError
 from ..kernels.functions import trusted
 from .eskf import Layout
-from .measurement import CORE_BLOCKS, MeasurementModel
+from .measurement import BAD_ROW, CORE_BLOCKS, ROW_PROBLEMS, ROWS_PER_PROBLEM, MeasurementModel
 from .process_noise import Noise
 from .recorders import SAMPLE_KEYS, from_columns
 from .smoothing import Smoothing
@@ -125,7 +125,8 @@ class RowCountError(TypeError):
 
 def model_fault(setup: Setup, j: int, rows: int, k: int, caught: list[BaseException], where: str) -> PluginError:
     """The :class:`~footzoo.core.errors.PluginError` of model ``j`` (−1: not known) that broke its contract at
-    sample ``k`` in ``where`` (the engine's loop): a row count ``rows`` outside ``[m, m + max_rows]``, or an
+    sample ``k`` in ``where`` (the engine's loop): a row count ``rows`` outside ``[m, m + max_rows]`` (or, from
+    :data:`~footzoo.filters.measurement.BAD_ROW` on, a row no update can use), or an
     exception ``caught`` in one of its functions."""
     names, models = setup.names, setup.models
     suspects = [name for name, m in zip(names, models, strict=True)
@@ -140,6 +141,12 @@ def model_fault(setup: Setup, j: int, rows: int, k: int, caught: list[BaseExcept
         return PluginError(f"{who}: a measurement function failed inside {where} ({text}) at sample {k} or before; "
                            "a write outside the rows its model declares (max_rows) or outside its par/mem/data "
                            f"arrays is refused: fix the function{hint}", plugin=who, method="measure")
+    if rows >= BAD_ROW:
+        problem, row = divmod(rows - BAD_ROW, ROWS_PER_PROBLEM)
+        return PluginError(f"{who}: its measure function wrote a row no Kalman update can use at sample {k}: row {row} "
+                           f"of its own has {ROW_PROBLEMS[problem]}; write a positive, finite variance R and finite z "
+                           "and H (skip the row, return m unchanged, when there is nothing to measure)",
+                           plugin=who, method="measure")
     fix = "return m plus the rows written (at most max_rows), or raise max_rows in its MeasurementModel"
     if rows >= 0:
         problem = f"returned {rows} rows at sample {k}, but its model declares max_rows={models[j].max_rows}"

@@ -53,7 +53,9 @@ The three functions (compile them with :func:`measurement_function`,
     rows. A plug-in's functions are compiled with bounds checks, so a write
     past the end (or outside ``par``, ``mem``, ``data``) is refused, and so is
     a returned row count outside ``[m, m + max_rows]``: both are the plug-in's
-    :class:`~footzoo.core.errors.PluginError`.
+    :class:`~footzoo.core.errors.PluginError`. So is a row no update can use:
+    an ``R`` that is not a positive finite number, a ``z`` or an ``H`` entry
+    that is NaN or infinite (:func:`row_problem`).
 ``rows.m`` (int)
     The first free row; ``measure`` returns the next free row (``rows.m`` when
     there is nothing to measure).
@@ -355,6 +357,43 @@ class MeasurementModel:
             data=self.data, feedback=_compile(self.feedback, "feedback"), after=_compile(self.after, "after"),
             block_names=self.block_names, diagnostics=self.diagnostics,
         )
+
+
+#: ``Fault.rows`` of a model that wrote a row no update can use: ``BAD_ROW + ROWS_PER_PROBLEM * problem + row``
+#: (never a row count); the problems are :data:`ROW_PROBLEMS`' keys.
+BAD_ROW = 1 << 40
+ROWS_PER_PROBLEM = 1 << 20
+#: What :func:`row_problem`'s codes mean, as the error names them.
+ROW_PROBLEMS = {
+    1: "R (the row's measurement variance) that is not a positive number",
+    2: "R that is NaN or infinite",
+    3: "z (the residual) that is NaN or infinite",
+    4: "H (the measurement matrix) with a NaN or infinite entry",
+}
+
+
+@njit(inline=True)
+def row_problem(z: np.ndarray, H: np.ndarray, R: np.ndarray, m0: int, m1: int) -> tuple[int, int]:
+    """The first row of ``m0 … m1 − 1`` no Kalman update can use and its problem (a key of :data:`ROW_PROBLEMS`);
+    ``(0, -1)`` when every row is usable."""
+    for i in range(m0, m1):
+        r = R[i]
+        if not math.isfinite(r):
+            return 2, i
+        if r <= 0.0:
+            return 1, i
+        if not math.isfinite(z[i]):
+            return 3, i
+        for c in range(H.shape[1]):
+            if not math.isfinite(H[i, c]):
+                return 4, i
+    return 0, -1
+
+
+@njit(inline=True)
+def row_fault(problem: int, row: int) -> int:
+    """``Fault.rows`` for ``problem`` in ``row`` (see :data:`BAD_ROW`)."""
+    return BAD_ROW + ROWS_PER_PROBLEM * problem + row
 
 
 @njit(inline=True)

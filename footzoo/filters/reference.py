@@ -19,7 +19,7 @@ import numpy as np
 from ..core.conventions import quat_from_rotvec, quat_mul, quat_to_matrix
 from .eskf import ErrorStateFilter, Layout, transition
 from .implementation import TRAJECTORY, Implementation, RowCountError, model_fault
-from .measurement import BA, BG, MeasurementModel, P, Q, V, calling
+from .measurement import BA, BG, MeasurementModel, P, Q, V, calling, row_fault, row_problem
 from .process_noise import velocity_variance
 from .recorders import ROW_KEYS, SAMPLE_KEYS, columns, packed, record
 from .smoothing import Smoothing
@@ -180,6 +180,9 @@ class Loop:
             m_new = row_count(j, self.k0 + k, call(j, self.k0 + k, self.measures[j], *a, z[:top], H[:top], R[:top], m))
             if m_new < m or m_new > top:
                 raise ModelFault(j, m_new - m, self.k0 + k)
+            problem, row = row_problem(z, H, R, m, m_new)
+            if problem:
+                raise ModelFault(j, row_fault(problem, row - m), self.k0 + k)
             m = m_new
         return z[:m], H[:m], R[:m]
 

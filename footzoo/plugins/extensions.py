@@ -155,7 +155,7 @@ def load_entry_points() -> list[dict[str, Any]]:
             dist = getattr(getattr(ep, "dist", None), "name", None) or "an installed package"
             try:
                 ep.load()
-            except (KeyboardInterrupt, MemoryError):
+            except KeyboardInterrupt:
                 raise
             except BaseException as err:  # noqa: BLE001 - any failure of third-party code is a named footzoo error
                 raise PluginImportError(
@@ -231,7 +231,7 @@ def _load_file(path: Path, label: str) -> dict[str, Any]:
     sys.modules[name] = module  # before executing: dataclasses, pickling and registration look it up
     try:
         exec(code, module.__dict__)
-    except (KeyboardInterrupt, MemoryError):
+    except KeyboardInterrupt:
         _restore(name, previous)
         raise
     except BaseException as err:  # noqa: BLE001 - a plug-in's import failure (sys.exit() too) is a named error
@@ -260,7 +260,7 @@ def _load_module(name: str, label: str, base_dir: str | Path | None = None) -> d
     except SyntaxError as err:
         raise ConfigError(f"{label}: syntax error in plug-in module {name!r}, file {err.filename}, line {err.lineno}: "
                           f"{err.msg}; fix the file") from None
-    except (KeyboardInterrupt, MemoryError):
+    except KeyboardInterrupt:
         raise
     except BaseException as err:  # noqa: BLE001 - a plug-in's import failure (sys.exit() too) is a named error
         raise PluginImportError(f"{label}: importing plug-in module {name!r} failed: {_cause(err)}",
@@ -293,7 +293,14 @@ def _cause(err: BaseException) -> str:
     if isinstance(err, SystemExit):
         return (f"it called sys.exit({err.code!r}) (SystemExit) while being imported; a plug-in must raise an "
                 "exception, never exit the process: remove the exit")
-    return f"{type(err).__name__}: {err}"
+    if isinstance(err, MemoryError):
+        return ("MemoryError: it ran out of memory while being imported (an array too large for this machine at "
+                "import time?); allocate in the plug-in's methods, sized by the recording")
+    try:
+        text = str(err)
+    except Exception as inner:  # noqa: BLE001 - an exception whose message itself fails is still named
+        text = f"(its message could not be printed: {type(inner).__name__})"
+    return f"{type(err).__name__}: {text}" if text else type(err).__name__
 
 
 def _where(err: BaseException, path: Path) -> str:
