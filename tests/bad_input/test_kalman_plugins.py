@@ -256,3 +256,78 @@ def test_the_fault_capture_survives_a_replaced_hook_and_restores_it(walk):
             assert sys.unraisablehook is theirs
     finally:
         sys.unraisablehook = before
+
+
+def unusable_rows(ctx, rows):
+    """Plain Python: a zero-velocity update whose row values come from ``par``: H's entry, the factor of z, R."""
+    k, t, nav, w, f, stance, idx, par, mem, data = ctx
+    z, H, R, m = rows
+    if not stance:
+        return m
+    for i in range(3):
+        H[m, idx[VEL] + i] = par[0]
+        z[m] = nav[7 + i] * par[1]
+        R[m] = par[2]
+        m += 1
+    return m
+
+
+#: (H entry, factor of z, R) -> the problem the error names; z's factor inf gives inf or NaN (0 * inf)
+UNUSABLE = {"R zero": ((1.0, 1.0, 0.0), "R .* not a positive number"),
+            "R negative": ((1.0, 1.0, -0.01), "R .* not a positive number"),
+            "R NaN": ((1.0, 1.0, np.nan), "R that is NaN or infinite"),
+            "R inf": ((1.0, 1.0, np.inf), "R that is NaN or infinite"),
+            "z inf": ((1.0, np.inf, 0.01), "z .* NaN or infinite"),
+            "H NaN": ((np.nan, 1.0, 0.01), "H .* NaN or infinite entry")}
+
+
+class Unusable(KalmanCorrection):
+    """Rows no Kalman update can use, their values given as ``values`` (H entry, factor of z, R)."""
+
+    name = "test_unusable_rows"
+    paper = "none: a test of the measurement model's contract"
+    values = (1.0, 1.0, 0.01)
+    measure = staticmethod(unusable_rows)
+
+    def model(self, samples):
+        return MeasurementModel(measure=self.measure, max_rows=3, par=np.array(self.values, float))
+
+
+@pytest.mark.parametrize("problem", UNUSABLE)
+def test_a_row_no_update_can_use_is_a_plugin_error_naming_the_problem(problem, walk):
+    """A variance that is not positive or a NaN/inf residual or matrix entry used to run on silently (a negative R
+    makes the update's covariance indefinite; a NaN one spreads through the whole state)."""
+    values, cause = UNUSABLE[problem]
+    cls = type("UnusableNow", (Unusable,), {"values": values})
+    footzoo.register(cls)
+    try:
+        with pytest.raises(PluginError, match=f"test_unusable_rows': its measure function wrote a row no Kalman "
+                                              f"update can use at sample \\d+: row 0 of its own has {cause}") as info:
+            Pipeline.from_dict({**_config("honest"), "corrections": [{"type": "test_unusable_rows"}]}).run(
+                walk, engine="reference")
+        assert info.value.method == "measure" and "positive, finite variance R" in str(info.value)
+    finally:
+        from footzoo.plugins import registry
+
+        registry._REGISTRY[cls.kind].pop(cls.name, None)
+
+
+# slow: compiles the forward loop for a signature no shipped config has (as the smoothed runs above)
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["batch", "rts", "live"])
+def test_the_compiled_loops_refuse_a_row_no_update_can_use(how, walk):
+    from footzoo.filters.measurement import measurement_function
+    from footzoo.plugins import registry
+
+    cls = type("UnusableCompiled", (Unusable,), {"values": (1.0, 1.0, -0.01),
+                                                 "measure": staticmethod(measurement_function(unusable_rows))})
+    footzoo.register(cls)
+    config = {**_config("honest"), "corrections": [{"type": "ekf_zupt"}, {"type": "test_unusable_rows"}]}
+    try:
+        with pytest.raises(PluginError, match="test_unusable_rows'.*R .* not a positive number"):
+            if how == "live":
+                Stream(Pipeline.from_dict(config), rate=walk.rate).run(walk)
+            else:
+                Pipeline.from_dict({**config, **({"smoother": "rts"} if how == "rts" else {})}).run(walk)
+    finally:
+        registry._REGISTRY[cls.kind].pop(cls.name, None)

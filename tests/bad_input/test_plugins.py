@@ -286,12 +286,26 @@ def test_live_a_mutating_plugin_cannot_change_the_pushed_samples(walk):
     np.testing.assert_array_equal(walk.gyr, gyr)
 
 
-def test_a_plugin_file_that_exits_on_import_is_a_plugin_error(tmp_path):
-    bad = tmp_path / "exits.py"
-    bad.write_text("import sys\nsys.exit(0)\n")
-    with pytest.raises(PluginImportError, match=r"sys.exit\(0\).*never exit the process") as info:
+IMPORT_FAILURES = {
+    "exits": ("import sys\nsys.exit(0)\n", r"sys.exit\(0\).*never exit the process"),
+    # an allocation too large at import is the plug-in's, not "use a smaller recording"
+    "out_of_memory": ("raise MemoryError()\n",
+                      r"MemoryError: it ran out of memory while being imported.*plug-in's methods"),
+    # an exception whose message itself raises is still named, not an internal error
+    "unprintable": ("class Odd(Exception):\n    def __str__(self):\n        raise RuntimeError('no')\nraise Odd()\n",
+                    r"at line 4: Odd: \(its message could not be printed: RuntimeError\)"),
+}
+
+
+@pytest.mark.parametrize("how", IMPORT_FAILURES)
+def test_a_plugin_file_that_fails_on_import_is_a_plugin_error_naming_it(how, tmp_path):
+    source, cause = IMPORT_FAILURES[how]
+    bad = tmp_path / f"{how}.py"
+    bad.write_text(source)
+    with pytest.raises(PluginImportError, match=cause) as info:
         load_plugins([str(bad)])
     assert isinstance(info.value, ConfigError) and info.value.method == "import"
+    assert f"{how}.py" in str(info.value)
 
 
 
