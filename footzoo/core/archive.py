@@ -350,6 +350,9 @@ def _prepare_folder(path: str | os.PathLike, what: str) -> Path:
         raise OutputError(f"{what}: give a folder path (got {path!r:.80})")
     if nul_in_path(path):
         raise OutputError(f"{what} {nul_in_path(path)}")
+    if isinstance(path, str) and path.strip() == "-":  # as the command line's --out: not a stream
+        raise OutputError(f"{what}: '-' means standard output to most tools, but a result is a folder of tables and "
+                          "JSON files; give a folder name (for a folder really named '-', write './-')")
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{what} {str(folder)!r} is a file; a result is saved as a folder: choose a folder name")

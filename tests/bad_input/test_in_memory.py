@@ -1,5 +1,5 @@
-"""Bad input in memory: complex samples, a path given for a recording, a result folder named like a file, a session
-run without a pipeline."""
+"""Bad input in memory: complex samples, a path given for a recording, a result folder named like a file or '-', a
+session run without a pipeline."""
 
 from __future__ import annotations
 
@@ -42,6 +42,19 @@ def test_a_result_folder_named_like_a_file_is_refused(sim_walk, tmp_path):
         res.save(tmp_path / "result.xlsx")
     assert not (tmp_path / "result.xlsx").exists()
     assert res.save(tmp_path / "result.v2").is_dir()  # a dotted folder name that is no file type is fine
+
+
+@pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)
+def test_a_result_saved_to_dash_is_refused_as_on_the_command_line(sim_walk, tmp_path, monkeypatch):
+    """'-' (standard output to most tools) used to create a folder named '-'; './-' still names such a folder."""
+    from footzoo.core.errors import OutputError
+
+    monkeypatch.chdir(tmp_path)
+    res = footzoo.Pipeline.from_yaml("yun2012").run(sim_walk)
+    with pytest.raises(OutputError, match=r"Result.save: '-' means standard output.*give a folder name.*'\./-'"):
+        res.save("-")
+    assert not (tmp_path / "-").exists()
+    assert res.save("./-").is_dir() and footzoo.Result.load("./-").steps.shape == res.steps.shape
 
 
 def test_a_session_run_without_a_pipeline_says_how_to_build_one(sim_walk):
