@@ -232,6 +232,10 @@ def validate_block(
     arrays = []
     for name, value, bound, unit in (("acc", acc, ACC_MAX, "m/s^2"), ("gyr", gyr, GYR_MAX, "rad/s"),
                                      ("mag", mag, None, "")):
+        if value is None and name != "mag":  # a sensor that stopped sending it: not an optional channel
+            raise RecordingError(f"{name} is missing (None) in the block from t = {shown(tf[0])}: every sample "
+                                 f"needs {name} ({unit}, 3 numbers, here ({n}, 3)); a sensor that dropped out cannot "
+                                 "be bridged: repair the gap or end the stream there")
         if value is None:
             arrays.append(None)
             continue

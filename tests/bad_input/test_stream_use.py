@@ -60,6 +60,15 @@ def _gyr_missing(pipeline, walk, first: int):
     return action
 
 
+def _block_missing(pipeline, walk, first: int, channel: str):
+    def action():
+        stream = Stream(pipeline, rate=walk.rate)
+        stream.extend(walk.t[:first], walk.acc[:first], walk.gyr[:first])
+        block = {"acc": walk.acc[first:first + 50], "gyr": walk.gyr[first:first + 50], channel: None}
+        stream.extend(walk.t[first:first + 50], block["acc"], block["gyr"])
+    return action
+
+
 USES = [
     ("run-twice", lambda p, w: _run_then(p, w, lambda s: s.run(w)),
      "Stream.run(): this stream has run (or was closed) already; a stream takes one recording: make a new Stream"),
@@ -78,6 +87,13 @@ USES = [
     ("gyr-missing", lambda p, w: _gyr_missing(p, w, 150),
      "gyr is missing (None) at t = 1.5: every sample needs gyr (rad/s, 3 numbers); a sensor that dropped out cannot "
      "be bridged"),
+    # a block (extend) without one of the two channels every sample needs: was "zero-dimensional arrays cannot be
+    # concatenated" from inside the stream
+    ("gyr-missing-block", lambda p, w: _block_missing(p, w, 150, "gyr"),
+     "gyr is missing (None) in the block from t = 1.5: every sample needs gyr (rad/s, 3 numbers, here (50, 3)); a "
+     "sensor that dropped out cannot be bridged"),
+    ("acc-missing-block", lambda p, w: _block_missing(p, w, 150, "acc"),
+     "acc is missing (None) in the block from t = 1.5: every sample needs acc (m/s^2, 3 numbers, here (50, 3))"),
 ]
 
 
