@@ -23,7 +23,6 @@ import pandas as pd
 
 from footzoo.analysis.gait_events import contact_times, sagittal_rate, segment_argext
 from footzoo.analysis.strides import real_stances
-from footzoo.core.conventions import quat_rotate
 from footzoo.evaluation.metrics import gait_phase_errors, match_strides, reference_steps, stride_errors
 from footzoo.runtime.pipeline import Pipeline
 from footzoo.sim import NoiseModel, simulate
@@ -95,7 +94,6 @@ def landmarks(rec, res) -> pd.DataFrame:
     lo = np.minimum(mid[:-1], p)
     j = segment_argext(w, lo, np.maximum(p, lo + 1), largest=False)
     mids = _mid(t, np.arange(n))
-    f_n = quat_rotate(q, rec.acc)  # the specific force in NED, as the library's steps table takes it
     rows = []
     for i in range(len(p)):
         if not (w[p[i]] > 0 > w[j[i]]):
@@ -103,7 +101,7 @@ def landmarks(rec, res) -> pd.DataFrame:
         ic = _crossing(t, w, p[i], mid[i + 1], 0.0, up=False)
         k = int(np.searchsorted(mids, ic)) if np.isfinite(ic) else mid[i + 1]
         m = k + int(np.argmin(w[k:min(k + int(0.15 * rec.rate), mid[i + 1]) + 1])) if k < mid[i + 1] else k
-        contact = float(contact_times(t, f_n, np.array([ic]), mid[i + 1:i + 2], np.array([True]))[0]) \
+        contact = float(contact_times(t, rec.acc, np.array([ic]), mid[i + 1:i + 2], np.array([True]), q)[0]) \
             if np.isfinite(ic) else np.nan
         rows.append({"push-off peak": float(_mid(t, np.array([j[i]]))[0]),
                      "half-way back (TO)": _crossing(t, w, j[i], p[i], 0.5 * w[j[i]], up=True),

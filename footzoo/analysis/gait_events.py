@@ -260,26 +260,57 @@ def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: n
     return out
 
 
-@njit
-def _contact_kernel(mids: np.ndarray, acc: np.ndarray, pitch: np.ndarray, first: np.ndarray, stop: np.ndarray,
-                    level: float, least: float, out: np.ndarray) -> None:
-    """``out[i]``: when ``‖f_k − f_{first−1}‖`` first reaches ``level`` of its largest value in ``[first_i, stop_i)``.
+@njit(inline=True)
+def _interval_middle(t: np.ndarray, k: int, first_interval: float) -> float:
+    """The middle of sample ``k``'s interval ``(t[k-1], t[k]]`` (s); the first sample's is ``first_interval`` long."""
+    return t[k] - 0.5 * (t[k] - t[k - 1]) if k > 0 else t[0] - 0.5 * first_interval
 
-    Walks back from the largest change to the first sample of the run at or above the level and
-    interpolates linearly between the interval middles ``mids`` (the change is 0 at ``first − 1``);
-    never before ``pitch[i]``. ``out[i] = pitch[i]`` where the window has fewer than two samples.
+
+@njit(inline=True)
+def _force(acc: np.ndarray, quat: np.ndarray, k: int, out: np.ndarray) -> None:
+    """``out = C(q_k) f_k``: sample ``k``'s specific force in NED (as given where ``quat`` has no rows)."""
+    fx, fy, fz = acc[k, 0], acc[k, 1], acc[k, 2]
+    if quat.shape[0] == 0:
+        out[0], out[1], out[2] = fx, fy, fz
+        return
+    w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
+    out[0] = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
+    out[1] = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
+    out[2] = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz
+
+
+@njit
+def _contact_kernel(t: np.ndarray, first_interval: float, acc: np.ndarray, quat: np.ndarray, pitch: np.ndarray,
+                    start: np.ndarray, stop: np.ndarray, window: float, level: float, least: float,
+                    out: np.ndarray) -> None:
+    """``out[i]``: when ``‖f_k − f_{a−1}‖`` first reaches ``level`` of its largest value over the samples ``k`` whose
+    interval middles lie in ``[pitch_i, pitch_i + window)``, before ``stop_i`` (``a``: the first of them).
+
+    The search for ``a`` starts at ``start_i`` (−1: no largest pitch, ``out[i] = pitch[i]``). Walks back from the
+    largest change to the first sample of the run at or above the level and interpolates linearly between the
+    interval middles (the change is 0 at ``a − 1``); never before ``pitch[i]``. ``out[i] = pitch[i]`` where the
+    window has fewer than two samples or the largest change is below ``least``. Only the windows' samples are
+    rotated (``f`` in NED with ``quat``, :func:`_force`).
     """
+    n = t.shape[0]
+    base, f = np.empty(3), np.empty(3)
     for i in range(pitch.shape[0]):
         out[i] = pitch[i]
-        a, b = first[i], stop[i]
+        if start[i] < 0:
+            continue
+        a = start[i]
+        while a < n and _interval_middle(t, a, first_interval) < pitch[i]:
+            a += 1
+        b, lim = a, min(stop[i], n)
+        while b < lim and _interval_middle(t, b, first_interval) < pitch[i] + window:
+            b += 1
         if a < 1 or b - a < 2:
             continue
+        _force(acc, quat, a - 1, base)
         e = np.empty(b - a)
         for k in range(a, b):
-            s = 0.0
-            for j in range(acc.shape[1]):
-                s += (acc[k, j] - acc[a - 1, j]) ** 2
-            e[k - a] = np.sqrt(s)
+            _force(acc, quat, k, f)
+            e[k - a] = np.sqrt((f[0] - base[0]) ** 2 + (f[1] - base[1]) ** 2 + (f[2] - base[2]) ** 2)
         top = int(np.argmax(e))
         lev = level * e[top]
         if e[top] < least:
@@ -289,12 +320,13 @@ def _contact_kernel(mids: np.ndarray, acc: np.ndarray, pitch: np.ndarray, first:
             k -= 1
         prev = e[k - 1] if k > 0 else 0.0
         frac = (lev - prev) / (e[k] - prev) if e[k] > prev else 1.0
-        when = mids[a + k - 1] + frac * (mids[a + k] - mids[a + k - 1])
+        m0 = _interval_middle(t, a + k - 1, first_interval)
+        when = m0 + frac * (_interval_middle(t, a + k, first_interval) - m0)
         out[i] = max(pitch[i], when)
 
 
 def contact_times(t: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.ndarray,
-                  ok: np.ndarray) -> np.ndarray:
+                  ok: np.ndarray, quat: np.ndarray | None = None) -> np.ndarray:
     """Initial contacts (s): the heel's impact after each swing's largest pitch (see the module docstring).
 
     Parameters
@@ -302,29 +334,31 @@ def contact_times(t: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.nd
     t : (N,) ndarray
         Time (s).
     acc : (N, 3) ndarray
-        Specific force in the sensor frame (m/s²); only the norm of its changes is used, so any
-        frame and mounting give the same contacts.
+        Specific force in the sensor frame (m/s²).
     pitch : (K,) ndarray
         Each swing's largest pitch, the zero crossing of ``ω_ml`` (s).
     stop : (K,) int ndarray
         The search ends before this sample at the latest (the middle of the next stance).
     ok : (K,) bool ndarray
         Swings whose largest pitch was found; the others keep ``pitch``.
+    quat : (N, 4) ndarray, optional
+        Attitude (scalar-first, body to NED): the change is measured in the navigation frame,
+        where the turning of gravity's projection does not count; without it, in the sensor frame.
+        Either way only its norm counts, so any mounting gives the same contacts.
     """
-    ts = np.asarray(t, dtype=float)
-    mids = ts - 0.5 * np.diff(ts, prepend=ts[0] - (np.median(np.diff(ts)) if len(ts) > 1 else 0.0))
-    first = np.searchsorted(mids, pitch, side="left").astype(np.int64)
-    end = np.searchsorted(mids, pitch + CONTACT_WINDOW, side="left").astype(np.int64)
-    end = np.minimum(np.minimum(end, np.asarray(stop, dtype=np.int64)), len(ts))
-    first = np.where(ok, first, 0)
+    ts = np.ascontiguousarray(t, dtype=float)
+    pitch = np.asarray(pitch, dtype=float)
+    first_interval = float(np.median(np.diff(ts[:101]))) if len(ts) > 1 else 0.0
+    start = np.where(ok, np.maximum(np.searchsorted(ts, pitch) - 1, 0), -1).astype(np.int64)
+    q = np.zeros((0, 4)) if quat is None else np.ascontiguousarray(quat, dtype=float)
     out = np.empty(len(pitch))
-    _contact_kernel(mids, np.ascontiguousarray(acc, dtype=float), np.asarray(pitch, dtype=float), first, end,
-                    CONTACT_LEVEL, CONTACT_MIN_CHANGE, out)
+    _contact_kernel(ts, first_interval, np.ascontiguousarray(acc, dtype=float), q, pitch, start,
+                    np.asarray(stop, dtype=np.int64), CONTACT_WINDOW, CONTACT_LEVEL, CONTACT_MIN_CHANGE, out)
     return out
 
 
 def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
-                       acc: np.ndarray | None = None) -> GaitEvents:
+                       acc: np.ndarray | None = None, quat: np.ndarray | None = None) -> GaitEvents:
     """TO and IC of each swing between consecutive stances (see the module docstring for the definitions).
 
     Parameters
@@ -341,6 +375,8 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
         Specific force in the sensor frame (m/s²). IC is the heel's impact after the largest
         pitch (:func:`contact_times`); without it, the largest pitch itself (about 20 ms early
         on real walks).
+    quat : (N, 4) ndarray, optional
+        Attitude (scalar-first, body to NED) in which the impact is measured (:func:`contact_times`).
 
     Returns
     -------
@@ -384,7 +420,7 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
     to = _crossing_times(ts, w, r, level, ok)
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
     pitch = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
-    ic = pitch if acc is None else np.where(ok, contact_times(ts, acc, pitch, mid[1:], ok), pitch)
+    ic = pitch if acc is None else np.where(ok, contact_times(ts, acc, pitch, mid[1:], ok, quat), pitch)
     return GaitEvents(to=to, ic=ic, from_rate=ok, largest_pitch=pitch)
 
 

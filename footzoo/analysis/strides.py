@@ -8,7 +8,6 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..core.conventions import quat_rotate
 from ..evaluation.metrics import intervals
 from .gait_events import detect_gait_events, sagittal_rate, segment_argext
 
@@ -111,8 +110,7 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
     if gyr is not None:
         rate = gyr if quat is None else sagittal if sagittal is not None else sagittal_rate(quat, gyr, pos, st)
         # the impact in the navigation frame: the foot's acceleration, without the turning of gravity's projection
-        f = None if acc is None or quat is None else quat_rotate(quat, acc)
-        ev = detect_gait_events(t, rate, st, f)
+        ev = detect_gait_events(t, rate, st, None if quat is None else acc, quat)
         to, ic, pitch, from_rate = ev.to, ev.ic, ev.largest_pitch, ev.from_rate
     else:
         to, ic, from_rate = t[np.minimum(b[:-1], n - 1)], t[a[1:]], np.zeros(len(st) - 1, bool)

@@ -32,8 +32,8 @@ def test_the_landmark_loop_finds_footzoos_events(events):
     assert len(marks) == len(res.steps) == 24
     pos = res.samples[["pos_n", "pos_e", "pos_d"]].to_numpy()
     st = real_stances(res.samples["stance"].to_numpy(bool), pos)
-    ev = detect_gait_events(rec.t, sagittal_rate(res.samples[["qw", "qx", "qy", "qz"]].to_numpy(), rec.gyr, pos, st),
-                            st, rec.acc)
+    quat = res.samples[["qw", "qx", "qy", "qz"]].to_numpy()
+    ev = detect_gait_events(rec.t, sagittal_rate(quat, rec.gyr, pos, st), st, rec.acc, quat)
     np.testing.assert_allclose(marks["largest pitch (zero crossing)"], ev.largest_pitch, atol=1e-9)
     np.testing.assert_allclose(marks["contact (IC)"], res.steps["end_s"], atol=1e-9)
     np.testing.assert_allclose(marks["half-way back (TO)"], res.steps["to_s"], atol=5e-4)
