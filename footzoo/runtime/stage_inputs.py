@@ -69,8 +69,12 @@ def stance(where: str, value: Any, rec: Recording) -> np.ndarray:
     return arr.astype(bool)
 
 
+#: A q0 whose norm is this far from 1 or farther is refused; nearer, it is normalised (rounding of a printed one).
+Q0_NORM_TOLERANCE = 0.01
+
+
 def initial_attitude(where: str, q0: Any) -> np.ndarray:
-    """The initial attitude: a finite, non-zero quaternion (4,), scalar first (body -> NED)."""
+    """The initial attitude: a finite quaternion (4,) of norm 1 within 1 %, scalar first (body -> NED), normalised."""
     arr = _array(where, "q0", q0, FIX_Q0)
     if arr.shape != (4,):
         raise RecordingError(f"{where}: q0 must be one quaternion (4,) [w, x, y, z], body -> NED, got shape "
@@ -78,7 +82,12 @@ def initial_attitude(where: str, q0: Any) -> np.ndarray:
     if not np.all(np.isfinite(arr)) or np.linalg.norm(arr) < 1e-6:
         raise RecordingError(f"{where}: q0 = {arr.tolist()} is not a rotation (a finite quaternion of norm 1); "
                              f"{FIX_Q0}")
-    return arr / np.linalg.norm(arr)
+    norm = float(np.linalg.norm(arr))
+    if abs(norm - 1.0) >= Q0_NORM_TOLERANCE:
+        raise RecordingError(f"{where}: q0 = {arr.tolist()} has norm {norm:.4g}, not 1: a rotation is a unit "
+                             "quaternion [w, x, y, z] (scalar first); not an attitude, or not normalised "
+                             f"(q0 / np.linalg.norm(q0) if it is one); {FIX_Q0}")
+    return arr / norm
 
 
 def attitude(where: str, quat: Any, rec: Recording, fix: str) -> np.ndarray:

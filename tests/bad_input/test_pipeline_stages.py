@@ -48,6 +48,9 @@ def parts():
     (lambda p: p["pipe"].orient(p["rec"], p["stance"], p["q0"][1:]), RecordingError, r"q0 must be one quaternion"),
     (lambda p: p["pipe"].orient(p["rec"], p["stance"], np.tile(p["q0"], (5, 1))), RecordingError, "got shape"),
     (lambda p: p["pipe"].orient(p["rec"], p["stance"], np.zeros(4)), RecordingError, "is not a rotation"),
+    (lambda p: p["pipe"].orient(p["rec"], p["stance"], 2 * p["q0"]), RecordingError, "has norm 2, not 1"),
+    (lambda p: p["pipe"].navigate(p["rec"], p["stance"], [1.0, 0.2, 0.0, 0.0], None), RecordingError,
+     r"has norm 1\.02, not 1"),
     (lambda p: p["pipe"].navigate(p["rec"], p["stance"], p["q0"], p["quat"][:-5]), RecordingError,
      "navigate: quat has"),
     (lambda p: p["pipe"].navigate(p["rec"], p["stance"], p["q0"], p["quat"][:, 1:]), RecordingError,
@@ -70,9 +73,10 @@ def test_a_mismatched_piece_is_named_with_its_fix(parts, call, error, words):
 
 
 def test_pieces_that_mean_the_same_give_the_same_result(parts):
-    """A 1/0 stance, a q0 of norm 2 and a q0 given as a list are the canonical stance and q0."""
+    """A 1/0 stance, a q0 rounded to a norm within 1 % of 1 and a q0 given as a list are the canonical stance and q0
+    (a q0 farther from norm 1 is refused: test_a_mismatched_piece_is_named_with_its_fix)."""
     pipe, rec, stance, q0 = parts["pipe"], parts["rec"], parts["stance"], parts["q0"]
-    np.testing.assert_array_equal(pipe.orient(rec, stance.astype(int), 2.0 * q0), parts["quat"])
+    np.testing.assert_allclose(pipe.orient(rec, stance.astype(int), 1.005 * q0), parts["quat"], atol=1e-12)
     np.testing.assert_array_equal(pipe.orient(rec, stance, list(q0)), parts["quat"])
 
 
