@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from footzoo.analysis.gait_events import detect_gait_events, segment_argext
+from footzoo.analysis.gait_events import CONTACT_WINDOW, detect_gait_events, segment_argext
 from footzoo.analysis.strides import STEP_COLUMNS, real_stances, segment_steps
 from footzoo.evaluation.metrics import match_strides, reference_steps, stride_errors
 from footzoo.runtime.pipeline import Pipeline
@@ -316,13 +316,22 @@ def test_any_stance_mask_and_rate_give_a_consistent_table():
         stance = np.asarray(mask)
         pos = np.cumsum(rng.normal(0.0, 0.05, (n, 3)), axis=0)
         gyr = rng.normal(0.0, 2.0, (n, 3))
-        steps = segment_steps(t, stance, pos, gyr)
+        # half the cases with an attitude and a specific force: IC is then the contact after the largest pitch
+        quat = rng.normal(size=(n, 4)) if seed % 2 else None
+        quat = None if quat is None else quat / np.linalg.norm(quat, axis=1, keepdims=True)
+        acc = rng.normal(0.0, 20.0, (n, 3))
+        steps = segment_steps(t, stance, pos, gyr, quat=quat, acc=acc)
         assert list(steps.columns) == STEP_COLUMNS
         assert len(steps) == max(len(real_stances(stance, pos)) - 1, 0)
         if len(steps):
             assert (steps["swing_time_s"] > 0).all()
             assert (steps["stride_time_s"].dropna() > 0).all()
             assert steps["to_s"].between(t[0] - 0.01, t[-1]).all() and steps["end_s"].between(t[0], t[-1]).all()
+            rate = steps[steps["events_from_rate"]]
+            late = rate["end_s"] - rate["largest_pitch_s"]
+            assert (late >= 0).all() and (late < CONTACT_WINDOW).all()
+            if quat is None:  # no attitude: no navigation frame to take the impact in, IC is the largest pitch
+                assert (late == 0).all()
 
     check()
 
