@@ -76,6 +76,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.errors import RecordingError
 from ..kernels.jit import njit
 
 #: Toe-off: the fraction of the push-off peak of ``ω_ml`` to which the rate has recovered (half).
@@ -348,6 +349,14 @@ def contact_times(t: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.nd
     """
     ts = np.ascontiguousarray(t, dtype=float)
     pitch = np.asarray(pitch, dtype=float)
+    acc = np.asarray(acc, dtype=float)
+    n = len(ts)
+    if acc.shape != (n, 3) or (quat is not None and np.shape(quat) != (n, 4)):
+        raise RecordingError(f"contact_times: acc must be (N, 3) and quat (N, 4) for the N = {n} samples of t, got "
+                             f"{acc.shape} and {None if quat is None else np.shape(quat)}")
+    if not (len(pitch) == len(np.asarray(stop)) == len(np.asarray(ok))):
+        raise RecordingError(f"contact_times: pitch, stop and ok must have one entry per swing, got {len(pitch)}, "
+                             f"{len(np.asarray(stop))} and {len(np.asarray(ok))}")
     first_interval = float(np.median(np.diff(ts[:101]))) if len(ts) > 1 else 0.0
     start = np.where(ok, np.maximum(np.searchsorted(ts, pitch) - 1, 0), -1).astype(np.int64)
     q = np.zeros((0, 4)) if quat is None else np.ascontiguousarray(quat, dtype=float)

@@ -389,3 +389,12 @@ def test_contact_is_the_impacts_onset_hand_derived():
     # the impact is never before the largest pitch, and a swing without one keeps its pitch
     assert contact_times(t, acc, np.array([0.512]), np.array([90]), ok)[0] >= 0.512
     assert contact_times(t, acc, np.array([0.49]), np.array([90]), np.array([False]))[0] == pytest.approx(0.49)
+    # shapes that do not fit the samples or each other are refused, not read out of bounds
+    from footzoo.core.errors import RecordingError
+
+    with pytest.raises(RecordingError, match=r"acc must be \(N, 3\)"):
+        contact_times(t, acc[:, :2], np.array([0.49]), np.array([90]), ok)
+    with pytest.raises(RecordingError, match="quat"):
+        contact_times(t, acc, np.array([0.49]), np.array([90]), ok, quat=np.ones((10, 4)))
+    with pytest.raises(RecordingError, match="one entry per swing"):
+        contact_times(t, acc, np.array([0.49, 0.6]), np.array([90]), ok)
