@@ -320,7 +320,9 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
         the column: median absolute error of the initial contact
         (``ic_error_median_abs_s``, on ``end_s``) and toe-off
         (``to_error_median_abs_s``), mean and median signed errors (``ic_error_mean_s``,
-        ``ic_error_median_s``, ``to_error_mean_s``, ``to_error_median_s``), stride-time error;
+        ``ic_error_median_s``, ``to_error_mean_s``, ``to_error_median_s``), the same of the foot's
+        largest pitch before IC where the reference marks it (``largest_pitch_error_median_abs_s``,
+        ``largest_pitch_error_mean_s``, ``largest_pitch_error_median_s``), stride-time error;
         stride-length RMS and mean error (m) over every matched stride
         (``stride_length_rms_error_m``, ``stride_length_mean_error_m``) and over
         the straight ones only (``stride_length_rms_error_straight_m``,
@@ -344,7 +346,7 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
     def put(name: str, d: np.ndarray, stat) -> None:  # NaN when no matched stride has both values
         out[name] = float(stat(d)) if d.size else float("nan")
 
-    for col, name in (("end_s", "ic"), ("to_s", "to")):
+    for col, name in (("end_s", "ic"), ("to_s", "to"), ("largest_pitch_s", "largest_pitch")):
         d = diff(col)
         if d is not None:
             put(f"{name}_error_median_abs_s", d, lambda v: np.median(np.abs(v)))
@@ -496,6 +498,9 @@ METRICS: dict[str, str] = {
     "ic_error_median_abs_s": "median absolute initial-contact timing error (s)",
     "ic_error_mean_s": "mean initial-contact timing error, estimate minus reference (s)",
     "ic_error_median_s": "median initial-contact timing error, estimate minus reference (s)",
+    "largest_pitch_error_median_abs_s": "median absolute timing error of the foot's largest pitch before IC (s)",
+    "largest_pitch_error_mean_s": "mean timing error of the foot's largest pitch before IC (s)",
+    "largest_pitch_error_median_s": "median timing error of the foot's largest pitch before IC (s)",
     "to_error_median_abs_s": "median absolute toe-off timing error (s)",
     "to_error_mean_s": "mean toe-off timing error, estimate minus reference (s)",
     "to_error_median_s": "median toe-off timing error, estimate minus reference (s)",

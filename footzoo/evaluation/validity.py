@@ -65,6 +65,8 @@ NEEDS: dict[str, tuple[str, ...]] = {
     "stride_length_m": ("stride_length_rms_error_m", "stride_length_mean_error_m",
                         "stride_length_rms_error_straight_m", "stride_length_mean_error_straight_m"),
     "fpa_rad": ("fpa_mean_error_deg", "fpa_rms_error_deg"),
+    "largest_pitch_s": ("largest_pitch_error_median_abs_s", "largest_pitch_error_mean_s",
+                        "largest_pitch_error_median_s"),
 }
 #: The gait events a reference stride table is expected to have (an absent quantity column is no comparison).
 EVENTS = ("start_s", "to_s", "end_s")
@@ -177,6 +179,8 @@ _NEEDS_REFERENCE: dict[str, tuple[str, str | None, str]] = {
                     ("steps", "stride_length_m", "a stride table with stride lengths")),
     **dict.fromkeys(("fpa_mean_error_deg", "fpa_rms_error_deg"),
                     ("steps", "fpa_rad", "a stride table with foot progression angles")),
+    **dict.fromkeys(("largest_pitch_error_median_abs_s", "largest_pitch_error_mean_s", "largest_pitch_error_median_s"),
+                    ("steps", "largest_pitch_s", "a stride table with the foot's largest pitch before IC")),
     **dict.fromkeys(("footprints_ref", "footprints_est", "footprint_error_mean_m", "footprint_error_rms_m",
                      "footprint_error_end_m"), ("footprints", None, "measured footprints")),
     **dict.fromkeys(("stride_path_rms_error_median_m", "stride_paths"),

@@ -5,9 +5,12 @@
 ``start`` and ``end`` (minimum foot velocity, i.e. mid-stance), ``pre_ic`` (the
 initial contact before ``start``), ``tc`` (toe-off) and ``ic`` (the initial
 contact before ``end``), in IMU samples at 204.8 Hz. These become footzoo's
-stride columns ``start_s`` (pre_ic), ``to_s`` (tc), ``end_s`` (ic), and
-``ms_start_s``/``ms_end_s`` (the mid-stances). Per stride: the stride length is the horizontal distance the heel
-marker moved from ``start`` to ``end`` (each position a 0.1 s mean around the
+stride columns ``to_s`` (tc), ``largest_pitch_s`` (ic) and ``ms_start_s``/``ms_end_s`` (the
+mid-stances). The event file's ``ic`` marks the foot's largest pitch (the heel→toe markers' pitch
+peaks a median 1 ms from it), where the heel is still in the air; the contacts ``start_s`` and
+``end_s`` are the heel marker's touch-downs after ``pre_ic`` and ``ic`` (:func:`heel_touchdowns`:
+where its descent stops, a median 22 ms later; docs/gait-events.md). Per stride: the stride
+length is the horizontal distance the heel marker moved from ``start`` to ``end`` (each position a 0.1 s mean around the
 event); the line of progression is that displacement; the foot progression
 angle of the stance at ``end`` is the angle of the heel→toe axis against it,
 positive for toe-out (left foot: heel→toe turned counter-clockwise seen from
@@ -51,8 +54,43 @@ def has_reference(folder: str | Path) -> bool:
     return (folder / "mocap_sample.csv").exists() and (folder / "stride_events_sample.csv").exists()
 
 
+#: The heel marker's descent has stopped once its vertical velocity is back above this (m/s, z up).
+STOPPED_DESCENT = -0.02
+#: The heel's fastest descent is searched this far (s) around the event file's IC.
+DESCENT_SEARCH = 0.06
+#: A fastest descent slower than this (m/s, down) is none: the heel did not come down from the air.
+LEAST_DESCENT = 0.05
+
+
+def heel_touchdowns(heel_up: np.ndarray, largest_pitch: np.ndarray, lag: float = 0.0) -> np.ndarray:
+    """When the heel marker touches down after each of the event file's ICs (s, the IMU's clock).
+
+    The marker's height ``heel_up`` (m, z up, 100 Hz) through a cubic spline: its fastest descent
+    within :data:`DESCENT_SEARCH` of the IC, then the first instant (1 ms steps) its vertical velocity
+    is back above :data:`STOPPED_DESCENT`: the heel rests on the floor (a kinematic contact from the
+    markers). Where the markers do not cover the search, or the heel does not come down faster than
+    :data:`LEAST_DESCENT` (no air phase to end), the event file's IC itself.
+    """
+    from scipy.interpolate import CubicSpline
+
+    t = np.arange(len(heel_up)) / MOCAP_RATE
+    velocity = CubicSpline(t, heel_up).derivative()
+    out = np.array(largest_pitch, dtype=float)
+    for i, ic in enumerate(out + lag):
+        fine = ic + np.arange(-DESCENT_SEARCH, 0.1, 0.001)
+        if fine[0] < t[0] or fine[-1] > t[-1]:
+            continue
+        v = velocity(fine)
+        k = int(np.argmin(np.where(fine <= ic + DESCENT_SEARCH, v, np.inf)))
+        stopped = np.flatnonzero(v[k:] >= STOPPED_DESCENT)
+        if v[k] < -LEAST_DESCENT and len(stopped):
+            out[i] = fine[k + stopped[0]] - lag
+    return out
+
+
 def reference_strides(folder: str | Path, foot: str, lag: float = 0.0) -> pd.DataFrame:
-    """Per-stride reference: events (s), ``stride_length_m``, ``fpa_rad``, ``heading_rad``, ``turn``.
+    """Per-stride reference: events (s; contacts from the heel marker), ``stride_length_m``, ``fpa_rad``,
+    ``heading_rad``, ``turn``.
 
     Parameters
     ----------
@@ -75,21 +113,25 @@ def reference_strides(folder: str | Path, foot: str, lag: float = 0.0) -> pd.Dat
     heel = mocap[f"{side}_FCC"][["x", "y"]].to_numpy() / 1000.0
     toe = mocap[f"{side}_TOE"][["x", "y"]].to_numpy() / 1000.0
     sign = 1.0 if foot == "left" else -1.0
+    mine = events[events.foot == foot]
+    heel_up = mocap[f"{side}_FCC"]["z"].to_numpy() / 1000.0
+    contact_end = heel_touchdowns(heel_up, mine["ic"].to_numpy() / IMU_RATE, lag)
+    contact_start = heel_touchdowns(heel_up, mine["pre_ic"].to_numpy() / IMU_RATE, lag)
 
     def around(arr: np.ndarray, t: float) -> np.ndarray:
         k = int(round((t + lag) * MOCAP_RATE))
         return arr[max(k - 5, 0):k + 5].mean(axis=0)
 
     rows = []
-    for _, ev in events[events.foot == foot].iterrows():
+    for i, (_, ev) in enumerate(mine.iterrows()):
         t0, t1 = ev.start / IMU_RATE, ev.end / IMU_RATE
         d = around(heel, t1) - around(heel, t0)
         axis = around(toe, t1) - around(heel, t1)
         prog = np.arctan2(d[1], d[0])
         fpa = sign * np.angle(np.exp(1j * (np.arctan2(axis[1], axis[0]) - prog)))
-        rows.append({"start_s": ev.pre_ic / IMU_RATE, "to_s": ev.tc / IMU_RATE, "end_s": ev.ic / IMU_RATE,
-                     "ms_start_s": t0, "ms_end_s": t1, "stride_length_m": float(np.hypot(*d)),
-                     "fpa_rad": float(fpa), "heading_rad": float(prog)})
+        rows.append({"start_s": contact_start[i], "to_s": ev.tc / IMU_RATE, "end_s": contact_end[i],
+                     "largest_pitch_s": ev.ic / IMU_RATE, "ms_start_s": t0, "ms_end_s": t1,
+                     "stride_length_m": float(np.hypot(*d)), "fpa_rad": float(fpa), "heading_rad": float(prog)})
     out = pd.DataFrame(rows)
     # a turn stride changes direction by more than 20° against its neighbours
     h = np.unwrap(out["heading_rad"].to_numpy())

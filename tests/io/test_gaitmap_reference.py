@@ -68,9 +68,27 @@ def test_a_hand_built_walk_gives_the_heel_displacement_between_the_minimum_veloc
     period = STANCE + SWING
     k = np.arange(4)
     np.testing.assert_allclose(ref["ms_start_s"], k * period + STANCE / 2, atol=1 / IMU_RATE)
+    # the heel marker stays at one height (no descent to end): the contacts are the event file's ICs
     np.testing.assert_allclose(ref["start_s"], k * period, atol=1 / IMU_RATE)  # pre_ic
     np.testing.assert_allclose(ref["to_s"], k * period + STANCE, atol=1 / IMU_RATE)  # tc
     np.testing.assert_allclose(ref["end_s"], (k + 1) * period, atol=1 / IMU_RATE)  # ic
+    np.testing.assert_allclose(ref["largest_pitch_s"], (k + 1) * period, atol=1 / IMU_RATE)  # ic
+
+
+def test_heel_touchdown_is_where_the_markers_descent_stops():
+    """Hand-made heel heights at 100 Hz: down at 0.3 m/s until 1.020 s, then resting; the file's IC at 1.000 s.
+
+    The spline's vertical velocity is back above −0.02 m/s within a sample of the kink: 1.020 s ± 10 ms. A heel
+    that does not come down (no air phase) and an IC the markers do not cover keep the file's IC.
+    """
+    from footzoo.io.gaitmap_reference import heel_touchdowns
+
+    t = np.arange(0.0, 2.0, 0.01)
+    z = 0.05 + 0.3 * np.clip(1.02 - t, 0.0, None)
+    got = heel_touchdowns(z, np.array([1.0]))
+    assert got[0] == pytest.approx(1.02, abs=0.01)
+    assert heel_touchdowns(np.full(len(t), 0.05), np.array([1.0]))[0] == 1.0
+    assert heel_touchdowns(z, np.array([1.97]))[0] == 1.97
 
 
 def test_a_stance_instant_moved_within_the_stance_leaves_the_hand_built_length(tmp_path):
