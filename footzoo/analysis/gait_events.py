@@ -78,6 +78,7 @@ import numpy as np
 
 from ..core.errors import RecordingError
 from ..kernels.jit import njit
+from .inputs import check_samples, check_stances, check_time
 
 #: Toe-off: the fraction of the push-off peak of ``ω_ml`` to which the rate has recovered (half).
 TO_LEVEL = 0.5
@@ -392,12 +393,18 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
     GaitEvents
         One TO and one IC per swing (K of each).
     """
-    w = np.asarray(gyr, dtype=float)
-    w = w if w.ndim == 1 else w[:, 1]
-    n = len(t)
+    fn = "detect_gait_events"
     # a sample is the mean over (t[k-1], t[k]] (footzoo's interval convention): it belongs to the middle
     # of its interval, computed for the event samples only (_mid_times)
-    ts = np.asarray(t, dtype=float)
+    ts = check_time(fn, t)
+    n = len(ts)
+    w = check_samples(fn, "gyr", gyr, n, (0, 3), "(the sagittal rate, or the angular rate in FRD, rad/s)")
+    w = np.ascontiguousarray(w if w.ndim == 1 else w[:, 1])
+    stances = check_stances(fn, stances, n)
+    if acc is not None:
+        acc = check_samples(fn, "acc", acc, n, (3,), "(specific force, m/s²)")
+    if quat is not None:
+        quat = check_samples(fn, "quat", quat, n, (4,), "(attitude quaternions, scalar first)")
     k = len(stances) - 1
     if k < 1:
         empty = np.zeros(0)

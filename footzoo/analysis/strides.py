@@ -8,8 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..core.checks import check_positive
 from ..evaluation.metrics import intervals
 from .gait_events import detect_gait_events, sagittal_rate, segment_argext
+from .inputs import check_mask, check_samples, check_stances, check_time
 
 #: Columns of :func:`segment_steps`, units in the names.
 STEP_COLUMNS = [
@@ -26,6 +28,10 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
     ``min_stride_length`` (m, horizontal) between the middles of the two stances;
     otherwise (a shuffle, a stance split by a twitch) the two stances are joined.
     """
+    fn = "real_stances"
+    stance = check_mask(fn, "stance", stance, len(np.asarray(stance)))
+    pos = check_samples(fn, "pos", pos, len(stance), (3,), "(position in NED, m)")
+    min_stride_length = check_positive("min_stride_length", min_stride_length, allow_zero=True, unit="m")
     st = intervals(stance)
     if len(st) < 2:
         return st
@@ -99,12 +105,20 @@ def segment_steps(t: np.ndarray, stance: np.ndarray, pos: np.ndarray, gyr: np.nd
         mid-stance, up positive) and ``events_from_rate`` (False where the events
         fell back to the stance edges).
     """
-    t = np.asarray(t, dtype=float)
-    pos = np.asarray(pos, dtype=float)
-    st = real_stances(stance, pos, min_stride_length) if stances is None else stances
+    fn = "segment_steps"
+    t = check_time(fn, t)
+    n = len(t)
+    stance = check_mask(fn, "stance", stance, n)
+    pos = check_samples(fn, "pos", pos, n, (3,), "(position in NED, m)")
+    max_stance_time = check_positive("max_stance_time", max_stance_time, unit="s")
+    for name, value, cols, what in (("gyr", gyr, 3, "(angular rate, rad/s)"),
+                                    ("quat", quat, 4, "(attitude quaternions, scalar first)"),
+                                    ("acc", acc, 3, "(specific force, m/s²)"), ("sagittal", sagittal, 0, "(rad/s)")):
+        if value is not None:
+            check_samples(fn, name, value, n, (cols,), what)
+    st = real_stances(stance, pos, min_stride_length) if stances is None else check_stances(fn, stances, n)
     if len(st) < 2:
         return pd.DataFrame({c: pd.Series(dtype=bool if c == "events_from_rate" else float) for c in STEP_COLUMNS})
-    n = len(t)
     a, b = st[:, 0], st[:, 1]
     mid = (a + b - 1) // 2
     if gyr is not None:
