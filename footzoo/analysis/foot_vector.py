@@ -96,6 +96,9 @@ def calibrate_foot_vector(
     largest eigenvalue), its sign chosen to point to the sensor's right (+y),
     which assumes the sensor's y axis within 90° of the foot's right side.
     """
+    if not isinstance(rec, Recording):
+        raise RecordingError(f"calibrate_foot_vector expects a footzoo Recording, got {type(rec).__name__}: build one "
+                             "with footzoo.load(path) or footzoo.Recording(t=..., acc=..., gyr=...)")
     t = rec.t
     if still is None or flex is None:
         runs = intervals(np.linalg.norm(rec.gyr, axis=1) <= max_gyr)

@@ -16,6 +16,7 @@ from ..plugins.base import Analysis, Choice, File, Real, Vector
 from ..plugins.registry import register
 from .foot_side import infer_foot
 from .foot_vector import FootVector
+from .inputs import check_mask, check_samples, check_time
 
 #: Largest angle (rad) between the heading vector and the line of progression for which an FPA is kept: 15°.
 MAX_HEADING_OFFSET = math.radians(15.0)
@@ -191,6 +192,11 @@ class HuangFPA(Analysis):
     def analyze(self, t: np.ndarray, quat: np.ndarray, pos: np.ndarray, stance: np.ndarray,
                 meta: dict) -> HuangFPA:
         """FPA per stance (eqs. 12–16)."""
+        fn = "HuangFPA.analyze"
+        t = check_time(fn, t)
+        stance = check_mask(fn, "stance", stance, len(t))
+        quat = check_samples(fn, "quat", quat, len(t), (4,), "(attitude quaternions, scalar first)")
+        pos = check_samples(fn, "pos", pos, len(t), (3,), "(position in NED, m)")
         foot, self.foot_source_ = self._declared(meta)
         self.foot_evidence_, self.note_ = None, ""
         self.heel_strikes_ = intervals(stance)[:, 0]

@@ -201,7 +201,8 @@ class RecordingSpec:
         except OSError as err:
             return f"{self.path!r} cannot be accessed: {err.strerror or err}"
         if stat.S_ISDIR(st.st_mode):
-            return f"{self.path!r} is a directory, not a recording file; narrow the study's glob"
+            return (f"{self.path!r} is a directory, not a recording file; give its recordings with a glob such as "
+                    f"{str(Path(self.path) / '*.csv')!r}, or narrow the study's glob")
         if not stat.S_ISREG(st.st_mode):
             return f"{self.path!r} is not a regular file"
         if not os.access(p, os.R_OK):

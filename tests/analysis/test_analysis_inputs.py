@@ -1,4 +1,4 @@
-"""The public analysis functions refuse arrays their compiled loops cannot read, naming the argument.
+"""Public analysis functions and HuangFPA.analyze refuse arrays their compiled loops cannot read, naming the argument.
 
 Hand-built cases: 200 samples at 100 Hz, three stances; every bad argument must give a footzoo error
 whose message names the argument (the compiled loops read without bounds checks, so an index past the
@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from footzoo import ConfigError, RecordingError
-from footzoo.analysis import detect_gait_events, real_stances, segment_steps
+from footzoo.analysis import HuangFPA, calibrate_foot_vector, detect_gait_events, real_stances, segment_steps
 
 N = 200
 T = np.arange(N) / 100.0
@@ -57,6 +57,9 @@ T_REPEAT[50] = T_REPEAT[49]
     (lambda: real_stances(STANCE, POS[:100]), ["pos", "(100, 3)"]),
     (lambda: real_stances(STANCE, POS, -1.0), ["min_stride_length"]),
     (lambda: real_stances(STANCE, POS, float("nan")), ["min_stride_length"]),
+    (lambda: HuangFPA(foot="right").analyze(T, QUAT[:10], POS, STANCE, {}), ["quat", "(10, 4)"]),
+    (lambda: HuangFPA(foot="right").analyze(T, QUAT, POS, STANCE[:10], {}), ["stance", "(10,)"]),
+    (lambda: calibrate_foot_vector(np.zeros((100, 7))), ["recording", "ndarray"]),
 ])
 def test_bad_array_names_the_argument(call, words):
     with pytest.raises((RecordingError, ConfigError)) as err:

@@ -107,6 +107,7 @@ def test_a_dangling_link_or_a_directory_fails_its_cells_not_the_study(tmp_path, 
     assert by_rec["a_good"]["error"].isna().all() and by_rec["a_good"]["metric"].notna().all()
     assert by_rec["b_dangling"]["error"].str.contains("dangling link").all()
     assert by_rec["c_folder"]["error"].str.contains("is a directory").all()
+    assert by_rec["c_folder"]["error"].str.contains(r"\*\.csv", regex=True).all()  # the glob to give instead
     assert by_rec["d_garbage"]["error"].str.startswith("FormatError: ").all()
     assert table.attrs["failed"] == 6 and "failed runs" in (out / "summary.md").read_text()
     # the data changes: the link's target appears; its cells run again (new key), the others stay cached
