@@ -27,6 +27,7 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
     A gap between two stances is a step when the foot moved at least
     ``min_stride_length`` (m, horizontal) between the middles of the two stances;
     otherwise (a shuffle, a stance split by a twitch) the two stances are joined.
+    Where the position is NaN the gap stays a step (its stride length is NaN, shown, not dropped).
     """
     fn = "real_stances"
     stance = check_mask(fn, "stance", stance, len(np.asarray(stance)))
@@ -38,7 +39,7 @@ def real_stances(stance: np.ndarray, pos: np.ndarray, min_stride_length: float =
     for _ in range(3):  # joining moves the middles; repeat until stable (usually once)
         mid = (st[:, 0] + st[:, 1] - 1) // 2
         d = np.hypot(*(pos[mid[1:], :2] - pos[mid[:-1], :2]).T)
-        keep = d >= min_stride_length
+        keep = ~(d < min_stride_length)  # a NaN position keeps its stride (NaN length), never drops it
         if keep.all():
             break
         st = np.column_stack([np.concatenate([st[:1, 0], st[1:, 0][keep]]),

@@ -76,3 +76,11 @@ def test_lists_and_tables_give_the_arrays_result():
         np.testing.assert_array_equal(other.to, ev.to)
     steps = segment_steps(T, STANCE, POS, GYR)
     pd.testing.assert_frame_equal(segment_steps(T.tolist(), STANCE.astype(int), POS.tolist(), GYR.tolist()), steps)
+
+
+def test_nan_position_keeps_the_strides_with_nan_length():
+    pos = POS.copy()
+    pos[:] = np.nan
+    np.testing.assert_array_equal(real_stances(STANCE, pos), ST)  # the gaps' lengths are unknown, not zero
+    steps = segment_steps(T, STANCE, pos)
+    assert len(steps) == len(ST) - 1 and steps["stride_length_m"].isna().all()
