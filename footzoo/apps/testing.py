@@ -190,7 +190,9 @@ def _interactive() -> bool:
 
 # --------------------------------------------------------------------------- declaration
 def _check_declaration(cls: type[Plugin]) -> None:
-    assert isinstance(cls, type) and issubclass(cls, Plugin), f"{cls!r} is not a footzoo plug-in class"
+    assert isinstance(cls, type) and issubclass(cls, Plugin), (
+        f"check_plugin expects a footzoo plug-in class, got {cls!r} ({type(cls).__name__}): pass the class itself, "
+        "the one decorated with @footzoo.register")
     assert cls.name, f"{cls.__name__}: class attribute 'name' is empty"
     registered = available(cls.kind).get(cls.name)
     assert registered is not None and same_plugin(registered, cls), (

@@ -329,3 +329,9 @@ def test_check_plugin_checks_the_declarations():
     Unitless.parameters["threshold"].source = "test"
     with pytest.raises(AssertionError, match="declares no unit"):
         check_plugin(Unitless)
+
+
+@pytest.mark.parametrize("given", ["shoe", 3, np.zeros(3)])
+def test_check_plugin_of_a_non_class_says_to_pass_the_class(given):
+    with pytest.raises(AssertionError, match=r"check_plugin expects a footzoo plug-in class, got .*the class itself"):
+        check_plugin(given)
