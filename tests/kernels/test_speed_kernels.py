@@ -210,7 +210,9 @@ def test_gait_events_equal_the_vectorised_code(scenario, flip):
     gyr = -r.gyr if flip else r.gyr  # upside down: no pattern, the fallbacks
     stance = build("detector", {"type": "shoe"}).detect(t, r.acc, gyr).stance_
     st = real_stances(stance, r.truth.pos)
-    for stances in (st, np.vstack([[0, 1], st]), st[:2]):
+    # a one-sample stance at sample 0 (the first interval's median) before the first one, moved past it
+    first = np.vstack([[0, 1], np.column_stack([np.maximum(st[:, 0], 2), st[:, 1]])])
+    for stances in (st, first, st[:2]):
         ev = detect_gait_events(t, gyr, stances)
         to, ic, ok = _reference_gait_events(t, gyr, stances)
         np.testing.assert_array_equal(ev.from_rate, ok)
