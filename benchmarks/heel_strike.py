@@ -21,9 +21,11 @@ and of the loading response that follows, the forefoot coming down to foot flat 
   150 ms after IC (``LOADING_SPAN``), and when it comes;
 * **foot flat after IC** (ms): when ``|ω|`` first falls below 1 rad/s after that peak (linear between samples).
 
-IC is the simulator's truth (the heel touching the floor), gaitmap's motion-capture IC, and, where there is
-no independent IC (PyShoe's walks, the IPOL trials), footzoo's (the sagittal rate's zero crossing, which the
-motion capture agrees with within a few ms: docs/gait-events.md). Simulator: noise-free, physical profile,
+"IC" here is the foot's largest pitch, where the sagittal rate crosses zero (about 20 ms before the heel's
+touch-down on real walks, docs/gait-events.md): the simulator's truth (its heel touches the floor there),
+gaitmap's event-file IC (the reference's ``largest_pitch_s``), and, where there is no independent one
+(PyShoe's walks, the IPOL trials), footzoo's ``largest_pitch_s``, which the event file agrees with within a
+few ms. Simulator: noise-free, physical profile,
 the accuracy benchmark's walk (a 10 m × 5 m rectangle), stairs and mixed-speed walk, at 100, 200 and 400 Hz.
 Real: gaitmap's example walk (both feet, 204.8 Hz), PyShoe's 23 walking trials (200 Hz), the IPOL trials
 (100 Hz, both feet).
@@ -131,13 +133,14 @@ def loading_response(t: np.ndarray, w: np.ndarray, mag: np.ndarray, ics: np.ndar
 def heel_strikes(rec, ics: np.ndarray | None = None, config: str = "recommended") -> pd.DataFrame:
     """Per heel strike of ``rec``: dwell of |ω| and of the sagittal rate below 1 rad/s (ms), and the slope (rad/s²).
 
-    ``ics``: the IC times (s); default footzoo's (the pipeline's). The sagittal rate uses the pipeline's attitude.
+    ``ics``: the IC times (s); default footzoo's largest pitch (the pipeline's ``largest_pitch_s``). The sagittal
+    rate uses the pipeline's attitude.
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = Pipeline.from_yaml(config).run(rec)
     if ics is None:
-        ics = res.steps["end_s"].to_numpy(float)
+        ics = res.steps["largest_pitch_s"].to_numpy(float)
     q = res.samples[["qw", "qx", "qy", "qz"]].to_numpy()
     pos = res.samples[["pos_n", "pos_e", "pos_d"]].to_numpy()
     w = sagittal_rate(q, rec.gyr, pos, real_stances(res.samples["stance"].to_numpy(bool), pos))
@@ -167,7 +170,7 @@ def real(data: Path) -> list[tuple[str, str, pd.DataFrame]]:
     if gaitmap.exists():
         for foot in ("left", "right"):
             rec = load(gaitmap, foot=foot)
-            ics = reference_steps(rec.truth.steps)["end_s"].to_numpy(float)
+            ics = reference_steps(rec.truth.steps)["largest_pitch_s"].to_numpy(float)
             out.append(("gaitmap (motion-capture IC)", foot, heel_strikes(rec, ics)))
     for f in sorted((data / "pyshoe_vicon").glob("2017-11-22-*.mat")):
         with warnings.catch_warnings():

@@ -50,7 +50,7 @@ def test_the_simulated_heel_strike_turns_like_gaitmaps_feet():
     real = []
     for foot in ("left", "right"):
         rec = load(path, foot=foot)
-        real.append(hs.heel_strikes(rec, reference_steps(rec.truth.steps)["end_s"].to_numpy(float)))
+        real.append(hs.heel_strikes(rec, reference_steps(rec.truth.steps)["largest_pitch_s"].to_numpy(float)))
     real_dwell = np.concatenate([r["dwell_ms"] for r in real])
     real_off = np.concatenate([r["off_sagittal_ic"] for r in real])
     real_sag = np.concatenate([r["dwell_sagittal_ms"] for r in real])
