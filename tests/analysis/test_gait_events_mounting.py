@@ -288,6 +288,7 @@ def test_a_tilted_sensor_still_gets_its_nearest_axis_map():
     assert nearest_axis_map(_turned(1, 45.0)) is None  # halfway between [x, y, z] and [z, y, -x]: no map named
 
 
+@pytest.mark.slow  # two runs of a 30 s real trial (3.6 s)
 def test_ipol_trial_read_upside_down_is_named_with_its_fix():
     """A tilted MTw (IPOL, about 30° pitched on the foot) read as if turned 180° about z: the warning names the map."""
     from footzoo.io import load

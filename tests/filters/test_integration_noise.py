@@ -110,6 +110,7 @@ def test_gaitmap_stride_lengths_against_motion_capture(foot):
     assert timed < 0.03 < uniform - 0.015
 
 
+@pytest.mark.slow  # the integration noise live with the step-wise smoother: kernels no shipped config uses (12 s)
 def test_live_chunks_give_the_batch_numbers(walk):
     """The change ``f_k − f_{k−1}`` spans the chunks' borders: live (step-wise smoothing) equals the batch run."""
     rec, _ = unresolved_impacts(walk)

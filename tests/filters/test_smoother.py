@@ -278,6 +278,8 @@ def test_the_checkpointed_rts_smoother_is_the_one_over_a_record_of_every_sample(
     assert np.abs(got["vel"] - got["vel_forward"]).max() > 1e-4  # it did smooth
 
 
+# slow: its reference, the smoother over one record, is a kernel no shipped config uses (12 s to compile on CI)
+@pytest.mark.slow
 @pytest.mark.parametrize("stance_kind", ["flickering", "never", "always", "ends_in_swing"])
 def test_the_checkpointed_rts_smoother_holds_whatever_the_stance(walk, stance_kind):
     """Pieces start at the stance's starts: a detector's stance that flickers sample by sample, that never
