@@ -77,6 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.errors import RecordingError
+from ..filters.strapdown import rotate
 from ..kernels.jit import njit
 from .inputs import check_samples, check_stances, check_time
 
@@ -111,7 +112,7 @@ class GaitEvents:
     to: np.ndarray
     ic: np.ndarray
     from_rate: np.ndarray
-    largest_pitch: np.ndarray | None = None
+    largest_pitch: np.ndarray
 
 
 def segment_ranges(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -220,18 +221,15 @@ def _sagittal_kernel(quat: np.ndarray, gyr: np.ndarray, mid: np.ndarray, d: np.n
     """``out[k] = (C(q_k) ω_k) · (−d_e, d_n, 0)`` with ``d`` the direction of sample ``k``'s stride.
 
     Sample ``k`` belongs to the last stride ``i`` with ``mid[i] ≤ k`` (the first one before
-    ``mid[0]``, the last one after the last middle), as in :func:`travel_directions`; ``C(q)``
-    is :func:`footzoo.core.conventions.quat_to_matrix`, written out.
+    ``mid[0]``, the last one after the last middle), as in :func:`travel_directions`; ``C(q) ω``
+    is :func:`footzoo.filters.strapdown.rotate`.
     """
     last = d.shape[0] - 1
     i = 0
     for k in range(quat.shape[0]):
         while i < last and mid[i + 1] <= k:
             i += 1
-        w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
-        gx, gy, gz = gyr[k, 0], gyr[k, 1], gyr[k, 2]
-        north = (1 - 2 * (y * y + z * z)) * gx + 2 * (x * y - w * z) * gy + 2 * (x * z + w * y) * gz
-        east = 2 * (x * y + w * z) * gx + (1 - 2 * (x * x + z * z)) * gy + 2 * (y * z - w * x) * gz
+        north, east, _ = rotate(quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3], gyr[k, 0], gyr[k, 1], gyr[k, 2])
         out[k] = -north * d[i, 1] + east * d[i, 0]
 
 
@@ -274,11 +272,8 @@ def _force(acc: np.ndarray, quat: np.ndarray, k: int, out: np.ndarray) -> None:
     fx, fy, fz = acc[k, 0], acc[k, 1], acc[k, 2]
     if quat.shape[0] == 0:
         out[0], out[1], out[2] = fx, fy, fz
-        return
-    w, x, y, z = quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]
-    out[0] = (1 - 2 * (y * y + z * z)) * fx + 2 * (x * y - w * z) * fy + 2 * (x * z + w * y) * fz
-    out[1] = 2 * (x * y + w * z) * fx + (1 - 2 * (x * x + z * z)) * fy + 2 * (y * z - w * x) * fz
-    out[2] = 2 * (x * z - w * y) * fx + 2 * (y * z + w * x) * fy + (1 - 2 * (x * x + y * y)) * fz
+    else:
+        out[0], out[1], out[2] = rotate(quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3], fx, fy, fz)
 
 
 @njit
@@ -348,16 +343,22 @@ def contact_times(t: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.nd
         where the turning of gravity's projection does not count; without it, in the sensor frame.
         Either way only its norm counts, so any mounting gives the same contacts.
     """
-    ts = np.ascontiguousarray(t, dtype=float)
-    pitch = np.asarray(pitch, dtype=float)
-    acc = np.asarray(acc, dtype=float)
+    fn = "contact_times"
+    ts = check_time(fn, t)
     n = len(ts)
-    if acc.shape != (n, 3) or (quat is not None and np.shape(quat) != (n, 4)):
-        raise RecordingError(f"contact_times: acc must be (N, 3) and quat (N, 4) for the N = {n} samples of t, got "
-                             f"{acc.shape} and {None if quat is None else np.shape(quat)}")
+    acc = check_samples(fn, "acc", acc, n, (3,), "(specific force, m/s²)")
+    if quat is not None:
+        quat = check_samples(fn, "quat", quat, n, (4,), "(attitude quaternions, scalar first)")
+    pitch = np.asarray(pitch, dtype=float)
     if not (len(pitch) == len(np.asarray(stop)) == len(np.asarray(ok))):
-        raise RecordingError(f"contact_times: pitch, stop and ok must have one entry per swing, got {len(pitch)}, "
+        raise RecordingError(f"{fn}: pitch, stop and ok must have one entry per swing, got {len(pitch)}, "
                              f"{len(np.asarray(stop))} and {len(np.asarray(ok))}")
+    return _contacts(ts, acc, pitch, stop, ok, quat)
+
+
+def _contacts(ts: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.ndarray, ok: np.ndarray,
+              quat: np.ndarray | None) -> np.ndarray:
+    """:func:`contact_times` on arrays already checked."""
     first_interval = float(np.median(np.diff(ts[:101]))) if len(ts) > 1 else 0.0
     start = np.where(ok, np.maximum(np.searchsorted(ts, pitch) - 1, 0), -1).astype(np.int64)
     q = np.zeros((0, 4)) if quat is None else np.ascontiguousarray(quat, dtype=float)
@@ -408,7 +409,7 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
     k = len(stances) - 1
     if k < 1:
         empty = np.zeros(0)
-        return GaitEvents(empty, empty, np.zeros(0, bool))
+        return GaitEvents(empty, empty, np.zeros(0, bool), empty)
     a, b = stances[:, 0], stances[:, 1]
     mid = (a + b - 1) // 2
     sw0, sw1 = b[:-1], a[1:]  # swing samples [sw0, sw1)
@@ -436,7 +437,7 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
     to = _crossing_times(ts, w, r, level, ok)
     to = np.where(ok, to, ts[np.minimum(sw0, n - 1)])  # fall back to the stance edges (sample times)
     pitch = np.where(ok, ic, ts[np.minimum(sw1, n - 1)])
-    ic = pitch if acc is None else np.where(ok, contact_times(ts, acc, pitch, mid[1:], ok, quat), pitch)
+    ic = pitch if acc is None else np.where(ok, _contacts(ts, acc, pitch, mid[1:], ok, quat), pitch)
     return GaitEvents(to=to, ic=ic, from_rate=ok, largest_pitch=pitch)
 
 
