@@ -22,8 +22,9 @@ from ..conftest import made_once
 BASE = {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
         "corrections": [{"type": "zvu_dedrift"}]}
 SIM = {"simulate": {"path": "straight", "n_strides": 4, "rate": 50, "noise": {"scale": 1}}, "seeds": [0, 1]}
+#: Figures are drawn only where a test is about them (drawing is most of a small study's time).
 SMALL = {"name": "small", "base": BASE, "factors": {"detector.type": ["angular_rate_fsm", "windowed"]},
-         "recordings": [SIM]}
+         "recordings": [SIM], "figures": "none"}
 
 
 def entries(out):
@@ -320,7 +321,8 @@ def test_two_studies_on_one_output_folder_at_once(tmp_path):
 
 
 #: A study with figures of every kind (a factor of two levels each, a sweep, the ROC, trajectories).
-FIGURES = {**SMALL, "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]}, "sweep": {"points": 5}}
+FIGURES = {**{k: v for k, v in SMALL.items() if k != "figures"}, "sweep": {"points": 5},
+           "factors": {**SMALL["factors"], "orientation.static_gain": [0.5, 1.05]}}
 
 
 @pytest.fixture(scope="module")
