@@ -353,7 +353,8 @@ def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list
 
     figures = _figures(result, rec) if plot else {}
     files = {**figures, LOG: log_text(result.diagnostics["warnings"])}
-    folder = result.save(out, backend="csv", inputs=inputs, files=files)
+    # absolute: --out ./- (a folder named "-", which --out accepts) is Path("-") once made a Path, which save refuses
+    folder = result.save(out.absolute(), backend="csv", inputs=inputs, files=files)
     saved = json.loads((folder / MANIFEST).read_text(encoding="utf-8")).get("files", [])
     return sorted({*(str(f) for f in saved if f not in files), MANIFEST}) + sorted(files)  # reference tables too
 
@@ -465,7 +466,7 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
     if args.out is not None:
         out = Path(args.out)
         figures = {foot: _figures(r, session.recordings[foot]) for foot, r in res.results.items()} if args.plot else {}
-        res.save(out, backend="csv", inputs=inputs, files={**figures, ".": {LOG: log_text(texts)}})
+        res.save(out.absolute(), backend="csv", inputs=inputs, files={**figures, ".": {LOG: log_text(texts)}})
         written = sorted(p.name for p in (out / next(iter(res.results))).iterdir() if p.name in RUN_OUTPUTS)
         written += sorted(next(iter(figures.values()), {}))
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "

@@ -5,6 +5,7 @@ A result is saved as a folder::
     run1/
       manifest.json     what this is (format "footzoo-result", format version, footzoo version, time),
                         the table backend, and every file with what it holds (tables: rows and column dtypes)
+                        and its SHA-256 (a file changed after the save is named when it is loaded)
       samples.parquet   per-sample estimates (Result.samples)          .csv without pyarrow
       steps.parquet     per-stride table (Result.steps)                .csv without pyarrow
       metrics.json      Result.metrics with the config, versions and the recording's plain metadata
@@ -35,6 +36,7 @@ from __future__ import annotations
 import base64
 import contextlib
 import datetime as _dt
+import hashlib
 import importlib.util
 import io
 import json
@@ -350,9 +352,10 @@ def _prepare_folder(path: str | os.PathLike, what: str) -> Path:
         raise OutputError(f"{what}: give a folder path (got {path!r:.80})")
     if nul_in_path(path):
         raise OutputError(f"{what} {nul_in_path(path)}")
-    if isinstance(path, str) and path.strip() == "-":  # as the command line's --out: not a stream
+    if os.fspath(path).strip() == "-":  # as the command line's --out: not a stream; Path('-') as the text '-'
         raise OutputError(f"{what}: '-' means standard output to most tools, but a result is a folder of tables and "
-                          "JSON files; give a folder name (for a folder really named '-', write './-')")
+                          "JSON files; give a folder name (for a folder really named '-', write './-', or "
+                          "Path.cwd() / '-' as a Path: Path('./-') is Path('-'))")
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{what} {str(folder)!r} is a file; a result is saved as a folder: choose a folder name")
@@ -525,10 +528,40 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
             written = _result_files(result, folder, group, backend)
             written.update(_extra_files(group, folder, files))
             _refuse_foreign(folder, set(written) | {MANIFEST}, earlier, what)
+            _hash_files(folder, group, written)
             with group.open(folder / MANIFEST) as fh:
                 fh.write(_manifest(FORMAT, backend, written))
             _commit(folder, group, written, earlier)
     return folder
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _hash_files(folder: Path, group: FileGroup, files: dict[str, Any]) -> None:
+    """Add the SHA-256 of each file of the archive (as written, not yet renamed into place) to its manifest entry;
+    the files saved with it (figures, the log: kind ``file``) are not what :func:`read_result` reads."""
+    for name, info in files.items():
+        if info.get("kind") != "file":
+            info["sha256"] = _sha256(group.path(folder / name))
+
+
+def _verify(folder: Path, files: dict[str, Any], loader: str) -> None:
+    """Warn of each file whose SHA-256 differs from its manifest's (archives saved without hashes: nothing)."""
+    changed = [name for name, info in files.items() if isinstance(info, dict) and isinstance(info.get("sha256"), str)
+               and (folder / name).is_file() and _sha256(folder / name) != info["sha256"]]
+    if changed:
+        names = ", ".join(repr(str(folder / n)) for n in changed)
+        warnings.warn(FootzooWarning(
+            f"{loader}: {names} changed after the result was saved (the SHA-256 differs from the one its "
+            "manifest.json records): loaded as it is now, edited by hand or by another program, not as footzoo "
+            f"wrote it; restore the folder from a copy or save the result again, or {loader}(path, verify=False) "
+            "to load it without this check"), stacklevel=4)
 
 
 def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
@@ -590,24 +623,29 @@ def _result_fields(folder: Path, files: dict[str, Any]) -> dict[str, Any]:
 _DAMAGED = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
 
 
-def read_result(path: str | os.PathLike) -> dict[str, Any]:
+def read_result(path: str | os.PathLike, verify: bool = True, loader: str = "Result.load") -> dict[str, Any]:
     """The fields of the :class:`~footzoo.evaluation.result.Result` saved in the folder ``path`` (see the module doc):
     ``samples``, ``steps``, ``config``, ``versions``, ``recording``, ``diagnostics`` and ``reference`` (a
     :class:`~footzoo.core.data.Truth` or None); :meth:`Result.load <footzoo.evaluation.result.Result.load>` makes
     the result from them.
 
     A file of the archive that is truncated, overwritten or otherwise damaged is a FormatError
-    naming the folder and the cause (never a raw parser error).
+    naming the folder and the cause (never a raw parser error). A file that reads but whose SHA-256
+    differs from the manifest's (edited after the save) is loaded as it is, with a ``FootzooWarning``
+    naming it; ``verify=False`` skips that check (archives saved without hashes are not checked).
     """
     data = _read_manifest(path, FORMAT)
     folder = Path(path)
     try:
-        return _result_fields(folder, data["files"])
+        fields = _result_fields(folder, data["files"])
     except FormatError:
         raise
     except _DAMAGED as err:
         raise FormatError(f"{str(folder)!r}: the archive is damaged, a file cannot be read ({type(err).__name__}: "
                           f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
+    if verify:
+        _verify(folder, data["files"], loader)
+    return fields
 
 
 def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", inputs: Any = (),
@@ -630,6 +668,7 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
             sub.mkdir(exist_ok=True)
             own = _result_files(result, sub, group, backend)
             own.update(_extra_files(group, sub, extra.get(foot)))
+            _hash_files(sub, group, own)
             with group.open(sub / MANIFEST) as fh:
                 fh.write(_manifest(FORMAT, backend, own, foot=foot))
             files.update({f"{foot}/{name}": info for name, info in own.items()})
@@ -641,17 +680,22 @@ def save_session(session: Any, path: str | os.PathLike, backend: str = "auto", i
             files[name] = {"holds": holds, **info}
         files.update(_extra_files(group, folder, extra.get(".")))
         _refuse_foreign(folder, set(files) | {MANIFEST}, earlier, what)
+        _hash_files(folder, group, {k: v for k, v in files.items() if "/" not in k})
         with group.open(folder / MANIFEST) as fh:
             fh.write(_manifest(SESSION_FORMAT, backend, files, name=session.name, feet=list(session.results)))
         _commit(folder, group, files, earlier)
     return folder
 
 
-def read_session(path: str | os.PathLike) -> tuple[str, dict[str, dict[str, Any]]]:
-    """``(name, {foot: the fields of its Result})`` of a session saved by :func:`save_session` (:func:`read_result`)."""
+def read_session(path: str | os.PathLike, verify: bool = True) -> tuple[str, dict[str, dict[str, Any]]]:
+    """``(name, {foot: the fields of its Result})`` of a session saved by :func:`save_session` (:func:`read_result`;
+    ``verify`` as there)."""
     data = _read_manifest(path, SESSION_FORMAT)
     folder = Path(path)
-    results = {str(foot): read_result(folder / str(foot)) for foot in data.get("feet") or []}
+    results = {str(foot): read_result(folder / str(foot), verify, "SessionResult.load")
+               for foot in data.get("feet") or []}
+    if verify:  # the session's own tables (each foot's files are checked by its read_result)
+        _verify(folder, {k: v for k, v in data.get("files", {}).items() if "/" not in k}, "SessionResult.load")
     return str(data.get("name", folder.name)), results
 
 

@@ -133,9 +133,14 @@ class Result:
         return save_result(self, path, backend=backend, inputs=inputs, files=files)
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> Result:
-        """A result saved by :meth:`save` (tables with their dtypes, every value as it was saved)."""
-        return cls(**read_result(path))
+    def load(cls, path: str | os.PathLike, verify: bool = True) -> Result:
+        """A result saved by :meth:`save` (tables with their dtypes, every value as it was saved).
+
+        ``verify``: compare each file with the SHA-256 its manifest records and warn
+        (``FootzooWarning``) of one changed after the save; it is loaded as it is now. ``False``
+        skips the check. A truncated or unreadable file is a ``FormatError`` either way.
+        """
+        return cls(**read_result(path, verify))
 
     @property
     def pos(self) -> np.ndarray:

@@ -156,10 +156,11 @@ class SessionResult:
         return save_session(self, path, backend=backend, inputs=inputs, files=files)
 
     @classmethod
-    def load(cls, path: str | Path) -> SessionResult:
-        """A session saved by :meth:`save` (the stride and bilateral tables are recomputed)."""
+    def load(cls, path: str | Path, verify: bool = True) -> SessionResult:
+        """A session saved by :meth:`save` (the stride and bilateral tables are recomputed); ``verify`` as
+        :meth:`Result.load`'s."""
 
-        name, fields = read_session(path)
+        name, fields = read_session(path, verify)
         return cls(results={foot: Result(**f) for foot, f in fields.items()}, name=name)
 
     @cached_property

@@ -161,3 +161,13 @@ def test_run_names_every_file_it_wrote_and_keeps_the_values_in_one_column(walk, 
     rows = [line for line in printed.splitlines() if line.startswith("  ")]
     assert any(len(line.split()[0]) > 32 for line in rows)  # a name longer than the usual column
     assert len({len(line) - len(line.lstrip()[len(line.split()[0]):].lstrip()) for line in rows}) == 1
+
+
+@pytest.mark.slow  # a whole run through the command line (about 1.3 s)
+def test_run_out_dot_slash_dash_writes_a_folder_named_dash(walk, tmp_path, monkeypatch, capsys):
+    """``--out -`` is refused (standard output); ``--out ./-`` names a folder '-', although it is Path('-') once a
+    Path, which Result.save refuses as it refuses the text '-'."""
+    data = write(walk, tmp_path / "walk.csv")
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "yun2012", "--data", str(data), "--out", "./-"]) == EXIT_OK
+    assert len(Result.load(tmp_path / "-").samples) == walk.n

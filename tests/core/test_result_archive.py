@@ -15,7 +15,7 @@ import pytest
 import footzoo
 from footzoo import FormatError, Pipeline, Result, Session, SessionResult
 from footzoo.core import archive
-from footzoo.core.atomic import TMP_INFIX
+from footzoo.core.atomic import INCOMPLETE, TMP_INFIX
 from footzoo.core.errors import OutputError
 from footzoo.io import load
 from footzoo.io.canonical import write
@@ -231,3 +231,57 @@ def test_a_session_comes_back_equal(tmp_path):
     assert {"left", "right", "steps.csv", "bilateral.csv", "manifest.json"} <= {p.name for p in folder.iterdir()}
     with pytest.raises(FormatError, match="use Result.load for each foot"):
         SessionResult.load(folder / "left")
+
+
+def _edit_csv(path: Path) -> None:
+    """Change one number of a CSV table, as a hand edit in a spreadsheet would."""
+    table = pd.read_csv(path)
+    table.iloc[0, 0] = table.iloc[0, 0] + 1.0
+    table.to_csv(path, index=False)
+
+
+@pytest.mark.parametrize("name", ["steps.csv", "samples.csv", "result.json"])
+def test_a_file_edited_after_the_save_is_named_when_loaded(result, tmp_path, name):
+    folder = result.save(tmp_path / "run", backend="csv")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert all(len(info["sha256"]) == 64 for info in manifest["files"].values())
+    path = folder / name
+    if name.endswith(".csv"):
+        _edit_csv(path)
+    else:
+        path.write_text(path.read_text().replace('"steps_notes"', ' "steps_notes"'))
+    with pytest.warns(footzoo.FootzooWarning, match=rf"Result.load: '.*{name}' changed after the result was saved.*"
+                                                    r"Result.load\(path, verify=False\)"):
+        back = Result.load(folder)
+    assert len(back.steps) == len(result.steps)  # loaded as it is now
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Result.load(folder, verify=False)
+
+
+def test_an_archive_saved_without_hashes_loads_as_before_and_a_truncated_table_is_still_refused(result, tmp_path):
+    folder = result.save(tmp_path / "run", backend="csv")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    for info in manifest["files"].values():
+        del info["sha256"]
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert_same_result(result, Result.load(folder))
+    folder = result.save(tmp_path / "again", backend="csv")
+    text = (folder / "samples.csv").read_bytes()
+    (folder / "samples.csv").write_bytes(text[: len(text) // 2])  # read as fewer rows: named now, silent before
+    with pytest.warns(footzoo.FootzooWarning, match="samples.csv' changed after the result was saved"):
+        assert len(Result.load(folder).samples) < len(result.samples)
+    (folder / "manifest.json").rename(folder / INCOMPLETE)  # a save cut before its manifest: refused as before
+    with pytest.raises(FormatError, match="incomplete"):
+        Result.load(folder)
+
+
+@pytest.mark.parametrize("path", ["-", Path("-"), " - "])
+def test_dash_is_refused_as_text_and_as_a_path(result, tmp_path, monkeypatch, path):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError, match=r"'-' means standard output.*Path.cwd\(\) / '-'"):
+        result.save(path)
+    assert not any(tmp_path.iterdir())
+    assert result.save(Path.cwd() / "-").name == "-"
