@@ -143,7 +143,7 @@ def classify(message: str) -> str:
                        ("still creep", "so the detector is not the cause"), ("no stance", "no stance from"),
                        ("acc scale", "its unit or scale is wrong"), ("guard", "found no stance for"),
                        ("speed", "the estimated foot speed"), ("glitch", "spike(s)"), ("saturation", "saturated"),
-                       ("duplicates", "whose time stamp repeats")):
+                       ("duplicates", "whose time stamp repeats"), ("restless start", "too restless to tell a gain")):
         if words in message:
             return key
     return "other"

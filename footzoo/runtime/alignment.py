@@ -89,15 +89,26 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
     gain is ``gravity / ‖mean f‖`` over it when ``‖mean f‖`` differs from ``gravity`` (m/s²) by
     more than :data:`ACC_GAIN_TOLERANCE` and ‖f‖ is quiet there (:data:`ACC_GAIN_QUIET`), with a
     :class:`~footzoo.core.errors.SensorWarning` that names the reading; else exactly 1 (a calibrated
-    sensor's samples are used as they are).
+    sensor's samples are used as they are). A start that far off g but not quiet (it may be a moving
+    foot) is left uncorrected with a ``SensorWarning`` naming the reading, its scatter and the fix.
     ``t`` (s), ``acc`` (m/s², FRD), ``gyr`` (rad/s), ``duration`` (s), ``max_gyr`` (rad/s).
     """
     start, stop = first_still_window(t, gyr, duration, max_gyr)
     still = float(np.linalg.norm(acc[start:stop].mean(axis=0)))
     if abs(still / gravity - 1.0) <= ACC_GAIN_TOLERANCE:
         return 1.0
-    if float(np.std(np.linalg.norm(acc[start:stop], axis=1))) > ACC_GAIN_QUIET * gravity:
-        return 1.0  # the foot moves in its "still" start: no measure of the gain (the stance guards speak later)
+    scatter = float(np.std(np.linalg.norm(acc[start:stop], axis=1)))
+    if scatter > ACC_GAIN_QUIET * gravity:  # the foot moves in its "still" start: no measure of the gain
+        warnings.warn(
+            f"{name}: the accelerometer reads {still:.3f} m/s² in the still start (t = {t[start]:.2f}-"
+            f"{t[stop - 1]:.2f} s, the gyroscope quiet), {100.0 * (still / gravity - 1.0):+.1f} % off g = "
+            f"{gravity:g} m/s², but ‖f‖ scatters by {scatter:.2f} m/s² ({100.0 * scatter / gravity:.1f} % of g, more "
+            f"than the {100.0 * ACC_GAIN_QUIET:g} % of a sensor at rest): the start is too restless to tell a gain "
+            "error from motion, so the gain is not corrected. If the accelerometer's unit or scale is wrong, declare "
+            "it (the reader's acc_unit option) or calibrate the sensor; otherwise start the recording with the foot "
+            f"at rest for init.duration = {duration:g} s",
+            SensorWarning, stacklevel=2)
+        return 1.0
     warnings.warn(
         f"{name}: the accelerometer reads {still:.3f} m/s² in the still start "
         f"(t = {t[start]:.2f}-{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²: "

@@ -101,12 +101,33 @@ def test_a_walk_with_dropped_packets_and_a_gain_error_stands_still_at_its_end(wa
     assert -(climbs.pos[-1, 2] - climbs.pos[stand][0, 2]) > 1.0  # metres up during the stand
 
 
-def test_a_start_whose_foot_accelerates_is_no_measure_of_the_gain(walk, recwarn):
-    """Quiet gyroscope, moving foot (a slide): ‖f‖ scatters, its mean is not gravity, nothing is scaled."""
-    acc = walk.acc * 1.05
+def _restless(walk, gain, jolt=0.0, noise=0.0):
+    """The walk read ``gain`` too high, its still start shaken: a forward jolt (m/s²) every other sample and white
+    noise (m/s², each axis) while the gyroscope stays quiet."""
+    acc = walk.acc * gain
     start, stop = alignment.first_still_window(walk.t, walk.gyr, 0.5, 0.6)
-    acc[start:stop:2, 0] += 3.0  # a 3 m/s² forward jolt every other sample: ‖f‖ scatters by about 1.5 m/s²
-    assert alignment.accelerometer_gain(walk.t, acc, walk.gyr, 9.81) == 1.0
+    acc[start:stop:2, 0] += jolt
+    acc[start:stop] += np.random.default_rng(3).normal(0.0, noise, (stop - start, 3))
+    return acc
+
+
+@pytest.mark.parametrize("gain, jolt, noise, reading", [
+    (1.05, 3.0, 0.0, r"10\.\d+ m/s² .* \+[56]\.\d % off g"),  # a slide: ‖f‖ scatters by about 1.5 m/s²
+    (1.20, 0.0, 0.6, r"11\.\d+ m/s² .* \+2\d\.\d % off g"),  # 1.2 g with 0.6 m/s² of noise
+])
+def test_a_restless_start_far_from_g_is_named_not_corrected(walk, gain, jolt, noise, reading):
+    """Quiet gyroscope, moving foot: ‖f‖ scatters, its mean is not gravity, nothing is scaled, and the warning says
+    so with the reading, its scatter and the fixes (the reader's unit, a calibration, a still start)."""
+    acc = _restless(walk, gain, jolt, noise)
+    with pytest.warns(SensorWarning, match=reading + r".*scatters by \d\.\d\d m/s² \(\d+\.\d % of g.*too restless.*"
+                                           r"not corrected.*acc_unit.*at rest for init\.duration = 0\.5 s"):
+        assert alignment.accelerometer_gain(walk.t, acc, walk.gyr, 9.81) == 1.0
+
+
+def test_a_restless_start_near_g_says_nothing(walk, recwarn):
+    """A start that moves while the gyroscope is quiet but whose mean reads g (PyShoe 2017-11-22-11-52-02: +1.9 %,
+    scattering by 7 % of g) has nothing to correct and nothing to say."""
+    assert alignment.accelerometer_gain(walk.t, _restless(walk, 1.0, 0.0, 0.6), walk.gyr, 9.81) == 1.0
     assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
 
 
