@@ -7,15 +7,23 @@ objects defined in it pickle by reference and every worker process that loads th
 same module name. Loading is idempotent: a file or module already loaded with the same source is not
 executed again; an edited file is executed again and its plug-ins replace the old ones.
 
+Importing a plug-in file or module is bounded in time (:data:`IMPORT_TIMEOUT_S`, or the environment
+variable :data:`IMPORT_TIMEOUT_VARIABLE`): a plug-in whose import never returns (it waits for a
+device, the network or an endless loop) is a :class:`~footzoo.core.errors.PluginImportError` naming
+the file, not a command that hangs. The import runs in a daemon thread that is abandoned when the
+limit passes.
+
 This module sits at the bottom of the layers: it imports only :mod:`footzoo.core.errors` and
 :mod:`footzoo.core.files` at module level.
 """
 
 from __future__ import annotations
 
+import contextvars
 import hashlib
 import importlib
 import importlib.util
+import os
 import sys
 import threading
 import traceback
@@ -29,8 +37,67 @@ from ..core.files import why_missing
 ENTRY_POINT_GROUP = "footzoo.plugins"
 
 _LOCK = threading.RLock()
+_ENTRY_POINTS_LOCK = threading.RLock()  # apart from _LOCK: a plug-in's import (another thread) may load them
 _LOADED: dict[str, str] = {}  # module name -> sha256 of the source it was executed from
 _ENTRY_POINTS: list[dict[str, Any]] | None = None
+
+
+#: Seconds a plug-in file or module may take to import (a plug-in module must do no work at import).
+IMPORT_TIMEOUT_S = 30.0
+#: The environment variable that replaces :data:`IMPORT_TIMEOUT_S` (seconds; ``inf`` for no limit).
+IMPORT_TIMEOUT_VARIABLE = "FOOTZOO_PLUGIN_IMPORT_TIMEOUT"
+
+
+def import_timeout() -> float:
+    """The time limit (s) of a plug-in's import: :data:`IMPORT_TIMEOUT_VARIABLE` when set, else
+    :data:`IMPORT_TIMEOUT_S`.
+
+    Raises
+    ------
+    ConfigError
+        The variable is not a positive number of seconds.
+    """
+    text = os.environ.get(IMPORT_TIMEOUT_VARIABLE, "").strip()
+    if not text:
+        return IMPORT_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0:  # NaN too
+        raise ConfigError(f"{IMPORT_TIMEOUT_VARIABLE}={text!r}: give the seconds a plug-in's import may take, a "
+                          f"positive number (default {IMPORT_TIMEOUT_S:g}; inf for no limit)")
+    return value
+
+
+def _bounded(run: Any, label: str, what: str, plugin: str) -> Any:
+    """``run()`` in a daemon thread (with this thread's context variables), waited for :func:`import_timeout` s.
+
+    Its result, or its exception raised here; a :class:`PluginImportError` naming ``what`` when it has not
+    returned in time (the thread is abandoned).
+    """
+    limit = import_timeout()
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["value"] = run()
+        except BaseException as err:  # noqa: BLE001 - handed to the caller's thread as it is
+            box["error"] = err
+
+    thread = threading.Thread(target=contextvars.copy_context().run, args=(target,), daemon=True,
+                              name=f"footzoo plug-in import {plugin}")
+    thread.start()
+    thread.join(None if limit == float("inf") else limit)
+    if thread.is_alive():
+        raise PluginImportError(
+            f"{label}: importing plug-in {what} did not finish in {limit:g} s (it still runs, abandoned); a plug-in "
+            "module must not do work at import (read data, wait for a device or the network, loop): do it in the "
+            f"plug-in's methods. If its import is only slow, raise the limit with {IMPORT_TIMEOUT_VARIABLE}=SECONDS",
+            plugin=plugin, method="import")
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
 
 
 def is_path_spec(spec: str) -> bool:
@@ -146,7 +213,7 @@ def load_entry_points() -> list[dict[str, Any]]:
         An entry point that fails to load, naming its distribution and the fix.
     """
     global _ENTRY_POINTS
-    with _LOCK:
+    with _ENTRY_POINTS_LOCK:
         if _ENTRY_POINTS is not None:
             return list(_ENTRY_POINTS)
 
@@ -230,8 +297,8 @@ def _load_file(path: Path, label: str) -> dict[str, Any]:
     previous = sys.modules.get(name)
     sys.modules[name] = module  # before executing: dataclasses, pickling and registration look it up
     try:
-        exec(code, module.__dict__)
-    except KeyboardInterrupt:
+        _bounded(lambda: exec(code, module.__dict__), label, f"file {str(path)!r}", str(path))
+    except (KeyboardInterrupt, PluginImportError):
         _restore(name, previous)
         raise
     except BaseException as err:  # noqa: BLE001 - a plug-in's import failure (sys.exit() too) is a named error
@@ -251,7 +318,9 @@ def _load_module(name: str, label: str, base_dir: str | Path | None = None) -> d
         raise ConfigError(f"{label}: {name!r} is neither a module name (words joined by dots, e.g. mylab.detectors) "
                           f"nor a .py file; give the path to the plug-in's .py file")
     try:
-        module = importlib.import_module(name)
+        module = _bounded(lambda: importlib.import_module(name), label, f"module {name!r}", name)
+    except PluginImportError:
+        raise
     except ModuleNotFoundError as err:
         if err.name and (name == err.name or name.startswith(err.name + ".")):
             raise ConfigError(f"{label}: no plug-in module named {name!r}; install it, put it on PYTHONPATH or "

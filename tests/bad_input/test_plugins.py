@@ -29,7 +29,7 @@ from footzoo.orientation.madgwick import Madgwick
 from footzoo.plugins import registry
 from footzoo.plugins.base import Analysis, Calibration, Detector, Orientation, VelocityCorrection
 from footzoo.plugins.contract import QUAT_NORM_TOL, checked
-from footzoo.plugins.extensions import load_plugins
+from footzoo.plugins.extensions import IMPORT_TIMEOUT_VARIABLE, load_plugins
 from footzoo.runtime.stream import Stream
 from footzoo.sim import NoiseModel, simulate
 
@@ -307,6 +307,28 @@ def test_a_plugin_file_that_fails_on_import_is_a_plugin_error_naming_it(how, tmp
     assert isinstance(info.value, ConfigError) and info.value.method == "import"
     assert f"{how}.py" in str(info.value)
 
+
+
+@pytest.mark.parametrize("spec", ["file", "module"])
+def test_a_plugin_whose_import_never_returns_is_a_plugin_error_not_a_hang(spec, tmp_path, monkeypatch, capsys):
+    """A plug-in that waits forever at import (a device, the network) would hang every command that loads it."""
+    monkeypatch.setenv(IMPORT_TIMEOUT_VARIABLE, "0.2")
+    stem = f"sleeps_forever_{spec}"
+    (tmp_path / f"{stem}.py").write_text("import threading\nthreading.Event().wait()\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    name = str(tmp_path / f"{stem}.py") if spec == "file" else stem
+    with pytest.raises(PluginImportError, match=rf"importing plug-in {spec} '.*{stem}(\.py)?' did not finish in "
+                                                rf"0\.2 s.*must not do work at import.*{IMPORT_TIMEOUT_VARIABLE}"):
+        load_plugins([name])
+    assert main(["list", "--plugins", name]) == EXIT_PLUGIN
+    assert "did not finish in 0.2 s" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "soon", "nan"])
+def test_a_plugin_import_time_limit_that_is_no_time_is_refused(value, monkeypatch):
+    monkeypatch.setenv(IMPORT_TIMEOUT_VARIABLE, value)
+    with pytest.raises(ConfigError, match=rf"{IMPORT_TIMEOUT_VARIABLE}='{value}': give the seconds"):
+        load_plugins(["no_such_module_is_imported"])
 
 
 def test_listing_a_plugin_file_that_registers_nothing_says_so(tmp_path, capsys):
