@@ -20,7 +20,8 @@ The checks:
   :mod:`footzoo.core.params`) have a meaning, a unit where they are numbers and the source of their
   default, and every value their declaration refuses (wrong types, NaN, infinities, values just out
   of range) is refused where footzoo builds the plug-in (:meth:`~footzoo.plugins.base.Plugin.validate_params`,
-  as a config is built) and by ``set_params`` with a ``ConfigError`` naming the parameter, while the
+  as a config is built), by ``set_params`` and, given to the constructor in Python, by the action method
+  with a ``ConfigError`` naming the parameter, while the
   edges of the accepted ranges are accepted; a plug-in without declarations
   needs a unit in ``units`` for every numeric parameter (and the report suggests declaring);
   parameters are stored as attributes under their own names (``get_params``), constructing
@@ -59,6 +60,7 @@ from ..core.params import Real
 from ..filters.strapdown import motion_acceleration
 from ..io import Reader
 from ..plugins.base import (
+    CHECKS_PARAMS,
     AccelerationCorrection,
     Analysis,
     Calibration,
@@ -223,10 +225,16 @@ def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
     refused = accepted = 0
     for name, d in declaration.items():
         for bad in d.param.invalid_values():
-            for how in ("validate_params", "set_params"):
+            for how in ("validate_params", "set_params", "its action method"):
                 try:
                     if how == "set_params":
                         base.clone().set_params(**{name: copy.deepcopy(bad)})
+                    elif how == "its action method":
+                        plugin = _constructed(cls, {name: copy.deepcopy(bad)})
+                        if plugin is None:
+                            continue  # its constructor's own work refused it: the action method never sees it
+                        action = next(m for m in CHECKS_PARAMS if callable(getattr(cls, m, None)))
+                        getattr(plugin, action)()  # the parameters are checked before an argument is read
                     else:
                         _build(cls, {name: copy.deepcopy(bad)})
                 except ConfigError as err:
@@ -247,6 +255,15 @@ def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:
                 raise AssertionError(f"{cls.__name__}: {name}={edge!r} (within its declared range) raised "
                                      f"{type(err).__name__} ({err}), not a ConfigError") from None
     report.passed(f"declared parameters ({refused} bad values refused, {accepted} edge values accepted)")
+
+
+def _constructed(cls: type[Plugin], params: dict[str, Any]) -> Plugin | None:
+    """The plug-in constructed in Python with ``params`` as given (scikit-learn's rule: stored, not checked), or None
+    when its constructor refuses them itself (a rule between parameters, or work it does on them)."""
+    try:
+        return cls(**params)
+    except Exception:  # noqa: BLE001 - whatever the constructor's own work raises: the value goes no further
+        return None
 
 
 def _build(cls: type[Plugin], params: dict[str, Any]) -> Plugin:

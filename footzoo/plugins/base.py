@@ -11,9 +11,11 @@ scikit-learn:
   range, one line of meaning, the source of the default). The declarations are checked where a
   plug-in is put to use, not in ``__init__`` (which runs as written): :meth:`Plugin.validate_params`
   validates and converts the arguments of a config before :func:`footzoo.plugins.registry.build`
-  constructs the plug-in, :meth:`Plugin.set_params` does the same, and a
+  constructs the plug-in, :meth:`Plugin.set_params` does the same, a
   :class:`~footzoo.runtime.pipeline.Pipeline` calls :meth:`Plugin.check_params` on every block it is
-  given. The declarations also drive ``footzoo list``, the documentation and the fuzz tests.
+  given, and so does each action method (and ``begin``) before it runs (:data:`CHECKS_PARAMS`), so
+  ``SHOE(threshold=-1).detect(...)`` in a script is refused as the config would be. The
+  declarations also drive ``footzoo list``, the documentation and the fuzz tests.
   ``paper`` gives the reference, the class docstring the equations. (A plug-in without
   declarations, with a ``units`` dict and its own checks in ``__init__``, works too;
   ``check_plugin`` then suggests declaring.)
@@ -27,8 +29,9 @@ scikit-learn:
 The classes are plain :mod:`abc` classes: a method a kind requires is an ``abc.abstractmethod``
 (``Calibration.calibrate``, ``KalmanCorrection.model``, ``Analysis.analyze`` and ``annotate``);
 an optional one has a default implementation (a detector writes ``detect``, or ``step`` and gets
-``detect`` from it). footzoo wraps none of a plug-in's methods: its callers check the contract at
-each call (:func:`footzoo.plugins.contract.checked`), and
+``detect`` from it). footzoo wraps a plug-in's methods only to check its parameters first
+(:data:`CHECKS_PARAMS`, when its class is defined); its callers check the contract at each call
+(:func:`footzoo.plugins.contract.checked`), and
 ``footzoo.apps.testing.check_plugin`` runs a plug-in through it.
 """
 
@@ -60,8 +63,27 @@ from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocab
     declared,
 )
 from ..filters.measurement import MeasurementModel, StateBlock
-from .contract import Output, checked, inputs_checked_once  # noqa: F401 - the callers' side of the contract
+from .contract import ACTIONS, Output, checked, inputs_checked_once  # noqa: F401 - the callers' side of the contract
 from .incremental import WHOLE_RECORDING, Chunk, Latency, concat
+
+#: The methods that put a plug-in to use: each checks the parameters (:meth:`Plugin.check_params`) before it runs,
+#: so a plug-in constructed in Python with a value its declaration refuses is refused where it is used, as a
+#: config's is when the plug-in is built (``__init__`` stores what it is given, scikit-learn's rule).
+CHECKS_PARAMS = (*ACTIONS, "model", "begin")
+
+
+def _checking_params(method: Callable[..., Any]) -> Callable[..., Any]:
+    """``method``, checking its plug-in's parameters (:meth:`Plugin.check_params`) before it runs."""
+    if getattr(method, "_footzoo_checks_params", False):
+        return method
+
+    @functools.wraps(method)
+    def checking(self: Plugin, *args: Any, **kwargs: Any) -> Any:
+        self.check_params()
+        return method(self, *args, **kwargs)
+
+    checking._footzoo_checks_params = True  # type: ignore[attr-defined]
+    return checking
 
 
 class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plug-in must write
@@ -83,9 +105,14 @@ class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plu
     outputs: ClassVar[dict[str, Output]] = {}
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
-        """Check the class's parameter declarations when it is defined (see :func:`_declare`); nothing is wrapped."""
+        """Check the class's parameter declarations when it is defined (see :func:`_declare`); its methods of
+        :data:`CHECKS_PARAMS` check the parameters before they run."""
         super().__init_subclass__(**kwargs)
         _declare(cls)
+        for name in CHECKS_PARAMS:
+            method = cls.__dict__.get(name)
+            if inspect.isfunction(method):
+                setattr(cls, name, _checking_params(method))
 
     @classmethod
     def param_names(cls) -> list[str]:
@@ -135,7 +162,8 @@ class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plu
         """Refuse a declared parameter whose current value its declaration refuses; returns ``self``.
 
         A plug-in constructed in Python (``SHOE(threshold=35)``) stores what it was given; a
-        :class:`~footzoo.runtime.pipeline.Pipeline` calls this on each block it is given.
+        :class:`~footzoo.runtime.pipeline.Pipeline` calls this on each block it is given, and each
+        method of :data:`CHECKS_PARAMS` before it runs.
 
         Raises
         ------
@@ -204,6 +232,7 @@ class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plu
             return Latency() if self.causal else Latency(until=(WHOLE_RECORDING,))
         raise NotImplementedError(f"{type(self).__name__} implements step but not latency(ctx)")
 
+    @_checking_params
     def begin(self, ctx: RunContext) -> Plugin:
         """Start a run (batch or live): fresh state for the recording of ``ctx``; returns ``self``."""
         self.ctx_ = _context(ctx)

@@ -13,7 +13,7 @@ from footzoo.apps.testing import check_plugin
 from footzoo.core.errors import RecordingError
 from footzoo.plugins.base import Detector, Real
 from footzoo.plugins.contract import checked
-from footzoo.plugins.registry import KINDS, available
+from footzoo.plugins.registry import KINDS, available, build
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -77,8 +77,9 @@ def test_nan_input_to_any_action_method_footzoo_calls_is_a_clear_error():
 
 
 def test_a_plugin_class_is_plain_its_methods_run_as_written():
-    """footzoo wraps nothing: the constructor and the methods are the functions the author wrote; a method the
-    kind requires is an abc.abstractmethod; a direct call runs without the caller's checks."""
+    """footzoo wraps only to check the parameters: the constructor is the author's and stores what it is given, an
+    action method is the author's after that check; a method the kind requires is an abc.abstractmethod; a direct
+    call runs without the caller's checks of the arrays."""
     from footzoo.plugins.base import Calibration, KalmanCorrection
 
     def __init__(self, threshold: float = 0.5):
@@ -92,10 +93,13 @@ def test_a_plugin_class_is_plain_its_methods_run_as_written():
 
     Plain = type("Plain", (Detector,), {"__init__": __init__, "detect": detect, "name": "test_plain",
                                         "parameters": {"threshold": Real("rad/s", "(0, 10]", "t", source="test")}})
-    assert Plain.__init__ is __init__ and Plain.detect is detect and not Plain.incremental()
+    assert Plain.__init__ is __init__ and Plain.detect.__wrapped__ is detect and not Plain.incremental()
     gyr = np.ones((5, 3))
-    assert Plain(threshold=50).detect(np.arange(5) / 100.0, np.ones((5, 3)), gyr).threshold == 50
-    assert gyr[0].tolist() == [0.0, 0.0, 0.0]  # as written: no read-only view, no validation
+    assert Plain(threshold=5).detect(np.arange(5) / 100.0, np.ones((5, 3)), gyr).threshold == 5
+    assert gyr[0].tolist() == [0.0, 0.0, 0.0]  # as written: no read-only view
+    assert Plain(threshold=50).threshold == 50  # stored as given ...
+    with pytest.raises(footzoo.ConfigError, match=r"detector 'test_plain': threshold = 50 .*10"):
+        Plain(threshold=50).detect(np.arange(5) / 100.0, np.ones((5, 3)), gyr)  # ... and refused where it is used
     with pytest.raises(footzoo.PluginError, match="writes into an input array"):
         checked(Plain().detect, np.arange(5) / 100.0, np.ones((5, 3)), np.ones((5, 3)))
     for kind, method in ((Calibration, "calibrate"), (KalmanCorrection, "model")):
@@ -335,3 +339,30 @@ def test_check_plugin_checks_the_declarations():
 def test_check_plugin_of_a_non_class_says_to_pass_the_class(given):
     with pytest.raises(AssertionError, match=r"check_plugin expects a footzoo plug-in class, got .*the class itself"):
         check_plugin(given)
+
+
+@pytest.mark.parametrize("kind, name, params, message", [
+    ("detector", "shoe", {"threshold": -1}, r"detector 'shoe': threshold = -1 is out of range"),
+    ("analysis", "huang_fpa", {"alpha": -1}, r"analysis 'huang_fpa': alpha = -1 .*\(0, 1\]"),
+    ("analysis", "huang_fpa", {"foot_vector": [0.0, 0.0]}, r"analysis 'huang_fpa': foot_vector"),
+    ("orientation", "madgwick", {"gyro_error": float("nan")}, r"orientation 'madgwick': gyro_error"),
+])
+def test_a_plugin_built_in_python_with_a_refused_value_is_refused_where_it_is_used(kind, name, params, message):
+    """The constructor stores what it is given (scikit-learn's rule); the action method, called by hand or by a
+    stream (begin), checks it as a config's value is checked, with the same message."""
+    plugin = available(kind)[name](**params)
+    assert all(getattr(plugin, k) is v for k, v in params.items())
+    t = np.arange(200) / 100.0  # a foot at rest, 2 s: the value is refused before the samples are read
+    acc, gyr = np.tile([0.0, 0.0, -9.81], (200, 1)), np.zeros((200, 3))
+    quat, pos, stance = np.tile([1.0, 0.0, 0.0, 0.0], (200, 1)), np.zeros((200, 3)), np.ones(200, dtype=bool)
+    with pytest.raises(footzoo.ConfigError, match=message):
+        if kind == "detector":
+            plugin.detect(t, acc, gyr)
+        elif kind == "orientation":
+            plugin.estimate(t, acc, gyr, None)
+        else:
+            plugin.analyze(t, quat, pos, stance, {})
+    with pytest.raises(footzoo.ConfigError, match=message):
+        plugin.begin(footzoo.core.context.RunContext.from_time(t))
+    with pytest.raises(footzoo.ConfigError, match=message.partition(": ")[2]):  # the check of a config's value
+        build(kind, {"type": name, **params})
