@@ -39,7 +39,7 @@ import pandas as pd
 
 from ..core import errors
 from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
-from ..core.errors import ConfigError, FootzooWarning
+from ..core.errors import ConfigError, FootzooWarning, OutputError
 from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
 from ..evaluation.metrics import reference_steps, run_metrics
@@ -444,6 +444,7 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         cache.mkdir(parents=True, exist_ok=True)
         cache_dir = str(cache)
         if report:  # until the new report is complete, the folder's report is marked incomplete
+            _check_report_folder(Path(out), study)
             begin_folder(out, MANIFEST)
 
     bar.phase("reading cache")
@@ -523,11 +524,41 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         if kept is not None and kept.get(LOG) == logged:
             end_folder(out, MANIFEST)  # the earlier marker back, as it was
         else:
-            _write_manifest(Path(out), digest, [*written, LOG])
+            _write_manifest(Path(out), digest, [*written, LOG], _base_names(study))
     return table
 
 
 MANIFEST = "outputs.json"
+#: The report's tables (its figures aside): in a study's folder, an earlier study's report lists them.
+REPORT_TABLES = ("results.csv", "results.parquet", "summary.md", "summary.tex", "trajectories.parquet", "roc.parquet")
+
+
+def _base_names(study: Study) -> list[str]:
+    return sorted(name for name, _ in study.bases)
+
+
+def _check_report_folder(out: Path, study: Study) -> None:
+    """Refuse, before any run, a folder whose report this study would replace when that report is not its own: a
+    table no earlier study there wrote (a user's ``results.csv``), or the report of a study of other base configs.
+
+    The same study edited (other factors, recordings or metrics) resumes in its folder and replaces its report.
+    """
+    try:
+        manifest = previous_marker(out, MANIFEST)
+        earlier = set(manifest["files"]) if isinstance(manifest, dict) else set()
+    except (OSError, ValueError, KeyError, TypeError):
+        manifest, earlier = None, set()
+    foreign = [n for n in REPORT_TABLES if (out / n).exists() and n not in earlier]
+    if foreign:
+        raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} already holds {', '.join(foreign)}, "
+                          f"which no earlier study there wrote (its {MANIFEST} does not list them); the study's report "
+                          "would replace them: choose another --out, or move those files away")
+    before = manifest.get("bases") if isinstance(manifest, dict) else None
+    if isinstance(before, list) and sorted(map(str, before)) != _base_names(study):
+        raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} holds the report of a study of base "
+                          f"config(s) {sorted(map(str, before))} ({MANIFEST}), this study's are {_base_names(study)}: "
+                          "its report would replace that one; choose another --out for this study (or delete "
+                          f"{str(out / MANIFEST)!r} to replace the earlier report: its cached runs stay)")
 
 
 def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
@@ -565,7 +596,7 @@ def _write_log(out: Path, texts: list[str]) -> str:
     return hashlib.sha256(text).hexdigest()
 
 
-def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
+def _write_manifest(out: Path, digest: str, written: list[str], bases: list[str]) -> None:
     """Record the report's files (``written``) with their content, last (the folder's completion marker);
     remove the files the previous report wrote and this one did not (a figure of a metric no longer
     drawn), so none is taken for current."""
@@ -579,7 +610,8 @@ def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
         if Path(name).name == name:  # a file of this folder, as every report writes
             (out / name).unlink(missing_ok=True)
     files = {name: _file_sha256(out / name) for name in sorted(written)}
-    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
+    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files, "bases": bases},
+                                         indent=1))
 
 
 def _file_sha256(path: Path) -> str:
