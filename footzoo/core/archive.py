@@ -237,7 +237,7 @@ class _Packer:
     def pack(self, value: Any, where: str) -> Any:
         if value is None or isinstance(value, (bool, str)):
             return value
-        if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_, np.timedelta64)):
             return int(value)
         if isinstance(value, np.bool_):
             return bool(value)
@@ -275,6 +275,10 @@ class _Packer:
                 return {f"${kind.__name__}": value.isoformat()}
         if isinstance(value, np.datetime64):
             return {"$datetime64": str(value)}
+        if isinstance(value, _dt.timedelta):  # a duration (pd.Timedelta is one): exact in days, seconds, microseconds
+            return {"$timedelta": [value.days, value.seconds, value.microseconds]}
+        if isinstance(value, np.timedelta64):
+            return {"$timedelta64": [int(value.view(np.int64)), np.datetime_data(value.dtype)[0]]}
         self.dropped.append(f"{where}: {type(value).__name__}")
         return {"$dropped": type(value).__name__}
 
@@ -309,6 +313,10 @@ class _Unpacker:
                 return getattr(_dt, key[1:]).fromisoformat(inner)
             if key == "$datetime64":
                 return np.datetime64(inner)
+            if key == "$timedelta":
+                return _dt.timedelta(days=inner[0], seconds=inner[1], microseconds=inner[2])
+            if key == "$timedelta64":
+                return np.timedelta64(int(inner[0]), inner[1])
             if key == "$dropped":
                 return None
             if key == "$table":

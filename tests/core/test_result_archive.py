@@ -57,7 +57,8 @@ def tricky() -> Result:
                  "gaps": {"start_s": [0.1, 0.2]},
                  "started": dt.datetime(2026, 1, 2, 3, 4, 5, 6, tzinfo=dt.timezone(dt.timedelta(hours=1))),
                  "day": dt.date(2026, 1, 2), "clock": dt.time(23, 59, 1), "raw": b"\xff\x00id",
-                 "stamp": np.datetime64("2026-01-02T03:04:05.123456789")}
+                 "stamp": np.datetime64("2026-01-02T03:04:05.123456789"),
+                 "lasted": dt.timedelta(days=1, seconds=3, microseconds=7), "lag": np.timedelta64(-250, "ms")}
     ref = footzoo.Truth(pos=np.arange(15.0).reshape(n, 3), stance=np.array([1, 0, 1, 1, 0], dtype=bool),
                         steps=steps[["start_s", "turn"]], closed_loop=True, stride_count=3,
                         footprints=np.ones((2, 2)), source="hand-made")
