@@ -146,11 +146,28 @@ def _warn_unread(columns: Any, path: Path) -> None:
 STEP_TIME_COLUMNS = ("start_s", "to_s", "end_s", "ms_start_s", "ms_end_s", "swing_start", "swing_end", "start", "end")
 
 
+#: Columns of a true-steps sidecar footzoo reads: the times, the simulator's stride geometry and the steps table's.
+STEP_COLUMNS = (*STEP_TIME_COLUMNS, "stride_length", "heading", "fpa", "foot_yaw", "largest_pitch_s",
+                "stride_time_s", "stance_time_s", "swing_time_s", "cadence_steps_min", "stride_length_m", "speed_m_s",
+                "heading_rad", "fpa_rad", "max_clearance_m", "turn", "notes")
+
+
 def check_steps(steps: pd.DataFrame, path: Path, t: Any) -> pd.DataFrame:
     """A true-steps sidecar's table, or a FormatError when it is not one (no stride times, or times outside the
     recording): its rows would otherwise count as the reference's strides."""
     fix = f"a true-steps sidecar holds one row per stride with its times in s ({', '.join(STEP_TIME_COLUMNS[:3])}); " \
           f"fix or delete {path.name}"
+    names = [str(c) for c in steps.columns]
+    twice = sorted({m.group(1) for c in names if (m := re.fullmatch(r"(.+)\.\d+", c)) and m.group(1) in names})
+    if twice:  # pandas renames a repeated column 'x' to 'x.1': which one holds the reference would be a guess
+        raise FormatError(f"{path}: column(s) {twice} appear more than once; which one holds the reference is "
+                          f"unclear: keep one column of each name; {fix}")
+    near = [f"{c!r}{did_you_mean(c, list(STEP_COLUMNS))}" for c in names
+            if c not in STEP_COLUMNS and did_you_mean(c, list(STEP_COLUMNS))]
+    if near:
+        warnings.warn(FootzooWarning(
+            f"{path.name}: column(s) {', '.join(near)} are not read: a true-steps sidecar's columns are "
+            f"{', '.join(STEP_COLUMNS)}; rename a misspelt column to use it (or drop it to silence this)"), stacklevel=4)
     times = [c for c in STEP_TIME_COLUMNS if c in steps.columns]
     if not times:
         raise FormatError(f"{path}: not a stride table: its columns {list(steps.columns)[:8]} hold no stride times; "

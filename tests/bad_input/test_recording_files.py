@@ -163,6 +163,9 @@ CASES = [
          FormatError, "w.csv.steps.csv: not a stride table: its columns ['foo', 'bar'] hold no stride times"),
     Case("steps-in-samples", lambda d, w, x: (lambda: load(_steps_sidecar(d, w, "start,end\n200,260\n300,360\n"))),
          FormatError, "column 'start' runs from 200 to 300, but the recording spans 0 to"),
+    Case("steps-repeated-column", lambda d, w, x: (lambda: load(_steps_sidecar(
+        d, w, "start_s,end_s,end_s\n1.0,2.0,2.5\n3.0,4.0,4.5\n"))), FormatError,
+        "w.csv.steps.csv: column(s) ['end_s'] appear more than once; which one holds the reference is unclear"),
     Case("steps-text-times", lambda d, w, x: (lambda: load(_steps_sidecar(d, w, "start_s,end_s\n1.0,2.0\nlate,3\n"))),
          FormatError, "column 'start_s' holds text ('late'), not times in s"),
     # PyShoe's trials.csv and its variables

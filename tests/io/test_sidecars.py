@@ -74,3 +74,24 @@ def test_stale_sidecars_of_an_earlier_file_are_never_the_reference(tmp_path):
     p.with_name("walk.csv.steps.csv").write_text(first.truth.steps.to_csv(index=False))
     with pytest.warns(FootzooWarning, match="walk.csv.steps.csv is not listed in the metadata sidecar"):
         assert load(p).truth.steps is None
+
+
+@pytest.mark.parametrize("column, warned", [("stride_len", "'stride_len' (did you mean 'stride_length'?)"),
+                                            ("end_S", "'end_S' (did you mean 'end_s'?)"), ("comment", None)])
+def test_a_misspelt_column_of_a_true_steps_sidecar_is_named(column, warned, tmp_path):
+    import warnings
+
+    import numpy as np
+    import pandas as pd
+
+    from footzoo.io.canonical import check_steps
+
+    steps = pd.DataFrame({"start_s": [1.0, 2.0], "end_s": [2.0, 3.0], "stride_length": [1.2, 1.3], column: [1, 2]})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_steps(steps, tmp_path / "w.csv.steps.csv", np.arange(0.0, 4.0, 0.01))
+    texts = [str(w.message) for w in caught]
+    if warned is None:  # a column footzoo does not read and no near name of one: kept quietly (a note)
+        assert texts == []
+    else:
+        assert len(texts) == 1 and texts[0].startswith(f"w.csv.steps.csv: column(s) {warned} are not read")
