@@ -359,11 +359,23 @@ def _write_result(result, rec, out: Path, plot: bool, inputs: list[str]) -> list
     return sorted({*(str(f) for f in saved if f not in files), MANIFEST}) + sorted(files)  # reference tables too
 
 
+def _refuse_swapped(config: str, data: str | None) -> None:
+    """A ConfigError naming both when the config is a recording and ``--data`` a YAML file: the two were swapped."""
+    from ..core.yamlsafe import RECORDING_SUFFIXES
+
+    if data is None or Path(data).suffix.lower() not in (".yaml", ".yml"):
+        return
+    if Path(config).suffix.lower() in RECORDING_SUFFIXES:
+        raise ConfigError(f"{config!r} is a recording and --data {data!r} a config file: the config comes first and the "
+                          f"recording after --data (swapped?): footzoo run {data} --data {config}")
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     """Run a pipeline on a recording (or both feet of a session); print metrics; optionally write outputs."""
     # deferred: pandas and the engine: the command line starts without them
     from ..runtime.pipeline import Pipeline
 
+    _refuse_swapped(args.config, args.data)
     pipeline = Pipeline.from_yaml(args.config)
     out = _writable_dir(args.out) if args.out is not None else None
     if args.plot and out is None:

@@ -540,6 +540,10 @@ def _refuse_large(bases: int, factors: dict[str, list[Any]], recordings: list[in
             "raise the limit (max_cells: N in the study file, --max-cells N on the command line) if you mean it")
 
 
+#: The keys of a ``{simulate: {...}}`` entry of ``recordings:``.
+SIMULATE_ENTRY_KEYS = ["simulate", "seeds", "repeats", "label", "group"]
+
+
 def _seeds(r: dict[str, Any], i: int) -> list[int]:
     """The seeds of a ``simulate:`` entry, repeats included (``seeds`` and ``repeats`` checked)."""
     seeds = r.get("seeds", [0])
@@ -600,6 +604,11 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         return [RecordingSpec(name(m), path=m, format=r.get("format"), options=opts, group=group) for m in matches]
     if not isinstance(r["simulate"], dict):
         raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
+    unknown = [k for k in r if k not in SIMULATE_ENTRY_KEYS]
+    if unknown:
+        raise ConfigError(f"recordings[{i}]: unknown key {unknown[0]!r}{did_you_mean(str(unknown[0]), SIMULATE_ENTRY_KEYS)} "
+                          f"in a simulate: entry; its keys are {SIMULATE_ENTRY_KEYS} (the simulator's own options go "
+                          "inside simulate: {...})")
     sim = dict(r["simulate"])
     try:
         check_spec(sim)

@@ -37,6 +37,8 @@ CASES = [
     ("repeats-without-noise", _study([{"simulate": SIM, "repeats": 3}]), "its 3 seeds give 3 identical"),
     ("seed-negative", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seeds": [-1]}]),
      "recordings[0].seeds must be a list of whole numbers >= 0, got [-1]"),
+    ("seed-key-singular", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seed": 7}]),
+     "recordings[0]: unknown key 'seed' (did you mean 'seeds'?) in a simulate: entry"),
     ("noise-option-misspelt", _study([{"simulate": {**SIM, "noise": {"sclae": 1}}}]),
      "recordings[0].simulate: noise: unknown option 'sclae' (did you mean 'scale'?)"),
     ("noise-biases-text", _study([{"simulate": {**SIM, "noise": {"biases": "acc"}}}]),
