@@ -366,8 +366,8 @@ def _refuse_swapped(config: str, data: str | None) -> None:
     if data is None or Path(data).suffix.lower() not in (".yaml", ".yml"):
         return
     if Path(config).suffix.lower() in RECORDING_SUFFIXES:
-        raise ConfigError(f"{config!r} is a recording and --data {data!r} a config file: the config comes first and the "
-                          f"recording after --data (swapped?): footzoo run {data} --data {config}")
+        raise ConfigError(f"{config!r} is a recording and --data {data!r} a config file: the config comes first and "
+                          f"the recording after --data (swapped?): footzoo run {data} --data {config}")
 
 
 def cmd_run(args: argparse.Namespace) -> int:

@@ -167,7 +167,8 @@ def check_steps(steps: pd.DataFrame, path: Path, t: Any) -> pd.DataFrame:
     if near:
         warnings.warn(FootzooWarning(
             f"{path.name}: column(s) {', '.join(near)} are not read: a true-steps sidecar's columns are "
-            f"{', '.join(STEP_COLUMNS)}; rename a misspelt column to use it (or drop it to silence this)"), stacklevel=4)
+            f"{', '.join(STEP_COLUMNS)}; rename a misspelt column to use it (or drop it to silence this)"),
+            stacklevel=4)
     times = [c for c in STEP_TIME_COLUMNS if c in steps.columns]
     if not times:
         raise FormatError(f"{path}: not a stride table: its columns {list(steps.columns)[:8]} hold no stride times; "

@@ -606,9 +606,9 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
         raise ConfigError(f"recordings[{i}].simulate must be a mapping of simulator options, got {r['simulate']!r}")
     unknown = [k for k in r if k not in SIMULATE_ENTRY_KEYS]
     if unknown:
-        raise ConfigError(f"recordings[{i}]: unknown key {unknown[0]!r}{did_you_mean(str(unknown[0]), SIMULATE_ENTRY_KEYS)} "
-                          f"in a simulate: entry; its keys are {SIMULATE_ENTRY_KEYS} (the simulator's own options go "
-                          "inside simulate: {...})")
+        near = did_you_mean(str(unknown[0]), SIMULATE_ENTRY_KEYS)
+        raise ConfigError(f"recordings[{i}]: unknown key {unknown[0]!r}{near} in a simulate: entry; its keys are "
+                          f"{SIMULATE_ENTRY_KEYS} (the simulator's own options go inside simulate: {{...}})")
     sim = dict(r["simulate"])
     try:
         check_spec(sim)
