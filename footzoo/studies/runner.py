@@ -524,7 +524,7 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         if kept is not None and kept.get(LOG) == logged:
             end_folder(out, MANIFEST)  # the earlier marker back, as it was
         else:
-            _write_manifest(Path(out), digest, [*written, LOG], _base_names(study))
+            _write_manifest(Path(out), digest, [*written, LOG])
     return table
 
 
@@ -533,32 +533,19 @@ MANIFEST = "outputs.json"
 REPORT_TABLES = ("results.csv", "results.parquet", "summary.md", "summary.tex", "trajectories.parquet", "roc.parquet")
 
 
-def _base_names(study: Study) -> list[str]:
-    return sorted(name for name, _ in study.bases)
-
-
 def _check_report_folder(out: Path, study: Study) -> None:
-    """Refuse, before any run, a folder whose report this study would replace when that report is not its own: a
-    table no earlier study there wrote (a user's ``results.csv``), or the report of a study of other base configs.
-
-    The same study edited (other factors, recordings or metrics) resumes in its folder and replaces its report.
-    """
+    """Refuse, before any run, a folder holding a report table no earlier study there wrote (a user's
+    ``results.csv``): the study's report would replace it."""
     try:
         manifest = previous_marker(out, MANIFEST)
         earlier = set(manifest["files"]) if isinstance(manifest, dict) else set()
     except (OSError, ValueError, KeyError, TypeError):
-        manifest, earlier = None, set()
+        earlier = set()
     foreign = [n for n in REPORT_TABLES if (out / n).exists() and n not in earlier]
     if foreign:
         raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} already holds {', '.join(foreign)}, "
                           f"which no earlier study there wrote (its {MANIFEST} does not list them); the study's report "
                           "would replace them: choose another --out, or move those files away")
-    before = manifest.get("bases") if isinstance(manifest, dict) else None
-    if isinstance(before, list) and sorted(map(str, before)) != _base_names(study):
-        raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} holds the report of a study of base "
-                          f"config(s) {sorted(map(str, before))} ({MANIFEST}), this study's are {_base_names(study)}: "
-                          "its report would replace that one; choose another --out for this study (or delete "
-                          f"{str(out / MANIFEST)!r} to replace the earlier report: its cached runs stay)")
 
 
 def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
@@ -596,7 +583,7 @@ def _write_log(out: Path, texts: list[str]) -> str:
     return hashlib.sha256(text).hexdigest()
 
 
-def _write_manifest(out: Path, digest: str, written: list[str], bases: list[str]) -> None:
+def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
     """Record the report's files (``written``) with their content, last (the folder's completion marker);
     remove the files the previous report wrote and this one did not (a figure of a metric no longer
     drawn), so none is taken for current."""
@@ -610,8 +597,7 @@ def _write_manifest(out: Path, digest: str, written: list[str], bases: list[str]
         if Path(name).name == name:  # a file of this folder, as every report writes
             (out / name).unlink(missing_ok=True)
     files = {name: _file_sha256(out / name) for name in sorted(written)}
-    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files, "bases": bases},
-                                         indent=1))
+    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
 
 
 def _file_sha256(path: Path) -> str:

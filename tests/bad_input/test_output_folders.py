@@ -7,14 +7,13 @@
   incomplete (its completion marker, written last, is missing) and footzoo's readers refuse it;
 * a second ``run --plot --out`` into a folder: the figures of the earlier run that this one does not
   draw go with the earlier result (the folder holds one run's outputs, listed in its manifest);
-* a study whose report would replace one that is not its own (a user's ``results.csv``, the report of a
-  study of other base configs): refused before any run.
+* a study whose report would replace a table no earlier study there wrote (a user's ``results.csv``):
+  refused before any run.
 """
 
 from __future__ import annotations
 
 import hashlib
-import json
 import os
 import signal
 import subprocess
@@ -280,19 +279,12 @@ def test_a_result_folder_marked_incomplete_is_refused_by_load(tmp_path, walk_fil
     Result.load(out)
 
 
-@pytest.mark.parametrize("earlier", ["a user's results.csv", "another base's report"])
-def test_a_study_does_not_replace_a_report_that_is_not_its_own(earlier, tmp_path):
+@pytest.mark.parametrize("name", ["results.csv", "summary.md"])
+def test_a_study_does_not_replace_report_tables_it_did_not_write(name, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
-    if earlier == "a user's results.csv":
-        (out / "results.csv").write_text("mine,1\n")
-        match = r"already holds results.csv, which no earlier study there wrote"
-    else:  # the report of a study of the shipped 'recommended' base, as its outputs.json lists it
-        (out / "results.csv").write_text("theirs,1\n")
-        (out / "outputs.json").write_text(json.dumps({"digest": "x", "lists": "report files",
-                                                      "files": {"results.csv": "x"}, "bases": ["recommended"]}))
-        match = r"holds the report of a study of base config\(s\) \['recommended'\].*this study's are \['yun2012'\]"
+    (out / name).write_text("mine,1\n")  # the user's own table, under a name a study's report uses
     before = _digest(out)
-    with pytest.raises(OutputError, match=match):  # refused before any run
-        run_study(_study(tmp_path, "next", "angular_rate_fsm"), out=out, quiet=True, max_runs=0)
+    with pytest.raises(OutputError, match=rf"already holds {name}, which no earlier study there wrote"):
+        run_study(_study(tmp_path, "next", "angular_rate_fsm"), out=out, quiet=True, max_runs=0)  # before any run
     assert _digest(out) == before
