@@ -204,6 +204,15 @@ def validate_sample(
     return tf, a, g, m, d
 
 
+def _swapped(acc: np.ndarray, gyr: np.ndarray) -> str:
+    """A hint when a block's acc and gyr look swapped: |gyr| about gravity (m/s^2), |acc| far below it."""
+    g, a = float(np.median(np.linalg.norm(gyr, axis=1))), float(np.median(np.linalg.norm(acc, axis=1)))
+    if 7.0 < g < 13.0 and a < 5.0:
+        return (f"; acc and gyr look swapped: the median |gyr| is {g:.3g}, as gravity in m/s^2, the median |acc| "
+                f"{a:.3g}: give acc first, then gyr")
+    return ""
+
+
 def validate_block(
     t: Any,
     acc: Any,
@@ -254,7 +263,8 @@ def validate_block(
             k = int(np.argmax((np.abs(arr) > bound).any(axis=1)))
             raise RecordingError(
                 f"{name} at t = {shown(tf[k])} is {arr[k].tolist()} {unit}: beyond any body-worn IMU (|value| <= "
-                f"{bound:g} {unit}); the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)")
+                f"{bound:g} {unit}); the sample is corrupt, or the unit is wrong (footzoo expects SI, FRD)"
+                + (_swapped(arrays[0], arr) if name == "gyr" else ""))
         arrays.append(arr)
     if not np.isfinite(tf).all():
         k = int(np.argmax(~np.isfinite(tf)))

@@ -96,3 +96,15 @@ def test_a_stream_error_quotes_numpy_time_stamps_as_plain_numbers(sim_walk, seco
     with pytest.raises(RecordingError, match=match) as info:
         stream.extend(t[second], acc[second], gyr[second])
     assert "np.float64" not in str(info.value)
+
+
+@pytest.mark.parametrize("swap", [True, False])
+def test_a_block_with_acc_and_gyr_swapped_is_named_as_such(sim_walk, swap):
+    from footzoo.core.checks import validate_block
+
+    t, acc, gyr = sim_walk.t[:300], sim_walk.acc[:300], sim_walk.gyr[:300].copy()
+    if not swap:  # one corrupt gyro sample, the channels in their places: no swap hint
+        gyr[100] = [0.0, 60.0, 0.0]
+    with pytest.raises(RecordingError, match="beyond any body-worn IMU") as info:
+        validate_block(t, gyr, acc) if swap else validate_block(t, acc, gyr)
+    assert ("acc and gyr look swapped: the median |gyr| is" in str(info.value)) == swap
