@@ -1,6 +1,7 @@
 """The plug-in contract, checked by the caller: read-only inputs, faults named, results checked on return.
 
-A plug-in class is plain Python: footzoo wraps none of its methods. Whoever calls a plug-in on
+A plug-in class is plain Python: footzoo wraps its methods only to check its parameters before they run
+(:data:`footzoo.plugins.base.CHECKS_PARAMS`). Whoever calls a plug-in on
 footzoo's behalf — :class:`~footzoo.runtime.pipeline.Pipeline`, the stages of a
 :class:`~footzoo.Stream`, a study, :func:`~footzoo.apps.testing.check_plugin` — calls it through
 :func:`checked` (``checked(detector.detect, t, acc, gyr)`` instead of ``detector.detect(t, acc, gyr)``),
