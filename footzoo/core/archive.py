@@ -36,7 +36,6 @@ from __future__ import annotations
 import base64
 import contextlib
 import datetime as _dt
-import hashlib
 import importlib.util
 import io
 import json
@@ -55,7 +54,7 @@ from .._version import __version__
 from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, json_safe, previous_marker
 from .data import Truth
 from .errors import FootzooWarning, FormatError, OutputError
-from .files import nul_in_path
+from .files import nul_in_path, sha256
 
 FORMAT = "footzoo-result"
 SESSION_FORMAT = "footzoo-session-result"
@@ -543,26 +542,18 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     return folder
 
 
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _hash_files(folder: Path, group: FileGroup, files: dict[str, Any]) -> None:
     """Add the SHA-256 of each file of the archive (as written, not yet renamed into place) to its manifest entry;
     the files saved with it (figures, the log: kind ``file``) are not what :func:`read_result` reads."""
     for name, info in files.items():
         if info.get("kind") != "file":
-            info["sha256"] = _sha256(group.path(folder / name))
+            info["sha256"] = sha256(group.path(folder / name))
 
 
 def _verify(folder: Path, files: dict[str, Any], loader: str) -> None:
     """Warn of each file whose SHA-256 differs from its manifest's (archives saved without hashes: nothing)."""
     changed = [name for name, info in files.items() if isinstance(info, dict) and isinstance(info.get("sha256"), str)
-               and (folder / name).is_file() and _sha256(folder / name) != info["sha256"]]
+               and (folder / name).is_file() and sha256(folder / name) != info["sha256"]]
     if changed:
         names = ", ".join(repr(str(folder / n)) for n in changed)
         warnings.warn(FootzooWarning(

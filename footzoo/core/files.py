@@ -10,11 +10,14 @@ message names the real problem instead of the parser's symptom:
 * **NUL bytes**: a file that starts with them, or has a run of them in the middle, was damaged
   while it was written (a logger that pre-allocates its file, a power cut, a full card); NULs
   only at the end are padding (:func:`nul_padding`), which a reader may drop, saying so.
+
+And a file's SHA-256 (:func:`sha256`), read in blocks, for the hashes footzoo keeps of what it wrote or read.
 """
 
 from __future__ import annotations
 
 import codecs
+import hashlib
 import os
 from pathlib import Path
 
@@ -167,3 +170,12 @@ def damaged_text(name: str, data: bytes) -> str | None:
     return (f"{name}: a run of {length} NUL bytes (0x00) at byte {offset} (line {line}): the file was damaged while "
             "it was written (a power cut, a full card, a logger's crash); the rows there are not data. Cut the damaged "
             f"part out (the rows around line {line}) or recover the file, then read it again")
+
+
+def sha256(path: str | os.PathLike) -> str:
+    """SHA-256 (hex) of a file's bytes, read in blocks of 1 MiB."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()

@@ -25,7 +25,6 @@ reader builds its :class:`~footzoo.core.data.Truth` from the sidecars alone.
 from __future__ import annotations
 
 import datetime
-import hashlib
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -35,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import FootzooWarning, FormatError
+from ..core.files import sha256
 from ..core.yamlsafe import dump_text, load_file
 
 #: Keys of a metadata sidecar.
@@ -51,15 +51,6 @@ def meta_path(path: Path) -> Path:
 def steps_path(path: Path) -> Path:
     """The true-steps sidecar of a data file: ``<file>.steps.csv``."""
     return path.with_name(path.name + ".steps.csv")
-
-
-def sha256(path: Path) -> str:
-    """SHA-256 (hex) of a file's bytes."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 @dataclass
