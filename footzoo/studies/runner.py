@@ -40,6 +40,7 @@ import pandas as pd
 from ..core import errors
 from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
 from ..core.errors import ConfigError, FootzooWarning, OutputError
+from ..core.files import sha256
 from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
 from ..evaluation.metrics import reference_steps, run_metrics
@@ -524,7 +525,7 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         if kept is not None and kept.get(LOG) == logged:
             end_folder(out, MANIFEST)  # the earlier marker back, as it was
         else:
-            _write_manifest(Path(out), digest, [*written, LOG])
+            _write_manifest(Path(out), digest, [*written, LOG], _base_names(study))
     return table
 
 
@@ -533,19 +534,30 @@ MANIFEST = "outputs.json"
 REPORT_TABLES = ("results.csv", "results.parquet", "summary.md", "summary.tex", "trajectories.parquet", "roc.parquet")
 
 
+def _base_names(study: Study) -> list[str]:
+    return sorted(name for name, _ in study.bases)
+
+
 def _check_report_folder(out: Path, study: Study) -> None:
-    """Refuse, before any run, a folder holding a report table no earlier study there wrote (a user's
-    ``results.csv``): the study's report would replace it."""
+    """Before any run: refuse a folder holding a report table no earlier study there wrote (a user's
+    ``results.csv``), which the study's report would replace; warn when the folder's report is that of a study
+    of other base configs (it is replaced; its cached runs stay, so that study run again rebuilds it)."""
     try:
         manifest = previous_marker(out, MANIFEST)
         earlier = set(manifest["files"]) if isinstance(manifest, dict) else set()
     except (OSError, ValueError, KeyError, TypeError):
-        earlier = set()
+        manifest, earlier = None, set()
     foreign = [n for n in REPORT_TABLES if (out / n).exists() and n not in earlier]
     if foreign:
         raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} already holds {', '.join(foreign)}, "
                           f"which no earlier study there wrote (its {MANIFEST} does not list them); the study's report "
                           "would replace them: choose another --out, or move those files away")
+    before = manifest.get("bases") if isinstance(manifest, dict) else None
+    if isinstance(before, list) and sorted(map(str, before)) != _base_names(study):
+        warnings.warn(f"study {study.name!r}: the output folder {str(out)!r} holds the report of a study of base "
+                      f"config(s) {sorted(map(str, before))}; this study's ({_base_names(study)}) replaces it. That "
+                      "study's runs stay in the folder's cache: running it again rebuilds its report without "
+                      "recomputing. Give this study another --out to keep both reports", FootzooWarning, stacklevel=3)
 
 
 def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],
@@ -564,7 +576,7 @@ def _outputs_current(out: Path, digest: str) -> dict[str, str] | None:
     try:
         manifest = previous_marker(out, MANIFEST)  # set aside while this study runs (begin_folder)
         current = manifest["digest"] == digest and all(
-            _file_sha256(out / name) == sha for name, sha in manifest["files"].items() if name != LOG)
+            sha256(out / name) == sha for name, sha in manifest["files"].items() if name != LOG)
         return dict(manifest["files"]) if current else None
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return None
@@ -583,7 +595,7 @@ def _write_log(out: Path, texts: list[str]) -> str:
     return hashlib.sha256(text).hexdigest()
 
 
-def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
+def _write_manifest(out: Path, digest: str, written: list[str], bases: list[str]) -> None:
     """Record the report's files (``written``) with their content, last (the folder's completion marker);
     remove the files the previous report wrote and this one did not (a figure of a metric no longer
     drawn), so none is taken for current."""
@@ -596,12 +608,9 @@ def _write_manifest(out: Path, digest: str, written: list[str]) -> None:
     for name in sorted(before - set(written)):
         if Path(name).name == name:  # a file of this folder, as every report writes
             (out / name).unlink(missing_ok=True)
-    files = {name: _file_sha256(out / name) for name in sorted(written)}
-    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files}, indent=1))
-
-
-def _file_sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    files = {name: sha256(out / name) for name in sorted(written)}
+    end_folder(out, MANIFEST, json.dumps({"digest": digest, "lists": "report files", "files": files, "bases": bases},
+                                         indent=1))
 
 
 def _chunks(todo: list[int], cells: list[Cell], identity: dict[int, str], workers: int) -> list[list[int]]:

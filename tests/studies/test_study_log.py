@@ -13,7 +13,7 @@ import pytest
 
 from footzoo.core import atomic
 from footzoo.core.atomic import INCOMPLETE, lock_holder
-from footzoo.core.errors import CalibrationWarning, FormatError
+from footzoo.core.errors import CalibrationWarning, FootzooWarning, FormatError
 from footzoo.core.warninglog import LOG
 from footzoo.studies import Study, read_trajectories, run_study, runner, tune
 
@@ -73,17 +73,24 @@ def test_the_log_is_in_place_before_the_marker_and_never_the_previous_study_s(tm
         raise KeyboardInterrupt
 
     monkeypatch.setattr(runner, "end_folder", interrupted)
-    with pytest.raises(KeyboardInterrupt):
+    replaced = re.escape("the report of a study of base config(s) ['yun2012']; this study's (['calm']) replaces it")
+    with pytest.raises(KeyboardInterrupt), pytest.warns(FootzooWarning, match=replaced):
         run_study(Study.from_dict(CALM), out=tmp_path)
-    assert at_marker == ["no warnings\n"]  # the calm study's own log, written before its marker
-    assert (tmp_path / LOG).read_text() == "no warnings\n"
+    # the calm study's own log, written before its marker: its one warning (the report it replaces), not the
+    # warns study's calibration warnings
+    assert len(at_marker) == 1 and "replaces it" in at_marker[0] and UNCALIBRATED not in at_marker[0]
+    assert (tmp_path / LOG).read_text() == at_marker[0]
     assert not (tmp_path / "outputs.json").exists() and (tmp_path / INCOMPLETE).exists()
     with pytest.raises(FormatError, match="is incomplete"):
         read_trajectories(tmp_path)
     monkeypatch.undo()
-    run_study(Study.from_dict(CALM), out=tmp_path)  # run again: complete, its log listed with the report
-    assert not (tmp_path / INCOMPLETE).exists() and (tmp_path / LOG).read_text() == "no warnings\n"
-    assert listed(tmp_path)[LOG] == hashlib.sha256(b"no warnings\n").hexdigest()
+    with pytest.warns(FootzooWarning, match=replaced):  # the last complete report there is still the warns study's
+        run_study(Study.from_dict(CALM), out=tmp_path)  # run again: complete, its log listed with the report
+    log = (tmp_path / LOG).read_bytes()
+    assert not (tmp_path / INCOMPLETE).exists() and log == at_marker[0].encode()
+    assert listed(tmp_path)[LOG] == hashlib.sha256(log).hexdigest()
+    run_study(Study.from_dict(CALM), out=tmp_path)  # and again: the folder's report is its own, nothing to say
+    assert (tmp_path / LOG).read_text() == "no warnings\n"
 
 
 def test_a_tune_writes_its_log_with_its_tables_inside_its_lock(tmp_path, monkeypatch):
