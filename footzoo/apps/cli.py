@@ -412,8 +412,7 @@ def _run(args: argparse.Namespace, pipeline, out: Path | None) -> int:
     if out is not None:
         written = _write_result(result, rec, out, args.plot, _inputs(args, rec))
         print(f"wrote {', '.join(written)} to {args.out} (footzoo.Result.load({args.out!r}) reads it back)")
-    else:
-        tell_unshown(args, result.diagnostics["warnings"])
+    tell_unshown(args, result.diagnostics["warnings"], None if out is None else out / LOG)
     return 0
 
 
@@ -441,11 +440,22 @@ class kept_warnings:
                     warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
-def tell_unshown(args: argparse.Namespace, texts: list[str]) -> None:
-    """With ``--quiet`` and no folder to log into: one line saying how many warnings were not shown."""
+def tell_unshown(args: argparse.Namespace, texts: list[str], log: Path | None = None) -> None:
+    """With ``--quiet``: one line saying how many warnings were not shown, and where they are kept (``log``, the
+    command's folder log, when it wrote one)."""
     if getattr(args, "quiet", False) and texts:
-        print(f"footzoo: {len(texts)} warning(s) not shown (--quiet); without --quiet they are printed, with --out "
-              f"they are kept in OUT/{LOG}", file=sys.stderr)
+        where = (f"they are kept in {log}" if log is not None
+                 else f"without --quiet they are printed, with --out they are kept in OUT/{LOG}")
+        print(f"footzoo: {len(texts)} warning(s) not shown (--quiet); {where}", file=sys.stderr)
+
+
+def logged_texts(log: Path) -> list[str]:
+    """The warnings a command's folder log lists (none when it is absent or says there were none)."""
+    try:
+        lines = log.read_text(encoding="utf-8").splitlines()
+    except OSError:
+        return []
+    return [] if lines == ["no warnings"] else [line for line in lines if line.strip()]
 
 
 def _run_session(args: argparse.Namespace, pipeline) -> int:
@@ -483,8 +493,7 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
         written += sorted(next(iter(figures.values()), {}))
         print(f"wrote {'/ and '.join(res.results)}/ ({', '.join(written)}), steps.csv, bilateral.csv and {LOG} to "
               f"{out} (footzoo.SessionResult.load({str(out)!r}) reads it back)")
-    else:
-        tell_unshown(args, texts)
+    tell_unshown(args, texts, None if args.out is None else Path(args.out) / LOG)
     return 0
 
 
@@ -666,6 +675,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     notes = "".join(f", {n}" for n in notes if n)
     print(f"{a['computed'] + a['cached']} runs ({a['computed']} computed, {a['cached']} from the cache, "
           f"{a['failed']} failed{notes}); results in {out}/")
+    tell_unshown(args, logged_texts(out / LOG), out / LOG)
     total = a["computed"] + a["cached"]
     if a["causes"]:
         print(f"{'every' if a['failed'] == total else a['failed']} run{'' if a['failed'] == 1 else 's'} failed; "
@@ -704,6 +714,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     for edge in result.edges_:
         print(f"  at the edge of the search: {edge}")
     print(f"wrote {spec.config or out / 'best.yaml'} (footzoo run it), {out}/tune_folds.csv, {out}/tune_scores.csv")
+    tell_unshown(args, logged_texts(out / LOG), out / LOG)
     return EXIT_OK
 
 

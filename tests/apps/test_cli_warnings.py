@@ -42,11 +42,13 @@ def test_run_quiet_shows_no_warning_and_keeps_them_in_the_result_and_the_log(str
     out = tmp_path / "run"
     assert main(["run", "yun2012", "--data", str(straight), "--out", str(out), "--quiet"]) == 0
     captured = capsys.readouterr()
-    assert "warning" not in captured.err and "strides" in captured.out
     log = (out / LOG).read_text()
     assert f"CalibrationWarning: sim_straight: {WARNING}" in log  # the warning names the recording
     kept = Result.load(out).diagnostics["warnings"]
     assert any(WARNING in w for w in kept) and log.splitlines() == kept
+    # not shown, but counted, with where they are
+    assert WARNING not in captured.err and "strides" in captured.out
+    assert f"footzoo: {len(kept)} warning(s) not shown (--quiet); they are kept in {out / LOG}" in captured.err
 
 
 def test_run_without_quiet_shows_the_warnings_and_logs_them_too(straight, tmp_path, capsys):
@@ -72,7 +74,10 @@ def test_a_quiet_study_logs_the_runs_warnings(straight, tmp_path, capsys):
     assert main(["ablate", str(study), "--out", f"{tmp_path / 'out'}/", "--quiet"]) == 0
     captured = capsys.readouterr()
     assert WARNING not in captured.err and f"results in {tmp_path / 'out'}/\n" in captured.out  # not 'out//'
-    assert WARNING in (tmp_path / "out" / LOG).read_text()
+    logged = (tmp_path / "out" / LOG).read_text().splitlines()
+    assert any(WARNING in line for line in logged)
+    # the terminal says how many the log holds, as a quiet run does
+    assert f"{len(logged)} warning(s) not shown (--quiet); they are kept in {tmp_path / 'out' / LOG}" in captured.err
     assert LOG in json.loads((tmp_path / "out" / "outputs.json").read_text())["files"]  # part of the report
 
 
@@ -84,7 +89,8 @@ def test_a_quiet_tune_logs_the_runs_warnings(straight, tmp_path, capsys):
                          f"recordings: [{{path: {straight}, group: a}}, {{path: {straight}, group: b, label: again}}]\n"
                          "tune: {objective: armse_3d_m}\n")
     assert main(["tune", str(tune_file), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert WARNING not in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert WARNING not in err and f"not shown (--quiet); they are kept in {tmp_path / 'out' / LOG}" in err
     # one walk (read twice) and two settings: the same warning from 4 runs, once
     assert f"CalibrationWarning: 4 run(s): sim_straight: {WARNING}" in (tmp_path / "out" / LOG).read_text()
 
@@ -102,6 +108,9 @@ def test_a_refused_metric_is_warned_once_and_saving_the_result_warns_nothing_mor
     err = capsys.readouterr().err
     assert err.count("metrics refused (NaN): fpa_mean_deg") == 1
     assert main(["run", "huang2016", "--data", str(straight), "--out", str(out), "--quiet"]) == 0
-    assert "not shown" not in capsys.readouterr().err  # every warning is in the log, none escaped it
-    assert "metrics refused (NaN): fpa_mean_deg" in (out / LOG).read_text()
+    err = capsys.readouterr().err
+    logged = (out / LOG).read_text()
+    assert "metrics refused (NaN): fpa_mean_deg" in logged
+    # every warning is in the log, none escaped it: the one line counts the log's
+    assert f"footzoo: {len(logged.splitlines())} warning(s) not shown (--quiet); they are kept in {out / LOG}\n" == err
     assert "fpa_mean_deg" in Result.load(out).metric_notes
