@@ -154,6 +154,17 @@ def aligned_reference(result: Result, recording: Recording | None) -> np.ndarray
     return rotate_about_vertical(ref - ref[first], -psi) + pos[first]
 
 
+def broken_at_wraps(angle_deg: np.ndarray) -> np.ndarray:
+    """An angle (deg, within ±180°) for a line plot: NaN where it wraps (a step over 180°), so the line breaks there.
+
+    Unwrapping instead would add 360° at every wrap, and a foot whose pitch passes ±90° (a sensor pitched on the
+    foot, at push-off) flips roll and yaw by 180° at each stride: unwrapped, they climb by thousands of degrees.
+    """
+    y = np.array(angle_deg, dtype=float)
+    y[1:][np.abs(np.diff(angle_deg)) > 180.0] = np.nan
+    return y
+
+
 def _shade_stance(ax: Axes, t: np.ndarray, stance: np.ndarray, label: str | None = "stance",
                   max_bands: int = 60) -> None:
     """Grey bands behind the curves where ``stance`` is True (none when there are over ``max_bands``)."""
@@ -404,18 +415,17 @@ def states_figure(result: Result, recording: Recording | None = None,
     fig, axes = plt.subplots(len(ratios), 1, figsize=(10, 1.9 * sum(ratios) / 2.4 + 1.2), sharex=True,
                              gridspec_kw={"height_ratios": ratios}, layout="constrained")
     ax_att, ax_vel, ax_bars = axes[0], axes[1], axes[-1]
-    # angles unwrapped for display (no vertical jumps at ±180°)
-    euler = np.degrees(np.unwrap(smp[["roll", "pitch", "yaw"]].to_numpy()[sel], axis=0))
+    euler = np.degrees(smp[["roll", "pitch", "yaw"]].to_numpy()[sel])
     true_euler = None
     if truth is not None and truth.quat is not None and len(truth.quat) == len(t):
-        true_euler = np.degrees(np.unwrap(quat_to_euler(np.asarray(truth.quat)[sel]), axis=0))
+        true_euler = np.degrees(quat_to_euler(np.asarray(truth.quat)[sel]))
     j = idx - np.flatnonzero(sel)[0]
     for ax in axes[:2]:
         _shade_stance(ax, t[sel], stance[sel], label=None)
     for i, name in enumerate(("roll", "pitch", "yaw")):
-        ax_att.plot(t[idx], euler[j, i], color=f"C{i}", lw=1.0, label=name)
+        ax_att.plot(t[idx], broken_at_wraps(euler[j, i]), color=f"C{i}", lw=1.0, label=name)
         if true_euler is not None:
-            ax_att.plot(t[idx], true_euler[j, i], color=f"C{i}", ls="--", lw=0.8)
+            ax_att.plot(t[idx], broken_at_wraps(true_euler[j, i]), color=f"C{i}", ls="--", lw=0.8)
     ax_att.set_ylabel("attitude (deg)")
     vel = result.vel
     for i, name in enumerate(("north", "east", "down")):

@@ -15,6 +15,7 @@ import pytest
 import footzoo
 from footzoo.evaluation.plots import (
     aligned_reference,
+    broken_at_wraps,
     errors_figure,
     fpa_figure,
     plot_run,
@@ -112,6 +113,31 @@ def test_states_window_outside_the_recording_is_a_clear_error(walk):
     rec, res = walk
     with pytest.raises(footzoo.ConfigError, match="outside the recording"):
         states_figure(res, rec, window=(1e4, 2e4))
+
+
+def test_an_angle_line_breaks_where_it_wraps_and_never_climbs():
+    # hand-derived: 170 -> 179 -> -179 (a wrap) -> -170; -90 -> 90 is a real turn of 180, kept
+    got = broken_at_wraps(np.array([170.0, 179.0, -179.0, -170.0, -90.0, 89.0]))
+    np.testing.assert_array_equal(np.isnan(got), [False, False, True, False, False, False])
+    np.testing.assert_array_equal(got[~np.isnan(got)], [170.0, 179.0, -170.0, -90.0, 89.0])
+
+
+def test_the_states_figure_keeps_roll_and_yaw_within_180_degrees(walk):
+    # a pitched sensor whose pitch passes -90 deg at push-off flips roll and yaw by 180 deg every stride: ten such
+    # flips, unwrapped, drew roll and yaw climbing to 1800 deg (IPOL's MTw: 3200 deg over 20 strides)
+    import dataclasses
+
+    _, res = walk
+    smp = res.samples.copy()
+    flips = np.pi * np.floor(np.linspace(0.0, 10.0, len(smp)))
+    smp["roll"] = np.angle(np.exp(1j * (0.1 + flips)))
+    smp["yaw"] = np.angle(np.exp(1j * (-0.2 + flips)))
+    fig = states_figure(dataclasses.replace(res, samples=smp))
+    lines = {line.get_label(): line.get_ydata() for line in fig.axes[0].get_lines()}
+    for name in ("roll", "yaw"):
+        assert np.nanmax(np.abs(lines[name])) <= 180.0
+        assert np.isnan(lines[name]).any()  # the line breaks at the flips, no vertical stroke
+    close(fig)
 
 
 def test_a_recording_that_does_not_match_the_result_is_refused(walk):
