@@ -499,15 +499,22 @@ def _run_session(args: argparse.Namespace, pipeline) -> int:
 
 def cmd_list(args: argparse.Namespace) -> int:
     """Print every plug-in (or one kind, or one by name) with its parameters, and the config's settings."""
+    theirs: list[str] = []
     if args.plugins:
         from ..plugins.extensions import load_plugins  # deferred: the plug-ins' imports
 
         for i, loaded in enumerate(load_plugins(args.plugins, where="--plugins")):
+            theirs += registered_by(loaded["module"])
             if not registered_by(loaded["module"]):
                 warnings.warn(FootzooWarning(
                     f"--plugins[{i}]: {loaded['path']} registers no plug-in, so nothing of it is listed: decorate "
                     "each plug-in class with @footzoo.register (a subclass of a footzoo kind, e.g. Detector)"),
                     stacklevel=2)
+        if args.kind is None and args.name is None:  # the files' plug-ins, not buried among footzoo's own
+            if theirs:
+                print("".join(describe(None, name) for name in dict.fromkeys(theirs)), end="")
+                print("(the plug-ins of --plugins; footzoo list without it lists footzoo's own)")
+            return EXIT_OK
     if args.kind == "settings" or (args.kind is None and args.name is None):
         plugins = describe() if args.kind is None else ""
         print(plugins + ("\n" if plugins else "") + describe_settings(), end="")

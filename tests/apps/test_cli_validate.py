@@ -78,5 +78,10 @@ def test_list_shows_a_plug_in_file_given_with_plugins(tmp_path, capsys):
         assert main(["list", "listed_detector", "--plugins", str(mine)]) == 0
         out = capsys.readouterr().out
         assert "listed_detector — Stance when the rate is small." in out and "limit = 0.5 [rad/s]" in out
+        # without a name: the file's plug-ins alone, not buried among footzoo's own (360 lines)
+        assert main(["list", "--plugins", str(mine)]) == 0
+        out = capsys.readouterr().out
+        assert out.startswith("detector:\n  listed_detector — Stance when the rate is small.")
+        assert "angular_rate_fsm" not in out and "footzoo list without it lists footzoo's own" in out
     finally:
         registry._REGISTRY["detector"].pop("listed_detector", None)
