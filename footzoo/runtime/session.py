@@ -40,17 +40,21 @@ class Session:
 
     Parameters
     ----------
-    recordings : dict
+    recordings : dict or list
         ``{"left": Recording, "right": Recording}`` (one foot alone is allowed;
-        the bilateral table then stays empty).
+        the bilateral table then stays empty), or a list of recordings whose
+        ``meta["foot"]`` names each foot once (as the xsens reader's ``_lf`` / ``_rf`` files do).
     name : str
         Session name.
     """
 
-    def __init__(self, recordings: dict[str, Recording], name: str = "session"):
+    def __init__(self, recordings: dict[str, Recording] | list[Recording], name: str = "session"):
+        if isinstance(recordings, (list, tuple)):
+            recordings = _by_foot(recordings)
         bad = [k for k in recordings if k not in FEET]
         if bad or not recordings:
-            raise FormatError(f"a session holds recordings keyed 'left' and/or 'right', got {list(recordings)}")
+            raise FormatError(f"a session holds recordings keyed 'left' and/or 'right', got the keys "
+                              f"{[str(k) for k in recordings]}: give Session({{'left': rec_l, 'right': rec_r}})")
         for foot, rec in recordings.items():
             if not isinstance(rec, Recording):
                 raise NotARecordingError(f"session[{foot!r}] must be a footzoo Recording, got {type(rec).__name__}; "
@@ -88,6 +92,24 @@ class Session:
         require_pipeline(pipeline, "Session.run")
         results = {foot: pipeline.run(rec, engine=engine) for foot, rec in self.recordings.items()}
         return SessionResult(results=results, name=self.name)
+
+
+def _by_foot(recordings: list | tuple) -> dict[str, Recording]:
+    """A list of recordings keyed by the foot each names in ``meta["foot"]``; an error names any that names none or
+    a foot already taken."""
+    out: dict[str, Recording] = {}
+    for i, rec in enumerate(recordings):
+        if not isinstance(rec, Recording):
+            raise NotARecordingError(f"session[{i}] must be a footzoo Recording, got {type(rec).__name__}; "
+                                     "build it with footzoo.load(path)")
+        foot = rec.meta.get("foot")
+        if foot not in FEET or foot in out:
+            why = ("names no foot (meta['foot'] is " + repr(foot) + ")" if foot not in FEET
+                   else f"is a second {foot} foot (with {out[foot].name!r})")
+            raise FormatError(f"session[{i}] ({rec.name!r}) {why}: a list of recordings is keyed by the foot each "
+                              "names; give Session({'left': rec_l, 'right': rec_r}) to say which is which")
+        out[foot] = rec
+    return out
 
 
 def _check_one_clock(recordings: dict[str, Recording]) -> None:

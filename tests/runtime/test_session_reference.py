@@ -222,3 +222,19 @@ def test_two_feet_on_different_clocks_are_warned_and_one_clock_is_not():
     with warnings.catch_warnings():
         warnings.simplefilter("error", FootzooWarning)
         Session({"left": walk, "right": Recording(t=walk.t + 0.5, acc=walk.acc, gyr=walk.gyr)})
+
+
+def test_a_list_of_recordings_is_keyed_by_the_foot_each_names():
+    """IPOL's `_lf` / `_rf` files each name their foot: a list of the two was refused with the recordings' reprs."""
+    left = simulate(n_strides=3, rate=100.0, foot="left")
+    right = simulate(n_strides=3, rate=100.0, foot="right")
+    session = Session([right, left])
+    assert session.recordings == {"right": right, "left": left}
+    with pytest.raises(FormatError, match=r"session\[1\] \('sim_straight'\) is a second left foot"):
+        Session([left, left])
+    unnamed = Recording(t=left.t, acc=left.acc, gyr=left.gyr)
+    with pytest.raises(FormatError, match=r"session\[0\] \('recording'\) names no foot \(meta\['foot'\] is None\): "
+                                          r".*give Session\(\{'left': rec_l, 'right': rec_r\}\)"):
+        Session([unnamed, right])
+    with pytest.raises(FormatError, match=r"got the keys \['l'\]: give Session\(\{'left'"):
+        Session({"l": left})
