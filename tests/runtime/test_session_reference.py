@@ -226,11 +226,13 @@ def test_two_feet_on_different_clocks_are_warned_and_one_clock_is_not():
 
 def test_a_list_of_recordings_is_keyed_by_the_foot_each_names():
     """IPOL's `_lf` / `_rf` files each name their foot: a list of the two was refused with the recordings' reprs."""
-    left = simulate(n_strides=3, rate=100.0, foot="left")
-    right = simulate(n_strides=3, rate=100.0, foot="right")
+    t = np.arange(300) / 100.0
+    acc, gyr = np.tile([0.0, 0.0, -9.81], (300, 1)), np.zeros((300, 3))
+    left = Recording(t=t, acc=acc, gyr=gyr, meta={"name": "walk_lf", "foot": "left"})
+    right = Recording(t=t, acc=acc, gyr=gyr, meta={"name": "walk_rf", "foot": "right"})
     session = Session([right, left])
     assert session.recordings == {"right": right, "left": left}
-    with pytest.raises(FormatError, match=r"session\[1\] \('sim_straight'\) is a second left foot"):
+    with pytest.raises(FormatError, match=r"session\[1\] \('walk_lf'\) is a second left foot \(with 'walk_lf'\)"):
         Session([left, left])
     unnamed = Recording(t=left.t, acc=left.acc, gyr=left.gyr)
     with pytest.raises(FormatError, match=r"session\[0\] \('recording'\) names no foot \(meta\['foot'\] is None\): "
