@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from ..core.errors import ConfigError, FootzooWarning
+from ..core.errors import ConfigError, FootzooWarning, user_stacklevel
 from ..core.usage import fix
 from ..evaluation.metrics import intervals, nearest_index
 from ..kernels.jit import njit
@@ -230,12 +230,12 @@ class HuangFPA(Analysis):
             self.note_ = (f"the foot side is unknown (the recording does not name it, and {found.reason}); the foot "
                           "progression angle's sign depends on it")
             warnings.warn(FootzooWarning(f"huang_fpa: recording {name!r}: {self.note_}: every FPA is NaN, the rest "
-                                         f"of the run is unaffected; {declare}"), stacklevel=3)
+                                         f"of the run is unaffected; {declare}"), stacklevel=user_stacklevel())
             return None
         self.foot_source_ = "walk"
         warnings.warn(FootzooWarning(
             f"huang_fpa: recording {name!r} does not say which foot the sensor is on; read as the {found.side} foot "
-            f"from the walk: {found.reason}. To be sure, {declare}"), stacklevel=3)
+            f"from the walk: {found.reason}. To be sure, {declare}"), stacklevel=user_stacklevel())
         return found.side
 
     def _say_turning(self, had: np.ndarray, name: str) -> bool:
@@ -254,7 +254,8 @@ class HuangFPA(Analysis):
             self.note_ = why
         warnings.warn(FootzooWarning(
             f"huang_fpa: recording {name!r}: {why}; those FPAs are NaN, the rest of the run is unaffected. For a "
-            "foot progression angle, record straight walking (a walkway or a treadmill, turns apart)"), stacklevel=3)
+            "foot progression angle, record straight walking (a walkway or a treadmill, turns apart)"),
+            stacklevel=user_stacklevel())
         return True
 
     def _say_implausible(self, name: str) -> None:
@@ -271,7 +272,7 @@ class HuangFPA(Analysis):
             f"{vector} from the line of progression, and that axis is not along the foot. The FPA measures the "
             "sensor, not the foot: mount the sensor with its x axis along the foot, or give the foot's long axis "
             "in sensor axes: calibrate it (footzoo calibrate --data CALIBRATION_RECORDING --out foot.yaml, then "
-            "calibration: foot.yaml in the analysis config) or set foot_vector"), stacklevel=3)
+            "calibration: foot.yaml in the analysis config) or set foot_vector"), stacklevel=user_stacklevel())
 
     def annotate(self, steps: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
         """Add ``fpa_rad`` to the step table: the FPA of the stance that ends each stride.

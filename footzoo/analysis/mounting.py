@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..core.conventions import axis_map_text, proper_axis_maps, quat_to_matrix
-from ..core.errors import FormatError, SensorWarning
+from ..core.errors import FormatError, SensorWarning, user_stacklevel
 from ..io.axes import axes_fix, parse_axes
 from ..kernels.jit import njit
 from .gait_events import sagittal_rate, stride_directions
@@ -215,4 +215,5 @@ def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | N
            if suggested else "check the axis map (x toward the toe, y right, z down) and read the file with the "
                              "right one: --option 'axes=[...]' on the command line, footzoo.load(path, axes=...)")
     warnings.warn(f"{where}{'; '.join(symptoms)}. footzoo's strides and gait events do not depend on the "
-                  f"mounting; {fix}. Details in Result.diagnostics['mounting']", SensorWarning, stacklevel=3)
+                  f"mounting; {fix}. Details in Result.diagnostics['mounting']", SensorWarning,
+                  stacklevel=user_stacklevel())

@@ -50,6 +50,7 @@ from ..core.errors import (
     PluginError,
     RecordingError,
     did_you_mean,
+    user_stacklevel,
 )
 from ..core.files import nul_in_path, why_missing
 from ..core.params import describe as describe_parameters
@@ -509,7 +510,7 @@ def cmd_list(args: argparse.Namespace) -> int:
                 warnings.warn(FootzooWarning(
                     f"--plugins[{i}]: {loaded['path']} registers no plug-in, so nothing of it is listed: decorate "
                     "each plug-in class with @footzoo.register (a subclass of a footzoo kind, e.g. Detector)"),
-                    stacklevel=2)
+                    stacklevel=user_stacklevel())
         if args.kind is None and args.name is None:  # the files' plug-ins, not buried among footzoo's own
             if theirs:
                 print("".join(describe(None, name) for name in dict.fromkeys(theirs)), end="")

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.errors import CalibrationWarning
+from ..core.errors import CalibrationWarning, user_stacklevel
 from ..plugins.base import Calibration, Real, Vector
 from ..plugins.registry import register
 
@@ -229,7 +229,7 @@ class HardIron(Calibration):
             self.report_["reason"] = reason
             warnings.warn(f"hard_iron: magnetometer left uncalibrated: {reason}. Pass a known offset "
                           "(hard_iron: {offset: [x, y, z]}) or remove the calibration",
-                          CalibrationWarning, stacklevel=2)
+                          CalibrationWarning, stacklevel=user_stacklevel())
             return self
         self.mag_ = mag - fit.offset
         return self

@@ -53,7 +53,7 @@ import pandas as pd
 from .._version import __version__
 from .atomic import INCOMPLETE, FileGroup, check_complete, dumps_json, json_safe, previous_marker
 from .data import Truth
-from .errors import FootzooWarning, FormatError, OutputError
+from .errors import FootzooWarning, FormatError, OutputError, user_stacklevel
 from .files import nul_in_path, sha256
 
 FORMAT = "footzoo-result"
@@ -399,7 +399,7 @@ def _metrics_payload(result: Any) -> dict[str, Any]:
         metrics, notes = result.checked_metrics()
     except Exception as err:  # a failing metric must not lose the result
         warnings.warn(FootzooWarning(f"Result.save: the metrics could not be computed ({type(err).__name__}: {err}); "
-                                     "saved without them"), stacklevel=4)
+                                     "saved without them"), stacklevel=user_stacklevel())
         metrics = {"error": f"{type(err).__name__}: {err}"}
     recording = json_safe(result.recording)  # nested metadata as plain JSON; objects as their text, never dropped
     return {"metrics": metrics, "metric_notes": notes, "config": result.config, "versions": result.versions,
@@ -444,7 +444,7 @@ def _result_files(result: Any, folder: Path, group: FileGroup, backend: str) -> 
                                               "lossless (arrays and tables in the files listed here)", "kind": "json"}
     if packer.dropped:
         warnings.warn(FootzooWarning("Result.save: not saved (not plain values, arrays or tables): "
-                                     + "; ".join(packer.dropped[:10])), stacklevel=4)
+                                     + "; ".join(packer.dropped[:10])), stacklevel=user_stacklevel())
         files["result.json"]["dropped"] = packer.dropped
     return files
 
@@ -560,7 +560,7 @@ def _verify(folder: Path, files: dict[str, Any], loader: str) -> None:
             f"{loader}: {names} changed after the result was saved (the SHA-256 differs from the one its "
             "manifest.json records): loaded as it is now, edited by hand or by another program, not as footzoo "
             f"wrote it; restore the folder from a copy or save the result again, or {loader}(path, verify=False) "
-            "to load it without this check"), stacklevel=4)
+            "to load it without this check"), stacklevel=user_stacklevel())
 
 
 def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:

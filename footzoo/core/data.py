@@ -17,7 +17,7 @@ import pandas as pd
 
 from .checks import check_positive, gap_limit
 from .conventions import ACC_UNITS, DIST_UNITS, GRAVITY, GYR_UNITS, TIME_UNITS
-from .errors import FootzooWarning, RecordingError, shown
+from .errors import FootzooWarning, RecordingError, shown, user_stacklevel
 from .norms import row_norms, unit_error
 from .sanity import check_impossible, scan
 from .usage import fix
@@ -281,7 +281,7 @@ class Recording:
             if dup.any():
                 warnings.warn(
                     f"dropped {int(dup.sum())} row(s) whose time stamp repeats the previous one",
-                    FootzooWarning, stacklevel=2,
+                    FootzooWarning, stacklevel=user_stacklevel(),
                 )
                 df = df.loc[~dup].reset_index(drop=True)
                 t = t[~dup]
@@ -610,10 +610,10 @@ def _report_gaps(rec: Recording, warn: bool = True) -> None:
         "max_gap_s": float(_max_gap(rec, period)),
     }
     if warn:
-        warn_gaps(rec, stacklevel=4)  # as seen from _report_gaps: the caller of Recording(...)
+        warn_gaps(rec)
 
 
-def warn_gaps(rec: Recording, refuse: str | None = None, stacklevel: int = 2) -> None:
+def warn_gaps(rec: Recording, refuse: str | None = None) -> None:
     """The warning of the bridged gaps listed in ``rec.meta["diagnostics"]["gaps"]`` (none: no warning).
 
     ``refuse``: how to refuse them where the samples came from (default: the loader's ``max_gap`` option).
@@ -635,7 +635,7 @@ def warn_gaps(rec: Recording, refuse: str | None = None, stacklevel: int = 2) ->
             "The list is in meta['diagnostics']['gaps']; to refuse them, a smaller max_gap: "
             f"{refuse or option_fix('max_gap', 'SECONDS', number=True)}"
         ),
-        stacklevel=stacklevel + 1,
+        stacklevel=user_stacklevel(),
     )
 
 

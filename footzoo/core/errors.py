@@ -2,6 +2,12 @@
 
 import copy
 import difflib
+import inspect
+import os
+from pathlib import Path
+
+#: footzoo's package folder: a warning's stack level counts the frames inside it (:func:`user_stacklevel`).
+_PACKAGE = str(Path(__file__).resolve().parents[1]) + os.sep
 
 
 class FootzooError(Exception):
@@ -105,3 +111,19 @@ def prefixed(err: FootzooError, where: object) -> FootzooError:
     out = copy.copy(err)
     out.args = (f"{where}: {err}",)
     return out
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` for :func:`warnings.warn` that points at the first frame outside footzoo.
+
+    A warning then names the user's line (the script's ``footzoo.load(...)`` or ``pipe.run(rec)``), not a
+    line inside footzoo, however deep in footzoo it was raised: pass ``stacklevel=user_stacklevel()``.
+    """
+    frame = inspect.currentframe()
+    level = 0
+    # footzoo's frames, and the methods a dataclass generates (``Recording.__init__``, file ``<string>``)
+    while frame is not None and (frame.f_code.co_filename.startswith(_PACKAGE)
+                                 or frame.f_code.co_filename == "<string>"):
+        frame = frame.f_back
+        level += 1
+    return max(level, 1)

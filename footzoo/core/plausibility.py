@@ -100,7 +100,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from .conventions import GRAVITY
-from .errors import SensorWarning
+from .errors import SensorWarning, user_stacklevel
 from .norms import row_norms
 
 #: Hypotheses of a wrong rate: the declared rate is ``F`` times the real one (2: read at twice its rate).
@@ -476,7 +476,7 @@ class GaitScan:
             "rad/s): declare gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line "
             "--option gyr_unit=rad/s, a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. "
             "Details in diagnostics['sensor']['plausibility']",
-            SensorWarning, stacklevel=5,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
     # ------------------------------------------------------------------ the rate
@@ -531,7 +531,7 @@ class GaitScan:
             finding["time_scale_residual"] = {f"{s:.3g}": float(r) for s, r in zip(evidence["scales"],
                                                                                    evidence["residual"], strict=True)}
         self.report["rate"] = finding
-        warnings.warn(self._message(finding, evidence, verdict), SensorWarning, stacklevel=6)
+        warnings.warn(self._message(finding, evidence, verdict), SensorWarning, stacklevel=user_stacklevel())
         return True
 
     def _message(self, finding: dict[str, Any], evidence: dict[str, Any] | None, verdict: dict[str, Any]) -> str:

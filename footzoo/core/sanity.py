@@ -48,7 +48,7 @@ import numpy as np
 from ..kernels.jit import njit
 from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
-from .errors import RecordingError, SensorWarning
+from .errors import RecordingError, SensorWarning, user_stacklevel
 from .norms import row_norms, row_norms_squared
 from .plausibility import MOTION_ACC, GaitScan, RateEvidence
 
@@ -165,7 +165,7 @@ def find_frozen(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0
     return found
 
 
-def warn_frozen(found: list[dict[str, Any]], name: str, stacklevel: int = 4) -> None:
+def warn_frozen(found: list[dict[str, Any]], name: str) -> None:
     """The warning of the dropouts :func:`find_frozen` found."""
     if not found:
         return
@@ -176,7 +176,7 @@ def warn_frozen(found: list[dict[str, Any]], name: str, stacklevel: int = 4) -> 
     warnings.warn(
         f"{name}: {'; '.join(parts)}{more}: that channel dropped out (a lost connection, or a logger that repeats its "
         "last value); every estimate from there is wrong. Cut the recording before the dropout, or repair it. "
-        "Details in meta['sanity']['frozen']", SensorWarning, stacklevel=stacklevel)
+        "Details in meta['sanity']['frozen']", SensorWarning, stacklevel=user_stacklevel())
 
 
 def find_bursts(x: np.ndarray, jump: float, max_len: int = GLITCH_MAX_LEN) -> np.ndarray:
@@ -263,30 +263,29 @@ def scan(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording
         warnings.warn(
             f"{name}: sensor saturated (clipped): {'; '.join(parts)}. Velocity and position are "
             "underestimated there; use a sensor with a larger range. Details in meta['sanity']",
-            SensorWarning, stacklevel=4,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
     glitches = _glitches(t, acc, gyr)
     report.update(glitches)
     if warn:
-        _warn_found(t, acc, gyr, glitches, name, 0, 5)  # the caller of the Recording, as warn_frozen's
+        _warn_found(t, acc, gyr, glitches, name)
     frozen = find_frozen(t, acc, gyr)
     if frozen:
         report["frozen"] = frozen
     if frozen and warn:
-        warn_frozen(frozen, name, stacklevel=5)
+        warn_frozen(frozen, name)
     return report
 
 
-def warn_glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording",
-                  stacklevel: int = 4) -> dict[str, list[int]]:
+def warn_glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, name: str = "recording") -> dict[str, list[int]]:
     """Warn about gyroscope and accelerometer glitches (:func:`find_bursts`); ``{"gyro_glitches": [...], ...}``."""
     found = _glitches(t, acc, gyr)
-    _warn_found(t, acc, gyr, found, name, 0, stacklevel + 1)
+    _warn_found(t, acc, gyr, found, name)
     return found
 
 
 def _warn_found(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, found: dict[str, list[int]], name: str,
-                offset: int = 0, stacklevel: int = 5) -> None:
+                offset: int = 0) -> None:
     """The warnings of glitches ``found`` (absolute sample numbers; ``offset``: that of the arrays' first sample)."""
     for key, label, arr, bound, unit in (("gyro_glitches", "gyroscope", gyr, GLITCH_JUMP, "rad/s"),
                                          ("acc_glitches", "accelerometer", acc, ACC_GLITCH_JUMP, "m/s²")):
@@ -306,7 +305,7 @@ def _warn_found(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, found: dict[str
             f"them (bursts of 1 to {GLITCH_MAX_LEN} samples, measured from the line between the samples before and "
             f"after) at sample(s) {shown}{more}: {effect}. Repair those samples (e.g. replace them by the "
             "neighbours' mean). Details in meta['sanity']",
-            SensorWarning, stacklevel=stacklevel,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
 
@@ -456,7 +455,7 @@ class SignalScan:
         self._frozen_tail, self._frozen_x, self._frozen_k0 = tail_t[keep:], tail_x[keep:], base + keep
         if found:
             self.report.setdefault("frozen", []).extend(found)
-            warn_frozen(found, self.name, stacklevel=5)
+            warn_frozen(found, self.name)
         return found
 
     def _saturation(self, t: np.ndarray, x: np.ndarray, k0: int, step: np.ndarray) -> dict[str, Any]:
@@ -509,7 +508,7 @@ class SignalScan:
         warnings.warn(
             f"{self.name}: sensor saturated (clipped): {'; '.join(parts)}. Velocity and position are "
             "underestimated there; use a sensor with a larger range. Details in Stream.sensor",
-            SensorWarning, stacklevel=4,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
         return {"saturation": found}
 
@@ -695,7 +694,7 @@ class EstimateScan:
             f"m/s²): the velocity is held at zero through the swings, so the track ({moved:.2f} m) and the strides "
             "are not the foot's. Lower its threshold, or choose a detector made for this motion. Details in "
             "diagnostics['sensor']",
-            SensorWarning, stacklevel=4,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
     def _scale(self, k: np.ndarray, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, runs: np.ndarray) -> None:
@@ -739,7 +738,7 @@ class EstimateScan:
             f"{t1 - start[1]:.1f} s while the accelerometer reads {level:.3g}{unit}, far from g = "
             f"{self.gravity:.2f} m/s²: its unit or scale is wrong from there. Check the unit of the samples "
             "(live: every packet in m/s²). Details in diagnostics['sensor']",
-            SensorWarning, stacklevel=6,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
     def _close(self, run: dict[str, Any]) -> None:
@@ -762,7 +761,7 @@ class EstimateScan:
             f"{self.name}: the sensor lies still from t = {run['t0']:.2f} s to {run['t1']:.2f} s (samples "
             f"{run['first']}–{run['last']}, {duration:.1f} s: |ω| < {STILL_GYR:g} rad/s, |a| ≈ g) but the estimate "
             f"moves {run['drift']:.2f} m meanwhile: {why}. Details in diagnostics['sensor']",
-            SensorWarning, stacklevel=5,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
     def use_evidence(self, evidence: RateEvidence) -> None:
@@ -800,6 +799,6 @@ class EstimateScan:
                     "never corrected). Choose a detector made "
                     "for this motion or tune its threshold, and keep the stance guard on (guards.max_swing). Details "
                     "in diagnostics['sensor']",
-                    SensorWarning, stacklevel=4,
+                    SensorWarning, stacklevel=user_stacklevel(),
                 )
         return self.report

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import FootzooWarning
+from ..core.errors import FootzooWarning, user_stacklevel
 from .metrics import intervals, reference_steps, result_metrics
 
 MIN_STANCE_S = 0.1  #: shortest plausible stance phase (s); a running stance lasts about 0.2 s
@@ -283,4 +283,4 @@ def warn_refused(label: str, notes: dict[str, str]) -> None:
     for name, why in notes.items():
         by_reason.setdefault(why, []).append(name)
     text = "; ".join(f"{', '.join(names)}: {why}" for why, names in by_reason.items())
-    warnings.warn(f"{label}: metrics refused (NaN): {text}", MetricWarning, stacklevel=3)
+    warnings.warn(f"{label}: metrics refused (NaN): {text}", MetricWarning, stacklevel=user_stacklevel())

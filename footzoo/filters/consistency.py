@@ -67,7 +67,7 @@ from typing import Any
 import numpy as np
 
 from ..core.conventions import GRAVITY
-from ..core.errors import SensorWarning
+from ..core.errors import SensorWarning, user_stacklevel
 from ..core.norms import row_norms, row_norms_squared
 from ..core.plausibility import MAX_STRIDE_TIME
 from ..kernels.jit import njit
@@ -408,7 +408,7 @@ class ConsistencyScan:
             f"(real sensors: below {RESIDUAL_LIMIT:g}); with {cause.replace('has the', 'of the')} undone it is "
             f"{report['explained_residual']:.2f}. Most likely {cause}: {fix}. "
             "Details in diagnostics['sensor']['consistency']",
-            SensorWarning, stacklevel=6,
+            SensorWarning, stacklevel=user_stacklevel(),
         )
 
     def ready(self, until: int) -> bool:

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import Settings
-from ..core.errors import ConfigError, FootzooWarning
+from ..core.errors import ConfigError, FootzooWarning, user_stacklevel
 from ..core.params import Real
 from .compiled import CompiledEngine
 from .eskf import Layout
@@ -161,7 +161,7 @@ def compiled_models(models: list[MeasurementModel], names: list[str], engine: st
                 raise ConfigError(f"engine='fast': {name} cannot be compiled ({err}); use engine='reference' "
                                   "or make its measurement functions numba-compilable") from None
             warnings.warn(f"{name}: measurement model not compilable ({err}); running the reference engine",
-                          FootzooWarning, stacklevel=5)
+                          FootzooWarning, stacklevel=user_stacklevel())
             return None
     return compiled
 

@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ..core.data import Recording
-from ..core.errors import FootzooWarning, FormatError
+from ..core.errors import FootzooWarning, FormatError, user_stacklevel
 from ..core.files import SNIFF_BYTES, damaged_text, foreign_encoding, nul_padding
 
 #: Longest line read when looking at a file's header (characters).
@@ -269,7 +269,7 @@ def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
         data = data[:len(data) - padding]
         warnings.warn(FootzooWarning(
             f"{name}: the file ends with {padding} NUL bytes (0x00) after its last line (a logger that pre-allocates "
-            "its file, or a copy cut short); they were ignored"), stacklevel=3)
+            "its file, or a copy cut short); they were ignored"), stacklevel=user_stacklevel())
         if data.endswith((b"\n", b"\r")) or not data.strip():
             return io.BytesIO(data)
     cut = data.rfind(b"\n")
@@ -279,7 +279,7 @@ def text_source(path: Path, what: str = "") -> Path | io.BytesIO:
     warnings.warn(FootzooWarning(
         f"{name}: the file does not end with a line break, so its last row may have been cut short "
         f"(a logger stopped or a copy interrupted mid-write); dropped that row: {last[:80]!r}. If the file is "
-        "complete, end it with a line break"), stacklevel=3)
+        "complete, end it with a line break"), stacklevel=user_stacklevel())
     return io.BytesIO(data[:cut + 1])
 
 

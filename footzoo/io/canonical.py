@@ -27,7 +27,7 @@ from ..core.atomic import FileGroup
 from ..core.checks import check_bool
 from ..core.conventions import quat_from_matrix, quat_mul
 from ..core.data import ACC_COLS, GYR_COLS, MAG_COLS, TRUTH_POS_COLS, TRUTH_QUAT_COLS, TRUTH_VEL_COLS, Recording, Truth
-from ..core.errors import FootzooWarning, FormatError, OutputError, did_you_mean
+from ..core.errors import FootzooWarning, FormatError, OutputError, did_you_mean, user_stacklevel
 from ..core.files import not_utf8
 from .axes import describe_axes, parse_axes, rotate_columns
 from .base import (
@@ -139,7 +139,7 @@ def _warn_unread(columns: Any, path: Path) -> None:
         warnings.warn(FootzooWarning(
             f"{path.name}: column(s) {named}{more} are not read: the canonical format reads t, acc_x..z, gyr_x..z, "
             "mag_x..z, dist_*, and as the reference true_pos_n..d, true_vel_n..d, true_qw..qz, true_stance, "
-            "true_dist_*; rename a column to use it (or drop it to silence this)"), stacklevel=4)
+            "true_dist_*; rename a column to use it (or drop it to silence this)"), stacklevel=user_stacklevel())
 
 
 #: Columns of a true-steps sidecar that hold the strides' times (s): footzoo's names and the simulator's older ones.
@@ -168,7 +168,7 @@ def check_steps(steps: pd.DataFrame, path: Path, t: Any) -> pd.DataFrame:
         warnings.warn(FootzooWarning(
             f"{path.name}: column(s) {', '.join(near)} are not read: a true-steps sidecar's columns are "
             f"{', '.join(STEP_COLUMNS)}; rename a misspelt column to use it (or drop it to silence this)"),
-            stacklevel=4)
+            stacklevel=user_stacklevel())
     times = [c for c in STEP_TIME_COLUMNS if c in steps.columns]
     if not times:
         raise FormatError(f"{path}: not a stride table: its columns {list(steps.columns)[:8]} hold no stride times; "
@@ -320,11 +320,12 @@ def _warn_unwritten(rec: Recording, path: Path, meta: list[str] = ()) -> None:
     if meta:
         warnings.warn(FootzooWarning(
             f"{path.name}: metadata {', '.join(meta[:8])} not written to {path.name}.meta.yaml (not plain text, "
-            "numbers, lists or mappings); convert it (e.g. to text) before writing, or keep it apart"), stacklevel=3)
+            "numbers, lists or mappings); convert it (e.g. to text) before writing, or keep it apart"),
+            stacklevel=user_stacklevel())
     tr = rec.truth
     lost = [name for name in ("footprints", "stride_positions") if tr is not None and getattr(tr, name) is not None]
     if lost:
         warnings.warn(FootzooWarning(
             f"{path.name}: the reference's {' and '.join(lost)} (truth.{', truth.'.join(lost)}) are not written: the "
             "canonical files hold per-sample truth, the steps table, the stride count and the closed-loop marker only. "
-            "Keep the original recording for them (footzoo.load reads them from it)"), stacklevel=3)
+            "Keep the original recording for them (footzoo.load reads them from it)"), stacklevel=user_stacklevel())

@@ -29,7 +29,7 @@ import pandas as pd
 
 from ..core.checks import check_positive, check_range, gap_limit
 from ..core.data import Recording, Truth
-from ..core.errors import FootzooWarning, FormatError
+from ..core.errors import FootzooWarning, FormatError, user_stacklevel
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import RECORDING_OPTIONS, Option, Reader, data_suffix, first_line, frame_options, text_source
 from .gaitmap_reference import REFERENCE_FILES, has_reference, reference_stride_positions, reference_strides
@@ -130,7 +130,7 @@ def read(path: Path, foot: str | None = None, rate: float = RATE_HZ, axes: Any =
         warnings.warn(FootzooWarning(
             f"{path.name}: sensor(s) {others} are not read: footzoo reads the feet (left_sensor, right_sensor) of a "
             "gaitmap file; export another sensor as a file of its own (canonical or generic) to read it"),
-            stacklevel=4)
+            stacklevel=user_stacklevel())
     block = df[sensor]
     missing = [c for c in COLUMNS if c not in block.columns]
     if missing:

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import FootzooWarning, FormatError
+from ..core.errors import FootzooWarning, FormatError, user_stacklevel
 from ..core.files import sha256
 from ..core.yamlsafe import dump_text, load_file
 
@@ -110,7 +110,8 @@ def read_facts(path: Path) -> Facts:
         warnings.warn(FootzooWarning(
             f"{side.name} describes an earlier {path.name} (its data_sha256 does not match the file): stale, ignored"
             + (f" together with {steps.name}" if steps.exists() else "")
-            + "; delete it, or write the recording again with footzoo.io.canonical.write"), stacklevel=3)
+            + "; delete it, or write the recording again with footzoo.io.canonical.write"),
+            stacklevel=user_stacklevel())
         return Facts()
     facts = Facts(meta=dict(meta), closed_loop=closed_loop, truth=truth, files=[side])
     if steps.exists():
@@ -123,7 +124,7 @@ def read_facts(path: Path) -> Facts:
             why = "belongs to an earlier file (its hash does not match)" if vouched else \
                 "is not listed in the metadata sidecar"
             warnings.warn(FootzooWarning(f"{steps.name} {why}: stale, not used as the reference; delete it"),
-                          stacklevel=3)
+                          stacklevel=user_stacklevel())
     return facts
 
 

@@ -44,7 +44,7 @@ import pandas as pd
 
 from ..core.checks import check_bool, check_range
 from ..core.data import Recording
-from ..core.errors import FootzooWarning, FormatError
+from ..core.errors import FootzooWarning, FormatError, user_stacklevel
 from .axes import apply_axes, describe_axes, parse_axes
 from .base import RECORDING_OPTIONS, Option, Reader, check_encoding, frame_options, text_source
 
@@ -110,7 +110,8 @@ def _time_base(df: pd.DataFrame, rate: float | None, path: Path) -> tuple[np.nda
                 k = int(np.argmax(~good))
                 warnings.warn(FootzooWarning(
                     f"{path}: the device timer restarted {restarts} time(s) (the first after row {k}); each of those "
-                    f"intervals is taken as the median period ({median / TIMER_HZ * 1e3:.3f} ms)"), stacklevel=4)
+                    f"intervals is taken as the median period ({median / TIMER_HZ * 1e3:.3f} ms)"),
+                    stacklevel=user_stacklevel())
                 step = np.where(good, step, median)
             return np.concatenate([[0.0], np.cumsum(step)]) / TIMER_HZ, "device timer (3DM-GX3, 19.6608 MHz)"
     host = pd.to_numeric(df.get("ts_filtered", pd.Series(dtype=float)), errors="coerce").to_numpy(dtype=float)

@@ -32,7 +32,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from ..core.errors import FootzooWarning, FormatError, did_you_mean
+from ..core.errors import FootzooWarning, FormatError, did_you_mean, user_stacklevel
 from ..core.files import SNIFF_BYTES, foreign_encoding
 from .base import MAT_ROUTE, first_line
 
@@ -122,7 +122,7 @@ class Readers(Mapping[str, Any]):
     def _skip(self, name: str, reason: str, record: bool = True) -> None:
         if record:
             self.broken[name] = reason
-        warnings.warn(FootzooWarning(f"reader skipped: {reason}"), stacklevel=4)
+        warnings.warn(FootzooWarning(f"reader skipped: {reason}"), stacklevel=user_stacklevel())
 
     def __getitem__(self, name: str) -> Any:
         return self._readers[name]
@@ -162,7 +162,7 @@ class Readers(Mapping[str, Any]):
                     raise
                 warnings.warn(FootzooWarning(
                     f"reader {name!r} ({self.origins[name]}): guess_can_open raised {type(err).__name__}: {err}; "
-                    "it was skipped for this file (fix the reader, or pass format=)"), stacklevel=3)
+                    "it was skipped for this file (fix the reader, or pass format=)"), stacklevel=user_stacklevel())
                 continue
             if ok is True or (ok and ok is not NotImplemented):
                 accepted.append(name)

@@ -19,7 +19,7 @@ import warnings
 import numpy as np
 
 from ..core.conventions import quat_conj, quat_from_rotvec, quat_mul
-from ..core.errors import RecordingError, SensorWarning
+from ..core.errors import RecordingError, SensorWarning, user_stacklevel
 from ..orientation.fqa import fqa_sample
 
 
@@ -107,7 +107,7 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
             "error from motion, so the gain is not corrected. If the accelerometer's unit or scale is wrong, declare "
             "it (the reader's acc_unit option) or calibrate the sensor; otherwise start the recording with the foot "
             f"at rest for init.duration = {duration:g} s",
-            SensorWarning, stacklevel=2)
+            SensorWarning, stacklevel=user_stacklevel())
         return 1.0
     warnings.warn(
         f"{name}: the accelerometer reads {still:.3f} m/s² in the still start "
@@ -115,7 +115,7 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
         "a gain (scale-factor) error, which "
         "would hide the stand-stills from the stance detector and lift the track. The run scales the specific "
         f"force by {gravity / still:.4f} (result.diagnostics['acc_gain']); calibrate the sensor to remove this",
-        SensorWarning, stacklevel=2)
+        SensorWarning, stacklevel=user_stacklevel())
     return gravity / still
 
 

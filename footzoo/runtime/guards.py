@@ -45,7 +45,7 @@ import numpy as np
 
 from ..core.checks import Settings
 from ..core.context import RunContext
-from ..core.errors import GuardWarning
+from ..core.errors import GuardWarning, user_stacklevel
 from ..core.norms import row_norms
 from ..core.params import Real
 from ..evaluation.metrics import intervals
@@ -237,15 +237,12 @@ class StanceGuard(Settings):
             f"{recording}: detector {detector!r} found no stance for {report['longest_swing']:.1f} s (longest of "
             f"{len(long)} swing(s) over max_swing = {self.max_swing:g} s, {total:.1f} s in all, the first from "
             f"t = {long[0][0]:.2f} s). {cause}. Details in Result.diagnostics['guards']",
-            GuardWarning, stacklevel=4,
+            GuardWarning, stacklevel=user_stacklevel(),
         )
 
 
-def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str,
-                stacklevel: int = 4) -> dict[str, Any]:
+def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str) -> dict[str, Any]:
     """Report (and warn about) an estimated speed above ``max_speed`` (m/s): the estimate has diverged.
-
-    ``stacklevel``: of the warning (:func:`warnings.warn`), the caller's frame that it names.
 
     Returns
     -------
@@ -263,6 +260,6 @@ def check_speed(t: np.ndarray, vel: np.ndarray, max_speed: float, recording: str
             f"{recording}: the estimated foot speed reaches {top:.3g} m/s (above {max_speed:g} m/s from "
             f"t = {t[over[0]]:.2f} s, {over.size} samples): faster than any foot moves, the estimate has diverged "
             "(missed stances or a wrong attitude). Details in Result.diagnostics['guards']",
-            GuardWarning, stacklevel=stacklevel,
+            GuardWarning, stacklevel=user_stacklevel(),
         )
     return report

@@ -341,7 +341,7 @@ class Pipeline:
         stances = real_stances(stance, pos)  # the steps and the mounting report share them and the rate
         sagittal = sagittal_rate(quat, rec.gyr, pos, stances) if len(stances) >= 2 else None
         steps = self.analyse(rec, stance, quat, pos, stances, sagittal)
-        reports["guards"].update(check_speed(rec.t, out["vel"], self.guards.max_speed, rec.name, stacklevel=5))
+        reports["guards"].update(check_speed(rec.t, out["vel"], self.guards.max_speed, rec.name))
         scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, self.detector.name)
         scan.dropouts(rec.meta.get("sanity", {}).get("frozen", []))  # a frozen channel explains what follows it
         scan.push(out["k"], rec.t, rec.acc, rec.gyr, stance, pos)

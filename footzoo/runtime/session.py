@@ -21,7 +21,7 @@ import pandas as pd
 
 from ..core.archive import read_session, save_session
 from ..core.data import Recording
-from ..core.errors import FootzooWarning, FormatError, NotARecordingError
+from ..core.errors import FootzooWarning, FormatError, NotARecordingError, user_stacklevel
 from ..evaluation.result import Result
 from ..io import detect_format, load
 from ..io.gaitmap import feet
@@ -126,7 +126,7 @@ def _check_one_clock(recordings: dict[str, Recording]) -> None:
         f"session: the {lf} foot's recording spans t = {l0:.6g}–{l1:.6g} s and the {rf} foot's {r0:.6g}–{r1:.6g} s, "
         f"overlapping {overlap:.3g} s: the two are not on one clock, so the step times (each foot's contact after the "
         "other's) and their symmetry come out NaN or wrong; the per-foot results are unaffected. Put both on one "
-        "clock (e.g. Recording(t=rec.t - offset, ...)) for the bilateral table"), stacklevel=3)
+        "clock (e.g. Recording(t=rec.t - offset, ...)) for the bilateral table"), stacklevel=user_stacklevel())
 
 
 def step_times(steps: dict[str, pd.DataFrame]) -> dict[str, np.ndarray]:

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.errors import GuardWarning, PluginError
+from ..core.errors import GuardWarning, PluginError, user_stacklevel
 from ..evaluation.metrics import nis_summary
 from ..filters.recorders import ROW_KEYS, SAMPLE_KEYS
 from ..filters.smoothing import smoothing as smoother_named
@@ -92,7 +92,7 @@ def _reissue_naming(caught: list[warnings.WarningMessage], name: str | None) -> 
             message = w.category(f"{name}: {text}") if name and not text.startswith(f"{name}:") else w.message
         except Exception:  # a warning class with another constructor: as it was
             message = w.message
-        warnings.warn(message, stacklevel=4)
+        warnings.warn(message, stacklevel=user_stacklevel())
 
 
 class CalibrationStage(Stage):
@@ -271,7 +271,7 @@ class DetectorStage(Stage):
                       f"{self.max_swing:g} s (guards.max_swing) before t = {float(out['t'][-1]):.2f} s. The stance "
                       f"guard marked {starts.size} still instant(s) there as stance, the first at t = {t_first:.2f} s: "
                       f"the trajectory in that swing is suspect — {MISSED_STANCE}",
-                      GuardWarning, stacklevel=8)
+                      GuardWarning, stacklevel=user_stacklevel())
 
     def held(self) -> int:
         """Samples waiting for the detector's or the guard's final stance."""

@@ -35,7 +35,7 @@ import numpy as np
 from ..core.checks import gap_limit, validate_block, validate_sample
 from ..core.context import RunContext
 from ..core.data import check_units
-from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError
+from ..core.errors import ConfigError, FootzooWarning, GuardWarning, RecordingError, user_stacklevel
 from ..core.sanity import EstimateScan, SignalScan
 from ..filters.consistency import ConsistencyScan
 from ..filters.engine import ENGINES
@@ -395,7 +395,7 @@ class Stream:
             warnings.warn(f"Stream: {waiting / self.ctx.rate:.0f} s of samples wait for their final estimate "
                           f"(max_pending = {self.max_pending:g} s): the detector finds no stance, so the dedrift or "
                           "the smoother cannot close the swing; the stream's memory grows until it does",
-                          GuardWarning, stacklevel=4)
+                          GuardWarning, stacklevel=user_stacklevel())
 
     # ------------------------------------------------------------------ start
     def _start(self, last: bool = False) -> bool:
@@ -433,7 +433,7 @@ class Stream:
             rate = measured
             warnings.warn(f"Stream: no rate given; using {rate:.2f} Hz measured over the still start (a batch run "
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
-                          FootzooWarning, stacklevel=4)
+                          FootzooWarning, stacklevel=user_stacklevel())
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
         self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
         self._axes = ConsistencyScan(rate, pipe.gravity, "stream")

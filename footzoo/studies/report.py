@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..core.errors import FootzooWarning
+from ..core.errors import FootzooWarning, user_stacklevel
 from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
 from ..evaluation.plots import REFERENCE_STYLE, png_bytes, pyplot, save, styled
 from .cache import HEAVY, with_heavy
@@ -293,7 +293,8 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
     skipped += _write_frames(runs, out)
     if skipped:  # one warning for the missing package, naming every file it costs
         warnings.warn(f"pyarrow is not installed: {', '.join(skipped)} not written (results.csv has the table; "
-                      "pip install 'footzoo[parquet]' or pyarrow to get them)", FootzooWarning, stacklevel=3)
+                      "pip install 'footzoo[parquet]' or pyarrow to get them)", FootzooWarning,
+                      stacklevel=user_stacklevel())
     step(1)
     md, tex = [], []
     for f in ["base", *factors]:

@@ -39,7 +39,7 @@ import pandas as pd
 
 from ..core import errors
 from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
-from ..core.errors import ConfigError, FootzooWarning, OutputError
+from ..core.errors import ConfigError, FootzooWarning, OutputError, user_stacklevel
 from ..core.files import sha256
 from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
@@ -115,7 +115,7 @@ def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
     stat, truth = np.asarray(getattr(det, "statistic_", None) if getattr(det, "statistic_", None) is not None
                              else np.full(rec.n, np.nan), float), rec.truth.stance
     if not np.isfinite(stat).any():  # the detector has no statistic (an optional output): no ROC curve, said so
-        warnings.warn(FootzooWarning(no_statistic_note(det)), stacklevel=2)
+        warnings.warn(FootzooWarning(no_statistic_note(det)), stacklevel=user_stacklevel())
         return []
     out = []
     for th in np.quantile(stat, np.linspace(0.0, 1.0, points)):
@@ -245,7 +245,8 @@ def run_chunk(cells: list[Cell], keys: list[str], identity: str, plugins: list[s
                 write_entry(Path(cache_dir) / f"{key}.json", key, record)
                 record["entry"] = str(Path(cache_dir) / f"{key}.json")
             except OSError as err:  # a full or read-only cache costs the resume, not the result
-                warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning, stacklevel=2)
+                warnings.warn(f"could not write the cache entry of run {key}: {err}", CacheWarning,
+                              stacklevel=user_stacklevel())
         record["cached"] = False
         out.append(record)
         if on_cell is not None:
@@ -263,7 +264,7 @@ def run_cell(cell: Cell, cache_dir: str | None = None, metric_names: list[str] |
         if record is not None:
             return {**record, "base": cell.base, "levels": cell.levels, "recording": cell.recording.label,
                     "cached": True}
-        warnings.warn(f"cache entry {key} {problem}; running it again", CacheWarning, stacklevel=2)
+        warnings.warn(f"cache entry {key} {problem}; running it again", CacheWarning, stacklevel=user_stacklevel())
     plugins = [p for p in cell.config.get("plugins") or []]
     return run_chunk([cell], [key], identity, plugins, cache_dir, metric_names, sweep_points)[0]
 
@@ -413,7 +414,7 @@ def _replay_warnings(worker: dict[str, int], refused: dict[str, int], log: Warni
         if quiet:
             log.keep([f"{category.__name__}: {message}"])
         else:  # named at the line that called run_study
-            warnings.warn(message, category, stacklevel=4)
+            warnings.warn(message, category, stacklevel=user_stacklevel())
 
 
 def _counts(values) -> dict[str, int]:
@@ -475,7 +476,7 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
         warnings.warn(f"{len(recomputed)} damaged cache entr{'y' if len(recomputed) == 1 else 'ies'} "
                       f"(e.g. {next(iter(recomputed))}: {next(iter(recomputed.values()))}) will be run again"
                       + (f"; see {Path(out) / 'cache_report.log'}" if out is not None else ""),
-                      CacheWarning, stacklevel=3)
+                      CacheWarning, stacklevel=user_stacklevel())
     if max_runs is not None:
         bar.add(-(len(todo) - min(len(todo), max_runs)))
         todo = todo[:max_runs]
@@ -557,7 +558,8 @@ def _check_report_folder(out: Path, study: Study) -> None:
         warnings.warn(f"study {study.name!r}: the output folder {str(out)!r} holds the report of a study of base "
                       f"config(s) {sorted(map(str, before))}; this study's ({_base_names(study)}) replaces it. That "
                       "study's runs stay in the folder's cache: running it again rebuilds its report without "
-                      "recomputing. Give this study another --out to keep both reports", FootzooWarning, stacklevel=3)
+                      "recomputing. Give this study another --out to keep both reports", FootzooWarning,
+                      stacklevel=user_stacklevel())
 
 
 def _outputs_digest(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str],

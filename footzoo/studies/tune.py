@@ -55,7 +55,7 @@ import yaml
 
 from ..config.library import resolve
 from ..core.atomic import FileGroup, folder_lock, json_safe, write_text
-from ..core.errors import ConfigError, FootzooWarning, did_you_mean
+from ..core.errors import ConfigError, FootzooWarning, did_you_mean, user_stacklevel
 from ..core.warninglog import LOG, WarningLog, log_text
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import METRICS
@@ -519,19 +519,19 @@ def _tune(study: Study, spec: TuneSpec, score: Score, eligible: Callable[[str], 
         warnings.warn(FootzooWarning(
             f"tune: {len(left_out)} of {len(run.all_groups)} recording(s) gave no {spec.objective} in any setting "
             f"and are left out of the cross-validation: {left_out[:5]}; the study's note column and {LOG} say why "
-            "(e.g. no reference that can score it)"), stacklevel=2)
+            "(e.g. no reference that can score it)"), stacklevel=user_stacklevel())
     if len(values.columns) == 1:
         warnings.warn(FootzooWarning(
             f"tune: only one setting was scored ({best}): nothing was compared, so it is 'chosen' by default and the "
             "cross-validation only scores it; give a factor two or more values (or search a space) to choose"),
-            stacklevel=2)
+            stacklevel=user_stacklevel())
     settings = run.settings
     scores = pd.Series({s: score(values[s], groups) for s in values.columns}).sort_values(kind="stable")
     config = run.configs[best]
     edges = grid_edges(settings[best], study.factors if spec.search == "grid" else spec.space)
     result = TuneResult(best, config, folds, held_out, scores, values, groups, settings, spec.objective, edges)
     for edge in edges:
-        warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=2)
+        warnings.warn(FootzooWarning(f"tune: the chosen {edge}"), stacklevel=user_stacklevel())
     target = spec.config or (Path(out) / "best.yaml" if out is not None else None)
     # the tables, the chosen config and the log of this tune (every warning it gave), or none of them
     with FileGroup(what="tune output") as written:
