@@ -41,7 +41,9 @@ import io
 import json
 import math
 import os
+import re
 import shutil
+import time
 import warnings
 import zipfile
 from pathlib import Path
@@ -343,9 +345,13 @@ def _earlier_files(folder: Path, kind: str) -> set[str] | None:
 @contextlib.contextmanager
 def _new_folder(path: str | os.PathLike, what: str) -> Any:
     """The archive folder (created if needed); a folder created here is removed again when the save fails."""
-    existed = (Path(path).is_dir() if isinstance(path, (str, os.PathLike)) and str(path).strip()
-               and not nul_in_path(path) else False)
-    folder = _prepare_folder(path, what)
+    try:
+        existed = (Path(path).is_dir() if isinstance(path, (str, os.PathLike)) and str(path).strip()
+                   and not nul_in_path(path) else False)
+        folder = _prepare_folder(path, what)
+    except OSError as err:  # a name longer than the file system allows, a path it cannot look into
+        raise OutputError(f"{what} {str(path)[:120]!r}{'...' if len(str(path)) > 120 else ''}: cannot be used as a "
+                          f"folder ({err.strerror or err}); choose a shorter or reachable folder path") from None
     try:
         yield folder
     except BaseException:
@@ -542,6 +548,10 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     return folder
 
 
+#: A SHA-256 as the manifest records it.
+_HEX64 = re.compile(r"[0-9a-f]{64}")
+
+
 def _hash_files(folder: Path, group: FileGroup, files: dict[str, Any]) -> None:
     """Add the SHA-256 of each file of the archive (as written, not yet renamed into place) to its manifest entry;
     the files saved with it (figures, the log: kind ``file``) are not what :func:`read_result` reads."""
@@ -550,17 +560,48 @@ def _hash_files(folder: Path, group: FileGroup, files: dict[str, Any]) -> None:
             info["sha256"] = sha256(group.path(folder / name))
 
 
-def _verify(folder: Path, files: dict[str, Any], loader: str) -> None:
-    """Warn of each file whose SHA-256 differs from its manifest's (archives saved without hashes: nothing)."""
-    changed = [name for name, info in files.items() if isinstance(info, dict) and isinstance(info.get("sha256"), str)
-               and (folder / name).is_file() and sha256(folder / name) != info["sha256"]]
+def _problems(folder: Path, files: dict[str, Any], loader: str) -> list[str]:
+    """What :func:`_verify` warns of: each file whose SHA-256 differs from its manifest's (archives saved without
+    hashes: nothing), and each file a hashed manifest gives no well-formed SHA-256 for (its entry was edited)."""
+    out = []
+    checked = {name: info for name, info in files.items() if info.get("kind") != "file"}
+    fix = (f"restore the folder from a copy or save the result again, or {loader}(path, verify=False) to load it "
+           "without this check")
+    if any("sha256" in info for info in checked.values()):
+        unchecked = [name for name, info in checked.items() if not _HEX64.fullmatch(str(info.get("sha256", "")))]
+        if unchecked:
+            names = ", ".join(repr(str(folder / n)) for n in unchecked)
+            out.append(f"{loader}: manifest.json of {str(folder)!r} records no well-formed SHA-256 (64 hexadecimal "
+                       f"digits) for {names}, so whether it changed after the save cannot be checked; the manifest "
+                       f"was edited: {fix}")
+    changed = [name for name, info in checked.items() if isinstance(info.get("sha256"), str)
+               and _HEX64.fullmatch(info["sha256"]) and (folder / name).is_file()
+               and sha256(folder / name) != info["sha256"]]
     if changed:
         names = ", ".join(repr(str(folder / n)) for n in changed)
-        warnings.warn(FootzooWarning(
-            f"{loader}: {names} changed after the result was saved (the SHA-256 differs from the one its "
-            "manifest.json records): loaded as it is now, edited by hand or by another program, not as footzoo "
-            f"wrote it; restore the folder from a copy or save the result again, or {loader}(path, verify=False) "
-            "to load it without this check"), stacklevel=user_stacklevel())
+        out.append(f"{loader}: {names} changed after the result was saved (the SHA-256 differs from the one its "
+                   "manifest.json records): loaded as it is now, edited by hand or by another program, not as "
+                   f"footzoo wrote it; {fix}")
+    return out
+
+
+def _verify(folder: Path, files: dict[str, Any], loader: str) -> None:
+    """Warn of what :func:`_problems` finds."""
+    for message in _problems(folder, files, loader):
+        warnings.warn(FootzooWarning(message), stacklevel=user_stacklevel())
+
+
+def _stamp(folder: Path) -> tuple[Any, ...]:
+    """What changes when a save commits into ``folder`` (its manifest is replaced last) or is under way."""
+    try:
+        st = (folder / MANIFEST).stat()
+    except OSError:
+        return (None, (folder / INCOMPLETE).exists())
+    return (st.st_ino, st.st_mtime_ns, st.st_size, (folder / INCOMPLETE).exists())
+
+
+#: Reads of an archive that another process saves into meanwhile, before :func:`read_result` gives up.
+READ_ATTEMPTS = 5
 
 
 def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
@@ -586,7 +627,12 @@ def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
     if not isinstance(version, int) or version > FORMAT_VERSION:
         raise FormatError(f"{manifest}: format version {version!r} is newer than this footzoo reads "
                           f"({FORMAT_VERSION}); upgrade footzoo (footzoo {data.get('footzoo_version')} wrote it)")
-    missing = [f for f in data.get("files", {}) if not (folder / f).exists()]
+    files = data.get("files", {})
+    if not isinstance(files, dict) or not all(isinstance(k, str) and isinstance(v, dict) for k, v in files.items()):
+        raise FormatError(f"{manifest}: its 'files' entry is not a mapping of each file's name to its description "
+                          f"(got {type(files).__name__}); the manifest is damaged: save the result again or restore "
+                          "the folder from a copy")
+    missing = [f for f in files if not (folder / f).exists()]
     if missing:
         raise FormatError(f"{str(folder)!r}: the archive lacks {missing}, which its manifest lists; it is incomplete")
     return data
@@ -633,17 +679,34 @@ def read_result(path: str | os.PathLike, verify: bool = True, loader: str = "Res
     differs from the manifest's (edited after the save) is loaded as it is, with a ``FootzooWarning``
     naming it; ``verify=False`` skips that check (archives saved without hashes are not checked).
     """
-    data = _read_manifest(path, FORMAT)
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        _read_manifest(path, FORMAT)  # the error naming what to give
     folder = Path(path)
-    try:
-        fields = _result_fields(folder, data["files"])
-    except FormatError:
-        raise
-    except _DAMAGED as err:
-        raise FormatError(f"{str(folder)!r}: the archive is damaged, a file cannot be read ({type(err).__name__}: "
-                          f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
-    if verify:
-        _verify(folder, data["files"], loader)
+    for attempt in range(READ_ATTEMPTS):  # another process saving into the folder meanwhile: read it again
+        stamp = _stamp(folder)
+        try:
+            data = _read_manifest(path, FORMAT)
+            fields = _result_fields(folder, data["files"])
+            problems = _problems(folder, data["files"], loader) if verify else []
+        except FormatError:
+            if attempt + 1 < READ_ATTEMPTS and _stamp(folder) != stamp:
+                time.sleep(0.05 * (attempt + 1))
+                continue
+            raise
+        except _DAMAGED as err:
+            if attempt + 1 < READ_ATTEMPTS and _stamp(folder) != stamp:
+                time.sleep(0.05 * (attempt + 1))
+                continue
+            raise FormatError(f"{str(folder)!r}: the archive is damaged, a file cannot be read ({type(err).__name__}: "
+                              f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
+        if _stamp(folder) == stamp and not stamp[-1]:
+            break
+        time.sleep(0.05 * (attempt + 1))
+    else:
+        raise FormatError(f"{str(folder)!r}: another process saved into the folder while it was read, "
+                          f"{READ_ATTEMPTS} times; load it again when that save has ended")
+    for message in problems:
+        warnings.warn(FootzooWarning(message), stacklevel=3)
     return fields
 
 

@@ -286,3 +286,65 @@ def test_dash_is_refused_as_text_and_as_a_path(result, tmp_path, monkeypatch, pa
         result.save(path)
     assert not any(tmp_path.iterdir())
     assert result.save(Path.cwd() / "-").name == "-"
+
+
+@pytest.mark.parametrize("edit", ["short", "not hex", "number", "missing"])
+def test_a_malformed_or_missing_hash_in_a_hashed_manifest_is_named(result, tmp_path, edit):
+    folder = result.save(tmp_path / "run", backend="csv")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    info = manifest["files"]["samples.csv"]
+    if edit == "missing":
+        del info["sha256"]
+    else:
+        info["sha256"] = {"short": info["sha256"][:40], "not hex": "z" * 64, "number": 12345}[edit]
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.warns(footzoo.FootzooWarning, match=r"records no well-formed SHA-256 .* for '.*samples.csv'.*"
+                                                    r"verify=False"):
+        Result.load(folder)
+
+
+@pytest.mark.parametrize("files", [["samples.csv"], None, {"samples.csv": "table"}])
+def test_a_manifest_whose_files_are_not_a_mapping_is_a_format_error(result, tmp_path, files):
+    folder = result.save(tmp_path / "run", backend="csv")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["files"] = files
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(FormatError, match=r"manifest.json: its 'files' entry is not a mapping.*save the result again"):
+        Result.load(folder)
+
+
+def test_a_load_while_another_save_commits_reads_one_result(result, tmp_path, monkeypatch):
+    """The folder changes under the reader once (another process's save committing): read again, no mix, no
+    warning; a folder that keeps changing is a FormatError saying so."""
+    folder = result.save(tmp_path / "run", backend="csv")
+    real = archive._result_fields
+    calls = []
+
+    def racing(where, files):
+        calls.append(1)
+        if len(calls) == 1:  # a save commits while this read is under way: new tables, then the new manifest
+            (where / "manifest.json").write_bytes((where / "manifest.json").read_bytes())
+            _edit_csv(where / "samples.csv")
+            manifest = json.loads((where / "manifest.json").read_text())
+            manifest["files"]["samples.csv"]["sha256"] = archive.sha256(where / "samples.csv")
+            (where / "manifest.json").unlink()
+            (where / "manifest.json").write_text(json.dumps(manifest))
+        return real(where, files)
+
+    monkeypatch.setattr(archive, "_result_fields", racing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        back = Result.load(folder)
+    assert len(calls) == 2 and back.samples.iloc[0, 0] == pd.read_csv(folder / "samples.csv").iloc[0, 0]
+    monkeypatch.setattr(archive, "_stamp", lambda where: (object(), False))  # changes at every look
+    monkeypatch.setattr(archive, "_result_fields", real)
+    monkeypatch.setattr(archive.time, "sleep", lambda s: None)
+    with pytest.raises(FormatError, match=r"another process saved into the folder while it was read"):
+        Result.load(folder)
+
+
+@pytest.mark.parametrize("name", ["x" * 300, "/".join(["d" * 200] * 25)])
+def test_a_folder_name_the_file_system_refuses_is_an_output_error(result, tmp_path, monkeypatch, name):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputError, match=r"cannot be used as a folder \(File name too long\); choose a shorter"):
+        result.save(name)
