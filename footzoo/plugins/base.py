@@ -48,7 +48,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..core.context import RunContext
-from ..core.errors import ConfigError, did_you_mean
+from ..core.errors import ConfigError, FootzooError, PluginError, did_you_mean
 from ..core.params import (  # noqa: F401 - Real ... File: the declaration vocabulary, re-exported for plug-ins
     REQUIRED,
     Boolean,
@@ -79,11 +79,26 @@ def _checking_params(method: Callable[..., Any]) -> Callable[..., Any]:
 
     @functools.wraps(method)
     def checking(self: Plugin, *args: Any, **kwargs: Any) -> Any:
-        self.check_params()
+        _run_check_params(self)
         return method(self, *args, **kwargs)
 
     checking._footzoo_checks_params = True  # type: ignore[attr-defined]
     return checking
+
+
+def _run_check_params(plugin: Plugin) -> None:
+    """``plugin.check_params()``; a plug-in's own override raising anything but a footzoo error (or not callable)
+    is a :class:`PluginError` naming the plug-in, not a bare traceback."""
+    try:
+        plugin.check_params()
+    except FootzooError:
+        raise
+    except Exception as err:  # noqa: BLE001 - a plug-in's own check_params: any error is the plug-in's fault
+        who = f"{plugin.kind or 'plug-in'} {plugin.name or type(plugin).__name__!r}"
+        raise PluginError(f"{who}: its check_params raised {type(err).__name__}: {err}; check_params must return "
+                          "the plug-in or raise footzoo.ConfigError naming the refused parameter, its value and the "
+                          "accepted range (or call super().check_params())", plugin=who,
+                          method="check_params") from err
 
 
 class Plugin(abc.ABC):  # noqa: B024 - the kinds below declare the methods a plug-in must write
@@ -255,7 +270,7 @@ def check_parameters(blocks: list[Any]) -> None:
     """:meth:`Plugin.check_params` of each plug-in among ``blocks`` (a pipeline's, when it is assembled)."""
     for block in blocks:
         if isinstance(block, Plugin):
-            block.check_params()
+            _run_check_params(block)
 
 
 def _context(ctx: Any) -> RunContext:

@@ -67,7 +67,7 @@ def import_timeout() -> float:
     if not value > 0:  # NaN too
         raise ConfigError(f"{IMPORT_TIMEOUT_VARIABLE}={text!r}: give the seconds a plug-in's import may take, a "
                           f"positive number (default {IMPORT_TIMEOUT_S:g}; inf for no limit)")
-    return value
+    return value if value <= threading.TIMEOUT_MAX else float("inf")  # beyond what a wait accepts: no limit
 
 
 def _bounded(run: Any, label: str, what: str, plugin: str) -> Any:
@@ -175,8 +175,11 @@ def load_plugins(specs: list[str] | None, base_dir: str | Path | None = None,
         A missing file or module, a syntax error (with file and line) or an error while importing.
     """
     out = []
+    specs = resolve_specs(specs, base_dir, where)
+    if specs:
+        import_timeout()  # a malformed FOOTZOO_PLUGIN_IMPORT_TIMEOUT is the environment's error, not the plug-in's
     with _LOCK:
-        for i, spec in enumerate(resolve_specs(specs, base_dir, where)):
+        for i, spec in enumerate(specs):
             label = f"{where}[{i}]"
             if is_path_spec(spec):
                 out.append(_load_file(Path(spec), label))

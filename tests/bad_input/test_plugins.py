@@ -522,3 +522,21 @@ def test_a_notebook_plugin_that_raises_in_its_constructor_is_a_plugin_error(walk
             Pipeline.from_dict(_config(detector={"type": "test_no_licence"}))
     finally:
         registry._REGISTRY["detector"].pop("test_no_licence", None)
+
+
+@pytest.mark.parametrize("value, loads", [("30s", False), ("-inf", False), ("1e300", True), ("1e400", True)])
+def test_the_import_time_limit_is_checked_as_the_environment_s_and_a_huge_one_is_no_limit(value, loads, tmp_path,
+                                                                                          monkeypatch, capsys):
+    """A malformed limit is a config error (exit 2) naming the variable, not a plug-in's failed import (exit 4); a
+    limit beyond what a thread's wait accepts (1e300 s) is no limit, not an OverflowError."""
+    monkeypatch.setenv(IMPORT_TIMEOUT_VARIABLE, value)
+    plugin = tmp_path / f"quick_{len(value)}_{loads}.py"
+    plugin.write_text("QUICK = 1\n")
+    if loads:
+        assert load_plugins([str(plugin)])[0]["path"] == str(plugin)
+        return
+    with pytest.raises(ConfigError, match=rf"{IMPORT_TIMEOUT_VARIABLE}='{value}': give the seconds") as err:
+        load_plugins([str(plugin)])
+    assert not isinstance(err.value, PluginImportError)
+    assert main(["list", "--plugins", str(plugin)]) == 2
+    assert IMPORT_TIMEOUT_VARIABLE in capsys.readouterr().err

@@ -366,3 +366,39 @@ def test_a_plugin_built_in_python_with_a_refused_value_is_refused_where_it_is_us
         plugin.begin(footzoo.core.context.RunContext.from_time(t))
     with pytest.raises(footzoo.ConfigError, match=message.partition(": ")[2]):  # the check of a config's value
         build(kind, {"type": name, **params})
+
+
+def _raises_runtime_error(self):
+    raise RuntimeError("cannot check")
+
+
+def _raises_key_error(self):
+    return {}["x"]
+
+
+@pytest.mark.parametrize("check, cause", [(_raises_runtime_error, r"RuntimeError: cannot check"),
+                                          (_raises_key_error, r"KeyError: 'x'"),
+                                          (property(lambda self: None), r"TypeError: 'NoneType' object is not callable")])
+def test_a_plugins_own_check_params_raising_any_error_is_a_plugin_error_naming_it(check, cause):
+    """A plug-in overriding check_params with a bug: its action methods and a pipeline given it name the plug-in,
+    the method and the fix (was the bare error, without the plug-in's name)."""
+    from footzoo.plugins.base import check_parameters
+
+    class OwnCheck(Detector):
+        """Stance where |w| < 0.6 rad/s (test; paper none, eq. 0)."""
+
+        name = "own_check"
+        paper = "none (test)"
+        check_params = check
+
+        def detect(self, t, acc, gyr, ctx=None):
+            self.statistic_ = np.linalg.norm(gyr, axis=1)
+            self.stance_ = self.statistic_ < 0.6
+            return self
+
+    message = rf"detector 'own_check': its check_params raised {cause}; check_params must return the plug-in"
+    t = np.arange(50) / 100.0
+    with pytest.raises(footzoo.PluginError, match=message):
+        OwnCheck().detect(t, np.tile([0.0, 0.0, -9.81], (50, 1)), np.zeros((50, 3)))
+    with pytest.raises(footzoo.PluginError, match=message):
+        check_parameters([OwnCheck()])
