@@ -243,6 +243,10 @@ class Recording:
         """
         if not isinstance(df, pd.DataFrame):
             raise RecordingError(f"from_dataframe expects a pandas DataFrame, got {type(df).__name__}")
+        if isinstance(df.columns, pd.MultiIndex):
+            raise RecordingError(f"from_dataframe: the table has {df.columns.nlevels} levels of column names (e.g. "
+                                 f"{df.columns[0]!r}); give one level named t, acc_x, ..., gyr_z: flatten them first, "
+                                 "e.g. df.columns = ['_'.join(map(str, c)).strip('_') for c in df.columns]")
         _check_choice("acc_unit", acc_unit, ACC_UNITS)
         _check_choice("gyr_unit", gyr_unit, GYR_UNITS)
         _check_choice("dist_unit", dist_unit, DIST_UNITS)
@@ -269,7 +273,7 @@ class Recording:
         partial_mag = [c for c in MAG_COLS if c in df.columns]
         if partial_mag and not has_mag:
             raise RecordingError(f"magnetometer columns incomplete: found {partial_mag}, need {MAG_COLS}")
-        dist_cols = sorted(c for c in df.columns if c.startswith("dist_"))
+        dist_cols = sorted(c for c in df.columns if isinstance(c, str) and c.startswith("dist_"))
 
         df = df.reset_index(drop=True)
         t = pd.to_numeric(df[time_col], errors="coerce").to_numpy(dtype=float)

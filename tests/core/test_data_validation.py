@@ -36,6 +36,17 @@ def test_missing_columns_are_named():
         Recording.from_dataframe(frame().drop(columns="gyr_z"))
 
 
+def test_two_levels_of_column_names_are_named_with_the_way_to_flatten_them_and_number_names_are_missing_columns():
+    df = frame()
+    two = df.set_axis(pd.MultiIndex.from_tuples([(c, "") for c in df.columns]), axis=1)
+    with pytest.raises(RecordingError, match=r"2 levels of column names \(e.g. \('t', ''\)\).*df.columns = "):
+        Recording.from_dataframe(two)
+    flat = two.set_axis(["_".join(map(str, c)).strip("_") for c in two.columns], axis=1)  # the fix the error gives
+    assert Recording.from_dataframe(flat).n == len(df)
+    with pytest.raises(RecordingError, match=r"missing column\(s\) \['t', 'acc_x'"):  # a header=None table
+        Recording.from_dataframe(df.set_axis(range(7), axis=1))
+
+
 def test_empty_frame():
     with pytest.raises(RecordingError, match="empty"):
         Recording.from_dataframe(frame().iloc[:0])
