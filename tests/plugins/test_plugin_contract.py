@@ -376,9 +376,11 @@ def _raises_key_error(self):
     return {}["x"]
 
 
-@pytest.mark.parametrize("check, cause", [(_raises_runtime_error, r"RuntimeError: cannot check"),
-                                          (_raises_key_error, r"KeyError: 'x'"),
-                                          (property(lambda self: None), r"TypeError: 'NoneType' object is not callable")])
+@pytest.mark.parametrize("check, cause", [
+    (_raises_runtime_error, r"RuntimeError: cannot check"),
+    (_raises_key_error, r"KeyError: 'x'"),
+    (property(lambda self: None), r"TypeError: 'NoneType' object is not callable"),
+])
 def test_a_plugins_own_check_params_raising_any_error_is_a_plugin_error_naming_it(check, cause):
     """A plug-in overriding check_params with a bug: its action methods and a pipeline given it name the plug-in,
     the method and the fix (was the bare error, without the plug-in's name)."""
