@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 import numpy as np
 import pandas as pd
 
-from ..core.atomic import atomic_path
+from ..core.atomic import OutputError, atomic_path
 from ..core.conventions import quat_to_euler
 from ..core.data import Recording
 from ..core.errors import ConfigError, RecordingError
@@ -89,8 +89,16 @@ def save(fig: Figure, path: str | Path) -> Path:
     an interrupted save leaves the previous figure, never a truncated one.
     """
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fmt = out.suffix.lstrip(".").lower() or "png"
+    formats = fig.canvas.get_supported_filetypes()
+    if fmt not in formats:
+        # deferred: matplotlib, loaded at the first figure (footzoo runs without it)
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        raise OutputError(f"figure {str(out)!r}: matplotlib writes no '.{fmt}' files; end the name with one of "
+                          f"{', '.join('.' + f for f in sorted(formats))} (e.g. {str(out.with_suffix('.png'))!r})")
+    out.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(out, what="figure") as tmp:
         fig.savefig(tmp, format=fmt, dpi=STYLE["savefig.dpi"], bbox_inches=_bbox(fig))
     # deferred: matplotlib, loaded at the first figure (footzoo runs without it)

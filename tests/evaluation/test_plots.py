@@ -473,3 +473,18 @@ def test_a_figure_save_that_fails_midway_leaves_the_previous_figure(tmp_path):
         save(fig, target)
     assert target.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["trajectory.png"]
+
+
+@pytest.mark.parametrize("name", ["figure.xyz", "figure.PNGX"])
+def test_a_figure_name_whose_format_matplotlib_lacks_is_an_output_error_naming_the_formats(tmp_path, name):
+    import matplotlib.pyplot as plt
+
+    from footzoo.core.atomic import OutputError
+    from footzoo.evaluation.plots import save
+
+    fig = plt.figure()
+    suffix = name.split(".")[1].lower()
+    with pytest.raises(OutputError, match=rf"figure '.*{name}': matplotlib writes no '\.{suffix}' files; end the "
+                                          r"name with one of .*\.pdf, .*\.png.*\(e\.g\. '.*figure\.png'\)"):
+        save(fig, tmp_path / "sub" / name)
+    assert not plt.fignum_exists(fig.number) and not (tmp_path / "sub").exists()
