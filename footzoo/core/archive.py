@@ -628,10 +628,11 @@ def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
         raise FormatError(f"{manifest}: format version {version!r} is newer than this footzoo reads "
                           f"({FORMAT_VERSION}); upgrade footzoo (footzoo {data.get('footzoo_version')} wrote it)")
     files = data.get("files", {})
-    if not isinstance(files, dict) or not all(isinstance(k, str) and isinstance(v, dict) for k, v in files.items()):
+    bad = [k for k, v in files.items() if not isinstance(v, dict)] if isinstance(files, dict) else None
+    if bad is None or bad:
+        got = f"{type(files).__name__}" if bad is None else f"the entry of {', '.join(map(repr, bad[:5]))} is not one"
         raise FormatError(f"{manifest}: its 'files' entry is not a mapping of each file's name to its description "
-                          f"(got {type(files).__name__}); the manifest is damaged: save the result again or restore "
-                          "the folder from a copy")
+                          f"({got}); the manifest is damaged: save the result again or restore the folder from a copy")
     missing = [f for f in files if not (folder / f).exists()]
     if missing:
         raise FormatError(f"{str(folder)!r}: the archive lacks {missing}, which its manifest lists; it is incomplete")

@@ -227,11 +227,16 @@ class FileGroup:
             raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
         tmp = self.path(target)
         kwargs = {} if "b" in mode else {"encoding": encoding, "newline": newline}
-        with open(tmp, mode, **kwargs) as fh:
-            yield fh
-            fh.flush()
-            if self.fsync:
-                os.fsync(fh.fileno())
+        try:
+            with open(tmp, mode, **kwargs) as fh:
+                yield fh
+                fh.flush()
+                if self.fsync:
+                    os.fsync(fh.fileno())
+        except OutputError:
+            raise
+        except OSError as err:  # the disk full while writing, a quota: named, the old file kept (the group aborts)
+            raise _os_error(err, Path(target)) from None
 
     def forget(self, target: PathLike) -> None:
         """Drop ``target`` from the group (its temporary file is deleted; the final file is left as it is)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import signal
@@ -382,3 +383,26 @@ def test_a_folder_output_is_incomplete_from_its_start_until_its_marker_is_writte
     assert begin_folder(folder, "outputs.json") == {"digest": "one"}  # an interrupted run's marker is kept
     end_folder(folder, "outputs.json", '{"digest": "two"}')
     assert not incomplete(folder) and previous_marker(folder, "outputs.json") == {"digest": "two"}
+
+
+def _group_write(path: Path) -> None:
+    with atomic.FileGroup(what="test") as group, group.open(path) as fh:
+        fh.write("new")
+
+
+@pytest.mark.parametrize("writer", [lambda p: atomic.write_text(p, "new"), lambda p: atomic.write_bytes(p, b"new"),
+                                    lambda p: atomic.write_json(p, {"new": 1}), _group_write],
+                         ids=["write_text", "write_bytes", "write_json", "FileGroup.open"])
+def test_a_full_disk_while_writing_is_an_output_error_naming_the_file_and_the_old_file_is_kept(tmp_path, monkeypatch,
+                                                                                                writer):
+    target = tmp_path / "out.json"
+    target.write_text("old")
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(atomic.os, "fsync", full)
+    with pytest.raises(atomic.OutputError, match=r"out.json' cannot be written: no space left on the device; the old "
+                                                 r"file is kept"):
+        writer(target)
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["out.json"]
