@@ -707,7 +707,7 @@ def read_result(path: str | os.PathLike, verify: bool = True, loader: str = "Res
         raise FormatError(f"{str(folder)!r}: another process saved into the folder while it was read, "
                           f"{READ_ATTEMPTS} times; load it again when that save has ended")
     for message in problems:
-        warnings.warn(FootzooWarning(message), stacklevel=3)
+        warnings.warn(FootzooWarning(message), stacklevel=user_stacklevel())
     return fields
 
 
