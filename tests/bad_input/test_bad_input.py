@@ -632,6 +632,7 @@ def test_cli_internal_error_exit_1_and_debug_shows_traceback(monkeypatch, capsys
     assert "Traceback" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a new Python process per case
 def test_cli_console_script_has_no_traceback(tmp_path):
     """The real process: stderr carries one footzoo line, the exit code is documented in --help."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}

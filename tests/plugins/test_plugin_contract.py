@@ -304,6 +304,7 @@ def test_check_plugin_on_a_reader_file_says_how_readers_are_registered_and_tried
     assert main([str(empty)]) == 2 and "decorate the classes with @footzoo.register" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a new Python process
 def test_the_testing_module_runs_as_a_script():
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "footzoo.apps.testing", "--help"], capture_output=True, text=True,

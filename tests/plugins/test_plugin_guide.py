@@ -81,6 +81,7 @@ def test_a_disturbed_field_is_rejected_not_followed(magu):
     assert _heading_error(Pipeline.from_dict(cfg).run(rec), rec) < 3.0
 
 
+@pytest.mark.slow  # compiles the guide's correction for the live engine
 def test_the_magnetometer_update_runs_live_like_the_batch(magu):
     rec = _drifting_walk()
     p = Pipeline.from_dict({"orientation": {"type": "ins"}, "detector": {"type": "dgp", "min_swing": 0.2},

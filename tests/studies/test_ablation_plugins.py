@@ -312,6 +312,7 @@ class MyHardIron(HardIron):
 '''
 
 
+@pytest.mark.slow  # two worker processes start and import the plug-in
 def test_a_calibration_plugin_file_runs_in_a_parallel_study_like_the_builtin(tmp_path):
     name = "cal_" + "".join(c if c.isalnum() else "_" for c in tmp_path.name)
     (tmp_path / "my_calibration.py").write_text(CALIBRATION.format(name=name))

@@ -27,6 +27,7 @@ def test_a_record_in_memory_has_no_trajectory_once_its_entry_holds_it(tmp_path):
     assert not set(HEAVY) & set(light(stored))
 
 
+@pytest.mark.slow  # a study of many runs
 def test_the_report_reads_trajectories_back_in_batches(tmp_path, monkeypatch):
     whole = run_study(Study.from_dict(STUDY), out=tmp_path / "whole")
     expected = read_trajectories(tmp_path / "whole")
