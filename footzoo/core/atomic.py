@@ -442,7 +442,9 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "",
     try:
         p.mkdir(parents=True, exist_ok=True)
     except OSError as err:
-        raise OutputError(f"{what} {str(p)!r} cannot be created: {err.strerror or err}") from None
+        fix = ("it is a file, and the output is a folder: give a folder name, or move the file away"
+               if p.exists() and not p.is_dir() else "choose a folder you can write to")
+        raise OutputError(f"{what} {str(p)!r} cannot be created: {err.strerror or err}; {fix}") from None
     key = (os.path.realpath(p), threading.get_ident())
     with _HELD_LOCK:
         nested = key in _HELD

@@ -406,3 +406,14 @@ def test_a_full_disk_while_writing_is_an_output_error_naming_the_file_and_the_ol
                                                  r"file is kept"):
         writer(target)
     assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+@pytest.mark.parametrize("layout, fix", [("file", "it is a file, and the output is a folder"),
+                                         ("under_a_file", "choose a folder you can write to")])
+def test_a_locked_folder_that_cannot_be_made_names_the_fix(tmp_path, layout, fix):
+    (tmp_path / "taken").write_text("a user's file")
+    target = tmp_path / "taken" if layout == "file" else tmp_path / "taken" / "out"
+    with pytest.raises(OutputError, match=f"--out '{target}' cannot be created: .*; {fix}"):
+        with folder_lock(target, "--out", owner="study 'x'"):
+            pass
+    assert (tmp_path / "taken").read_text() == "a user's file"
