@@ -103,6 +103,7 @@ class Stream:
                  max_pending: float = 30.0, keep: bool = False):
         require_pipeline(pipeline, "Stream")
         reasons = pipeline.live_problems(fits=_fit_reports(fits))
+        pipeline_reasons = len(reasons)
         if rate is not None and not (isinstance(rate, (int, float)) and not isinstance(rate, bool)
                                      and math.isfinite(rate) and rate > 0):
             reasons.append(f"rate must be a positive number of Hz, got {rate!r}")
@@ -114,8 +115,9 @@ class Stream:
                 reasons.append(f"{label} must be a positive number of seconds, got {value!r}")
         if engine not in ENGINES:
             reasons.append(f"engine must be one of {list(ENGINES)}, got {engine!r}")
-        if reasons:
-            raise ConfigError("this pipeline cannot run live: " + "; ".join(reasons))
+        if reasons:  # the pipeline's own reasons, then the arguments'
+            head = "this pipeline cannot run live: " if pipeline_reasons else "Stream: "
+            raise ConfigError(head + "; ".join(reasons))
         self.pipeline = pipeline
         self.rate = rate
         self.engine = engine

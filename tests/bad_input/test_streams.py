@@ -108,3 +108,18 @@ def test_a_block_with_acc_and_gyr_swapped_is_named_as_such(sim_walk, swap):
     with pytest.raises(RecordingError, match="beyond any body-worn IMU") as info:
         validate_block(t, gyr, acc) if swap else validate_block(t, acc, gyr)
     assert ("acc and gyr look swapped: the median |gyr| is" in str(info.value)) == swap
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"rate": -100}, r"^Stream: rate must be a positive number of Hz, got -100$"),
+    ({"max_wait": 0}, r"^Stream: max_wait must be a positive number of seconds, got 0$"),
+    ({"engine": "quick"}, r"^Stream: engine must be one of \['auto', 'fast', 'reference'\], got 'quick'$"),
+])
+def test_a_bad_stream_argument_is_named_as_the_streams_not_the_pipelines(kwargs, message):
+    with pytest.raises(footzoo.ConfigError, match=message):
+        footzoo.Stream(footzoo.Pipeline.from_yaml("recommended_live"), **kwargs)
+
+
+def test_a_pipeline_that_cannot_run_live_says_so_before_the_arguments():
+    with pytest.raises(footzoo.ConfigError, match=r"^this pipeline cannot run live: smoother 'rts' .*; rate must be"):
+        footzoo.Stream(footzoo.Pipeline.from_yaml("recommended"), rate=-1)
