@@ -61,6 +61,7 @@ from . import stage_inputs as inputs
 from .chain import Chain, aligned, build_chain, input_stages, navigation_stage, recording_chunk, with_signals
 from .guards import StanceGuard, check_speed
 from .stage_inputs import engine as checked_engine
+from .stage_inputs import flag as checked_flag
 from .stages import GainStage, detected, estimate_attitude, guarded
 
 #: Default seconds a live stream fits an unfitted calibration on (:class:`footzoo.Stream`'s ``warmup``).
@@ -314,6 +315,7 @@ class Pipeline:
             (:func:`footzoo.evaluation.metrics.nis_summary`: 1 per row for a consistent filter).
         """
         checked_engine("Pipeline.run", engine)
+        covariance = checked_flag("Pipeline.run", "covariance", covariance)
         with inputs_checked_once(), _read_only(rec):  # each array is scanned for NaN once; none is written meanwhile
             return self._run(rec, engine, covariance)
 

@@ -17,6 +17,7 @@ import numpy as np
 from ..core.context import RunContext
 from ..core.data import Recording
 from ..core.errors import ConfigError, NotARecordingError, RecordingError
+from ..core.params import Boolean
 from ..filters.engine import ENGINES
 
 FIX_STANCE = "pipe.guard(rec, pipe.detect(rec))[0] gives the stance of a recording"
@@ -126,6 +127,11 @@ def fitted_detector(where: str, detector: Any, rec: Recording) -> Any:
         raise RecordingError(f"{where}: the detector's stance_ has shape {np.shape(detector.stance_)} but the "
                              f"recording {rec.name!r} has {rec.n} samples: it was fitted on another recording; {fix}")
     return detector
+
+
+def flag(where: str, name: str, value: Any) -> bool:
+    """``value`` when it is True or False (a text such as ``'no'``, truthy in Python, or 0/1 is refused)."""
+    return Boolean(name).check(f"{where}: {name}", value, False)
 
 
 def engine(where: str, value: Any) -> str:

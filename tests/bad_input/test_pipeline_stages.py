@@ -66,6 +66,8 @@ def parts():
     (lambda p: p["pipe"].analyse(None, p["stance"], p["nav"]["quat"], p["nav"]["pos"]), NotARecordingError,
      "analyse expects a footzoo Recording"),
     (lambda p: Stream(p["pipe"], rate=100.0, engine="turbo"), ConfigError, "engine must be one of"),
+    (lambda p: p["pipe"].run(p["rec"], covariance="no"), ConfigError,
+     "Pipeline.run: covariance must be true or false, got str 'no'"),
 ])
 def test_a_mismatched_piece_is_named_with_its_fix(parts, call, error, words):
     with pytest.raises(error, match=words):
