@@ -97,24 +97,22 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
     still = float(np.linalg.norm(acc[start:stop].mean(axis=0)))
     if abs(still / gravity - 1.0) <= ACC_GAIN_TOLERANCE:
         return 1.0
+    reading = (f"{name}: the accelerometer reads {still:.3f} m/s² in the still start (t = {t[start]:.2f}-"
+               f"{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²")
     scatter = float(np.std(np.linalg.norm(acc[start:stop], axis=1)))
     if scatter > ACC_GAIN_QUIET * gravity:  # the foot moves in its "still" start: no measure of the gain
         warnings.warn(
-            f"{name}: the accelerometer reads {still:.3f} m/s² in the still start (t = {t[start]:.2f}-"
-            f"{t[stop - 1]:.2f} s, the gyroscope quiet), {100.0 * (still / gravity - 1.0):+.1f} % off g = "
-            f"{gravity:g} m/s², but ‖f‖ scatters by {scatter:.2f} m/s² ({100.0 * scatter / gravity:.1f} % of g, more "
-            f"than the {100.0 * ACC_GAIN_QUIET:g} % of a sensor at rest): the start is too restless to tell a gain "
-            "error from motion, so the gain is not corrected. If the accelerometer's unit or scale is wrong, declare "
-            "it (the reader's acc_unit option) or calibrate the sensor; otherwise start the recording with the foot "
-            f"at rest for init.duration = {duration:g} s",
+            f"{reading}, but with the gyroscope quiet ‖f‖ scatters by {scatter:.2f} m/s² "
+            f"({100.0 * scatter / gravity:.1f} % of g, more than the {100.0 * ACC_GAIN_QUIET:g} % of a sensor at "
+            "rest): the start is too restless to tell a gain error from motion, so the gain is not corrected. If "
+            "the accelerometer's unit or scale is wrong, declare it (the reader's acc_unit option) or calibrate the "
+            f"sensor; otherwise start the recording with the foot at rest for init.duration = {duration:g} s",
             SensorWarning, stacklevel=user_stacklevel())
         return 1.0
     warnings.warn(
-        f"{name}: the accelerometer reads {still:.3f} m/s² in the still start "
-        f"(t = {t[start]:.2f}-{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²: "
-        "a gain (scale-factor) error, which "
-        "would hide the stand-stills from the stance detector and lift the track. The run scales the specific "
-        f"force by {gravity / still:.4f} (result.diagnostics['acc_gain']); calibrate the sensor to remove this",
+        f"{reading}: a gain (scale-factor) error, which would hide the stand-stills from the stance detector and lift "
+        f"the track. The run scales the specific force by {gravity / still:.4f} (result.diagnostics['acc_gain']); "
+        "calibrate the sensor to remove this",
         SensorWarning, stacklevel=user_stacklevel())
     return gravity / still
 
