@@ -284,6 +284,11 @@ def _write_outputs(table: pd.DataFrame, runs: list[dict[str, Any]], factors: lis
     step(1)
 
 
+#: The report's tables, as :func:`_write_tables` names them (its figures aside): in a study's folder, an earlier
+#: study's report lists them (the runner refuses a folder holding one that no study wrote).
+REPORT_TABLES = ("results.csv", "results.parquet", "summary.md", "summary.tex", "trajectories.parquet", "roc.parquet")
+
+
 def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list[str], out: Path,
                   step: Callable[[int], Any]) -> None:
     """The tidy table, the trajectories and sweeps, the summaries (``step(1)`` after each)."""

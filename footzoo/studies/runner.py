@@ -58,7 +58,7 @@ from .cache import (
     touch,
     write_entry,
 )
-from .report import alike, grouped, write_outputs
+from .report import REPORT_TABLES, alike, grouped, write_outputs
 from .study import Cell, Study, check_jobs, code_fingerprint
 
 TRAJECTORY_STEP = 0.1  # s between stored trajectory points (for the overlay plots)
@@ -531,8 +531,6 @@ def _run_study(study, jobs, scheduler, out, bar: _Progress, max_runs: int | None
 
 
 MANIFEST = "outputs.json"
-#: The report's tables (its figures aside): in a study's folder, an earlier study's report lists them.
-REPORT_TABLES = ("results.csv", "results.parquet", "summary.md", "summary.tex", "trajectories.parquet", "roc.parquet")
 
 
 def _base_names(study: Study) -> list[str]:
