@@ -439,7 +439,8 @@ def write_summary(table: pd.DataFrame, ref: pd.DataFrame, path: Path, recommende
                   "one to one when their toe-off and initial contact both agree within 0.3 s "
                   "(footzoo.evaluation.metrics.match_strides):\n"
                    "the left foot's turn, one reference stride over two steps, "
-                  "stays unpaired.", "",
+                  "stays unpaired. Where the stride-length error comes from (bias and scatter, the stride's "
+                  "definition, the recording itself): benchmarks/gaitmap_strides.md.", "",
                   to_markdown(gp, 3), ""]
     k = table[(table["dataset"] == "koroglu")
               & table["metric"].isin([*REFERENCE_METRICS["koroglu"], "path_length_m", "steps"])]
