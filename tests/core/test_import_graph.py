@@ -52,21 +52,18 @@ def _modules() -> dict[str, tuple[Path, bool]]:
 MODULES = _modules()
 
 
-def _type_checking_nodes(tree: ast.AST) -> set[int]:
-    """Ids of the nodes under ``if TYPE_CHECKING:`` (ast nodes of one parse: alive while it is used)."""
-    skip: set[int] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.If) and ast.unparse(node.test) in ("TYPE_CHECKING", "typing.TYPE_CHECKING"):
-            skip.update(id(n) for stmt in node.body for n in ast.walk(stmt))
-    return skip
+def _statements(node: ast.AST, in_function: bool = False):
+    """``(import statement, inside a function?)`` under ``node``, leaving out those under ``if TYPE_CHECKING:``.
 
-
-def _function_nodes(tree: ast.AST) -> set[int]:
-    inside: set[int] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
-            inside.update(id(n) for n in ast.walk(node) if n is not node)
-    return inside
+    One walk through the statements only (an import is a statement: expressions, lambdas included, hold none).
+    """
+    in_function = in_function or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+    type_checking = isinstance(node, ast.If) and ast.unparse(node.test) in ("TYPE_CHECKING", "typing.TYPE_CHECKING")
+    for child in node.orelse if type_checking else ast.iter_child_nodes(node):  # its body never runs, an else does
+        if isinstance(child, (ast.Import, ast.ImportFrom)):
+            yield child, in_function
+        elif isinstance(child, (ast.stmt, ast.excepthandler, ast.match_case)):
+            yield from _statements(child, in_function)
 
 
 def _targets(module: str, package: bool, node: ast.Import | ast.ImportFrom) -> list[str]:
@@ -93,22 +90,19 @@ def _imports() -> list[Import]:
     out = []
     for module, (path, package) in MODULES.items():
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-        skip, inside = _type_checking_nodes(tree), _function_nodes(tree)
-        for node in ast.walk(tree):
-            if not isinstance(node, (ast.Import, ast.ImportFrom)) or id(node) in skip:
-                continue
+        for node, in_function in _statements(tree):
             for target in _targets(module, package, node):
                 if target.split(".")[0] == "footzoo":
                     target = _nearest_module(target)
                     if target == module:
                         continue
-                out.append(Import(module, target, node.lineno, id(node) in inside))
+                out.append(Import(module, target, node.lineno, in_function))
     return out
 
 
 @functools.cache
 def imports() -> tuple[Import, ...]:
-    """Every import statement of the package (parsed once, when a test first asks: about 3 s, not at collection)."""
+    """Every import statement of the package (parsed once, when a test first asks, not at collection)."""
     return tuple(_imports())
 
 
