@@ -9,6 +9,8 @@ studies, stream, sensor sanity, command line).
 from __future__ import annotations
 
 import contextlib
+import copy
+import functools
 import math
 import os
 import subprocess
@@ -679,6 +681,16 @@ def test_every_value_a_declaration_refuses_is_a_clear_config_error(kind, name):
                 assert d.param.unit in ("", "1") or f" {d.param.unit}" in message, message  # "1": dimensionless
 
 
+@functools.cache
+def _parsed(name: str) -> dict:
+    return load_yaml(name)
+
+
+def shipped(name: str) -> dict:
+    """A fresh copy of the shipped config ``name`` (each parsed once: hundreds of cases below start from one)."""
+    return copy.deepcopy(_parsed(name))
+
+
 SETTINGS = [(key, d) for key, d in __import__("footzoo.runtime.validate", fromlist=["x"]).settings_declarations(
 ).items()]
 
@@ -688,7 +700,7 @@ def test_every_bad_setting_is_a_clear_config_error(key, declared):
     """The same for the settings blocks (gravity, init, navigation, guards): one mechanism."""
     for bad in declared.param.invalid_values():
         block, _, field = key.partition(".")
-        cfg = load_yaml("yun2012")
+        cfg = shipped("yun2012")
         cfg[block] = {field: bad} if field else bad
         with pytest.raises(ConfigError) as err:
             Pipeline.from_dict(cfg)
@@ -718,7 +730,7 @@ def sensors_walk() -> Recording:
 @pytest.mark.parametrize("kind, name, param, value", EDGES, ids=[f"{n}.{p}={v:g}" for _, n, p, v in EDGES])
 def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name, param, value, sensors_walk):
     """The declared ranges are safe: no NaN or crash at either end (or a clear footzoo error)."""
-    yun, nguyen = (load_yaml(c) for c in ("yun2012", "nguyen2016"))
+    yun, nguyen = (shipped(c) for c in ("yun2012", "nguyen2016"))
     if kind == "orientation":
         cfg = nguyen if name == "ins" else yun
         cfg["orientation"] = {"type": name, param: value}
@@ -727,10 +739,10 @@ def test_parameters_at_the_edges_of_their_range_give_finite_estimates(kind, name
         cfg["detector"] = {"type": name, param: value}
     else:  # in the first shipped config that has the correction, else added to duong2015_zupt's zero-velocity update
         # (the compiled loops of the shipped configs: a correction added to a two-update config would compile anew)
-        shipped = (load_yaml(n) for n in library.names("pipeline"))
-        cfg = next((c for c in shipped if name in [u["type"] for u in c.get("corrections", [])]), None)
+        configs = (shipped(n) for n in library.names("pipeline"))
+        cfg = next((c for c in configs if name in [u["type"] for u in c.get("corrections", [])]), None)
         if cfg is None:
-            cfg = load_yaml("duong2015_zupt")
+            cfg = shipped("duong2015_zupt")
             cfg["corrections"].append({"type": name})
         cfg["corrections"] = [{**u, param: value} if u["type"] == name else u for u in cfg["corrections"]]
     pipeline = Pipeline.from_dict(cfg)
