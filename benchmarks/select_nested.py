@@ -22,7 +22,12 @@ error-state Kalman filter's noises, RTS smoothing, no swing guard, the speed-ada
 * the rolling-foot stance update (``rolling_stance``, benchmarks/rolling_stance.md) with the shipped
   detector: alone in place of ``zupt`` with its defaults, with a wider contact spread (ℓ_s 0.05 m) and with a
   tighter lever prior (σ 0.02 m); after the shipped ``zupt`` (its own hold off) with its defaults and with
-  ℓ_s 0.05 m: 5 settings (:data:`ROLLING`).
+  ℓ_s 0.05 m: 5 settings (:data:`ROLLING`);
+* the shipped pipeline (its ``zupt`` with ``roll_lever`` 0.2 m included) with Huang et al.'s stance detector
+  (``huang_stance``: SHOE and a state machine that switches only after ``min_duration``) in place of the
+  speed-adaptive one: ``threshold`` ∈ {1.5e4, 3e4, 6e4} × ``min_duration`` ∈ {0.05, 0.1} s, its defaults
+  (3e4, 0.05 s) among them: 6 settings (:data:`HUANG`). On gaitmap's walk this swap brought the stride-length
+  RMS from 0.053/0.050 to 0.044/0.046 m (benchmarks/gaitmap_strides.md, table 6): one recording, tested here.
 
 Outer folds: 6, stratified by motion class (:func:`nested_cv.stratified_folds`, seed :data:`SEED`): every
 fold holds 6 trials, 3 or 4 walking and 1 or 2 running/fast, and the slow unusual and inverted trials sit
@@ -99,6 +104,11 @@ ROLLING: dict[str, list[dict[str, Any]]] = {
     "zupt + rolling_stance spread 0.05": [ZUPT, {"type": "rolling_stance", "contact_spread": 0.05,
                                                  "hold_after": 0.0}],
 }
+#: The Huang stance candidates: name -> the ``detector`` that replaces the shipped speed-adaptive one.
+HUANG: dict[str, dict[str, Any]] = {
+    f"huang_stance th {th:g} min {md:g}": {"type": "huang_stance", "threshold": th, "min_duration": md}
+    for th in (1.5e4, 3e4, 6e4) for md in (0.05, 0.1)
+}
 #: The fixed baseline (the shipped setting) and the setting the refinements started from.
 BASELINE = "th 2000 vs 0.8 roll 0.2"
 START = "th 3000 vs 1 roll 0"
@@ -137,6 +147,11 @@ def candidates() -> list[dict[str, Any]]:
     for name, corrections in ROLLING.items():
         cfg = copy.deepcopy(shipped)
         cfg["corrections"] = copy.deepcopy(corrections)
+        cfg["name"] = name
+        out.append(cfg)
+    for name, detector in HUANG.items():
+        cfg = copy.deepcopy(shipped)
+        cfg["detector"] = copy.deepcopy(detector)
         cfg["name"] = name
         out.append(cfg)
     return out
@@ -259,7 +274,7 @@ def nested(args: argparse.Namespace) -> int:
     classes = pd.Series([motion_class(x) for x in err2.index], index=err2.index)
     folds = stratified_folds(classes, FOLDS, SEED)
     scored = class_score(best)
-    zupt_grid = [n for n in names if n not in ROLLING]
+    zupt_grid = [n for n in names if n not in ROLLING and n not in HUANG]
     procedures = {"procedure": chooser(scored, qualified), "zupt grid": chooser(scored, [n for n in qualified
                                                                                          if n in zupt_grid])}
     runs = {}
@@ -378,9 +393,24 @@ def report(err2: pd.DataFrame, err3: pd.DataFrame, classes: pd.Series, folds: pd
               to_markdown(targets(decision, held2, held3, err2, err3, other), 4), "",
               "### Every candidate on all 36 trials (in-sample), and how often an outer fold chose it", "",
               to_markdown(ranking, 4), "",
+              "### Per motion class: the baseline and the Huang stance candidates (in-sample, 2-D, m)", "",
+              "Medians per class, the worst trial and how many trials exceed 0.2 m.", "",
+              to_markdown(by_class(err2, classes, [BASELINE, *HUANG]), 4), "",
               "### Every candidate on the other references", "",
               to_markdown(other.reset_index().rename(columns={"index": "candidate"}), 4)]
     return lines, decision
+
+
+def by_class(err2: pd.DataFrame, classes: pd.Series, names: list[str]) -> pd.DataFrame:
+    """Per candidate in ``names``: its 2-D median per motion class, its worst trial, the trials over 0.2 m."""
+    rows = []
+    for n in names:
+        e = err2[n].fillna(np.inf)
+        medians = {c: float(e[classes == c].median()) for c in CLASS_ORDER if (classes == c).any()}
+        rows.append({"candidate": n, **medians,
+                     "worst trial": str(e.idxmax())[5:], "worst (m)": float(e.max()),
+                     "trials over 0.2 m": int((e > 0.2).sum())})
+    return pd.DataFrame(rows)
 
 
 def targets(decision: str, held2: pd.Series, held3: pd.Series, err2: pd.DataFrame, err3: pd.DataFrame,

@@ -115,11 +115,27 @@ def test_the_rule_ships_a_choice_only_when_it_is_no_worse_elsewhere(nested):
 
 def test_the_baseline_is_the_shipped_recommended(nested):
     cands = {c["name"]: c for c in nested.candidates()}
-    assert len(cands) == 12 + len(nested.ROLLING) and nested.START in cands
+    assert len(cands) == 12 + len(nested.ROLLING) + len(nested.HUANG) and nested.START in cands
     ours = Pipeline.from_dict(cands[nested.BASELINE]).to_dict()
     shipped = Pipeline.from_yaml("recommended").to_dict()
     ours.pop("name"), shipped.pop("name")
     assert ours == shipped
+
+
+def test_the_huang_candidates_swap_only_the_shipped_detector(nested):
+    cands = {c["name"]: c for c in nested.candidates()}
+    shipped = Pipeline.from_yaml("recommended").to_dict()
+    shipped.pop("name"), shipped.pop("detector")
+    grid = set()
+    for name in nested.HUANG:
+        ours = Pipeline.from_dict(cands[name]).to_dict()
+        detector = ours.pop("detector")
+        ours.pop("name")
+        assert ours == shipped and detector["type"] == "huang_stance"
+        grid.add((detector["threshold"], detector["min_duration"]))
+    # the 3 x 2 grid, the detector's own defaults (3e4, 0.05 s) among it
+    assert grid == {(th, md) for th in (1.5e4, 3e4, 6e4) for md in (0.05, 0.1)}
+    assert "huang_stance th 30000 min 0.05" in cands
 
 
 def test_written_configs_are_twins_but_for_the_smoother(nested, tmp_path):
@@ -132,3 +148,12 @@ def test_written_configs_are_twins_but_for_the_smoother(nested, tmp_path):
     assert (offline.pop("smoother"), live.pop("smoother")) == ("rts", "stepwise")
     assert offline == live and offline["corrections"][0]["type"] == "rolling_stance"
     assert "2-D median\n# 0.0450 m" in (tmp_path / "recommended.yaml").read_text()
+
+
+def test_by_class_by_hand(nested):
+    err2 = pd.DataFrame({"A": [0.01, 0.03, 0.5, np.nan]}, index=["2017-w1", "2017-w2", "2017-r1", "2017-r2"])
+    classes = pd.Series(["walking", "walking", "running/fast", "running/fast"], index=err2.index)
+    row = nested.by_class(err2, classes, ["A"]).iloc[0]
+    # walking: median of 0.01 and 0.03; running: 0.5 and a failed run (infinitely wrong)
+    assert row["walking"] == pytest.approx(0.02) and row["running/fast"] == np.inf
+    assert (row["worst trial"], row["worst (m)"], row["trials over 0.2 m"]) == ("r2", np.inf, 2)
