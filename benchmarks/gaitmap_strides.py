@@ -295,7 +295,10 @@ FINDINGS = """## Findings (from the tables below)
 So ``recommended`` misses the target on this walk by a left-foot bias of −2.6 cm, on top of a stride-to-stride
 scatter of about 5 cm that every pipeline inherits from the recording; its stance detector accounts for
 about a third of that bias. This is a measurement on one recording, not a candidate setting: a change of
-``recommended`` goes through the nested cross-validation on PyShoe (benchmarks/select_nested.py).
+``recommended`` goes through the nested cross-validation on PyShoe (benchmarks/select_nested.py). There,
+``huang_stance`` in the shipped pipeline (six settings of its threshold and Γ_th) is chosen by no outer fold:
+on PyShoe's running and fast trials it misses stances and the trajectories run away (2-D worst 29-53 m on the
+36 trials, benchmarks/recommended_selection.md), so the gain on this walk does not generalise.
 """
 
 
