@@ -37,6 +37,27 @@ def made_once(tmp_path_factory: pytest.TempPathFactory, name: str, make) -> Path
     return folder
 
 
+#: The mark of the tests that run a study on :func:`process_cluster`: CI's slow run (``--dist loadgroup``) gives them
+#: all to one xdist worker, which starts the cluster once for them.
+ON_PROCESS_CLUSTER = pytest.mark.xdist_group("dask-processes")
+
+
+@pytest.fixture(scope="session")
+def process_cluster():
+    """A local Dask cluster of two worker processes, one thread each, shared by a worker's tests that need one.
+
+    Starting a cluster and importing footzoo in its two processes costs several seconds; each test that
+    compares a study on a cluster with the study run in this process would pay it again. The tests use a
+    cluster of processes as a user's would be (plug-in files imported in other processes, results pickled).
+    """
+    import logging
+
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                  silence_logs=logging.CRITICAL) as cluster:
+        yield cluster
+
+
 # Warning filters (pytest.mark.filterwarnings) for warnings that are the right outcome of a test's input but not what
 # the test checks; each test that uses one says why. A footzoo warning no test expects fails the run (pyproject.toml).
 

@@ -23,6 +23,8 @@ from footzoo.plugins.contract import MAX_MODEL_ROWS, check_annotated
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 
+from ..conftest import ON_PROCESS_CLUSTER
+
 PLUGINS = '''
 """Plug-ins that break their outputs' contract (bad-input tests)."""
 import numpy as np
@@ -212,12 +214,10 @@ def test_in_a_study_run_serially_the_faulty_cells_fail_and_say_why(plugin_file):
 
 
 @pytest.mark.slow
-def test_in_a_study_on_local_workers_and_on_a_dask_cluster_the_same(plugin_file):
-    from dask.distributed import LocalCluster
-
+@ON_PROCESS_CLUSTER
+def test_in_a_study_on_local_workers_and_on_a_dask_cluster_the_same(plugin_file, process_cluster):
     _check_study(run_study(_study(plugin_file), jobs=2, quiet=True))
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        _check_study(run_study(_study(plugin_file), scheduler=cluster.scheduler_address, quiet=True))
+    _check_study(run_study(_study(plugin_file), scheduler=process_cluster.scheduler_address, quiet=True))
 
 
 @settings(max_examples=60, deadline=None, derandomize=True)

@@ -17,7 +17,7 @@ from footzoo.studies import CacheWarning, Study, read_trajectories, run_study
 from footzoo.studies import runner as runner_mod
 from footzoo.studies.cache import CACHE_FORMAT, read_entry
 
-from ..conftest import made_once
+from ..conftest import ON_PROCESS_CLUSTER, made_once
 
 BASE = {"name": "yun", "orientation": {"type": "fqa_complementary"}, "detector": {"type": "angular_rate_fsm"},
         "corrections": [{"type": "zvu_dedrift"}]}
@@ -344,21 +344,30 @@ def test_figures_drawn_by_workers_are_the_serial_figures(tmp_path, serial_output
     assert (tmp_path / "parallel" / "summary.md").read_text() == summary
 
 
+def _check_dask_figures(serial_outputs, folder, scheduler) -> None:
+    serial, summary = serial_outputs
+    table = run_study(Study.from_dict(FIGURES), out=folder, scheduler=scheduler)
+    dask = {f.name: f.read_bytes() for f in folder.glob("*.png")}
+    assert serial.keys() == dask.keys()
+    assert all(serial[name] == dask[name] for name in serial)
+    assert (folder / "summary.md").read_text() == summary
+    assert table.attrs["failed"] == 0
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("processes", [False, True])
-def test_figures_drawn_on_a_dask_cluster_are_the_serial_figures(tmp_path, serial_outputs, processes):
+def test_figures_drawn_on_a_dask_cluster_of_threads_are_the_serial_figures(tmp_path, serial_outputs):
     """The cluster's workers draw in memory (one figure at a time per process), the client writes the files."""
     from dask.distributed import LocalCluster
 
-    serial, summary = serial_outputs
-    with LocalCluster(n_workers=2 if processes else 1, threads_per_worker=1 if processes else 2, processes=processes,
-                      dashboard_address=":0") as cluster:
-        table = run_study(Study.from_dict(FIGURES), out=tmp_path / "dask", scheduler=cluster.scheduler_address)
-    dask = {f.name: f.read_bytes() for f in (tmp_path / "dask").glob("*.png")}
-    assert serial.keys() == dask.keys()
-    assert all(serial[name] == dask[name] for name in serial)
-    assert (tmp_path / "dask" / "summary.md").read_text() == summary
-    assert table.attrs["failed"] == 0
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0") as cluster:
+        _check_dask_figures(serial_outputs, tmp_path / "dask", cluster.scheduler_address)
+
+
+@pytest.mark.slow
+@ON_PROCESS_CLUSTER
+def test_figures_drawn_on_a_dask_cluster_of_processes_are_the_serial_figures(tmp_path, serial_outputs,
+                                                                            process_cluster):
+    _check_dask_figures(serial_outputs, tmp_path / "dask", process_cluster.scheduler_address)
 
 
 # --------------------------------------------------------------------------- the files beside a recording

@@ -14,7 +14,7 @@ from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 
-from ..conftest import STANCES_GUARDED
+from ..conftest import ON_PROCESS_CLUSTER, STANCES_GUARDED
 
 # A detector defined outside the package: Yun's angular-rate FSM under a new name, so its results must
 # equal the built-in's exactly; THRESHOLD is what the "edit" tests change.
@@ -213,14 +213,12 @@ def test_a_study_with_a_plugin_file_runs_serially_and_with_two_jobs(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tmp_path):
-    from dask.distributed import LocalCluster
-
+@ON_PROCESS_CLUSTER
+def test_a_study_with_a_plugin_file_runs_on_a_local_dask_cluster_of_processes(tmp_path, process_cluster):
     write_plugin(tmp_path)
     study = Study.from_dict(study_dict("my_detector.py", det_name(tmp_path)), root=tmp_path)
     serial = run_study(study)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
-        distributed = run_study(study, scheduler=cluster.scheduler_address)
+    distributed = run_study(study, scheduler=process_cluster.scheduler_address)
     assert distributed["error"].isna().all()
     assert serial.equals(distributed)
 

@@ -1,12 +1,13 @@
 """Large studies: run records without their trajectories in memory, the report streamed from the cache."""
 
-import logging
 
 import pandas as pd
 import pytest
 
 from footzoo.studies import Study, read_trajectories, report, run_study
 from footzoo.studies.cache import HEAVY, light, with_heavy
+
+from ..conftest import ON_PROCESS_CLUSTER
 
 STUDY = {
     "name": "scale",
@@ -46,12 +47,10 @@ def test_the_report_reads_trajectories_back_in_batches(tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
-def test_a_study_on_a_dask_cluster_writes_the_same_outputs(tmp_path):
-    distributed = pytest.importorskip("dask.distributed")
+@ON_PROCESS_CLUSTER
+def test_a_study_on_a_dask_cluster_writes_the_same_outputs(tmp_path, process_cluster):
     serial = run_study(Study.from_dict(STUDY), out=tmp_path / "serial")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                  silence_logs=logging.CRITICAL) as cluster:
-        dask = run_study(Study.from_dict(STUDY), scheduler=cluster.scheduler_address, out=tmp_path / "dask")
+    dask = run_study(Study.from_dict(STUDY), scheduler=process_cluster.scheduler_address, out=tmp_path / "dask")
     assert dask.equals(serial)
     pd.testing.assert_frame_equal(read_trajectories(tmp_path / "dask"), read_trajectories(tmp_path / "serial"))
     assert sorted(p.name for p in (tmp_path / "dask").glob("*.png")) == sorted(
