@@ -79,6 +79,7 @@ import numpy as np
 from ..core.errors import RecordingError
 from ..filters.strapdown import rotate
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from .inputs import check_samples, check_stances, check_time
 
 #: Toe-off: the fraction of the push-off peak of ``ω_ml`` to which the rate has recovered (half).
@@ -135,7 +136,7 @@ def segment_argext(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, largest: bool)
     lo = np.asarray(lo, dtype=np.int64)
     out = np.empty(len(lo), dtype=np.int64)
     if len(lo):
-        _argext_kernel(np.asarray(x, dtype=float), lo, np.asarray(hi, dtype=np.int64), bool(largest), out)
+        _argext_kernel(read_only(x), lo, np.asarray(hi, dtype=np.int64), bool(largest), out)
     return out
 
 
@@ -253,9 +254,9 @@ def sagittal_rate(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances: n
         ``(start, stop)`` sample indices (stop exclusive) of the stances, in order, K ≥ 1.
     """
     d, mid = stride_directions(pos, stances)
-    quat = np.ascontiguousarray(quat, dtype=float)
+    quat = read_only(quat)
     out = np.empty(len(quat))
-    _sagittal_kernel(quat, np.ascontiguousarray(gyr, dtype=float), np.ascontiguousarray(mid, dtype=np.int64),
+    _sagittal_kernel(quat, read_only(gyr), np.ascontiguousarray(mid, dtype=np.int64),
                      np.ascontiguousarray(d), out)
     return out
 
@@ -361,9 +362,9 @@ def _contacts(ts: np.ndarray, acc: np.ndarray, pitch: np.ndarray, stop: np.ndarr
     """:func:`contact_times` on arrays already checked."""
     first_interval = float(np.median(np.diff(ts[:101]))) if len(ts) > 1 else 0.0
     start = np.where(ok, np.maximum(np.searchsorted(ts, pitch) - 1, 0), -1).astype(np.int64)
-    q = np.zeros((0, 4)) if quat is None else np.ascontiguousarray(quat, dtype=float)
+    q = read_only(np.zeros((0, 4)) if quat is None else quat)
     out = np.empty(len(pitch))
-    _contact_kernel(ts, first_interval, np.ascontiguousarray(acc, dtype=float), q, pitch, start,
+    _contact_kernel(read_only(ts), first_interval, read_only(acc), q, read_only(pitch), start,
                     np.asarray(stop, dtype=np.int64), CONTACT_WINDOW, CONTACT_LEVEL, CONTACT_MIN_CHANGE, out)
     return out
 
@@ -426,10 +427,10 @@ def detect_gait_events(t: np.ndarray, gyr: np.ndarray, stances: np.ndarray,
     # TO: the rate recovers to TO_LEVEL of the push-off peak, on the flank between j and p
     level = TO_LEVEL * np.minimum(peak, w[j])
     r = np.empty(k, dtype=np.int64)
-    _first_up_crossing(w, j.astype(np.int64), p, level, r)
+    _first_up_crossing(read_only(w), j.astype(np.int64), p, level, r)
     # IC: first downward zero crossing after p, before the next mid-stance
     c = np.empty(k, dtype=np.int64)
-    _first_down_crossing(w, p, mid[1:].astype(np.int64), c)
+    _first_down_crossing(read_only(w), p, mid[1:].astype(np.int64), c)
     ok = (c >= 0) & (r >= 0) & (w[p] > 0.0) & (w[j] < 0.0)
     c, r = np.where(ok, c, 1), np.where(ok, r, 1)
     # sub-sample times: linear interpolation between the middles of the two samples around each crossing

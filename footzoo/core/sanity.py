@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from .checks import ACC_MAX, GYR_MAX
 from .conventions import GRAVITY
 from .errors import RecordingError, SensorWarning, user_stacklevel
@@ -534,13 +535,6 @@ def _glitches(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, offset: int = 0) 
     return out
 
 
-def _read_only(a: np.ndarray, dtype: type) -> np.ndarray:
-    """``a`` as a C-contiguous array of ``dtype`` seen through a read-only view (no copy when it is one already)."""
-    view = np.ascontiguousarray(a, dtype=dtype).view()
-    view.flags.writeable = False
-    return view
-
-
 @njit
 def _quiet_runs(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, stance: np.ndarray, t_start: float,
                 gravity: float) -> tuple[np.ndarray, np.ndarray, int, int]:
@@ -639,7 +633,7 @@ class EstimateScan:
             return
         # read-only views, whoever passes them (a batch run its recording's arrays, a stream its buffers):
         # the scan then needs one compiled variant, the one a wheel ships
-        t, acc, gyr, ok = (_read_only(a, d) for a, d in ((t, float), (acc, float), (gyr, float), (stance, bool)))
+        t, acc, gyr, ok = (read_only(a, d) for a, d in ((t, float), (acc, float), (gyr, float), (stance, bool)))
         self.gait.push(k, t, acc, gyr, ok, pos)
         self._plausibility()
         still, off_g, stances, first = _quiet_runs(t, acc, gyr, ok, float(self.t_start), float(self.gravity))

@@ -11,6 +11,7 @@ from ..core.conventions import GRAVITY
 from ..core.norms import row_norms_squared
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency
 from ..plugins.registry import register
@@ -394,7 +395,8 @@ class DGP(Detector):
         return Latency()
 
     def _advance(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray):
-        s_c, d_g = dgp_statistic_kernel(t, acc, gyr, self._w, self._n_c, self._scale, *self._stat_state)
+        s_c, d_g = dgp_statistic_kernel(read_only(t), read_only(acc), read_only(gyr), self._w, self._n_c, self._scale,
+                                        *self._stat_state)
         moving = None
         if self.max_stance_rate > 0.0:
             moving = row_norms_squared(gyr) > self.max_stance_rate**2

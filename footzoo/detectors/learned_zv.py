@@ -53,6 +53,7 @@ import numpy as np
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
 from ..core.errors import ConfigError
+from ..kernels.views import read_only
 from ..plugins.base import Detector, File, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, feed
 from ..plugins.registry import register
@@ -77,8 +78,7 @@ def window_samples(window: float, rate: float) -> int:
 
 def features(acc: np.ndarray, gyr: np.ndarray, rate: float) -> np.ndarray:
     """The (N, 16) features of every sample (see the module docstring), from specific force (m/s²) and rate (rad/s)."""
-    acc = np.ascontiguousarray(acc, dtype=float)
-    gyr = np.ascontiguousarray(gyr, dtype=float)
+    acc, gyr = read_only(acc), read_only(gyr)  # one compiled variant for every caller (kernels/views.py)
     cols = []
     for window in WINDOWS:
         m = window_moments(acc, gyr, window_samples(window, rate), GRAVITY)

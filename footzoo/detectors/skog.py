@@ -6,6 +6,7 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.conventions import GRAVITY
+from ..kernels.views import read_only
 from ..plugins.base import Detector, Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, feed
 from .windows import window_moments, window_statistic
@@ -83,8 +84,7 @@ class SkogTest(Detector):
 
     def _statistic(self, t: np.ndarray, acc: np.ndarray, gyr: np.ndarray) -> np.ndarray:
         self.window_samples_ = self.window_samples(self.ctx_)
-        acc = np.ascontiguousarray(acc, dtype=float)
-        gyr = np.ascontiguousarray(gyr, dtype=float)
+        acc, gyr = read_only(acc), read_only(gyr)  # one compiled variant for every caller (kernels/views.py)
         g = self.gravity_
         fused = FUSED_TESTS.get(type(self).test)
         if fused is not None:  # the same numbers as test(window_moments(...)), without the (N, 6) moments

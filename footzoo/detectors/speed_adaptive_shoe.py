@@ -9,6 +9,7 @@ import numpy as np
 from ..core.context import RunContext
 from ..filters.strapdown import quat_product, rotate, rotvec_quat
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from ..plugins.base import Real, run_context
 from ..plugins.incremental import Chunk, Latency, OverlapSave, run_starts
 from ..plugins.registry import register
@@ -322,7 +323,8 @@ class SpeedAdaptiveSHOE(AdaptiveSHOE):
         """Steps 2–3 over arrays: the swings' speeds, the speed-dependent test, the closing of gaps and pauses."""
         m = self.min_swing_samples(self.ctx_)
         g_max = max(self.max_threshold, self.threshold)
-        starts, ends, peaks, speed = swing_speeds(t, acc, gyr, provisional, self.LEVELLING)
+        starts, ends, peaks, speed = swing_speeds(read_only(t), read_only(acc), read_only(gyr),
+                                                   read_only(provisional, np.bool_), self.LEVELLING)
         speed_k = speed_per_sample(t, starts, ends, peaks, self.REACH)
         with np.errstate(over="ignore"):  # a tiny speed_scale overflows exp to inf: the threshold is then g_max
             threshold = np.minimum(self.threshold * np.exp(speed_k / self.speed_scale), g_max)

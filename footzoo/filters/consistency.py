@@ -71,6 +71,7 @@ from ..core.errors import SensorWarning, user_stacklevel
 from ..core.norms import row_norms, row_norms_squared
 from ..core.plausibility import MAX_STRIDE_TIME
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from .strapdown import quat_product, rotate, rotvec_quat, series_rotvec_quat
 
 #: (name, gyroscope axis signs, the fix) of each axis fault the scan can name.
@@ -369,10 +370,11 @@ class ConsistencyScan:
         first, last = first[:MAX_SWINGS - len(self.residuals)], last[:MAX_SWINGS - len(self.residuals)]
         if not len(first):
             return
+        t, acc, gyr = (read_only(buf[n]) for n in ("t", "acc", "gyr"))  # one compiled variant for every caller
         out = np.empty((len(first), len(_SCALE)))
-        _residuals(buf["t"], buf["acc"], buf["gyr"], first, last, _SCALE, _SIGNS, self.gravity, out)
+        _residuals(t, acc, gyr, first, last, _SCALE, _SIGNS, self.gravity, out)
         gait = np.empty((len(first), 4))
-        _swing_gait(buf["t"], buf["acc"], buf["gyr"], first, last, self.gravity, gait)
+        _swing_gait(t, acc, gyr, first, last, self.gravity, gait)
         before = len(self.residuals)
         self.residuals.extend(out)
         self.gait_rows.extend(np.column_stack([buf["t"][first], buf["t"][last] - buf["t"][first], gait]))

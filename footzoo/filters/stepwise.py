@@ -103,6 +103,7 @@ import math
 import numpy as np
 
 from ..kernels.jit import njit
+from ..kernels.views import read_only
 from .smoother import feed_back_attitude, smooth_segment
 
 #: What a live stream's smoothed estimate of a sample waits for (its latency, besides the one sample after it).
@@ -235,5 +236,4 @@ def segment_ends(stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
     sample; the last sample only when ``closed`` (the end of the data; live, its successor is
     not known yet).
     """
-    return _segment_ends(np.ascontiguousarray(stance, dtype=np.bool_), np.ascontiguousarray(t, dtype=float),
-                         bool(closed))
+    return _segment_ends(read_only(stance, np.bool_), read_only(t), bool(closed))

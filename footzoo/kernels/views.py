@@ -8,6 +8,8 @@ gives a view whose owner is null, so passing it costs nothing
 
 from __future__ import annotations
 
+import numpy as np
+
 from . import jit as _jit
 
 
@@ -25,3 +27,16 @@ def _compiled():
 #: ``unowned(a)``: a view of ``a`` that owns no reference (compiled code; ``a`` itself in Python). Made
 #: when numba is imported (at the first kernel call), so that importing a module that uses it does not.
 unowned = _jit.lazy(_compiled, _plain)
+
+
+def read_only(a: np.ndarray, dtype: type = float) -> np.ndarray:
+    """``a`` as a C-contiguous array of ``dtype`` seen through a read-only view (no copy when it is one already).
+
+    numba compiles a kernel once per argument type, and a read-only array is another type than a writable
+    one: a kernel's inputs passed through this view are typed alike whoever calls it (a run freezes its
+    recording's arrays, a calibrated channel or a user's own array is writable), so the machine code a wheel
+    ships serves every caller instead of one more compile at the first call of the other kind.
+    """
+    view = np.ascontiguousarray(a, dtype=dtype).view()
+    view.flags.writeable = False
+    return view
