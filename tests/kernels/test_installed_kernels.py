@@ -18,8 +18,8 @@ pytestmark = [pytest.mark.skipif(not _jit.HAVE_NUMBA, reason="needs numba"),
                                  "(an editable install): pip install . ships them")]
 
 # every shipped pipeline config, batch and (where it can run) live in packets and sample by sample, on walks
-# that are not those the wheel was compiled on (with every sensor, and with none); print the footzoo kernels numba
-# compiled for each run
+# that are not those the wheel was compiled on (with every sensor, with none, frozen as a study's, and with an
+# accelerometer the run rescales); print the footzoo kernels numba compiled for each run
 RUN = """
 import json, warnings
 warnings.simplefilter("ignore")
@@ -37,6 +37,12 @@ class Listener(event.Listener):
         pass
 recordings = [simulate(n_strides=4, rate=200.0, profile="physical", distance_sensors=True),
               simulate(n_strides=4, rate=200.0, profile="physical", magnetometer=False)]
+# as a study gives it (every array frozen), and read 5 % high (the run rescales the accelerometer: a writable copy)
+frozen, high = (simulate(n_strides=4, rate=200.0, profile="physical", magnetometer=False) for _ in range(2))
+for a in (frozen.t, frozen.acc, frozen.gyr):
+    a.flags.writeable = False
+high.acc *= 1.05
+recordings += [frozen, high]
 with event.install_listener("numba:compile", Listener()):
     for NAME in names("pipeline"):
         p = footzoo.Pipeline.from_yaml(NAME)
