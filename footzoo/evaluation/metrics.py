@@ -392,11 +392,18 @@ def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) ->
     return best[1], best[2]
 
 
+def estimated_footprints(steps: pd.DataFrame) -> np.ndarray:
+    """The estimated footprints (mid-stance positions; m, north and east): the first stride's start and every
+    stride's end, K + 1 points (rows) for K strides; none without strides."""
+    if len(steps) == 0:
+        return np.zeros((0, 2))
+    return np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
+
+
 def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, float]:
     """Error of every footprint (mid-stance position) against measured footprints, e.g. Köroğlu's GCPs.
 
-    The estimated footprints are the first stride's start and every stride's
-    end (K + 1 points for K strides). Compared only when the counts agree;
+    The estimated footprints are :func:`estimated_footprints`. Compared only when the counts agree;
     after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
     the mean and RMS distances (m) and the end-point distance are returned.
     """
@@ -404,7 +411,7 @@ def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, f
     out: dict[str, float] = {"footprints_ref": float(len(fp))}
     if len(steps) == 0:
         return out
-    est = np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
+    est = estimated_footprints(steps)
     out["footprints_est"] = float(len(est))
     if len(est) != len(fp):
         return out

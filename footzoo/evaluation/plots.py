@@ -24,7 +24,7 @@ from ..core.atomic import OutputError, atomic_path
 from ..core.conventions import quat_to_euler
 from ..core.data import Recording
 from ..core.errors import ConfigError, RecordingError
-from .metrics import match_strides, rotate_about_vertical, yaw_alignment
+from .metrics import estimated_footprints, match_strides, rigid_align_2d, rotate_about_vertical, yaw_alignment
 from .result import Result
 
 P = ParamSpec("P")
@@ -160,6 +160,24 @@ def aligned_reference(result: Result, recording: Recording | None) -> np.ndarray
     e, r = pos[ok] - pos[first], ref[ok] - ref[first]
     psi = yaw_alignment(e, r)
     return rotate_about_vertical(ref - ref[first], -psi) + pos[first]
+
+
+def aligned_footprints(result: Result, recording: Recording | None) -> np.ndarray | None:
+    """The recording's measured footprints (K, 2; m, north and east) in the estimate's frame; None without them.
+
+    Measured footprints (Köroğlu's ground control points) are in the dataset's own axes: they are aligned
+    onto the estimated footprints (:func:`~footzoo.evaluation.metrics.estimated_footprints`) by the 2-D
+    rigid alignment that the footprint metric uses the other way round (reflection allowed). None also when
+    the counts differ: the metric compares nothing then either (its ``footprints_est`` says how many).
+    """
+    check_pair(result, recording)
+    if recording is None or recording.truth is None or recording.truth.footprints is None:
+        return None
+    fp = np.asarray(recording.truth.footprints, dtype=float)
+    est = estimated_footprints(result.steps)
+    if len(est) != len(fp) or len(fp) < 2:
+        return None
+    return rigid_align_2d(fp, est)[0]
 
 
 def broken_at_wraps(angle_deg: np.ndarray) -> np.ndarray:
@@ -324,7 +342,9 @@ def _title(result: Result, recording: Recording | None) -> str:
 def trajectory_figure(result: Result, recording: Recording | None = None) -> Figure:
     """Top view (east vs north) with the stride ends numbered, and height over time with stance shaded.
 
-    The reference (``recording.truth.pos``), when present, is drawn yaw-aligned in black dashes.
+    The reference (``recording.truth.pos``), when present, is drawn yaw-aligned in black dashes; measured
+    footprints (``recording.truth.footprints``) as black crosses, aligned onto the estimated ones
+    (:func:`aligned_footprints`).
     """
     plt = pyplot()
     pos = result.pos
@@ -336,6 +356,10 @@ def trajectory_figure(result: Result, recording: Recording | None = None) -> Fig
         top.plot(ref[::s, 1], ref[::s, 0], **REFERENCE_STYLE, label="reference (yaw-aligned)")
         height.plot(t[::s], -ref[::s, 2], **REFERENCE_STYLE, label="reference")
     top.plot(pos[::s, 1], pos[::s, 0], color="C0", lw=1.3, label="estimate")
+    footprints = aligned_footprints(result, recording)
+    if footprints is not None:
+        top.plot(footprints[:, 1], footprints[:, 0], "x", color=REFERENCE_STYLE["color"], ms=6, mew=1.2,
+                 label="measured footprints (aligned)")
     ends = _stride_ends(result)
     if ends is not None:
         number, _, p = ends

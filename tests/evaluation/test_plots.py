@@ -488,3 +488,28 @@ def test_a_figure_name_whose_format_matplotlib_lacks_is_an_output_error_naming_t
                                           r"name with one of .*\.pdf, .*\.png.*\(e\.g\. '.*figure\.png'\)"):
         save(fig, tmp_path / "sub" / name)
     assert not plt.fignum_exists(fig.number) and not (tmp_path / "sub").exists()
+
+
+def test_measured_footprints_are_drawn_aligned_onto_the_estimated_ones(walk):
+    """Footprints in a dataset's own axes (mirrored, turned, moved, as Köroğlu's) land on the estimated footprints."""
+    import dataclasses
+
+    from footzoo.evaluation.metrics import estimated_footprints
+    from footzoo.evaluation.plots import aligned_footprints
+
+    rec, res = walk
+    est = estimated_footprints(res.steps)
+    assert len(est) == len(res.steps) + 1 >= 8
+    turn = np.radians(70.0)
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    measured = (est * [1.0, -1.0]) @ rot.T + [12.0, -3.0]  # another handedness, heading and origin
+    truth = dataclasses.replace(rec.truth, footprints=measured)
+    mine = dataclasses.replace(rec, truth=truth)
+    np.testing.assert_allclose(aligned_footprints(res, mine), est, atol=1e-9)
+    fig = trajectory_figure(res, mine)
+    assert "measured footprints (aligned)" in legend_texts(fig)
+    close(fig)
+    # a count that differs from the estimate's: nothing to align (the metric compares nothing either)
+    fewer = dataclasses.replace(rec, truth=dataclasses.replace(rec.truth, footprints=measured[:-1]))
+    assert aligned_footprints(res, fewer) is None
+    assert aligned_footprints(res, rec) is None  # no measured footprints
