@@ -180,13 +180,22 @@ def _compiled_convention(fn: Callable[..., Any], role: str) -> Callable[..., Any
     return compiled
 
 
+#: The attributes of numba's dispatcher a :class:`ModelFunction` hands on (compiling itself first).
+DISPATCHER_ATTRIBUTES = frozenset({
+    "signatures", "nopython_signatures", "overloads", "targetoptions", "stats", "get_compile_result", "get_overload",
+    "inspect_types", "inspect_llvm", "inspect_asm", "inspect_cfg", "get_call_template", "typeof_pyval",
+})
+
+
 class ModelFunction:
     """A measurement model's function, compiled to the engine's calling convention at its first use.
 
     Calling it runs the function as written (``measure(ctx, rows)``...), in Python. Asking for
-    :meth:`compiled`, or for numba's attributes (``signatures``, ``targetoptions``, ...), compiles
-    it into the calling convention (or loads it from numba's cache); :func:`calling` gives what the
-    engines call. Nothing is imported or compiled before: importing a correction's module stays cheap.
+    :meth:`compiled`, or for one of numba's dispatcher attributes of :data:`DISPATCHER_ATTRIBUTES`
+    (``signatures``, ``targetoptions``, ...), compiles it into the calling convention (or loads it from
+    numba's cache); :func:`calling` gives what the engines call. Nothing is imported or compiled before:
+    importing a correction's module stays cheap, and so does looking at the function (``hasattr``, ``dir``,
+    a test collector's or a documentation tool's probes: any other name is an ``AttributeError`` at once).
     """
 
     def __init__(self, fn: Callable[..., Any], role: str):
@@ -221,8 +230,8 @@ class ModelFunction:
         return self.py_func(*args)
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("__") or name in ("py_func", "role", "_dispatcher", "_error"):
-            raise AttributeError(name)
+        if name not in DISPATCHER_ATTRIBUTES:  # a probe of an attribute it does not have: no compile for it
+            raise AttributeError(f"footzoo model function has no attribute {name!r}")  # no repr: it reads attributes
         return getattr(self.compiled(), name)
 
     def __repr__(self) -> str:

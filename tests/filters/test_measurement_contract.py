@@ -204,3 +204,23 @@ def test_a_plugins_compiled_convention_is_cached_and_a_new_process_compiles_noth
         runs.append(json.loads(proc.stdout.strip().splitlines()[-1]))
     assert runs[0]["m"] == runs[1]["m"] == 3 and runs[0]["z"] == runs[1]["z"] == [1.0, 2.0, 3.0]
     assert runs[0]["misses"] >= 1 and runs[1]["hits"] >= 1 and runs[1]["misses"] == 0
+
+
+@pytest.mark.skipif(not _jit.HAVE_NUMBA, reason="numba not installed")
+def test_looking_at_a_model_function_compiles_nothing_and_numbas_attributes_compile_it():
+    """A test collector, ``hasattr`` or a documentation tool probes names a function does not have: an
+    AttributeError at once, not a compile (it took about 1 s per function, in every process that looked)."""
+
+    def one_row(ctx, rows):
+        m = rows.m
+        rows.z[m] = 0.0
+        rows.R[m] = 1.0
+        return m + 1
+
+    f = measurement_function(one_row)
+    for probe in ("pytestmark", "footzoo_convention", "_pytestfixturefunction", "__wrapped_by__", "anything"):
+        assert not hasattr(f, probe)
+    rows = Rows(np.full(2, 9.0), np.zeros((2, 3)), np.zeros(2), 1)
+    assert f(None, rows) == 2 and rows.z.tolist() == [9.0, 0.0] and rows.R.tolist() == [0.0, 1.0]  # as written
+    assert f._dispatcher is None  # nothing compiled by the probes nor by the call
+    assert len(f.signatures) >= 1 and f._dispatcher is not None  # numba's attribute: compiled, for it
