@@ -689,15 +689,12 @@ def read_result(path: str | os.PathLike, verify: bool = True, loader: str = "Res
             data = _read_manifest(path, FORMAT)
             fields = _result_fields(folder, data["files"])
             problems = _problems(folder, data["files"], loader) if verify else []
-        except FormatError:
-            if attempt + 1 < READ_ATTEMPTS and _stamp(folder) != stamp:
+        except (FormatError, *_DAMAGED) as err:
+            if attempt + 1 < READ_ATTEMPTS and _stamp(folder) != stamp:  # saved into meanwhile: read it again
                 time.sleep(0.05 * (attempt + 1))
                 continue
-            raise
-        except _DAMAGED as err:
-            if attempt + 1 < READ_ATTEMPTS and _stamp(folder) != stamp:
-                time.sleep(0.05 * (attempt + 1))
-                continue
+            if isinstance(err, FormatError):
+                raise
             raise FormatError(f"{str(folder)!r}: the archive is damaged, a file cannot be read ({type(err).__name__}: "
                               f"{str(err)[:200]}); save the result again or restore the folder from a copy") from None
         if _stamp(folder) == stamp and not stamp[-1]:
