@@ -16,7 +16,8 @@ Where a segment ends
     its estimate is taken as the smoothed one (``e_k = 0``). A segment holds the samples after
     the previous end up to this one: a swing and the stance after it (the first segment, the
     still start too). A stance that goes on (standing) also ends a segment at its first sample
-    :data:`MAX_SEGMENT` seconds or more after the segment's first, so that memory and latency
+    :data:`MAX_SEGMENT` seconds or more after the segment's first and :data:`SETTLE` seconds or more
+    into the stance (its first updates stay with the swing they correct), so that memory and latency
     stay bounded when the wearer stands still. :func:`segment_ends` is the rule; the batch run
     (:meth:`footzoo.filters.engine.KalmanEngine.run`) and the live stage
     (:class:`footzoo.runtime.stages.KalmanStage`) both use it, so a stream's final estimates
@@ -112,12 +113,29 @@ WAITS_FOR = "the end of the next stance"
 #: Longest segment (s) before a stance sample closes it although the stance goes on (standing still);
 #: a walking stride with its stance lasts about 1–1.5 s.
 MAX_SEGMENT = 3.0
+#: A stance that goes on closes a segment of :data:`MAX_SEGMENT` or more only once it has lasted this long (s):
+#: its first updates (the zero-velocity rows, a height row) correct the swing before it, and the backward pass
+#: carries those corrections into the swing only if they are in the swing's segment. Closed at the stance's first
+#: sample, a segment after a long swing (PyShoe 2017-11-27-11-12-44: 4 s of a foot the detector missed at rest)
+#: left the correction to the next segment, a stance with no path to spread it along: an 8 cm jump.
+SETTLE = 0.2
+
+
+@njit(inline=True)
+def settled(stance, t, k, lo):
+    """Whether the segment from sample ``lo`` has been in stance for the last :data:`SETTLE` s up to sample k."""
+    j = k
+    while j > lo and t[k] - t[j] < SETTLE:
+        j -= 1
+        if not stance[j]:
+            return False
+    return t[k] - t[j] >= SETTLE
 
 
 @njit(inline=True)
 def ends_segment(stance, t, k, lo):
     """Whether sample k (not the last) ends the segment that began at sample ``lo`` (module docstring)."""
-    return stance[k] and (not stance[k + 1] or t[k] - t[lo] >= MAX_SEGMENT)
+    return stance[k] and (not stance[k + 1] or (t[k] - t[lo] >= MAX_SEGMENT and settled(stance, t, k, lo)))
 
 
 @njit
@@ -233,7 +251,7 @@ def segment_ends(stance: np.ndarray, t: np.ndarray, closed: bool) -> np.ndarray:
 
     Sample k ends one when ``stance[k]`` and not ``stance[k + 1]``, or when ``stance[k]`` and
     ``stance[k + 1]`` but ``t[k]`` (s) is :data:`MAX_SEGMENT` or more after the segment's first
-    sample; the last sample only when ``closed`` (the end of the data; live, its successor is
-    not known yet).
+    sample and the segment has been in stance for the last :data:`SETTLE` s; the last sample only
+    when ``closed`` (the end of the data; live, its successor is not known yet).
     """
     return _segment_ends(read_only(stance, np.bool_), read_only(t), bool(closed))

@@ -146,3 +146,20 @@ def test_koroglus_walk_is_smoothed_stride_by_stride_without_a_jump():
         rts = Pipeline.from_yaml("recommended").run(rec)
         live = Pipeline.from_yaml("recommended_live").run(rec)
     assert _largest_move(live.pos) <= 2.0 * _largest_move(rts.pos), (_largest_move(live.pos), _largest_move(rts.pos))
+
+
+def test_a_long_swing_closes_its_segment_only_once_the_stance_has_settled():
+    """A segment longer than MAX_SEGMENT closes at a stance sample SETTLE s into the stance, not at its first: the
+    stance's first updates (zero velocity, a level height) correct the swing, and the backward pass carries them
+    into it only inside the swing's segment. A stand is still cut every MAX_SEGMENT s, and a stance that ends
+    sooner than SETTLE ends its segment at its last sample."""
+    from footzoo.filters.stepwise import MAX_SEGMENT, SETTLE, segment_ends
+
+    t = np.arange(0.0, 9.0, 0.005)
+    stand = (t < 0.5) | (t >= 4.0)  # the still start, a 3.5 s swing, a stand
+    ends = t[segment_ends(stand, t, True)]
+    np.testing.assert_allclose(ends, [0.495, 4.0 + SETTLE, 4.0 + SETTLE + MAX_SEGMENT, t[-1]], atol=0.006)
+    step = (t < 0.5) | ((t >= 4.0) & (t < 4.1)) | (t >= 5.0)  # the same swing, a 0.1 s stance, a swing, a stand
+    np.testing.assert_allclose(t[segment_ends(step, t, True)][:3], [0.495, 4.095, 4.1 + MAX_SEGMENT], atol=0.006)
+    still = np.ones(t.size, bool)
+    assert t[segment_ends(still, t, True)][0] == pytest.approx(MAX_SEGMENT)  # a stand from the start: as before
