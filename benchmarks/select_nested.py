@@ -14,7 +14,8 @@ elsewhere; otherwise the baseline stays.
 
 Candidates (a small grid, every other part of the pipeline as shipped: INS attitude, the 9-state
 error-state Kalman filter's noises, RTS smoothing, no swing guard, the speed-adaptive detector's
-``provisional_min_swing`` 0, the zero-velocity update's σ 0.03 m/s and its stillness hold):
+``provisional_min_swing`` 0, the zero-velocity update's σ 0.03 m/s and its stillness hold, and the shipped
+level-stance height update :data:`HEIGHT` after the stance updates, chosen by ``benchmarks/select_height.py``):
 
 * the speed-adaptive SHOE detector's ``threshold`` ∈ {2000, 3000} × ``speed_scale`` ∈ {0.8, 1.0} × the
   zero-velocity update's ``roll_lever`` ∈ {0, 0.1, 0.2} m: 12 settings, among them the shipped one
@@ -109,6 +110,9 @@ HUANG: dict[str, dict[str, Any]] = {
     f"huang_stance th {th:g} min {md:g}": {"type": "huang_stance", "threshold": th, "min_duration": md}
     for th in (1.5e4, 3e4, 6e4) for md in (0.05, 0.1)
 }
+#: The shipped height correction(s) every candidate keeps after its stance updates (benchmarks/height_level.md).
+HEIGHT: list[dict[str, Any]] = [c for c in yaml.safe_load((ROOT / "configs" / "recommended.yaml").read_text())
+                                ["corrections"] if c["type"] == "height_level"]
 #: The fixed baseline (the shipped setting) and the setting the refinements started from.
 BASELINE = "th 2000 vs 0.8 roll 0.2"
 START = "th 3000 vs 1 roll 0"
@@ -154,6 +158,8 @@ def candidates() -> list[dict[str, Any]]:
         cfg["detector"] = copy.deepcopy(detector)
         cfg["name"] = name
         out.append(cfg)
+    for cfg in out:
+        cfg["corrections"] += copy.deepcopy(HEIGHT)
     return out
 
 

@@ -3,6 +3,7 @@
 from .ekf_zupt import EKFZUPT, ZUPT
 from .hdr import HDR
 from .height import HeightDistance, HeightFlatFloor, load_calibration, save_calibration
+from .height_level import HeightLevel
 from .rolling_stance import RollingStance
 from .zvu_dedrift import ZVUDedrift, zvu_dedrift
 
@@ -12,6 +13,7 @@ __all__ = [
     "ZUPT",
     "HeightDistance",
     "HeightFlatFloor",
+    "HeightLevel",
     "RollingStance",
     "ZVUDedrift",
     "load_calibration",
