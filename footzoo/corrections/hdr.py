@@ -8,7 +8,15 @@ import numpy as np
 
 from ..core.context import RunContext
 from ..core.conventions import quat_yaw
-from ..filters.measurement import ATT, MeasurementModel, after_function, measurement_function, yaw_of
+from ..filters.measurement import (
+    ATT,
+    MeasurementModel,
+    after_function,
+    gated_row,
+    measurement_function,
+    stance_ended,
+    yaw_of,
+)
 from ..kernels.jit import njit
 from ..plugins.base import AccelerationCorrection, KalmanCorrection, Real, Samples
 from ..plugins.incremental import Chunk, Latency
@@ -77,30 +85,23 @@ def heading_measure(ctx, rows):
     ``par`` and ``mem``: see :data:`THRESHOLD` and :data:`WAS_STANCE`.
     """
     par, mem = ctx.par, ctx.mem
-    z, H, R, m = rows
     if not ctx.stance or mem[ENDS_SEEN] < 2:
-        return m
+        return rows.m
     a, b = mem[YAW_1], mem[YAW_2]
     mean = math.atan2(math.sin(a) + math.sin(b), math.cos(a) + math.cos(b))
     d = yaw_of(ctx.nav) - mean
     d = -((-d + math.pi) % (2 * math.pi) - math.pi)  # wrap to (-π, π], as conventions.wrap_angle
-    if abs(d) > par[THRESHOLD]:
-        return m
-    H[m, ctx.idx[ATT] + 2] = 1.0
-    z[m] = d
-    R[m] = par[YAW_STD] * par[YAW_STD]
-    return m + 1
+    return gated_row(rows, ctx.idx[ATT] + 2, d, par[THRESHOLD], par[YAW_STD])
 
 
 @after_function
 def heading_after(ctx):
     """Record the final heading of each stance (γ^{T_i}), after the update."""
-    mem, stance = ctx.mem, ctx.stance
-    if mem[WAS_STANCE] != 0.0 and not stance and ctx.k > 1:
+    mem = ctx.mem
+    if stance_ended(ctx, WAS_STANCE):
         mem[YAW_2] = mem[YAW_1]
         mem[YAW_1] = mem[LAST_YAW]
         mem[ENDS_SEEN] += 1.0
-    mem[WAS_STANCE] = 1.0 if stance else 0.0
     mem[LAST_YAW] = yaw_of(ctx.nav)
 
 

@@ -47,7 +47,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..filters.measurement import POS, MeasurementModel, P, after_function, measurement_function
+from ..filters.measurement import (
+    POS,
+    MeasurementModel,
+    P,
+    after_function,
+    gated_row,
+    measurement_function,
+    stance_ended,
+)
 from ..plugins.base import KalmanCorrection, Real, Samples
 from ..plugins.registry import register
 
@@ -62,23 +70,16 @@ WAS_STANCE, LAST_HEIGHT, ENDS_SEEN, LEVEL, ON_LEVEL, CHANGES = range(6)
 def level_measure(ctx, rows):
     """In stance, once a stance has ended: ``δh = p̂_d − h_{i−1}`` when ``|δh| ≤ th_h`` (one row on δp_d)."""
     par, mem = ctx.par, ctx.mem
-    z, H, R, m = rows
     if not ctx.stance or mem[ENDS_SEEN] < 1.0:
-        return m
-    d = ctx.nav[P + 2] - mem[LEVEL]
-    if abs(d) > par[THRESHOLD]:
-        return m
-    H[m, ctx.idx[POS] + 2] = 1.0
-    z[m] = d
-    R[m] = par[HEIGHT_STD] * par[HEIGHT_STD]
-    return m + 1
+        return rows.m
+    return gated_row(rows, ctx.idx[POS] + 2, ctx.nav[P + 2] - mem[LEVEL], par[THRESHOLD], par[HEIGHT_STD])
 
 
 @after_function
 def level_after(ctx):
     """At the first swing sample after a stance: that stance's final height becomes ``h_{i−1}`` (after the update)."""
-    mem, stance = ctx.mem, ctx.stance
-    if mem[WAS_STANCE] != 0.0 and not stance and ctx.k > 1:
+    mem = ctx.mem
+    if stance_ended(ctx, WAS_STANCE):
         if mem[ENDS_SEEN] >= 1.0:
             if abs(mem[LAST_HEIGHT] - mem[LEVEL]) <= ctx.par[THRESHOLD]:
                 mem[ON_LEVEL] += 1.0
@@ -86,7 +87,6 @@ def level_after(ctx):
                 mem[CHANGES] += 1.0
         mem[LEVEL] = mem[LAST_HEIGHT]
         mem[ENDS_SEEN] += 1.0
-    mem[WAS_STANCE] = 1.0 if stance else 0.0
     mem[LAST_HEIGHT] = ctx.nav[P + 2]
 
 

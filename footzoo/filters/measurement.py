@@ -406,6 +406,29 @@ def row_fault(problem: int, row: int) -> int:
 
 
 @njit(inline=True)
+def gated_row(rows, column: int, d: float, threshold: float, std: float) -> int:
+    """A heuristic's scalar row: ``z = d`` on state ``column`` with ``R = std²`` when ``|d| ≤ threshold`` (a larger
+    change is taken as real, not drift: HDR's gate, Nguyen & La 2016, eq. 24); the next free row either way.
+    Usable inside compiled measurement functions."""
+    z, H, R, m = rows
+    if abs(d) > threshold:
+        return m
+    H[m, column] = 1.0
+    z[m] = d
+    R[m] = std * std
+    return m + 1
+
+
+@njit(inline=True)
+def stance_ended(ctx, was_stance: int) -> bool:
+    """In an ``after`` function: whether this sample is the first after a stance, ``ctx.mem[was_stance]`` holding
+    whether the previous sample was stance (0/1); that entry is then set to this sample's."""
+    ended = ctx.mem[was_stance] != 0.0 and not ctx.stance and ctx.k > 1
+    ctx.mem[was_stance] = 1.0 if ctx.stance else 0.0
+    return ended
+
+
+@njit(inline=True)
 def yaw_of(nav: np.ndarray) -> float:
     """Z-Y-X heading of ``nav``'s attitude (rad); usable inside compiled measurement functions."""
     w, x, y, z = nav[Q], nav[Q + 1], nav[Q + 2], nav[Q + 3]
