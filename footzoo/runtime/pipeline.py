@@ -615,7 +615,9 @@ def check_compatibility(orientation: Plugin, detector: Plugin, corrections: list
     filter_only = [c.name for c in kalman if not isinstance(c, (AccelerationCorrection, VelocityCorrection))]
     if filter_only and velocity:
         raise ConfigError(
-            f"corrections: {velocity} and the Kalman filter {filter_only} both correct the velocity; choose one"
+            f"corrections: {velocity} corrects the velocity after the strapdown, and {filter_only} runs in the "
+            f"error-state Kalman filter, which corrects it too; choose one: drop {velocity}, and give the filter "
+            "its stance update (zupt or ekf_zupt), or drop the Kalman corrections"
         )
     if not filter_only:
         return
