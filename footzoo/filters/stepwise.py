@@ -82,7 +82,8 @@ What it cannot do
     at the end of the next stance has seen more. Where that later information is large (a long
     walk whose heading the later strides correct), the step-wise estimate stays as far from the
     RTS one as the filtered estimate is: on Köroğlu's experiment 33 the forward filter at the ends
-    of the stances is up to 1.23 m from the RTS estimate, and the step-wise estimate up to 1.23 m
+    of the stances is up to 1.06 m from the RTS estimate, and the step-wise estimate up to 1.06 m;
+    with the data up to 8 strides after a stance end it would still be 0.82 m
     (``benchmarks/stepwise_continuity.md`` gives every recording). The pinned start gives up, at
     the start of each stride, what the strides smoothed alone took from its stance: on PyShoe's 36
     trials (``recommended_live``, PyShoe's 2-D error) the median 0.0477 m against 0.0474 m, the
