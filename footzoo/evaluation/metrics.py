@@ -5,6 +5,8 @@ All positions are (N, 3) arrays in NED (m). Horizontal means north-east.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import pandas as pd
 
@@ -369,12 +371,25 @@ def stride_errors(estimated: pd.DataFrame, reference: pd.DataFrame, tolerance: f
     return out
 
 
-def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> tuple[np.ndarray, bool]:
-    """Least-squares 2-D rotation + translation of ``est`` onto ``ref`` (Kabsch), optionally a reflection.
+class RigidTransform2D(NamedTuple):
+    """A 2-D rigid transform (rotation, translation, optionally a reflection of the second axis) of points (m)."""
 
-    Returns the aligned points and whether a reflection was used (it is taken
-    only when it fits better: datasets such as Köroğlu's flip an axis).
-    """
+    rot: np.ndarray
+    mirror: bool
+    source_centre: np.ndarray
+    target_centre: np.ndarray
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        """``points`` (N, 2 or more; the first two columns are transformed) in the target's frame, (N, 2)."""
+        p = np.asarray(points, float)[:, :2]
+        if self.mirror:
+            p = p * np.array([1.0, -1.0])
+        return (p - self.source_centre) @ self.rot.T + self.target_centre
+
+
+def rigid_transform_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> RigidTransform2D:
+    """Least-squares 2-D rotation + translation of ``est`` onto ``ref`` (Kabsch), optionally a reflection (taken
+    only when it fits better: datasets such as Köroğlu's flip an axis)."""
     e = np.asarray(est, float)[:, :2]
     r = np.asarray(ref, float)[:, :2]
     best = None
@@ -385,11 +400,16 @@ def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) ->
         u, _, vt = np.linalg.svd(h)
         d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
         rot = vt.T @ np.diag([1.0, d]) @ u.T
-        aligned = (ee - ce) @ rot.T + cr
-        err = float(np.sum((aligned - r) ** 2))
+        err = float(np.sum(((ee - ce) @ rot.T + cr - r) ** 2))
         if best is None or err < best[0]:
-            best = (err, aligned, mirror)
-    return best[1], best[2]
+            best = (err, RigidTransform2D(rot, mirror, ce, cr))
+    return best[1]
+
+
+def rigid_align_2d(est: np.ndarray, ref: np.ndarray, reflection: bool = True) -> tuple[np.ndarray, bool]:
+    """``est`` aligned onto ``ref`` by :func:`rigid_transform_2d`, and whether a reflection was used."""
+    tf = rigid_transform_2d(est, ref, reflection)
+    return tf.apply(est), tf.mirror
 
 
 def estimated_footprints(steps: pd.DataFrame) -> np.ndarray:

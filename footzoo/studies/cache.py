@@ -143,7 +143,7 @@ def touch(path: Path) -> None:
 
 
 #: The parts of a run record that grow with the recording: kept in its cache entry, not in memory.
-HEAVY = ("trajectory", "reference", "roc")
+HEAVY = ("trajectory", "reference", "footprints", "trajectory_on_footprints", "roc")
 
 
 def light(record: dict[str, Any], keep: bool = True) -> dict[str, Any]:

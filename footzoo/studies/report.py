@@ -217,7 +217,7 @@ def loaded(task: tuple) -> tuple:
     """A figure task with its runs' trajectories or sweeps read back from the cache (a study keeps them
     on disk, :func:`footzoo.studies.cache.light`); a task that has them is returned as it is."""
     if task[0] == "trajectories":
-        return (task[0], with_heavy(task[1], ("trajectory", "reference")), *task[2:])
+        return (task[0], with_heavy(task[1], TRAJECTORY_FIELDS), *task[2:])
     if task[0] == "roc":
         return (task[0], with_heavy(task[1], ("roc",)), *task[2:])
     return task
@@ -530,12 +530,58 @@ def _grid(plt, n: int, size: float = 2.6, max_cols: int = 8):
 MAX_OVERLAID = 8
 
 
+#: The run-record fields a trajectories figure reads back from the cache.
+TRAJECTORY_FIELDS = ("trajectory", "reference", "footprints", "trajectory_on_footprints")
+#: How measured footprints are drawn (Köroğlu's ground control points): the single-run figure's crosses.
+FOOTPRINT_STYLE = {"marker": "x", "ls": "none", "color": REFERENCE_STYLE["color"], "ms": 6, "mew": 1.2}
+
+
+def _curves(runs: list[dict[str, Any]], labels: dict[str, str]
+            ) -> tuple[list[tuple[str, np.ndarray]], np.ndarray | None, np.ndarray | None, str]:
+    """Each run's top-view curve (label, (N, 3) NED m) in one common frame, the reference path, the measured
+    footprints (K, 2) and the frame's name (see :func:`trajectories_figure`)."""
+    ref = next((np.asarray(r["reference"], float) for r in runs if _has(r, "reference")), None)
+    footprints = next((np.asarray(r["footprints"], float) for r in runs if _has(r, "footprints")), None)
+    curves = []
+    if ref is not None:
+        ref = ref[:, 1:4] - ref[0, 1:4]
+        for r in runs:
+            tr = np.asarray(r["trajectory"], float)[:, 1:4]
+            tr = tr - tr[0]
+            if len(ref) == len(tr):
+                ok = np.all(np.isfinite(ref), axis=1) & np.all(np.isfinite(tr), axis=1)
+                if ok.sum() > 2:
+                    tr = rotate_about_vertical(tr, yaw_alignment(tr[ok], ref[ok]))
+            curves.append((labels.get(r["key"], r["key"]), tr))
+        return curves, ref, None, "estimates yaw-aligned to the reference"
+    if footprints is not None:
+        unpaired = 0
+        for r in runs:
+            if _has(r, "trajectory_on_footprints"):
+                on = np.asarray(r["trajectory_on_footprints"], float)[:, 1:4]
+                curves.append((labels.get(r["key"], r["key"]), on))
+            else:
+                unpaired += 1
+        frame = "estimates aligned on the measured footprints (×)"
+        if unpaired:
+            frame += f"; {unpaired} run(s) whose footprints do not pair with them not drawn"
+        return curves, None, footprints, frame
+    for r in runs:
+        tr = np.asarray(r["trajectory"], float)[:, 1:4]
+        curves.append((labels.get(r["key"], r["key"]), tr - tr[0]))
+    return curves, None, None, "estimates as computed"
+
+
 def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], recording: str):
     """Top views of every configuration on one recording, the reference (if stored) in black dashes.
 
     With a reference, each estimate is yaw-aligned to it (least squares), so all
-    share the reference's frame. Up to :data:`MAX_OVERLAID` configurations share
-    one axis with the legend below it; more get one small panel each (same
+    share the reference's frame. With measured footprints instead (Köroğlu's ground
+    control points), each estimate is drawn in their frame, moved there by the 2-D
+    rigid alignment of its estimated footprints that the footprint metric uses, and
+    the footprints are black crosses; a run whose footprints do not pair with them
+    is left out (the title says how many). Up to :data:`MAX_OVERLAID` configurations
+    share one axis with the legend below it; more get one small panel each (same
     scale), the reference repeated in every panel.
     """
 
@@ -546,36 +592,30 @@ def trajectories_figure(runs: list[dict[str, Any]], labels: dict[str, str], reco
     @styled
     def build():
         plt = pyplot()
-        ref = next((np.asarray(r["reference"], float) for r in runs if _has(r, "reference")), None)
-        if ref is not None:
-            ref = ref[:, 1:4] - ref[0, 1:4]
-        curves = []
-        for r in runs:
-            tr = np.asarray(r["trajectory"], float)[:, 1:4]
-            tr = tr - tr[0]
-            if ref is not None and len(ref) == len(tr):
-                ok = np.all(np.isfinite(ref), axis=1) & np.all(np.isfinite(tr), axis=1)
-                if ok.sum() > 2:
-                    tr = rotate_about_vertical(tr, yaw_alignment(tr[ok], ref[ok]))
-            curves.append((labels.get(r["key"], r["key"]), tr))
-        frame = "estimates yaw-aligned to the reference" if ref is not None else "estimates as computed"
+        curves, ref, footprints, frame = _curves(runs, labels)
         if len(curves) <= MAX_OVERLAID:
             fig, ax = plt.subplots(figsize=(6.5, 6), layout="constrained")
             if ref is not None:
                 ax.plot(ref[:, 1], ref[:, 0], **REFERENCE_STYLE, label="reference", zorder=5)
+            if footprints is not None:
+                ax.plot(footprints[:, 1], footprints[:, 0], **FOOTPRINT_STYLE, label="measured footprints", zorder=5)
             for label, tr in curves:
                 ax.plot(tr[:, 1], tr[:, 0], lw=1.2, label=label)
             ax.set_xlabel("east (m)")
             ax.set_ylabel("north (m)")
             ax.set_aspect("equal", adjustable="datalim")
             ax.set_title(f"{recording}: {frame}")
-            fig.legend(loc="outside lower center", ncol=2 if len(curves) > 3 else len(curves) + (ref is not None))
+            extra = (ref is not None) + (footprints is not None)
+            fig.legend(loc="outside lower center", ncol=2 if len(curves) > 3 else len(curves) + extra)
             return fig
         fig, axes = _grid(plt, len(curves))
-        mid, half = _common_frame([tr for _, tr in curves], ref)
+        marks = None if footprints is None else np.column_stack([footprints, np.zeros(len(footprints))])
+        mid, half = _common_frame([tr for _, tr in curves], ref if ref is not None else marks)
         for ax, (label, tr) in zip(axes, curves, strict=True):
             if ref is not None:
                 ax.plot(ref[:, 1], ref[:, 0], **REFERENCE_STYLE)
+            if footprints is not None:
+                ax.plot(footprints[:, 1], footprints[:, 0], **{**FOOTPRINT_STYLE, "ms": 4})
             ax.plot(tr[:, 1], tr[:, 0], lw=1.0, color="C0")
             ax.set_xlim(mid[1] - half, mid[1] + half)
             ax.set_ylim(mid[0] - half, mid[0] + half)

@@ -43,7 +43,7 @@ from ..core.errors import ConfigError, FootzooWarning, OutputError, user_stackle
 from ..core.files import sha256
 from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
-from ..evaluation.metrics import reference_steps, run_metrics
+from ..evaluation.metrics import estimated_footprints, reference_steps, rigid_transform_2d, run_metrics
 from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
 from ..plugins.contract import checked, no_statistic_note
 from ..plugins.extensions import load_plugins
@@ -198,6 +198,7 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
         out["trajectory"] = np.column_stack([rec.t, pos])[::step].round(4)
         if rec.truth is not None and rec.truth.pos is not None:  # reference path for the overlay plots
             out["reference"] = np.column_stack([rec.t, rec.truth.pos])[::step].round(4)
+        out.update(_on_footprints(rec, res, pos, step))
         if sweep_points:
             with warnings.catch_warnings(record=True) as swept:
                 warnings.simplefilter("always")
@@ -207,6 +208,21 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
         _fail(out, err)
     out["warnings"] = list(dict.fromkeys(f"{type(w.message).__name__}: {w.message}" for w in caught))[:5]
     return out
+
+
+def _on_footprints(rec, res, pos: np.ndarray, step: int) -> dict[str, np.ndarray]:
+    """For a recording with measured footprints (Köroğlu's ground control points): the footprints and the run's
+    trajectory in their frame (t, north, east, down), by the 2-D rigid transform of its estimated footprints onto
+    them that the footprint metric uses; nothing when the counts do not pair (the metric compares nothing then)."""
+    fp = None if rec.truth is None else rec.truth.footprints
+    if fp is None:
+        return {}
+    fp = np.asarray(fp, float)[:, :2]
+    est = estimated_footprints(res.steps)
+    if len(est) != len(fp) or len(fp) < 2:
+        return {"footprints": fp}
+    on = rigid_transform_2d(est, fp).apply(pos)
+    return {"footprints": fp, "trajectory_on_footprints": np.column_stack([rec.t, on, pos[:, 2]])[::step].round(4)}
 
 
 def _since(wall: float, cpu: float) -> tuple[float, float]:
