@@ -37,7 +37,8 @@ Limits
 * A stride whose own height error exceeds ``th_h`` (a fast run's can) starts a new level at the wrong
   height, as a real step would; the levels after it are held there.
 * The update observes the height only: the horizontal estimate changes only through the filter's
-  correlations (PyShoe's 2-D error: 0.1 mm at most, ``benchmarks/height_level.md``).
+  correlations (PyShoe's 2-D error per trial: 0.6 mm at most, the median and worst of the 36 within 0.2 mm;
+  ``benchmarks/height_level.md``).
 
 Result diagnostics ``height_level``: ``stances_on_level`` (stances that ended within ``th_h`` of the
 one before), ``level_changes`` (those that did not), and over the stances held the mean and the largest
