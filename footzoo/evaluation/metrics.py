@@ -423,8 +423,9 @@ def estimated_footprints(steps: pd.DataFrame) -> np.ndarray:
 def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, float]:
     """Error of every footprint (mid-stance position) against measured footprints, e.g. Köroğlu's GCPs.
 
-    The estimated footprints are :func:`estimated_footprints`. Compared only when the counts agree;
-    after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
+    The estimated footprints are :func:`estimated_footprints`. Compared only when the counts agree and
+    every footprint, measured and estimated, is finite (a footprint not measured, a run that diverged:
+    no alignment is defined); after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
     the mean and RMS distances (m) and the end-point distance are returned.
     """
     fp = np.asarray(footprints, float)
@@ -433,7 +434,7 @@ def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, f
         return out
     est = estimated_footprints(steps)
     out["footprints_est"] = float(len(est))
-    if len(est) != len(fp):
+    if len(est) != len(fp) or not (np.isfinite(fp).all() and np.isfinite(est).all()):
         return out
     aligned, _ = rigid_align_2d(est, fp)
     d = np.linalg.norm(aligned - fp, axis=1)

@@ -219,7 +219,7 @@ def _on_footprints(rec, res, pos: np.ndarray, step: int) -> dict[str, np.ndarray
         return {}
     fp = np.asarray(fp, float)[:, :2]
     est = estimated_footprints(res.steps)
-    if len(est) != len(fp) or len(fp) < 2:
+    if len(est) != len(fp) or len(fp) < 2 or not (np.isfinite(fp).all() and np.isfinite(est).all()):
         return {"footprints": fp}
     on = rigid_transform_2d(est, fp).apply(pos)
     return {"footprints": fp, "trajectory_on_footprints": np.column_stack([rec.t, on, pos[:, 2]])[::step].round(4)}

@@ -240,3 +240,13 @@ def test_a_list_of_recordings_is_keyed_by_the_foot_each_names():
         Session([unnamed, right])
     with pytest.raises(FormatError, match=r"got the keys \['l'\]: give Session\(\{'left'"):
         Session({"l": left})
+
+
+def test_footprint_errors_with_a_footprint_not_measured_or_a_run_that_diverged_compare_nothing():
+    """NaN in either set defines no alignment (the SVD would fail): the counts are kept, no error is given."""
+    steps = pd.DataFrame({"start_n_m": [0.0, 1.0], "start_e_m": [0.0, 0.0], "end_n_m": [1.0, 2.1],
+                          "end_e_m": [0.0, 0.0]})
+    e = footprint_errors(steps, np.array([[0.0, 0.0], [np.nan, 1.0], [0.0, 2.0]]))
+    assert e == {"footprints_ref": 3.0, "footprints_est": 3.0}
+    diverged = steps.assign(end_n_m=[1.0, np.inf])
+    assert "footprint_error_rms_m" not in footprint_errors(diverged, np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0]]))

@@ -53,6 +53,10 @@ def test_footprints_that_do_not_pair_move_nothing(walk):
     fewer = dataclasses.replace(rec, truth=dataclasses.replace(rec.truth, footprints=fp[:-2]))
     assert set(_on_footprints(fewer, res, res.pos, step=1)) == {"footprints"}
     assert _on_footprints(dataclasses.replace(rec, truth=None), res, res.pos, step=1) == {}
+    holed = fp.copy()
+    holed[3] = np.nan  # a footprint not measured: nothing to align on, and the run is not failed for it
+    holey = dataclasses.replace(rec, truth=dataclasses.replace(rec.truth, footprints=holed))
+    assert set(_on_footprints(holey, res, res.pos, step=1)) == {"footprints"}
 
 
 def test_the_study_figure_draws_the_footprints_and_says_what_it_left_out(walk):
