@@ -82,6 +82,7 @@ from select_recommended import (  # noqa: E402
     build,
     class_score,
     rate_check,
+    shipped_height,
 )
 
 from footzoo.studies import Study  # noqa: E402
@@ -111,8 +112,7 @@ HUANG: dict[str, dict[str, Any]] = {
     for th in (1.5e4, 3e4, 6e4) for md in (0.05, 0.1)
 }
 #: The shipped height correction(s) every candidate keeps after its stance updates (benchmarks/height_level.md).
-HEIGHT: list[dict[str, Any]] = [c for c in yaml.safe_load((ROOT / "configs" / "recommended.yaml").read_text())
-                                ["corrections"] if c["type"] == "height_level"]
+HEIGHT: list[dict[str, Any]] = shipped_height()
 #: The fixed baseline (the shipped setting) and the setting the refinements started from.
 BASELINE = "th 2000 vs 0.8 roll 0.2"
 START = "th 3000 vs 1 roll 0"

@@ -385,12 +385,22 @@ def refine_section(cands: list[dict[str, Any]], err: pd.DataFrame, err3: pd.Data
             ""]
 
 
+def shipped_height() -> list[dict[str, Any]]:
+    """The level-stance height correction(s) of the shipped ``configs/recommended.yaml`` (chosen apart, by
+    ``benchmarks/select_height.py``): every selection here keeps them after its stance updates."""
+    import yaml
+
+    shipped = yaml.safe_load((ROOT / "configs" / "recommended.yaml").read_text())
+    return [c for c in shipped["corrections"] if c["type"] == "height_level"]
+
+
 def write_config(cfg: dict[str, Any], cv: dict[str, Any]) -> None:
-    """``configs/recommended.yaml`` with the selection procedure in its header."""
+    """``configs/recommended.yaml`` with the selection procedure in its header (the shipped height update kept)."""
     import yaml
 
     cfg = copy.deepcopy(cfg)
     cfg["name"] = "recommended"
+    cfg["corrections"] += [h for h in shipped_height() if h not in cfg["corrections"]]
     header = [
         "# footzoo's recommended setting for foot-mounted IMUs (not a paper's): one fixed setting for walking,",
         "# running, slow unusual motion and any sensor mounting. Chosen by benchmarks/select_recommended.py:",

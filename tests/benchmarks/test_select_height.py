@@ -41,3 +41,11 @@ def test_no_worse_allows_the_resolution_not_more(sh):
     assert sh.no_worse(0.05001, 0.05, "min")  # 10 µm on a 5 cm RMS: 0.02 %
     assert not sh.no_worse(0.0501, 0.05, "min")
     assert sh.no_worse(56, 56, "max", count=True) and not sh.no_worse(55, 56, "max", count=True)
+
+
+def test_every_other_selection_keeps_the_shipped_height_update():
+    """select_recommended.py's and --nested's candidates (and so what their --write would ship) keep it."""
+    sr, sn = load_benchmark("select_recommended"), load_benchmark("select_nested")
+    shipped = yaml.safe_load(config_path("recommended").read_text())["corrections"]
+    assert sr.shipped_height() == [c for c in shipped if c["type"] == "height_level"] != []
+    assert all(c["corrections"][-1] == sr.shipped_height()[0] for c in sn.candidates())
