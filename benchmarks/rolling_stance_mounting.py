@@ -44,14 +44,13 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from accuracy import DEFAULT_DATA, motion_class  # noqa: E402
-from rolling_stance import RECOMMENDED, _load, over_pyshoe  # noqa: E402
+from rolling_stance import _load, over_pyshoe, stance_updates_only  # noqa: E402
 
 from footzoo.core.conventions import quat_from_euler, quat_to_euler, quat_to_matrix, skew  # noqa: E402
 from footzoo.evaluation.metrics import armse, loop_closure, pyshoe_error, stride_errors  # noqa: E402
@@ -72,8 +71,8 @@ SIM_PITCH = (0.0, -30.0, 30.0)
 
 
 def config(corrections: list[dict[str, Any]] | None) -> dict[str, Any]:
-    """``recommended.yaml``, its corrections replaced when given."""
-    cfg = yaml.safe_load(RECOMMENDED.read_text())
+    """``recommended.yaml``'s stance updates (without ``height_level``), its corrections replaced when given."""
+    cfg = stance_updates_only()
     if corrections is not None:
         cfg["corrections"] = copy.deepcopy(corrections)
     return cfg
