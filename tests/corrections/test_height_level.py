@@ -115,6 +115,25 @@ def test_a_staircase_keeps_its_steps(recommended):
     assert d["level_changes"] >= 2 * 6 - 1 and d["stances_on_level"] >= 2
 
 
+@pytest.mark.parametrize("rise", [0.06, 0.04])
+def test_low_stairs_are_kept_above_the_threshold_and_flattened_below_it(recommended, rise):
+    """The same stairs with 6 cm risers (12 cm per stride, above the 0.1 m threshold): the climb is kept; with 4 cm
+    risers (8 cm per stride, below it): flattened, as the docstring's limits say, and the stances held show it,
+    each landing about 8 cm off its level."""
+    st = simulate(path="stairs", n_strides=6, landing_strides=3, cycle=1.2, rate=100.0, profile="physical",
+                  clearance=0.1, noise=NoiseModel(seed=0), rise=rise)
+    up = -(st.truth.pos[:, 2] - st.truth.pos[0, 2])
+    top = int(np.argmax(up))
+    res = Pipeline.from_dict(recommended).run(st)
+    est = -(res.pos[:, 2] - res.pos[0, 2])
+    d = res.diagnostics["height_level"]
+    if 2 * rise > 0.1:
+        assert abs(est[top] - up[top]) < 0.01 and d["level_changes"] >= 11
+    else:
+        assert est[top] < up[top] / 2 and d["level_changes"] == 0
+        assert d["held_landing_max_m"] == pytest.approx(2 * rise, abs=0.025)
+
+
 @pytest.mark.parametrize("threshold", [0.0, -0.1, 2.0, float("nan")])
 def test_a_threshold_outside_its_range_is_refused_with_its_unit(threshold):
     with pytest.raises(ConfigError, match=r"threshold.*m"):
