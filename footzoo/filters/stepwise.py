@@ -117,8 +117,8 @@ MAX_SEGMENT = 3.0
 #: A stance that goes on closes a segment of :data:`MAX_SEGMENT` or more only once it has lasted this long (s):
 #: its first updates (the zero-velocity rows, a height row) correct the swing before it, and the backward pass
 #: carries those corrections into the swing only if they are in the swing's segment. Closed at the stance's first
-#: sample, a segment after a long swing (PyShoe 2017-11-27-11-12-44: 4 s of a foot the detector missed at rest)
-#: left the correction to the next segment, a stance with no path to spread it along: an 8 cm jump.
+#: sample, a segment after a long swing (PyShoe 2017-11-27-11-12-44: 4 s of fast steps in which the detector found no
+#: stance) left the correction to the next segment, a stance with no path to spread it along: an 8 cm jump.
 SETTLE = 0.2
 
 
