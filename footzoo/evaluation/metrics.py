@@ -420,22 +420,33 @@ def estimated_footprints(steps: pd.DataFrame) -> np.ndarray:
     return np.vstack([steps[["start_n_m", "start_e_m"]].to_numpy()[:1], steps[["end_n_m", "end_e_m"]].to_numpy()])
 
 
+def footprint_pairs(steps: pd.DataFrame, footprints: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The estimated footprints (:func:`estimated_footprints`) and the measured ones (K, 2; m) when they can be
+    compared: as many of each, at least two (a rigid alignment needs them) and all finite (a footprint not
+    measured, a run that diverged: no alignment is defined); None otherwise."""
+    fp = np.asarray(footprints, float)[:, :2]
+    est = estimated_footprints(steps)
+    if len(est) != len(fp) or len(fp) < 2 or not (np.isfinite(fp).all() and np.isfinite(est).all()):
+        return None
+    return est, fp
+
+
 def footprint_errors(steps: pd.DataFrame, footprints: np.ndarray) -> dict[str, float]:
     """Error of every footprint (mid-stance position) against measured footprints, e.g. Köroğlu's GCPs.
 
-    The estimated footprints are :func:`estimated_footprints`. Compared only when the counts agree and
-    every footprint, measured and estimated, is finite (a footprint not measured, a run that diverged:
-    no alignment is defined); after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
+    The estimated footprints are :func:`estimated_footprints`. Compared only when :func:`footprint_pairs`
+    pairs them; after a 2-D rigid alignment (reflection allowed, see :func:`rigid_align_2d`)
     the mean and RMS distances (m) and the end-point distance are returned.
     """
     fp = np.asarray(footprints, float)
     out: dict[str, float] = {"footprints_ref": float(len(fp))}
     if len(steps) == 0:
         return out
-    est = estimated_footprints(steps)
-    out["footprints_est"] = float(len(est))
-    if len(est) != len(fp) or not (np.isfinite(fp).all() and np.isfinite(est).all()):
+    out["footprints_est"] = float(len(estimated_footprints(steps)))
+    pairs = footprint_pairs(steps, fp)
+    if pairs is None:
         return out
+    est, fp = pairs
     aligned, _ = rigid_align_2d(est, fp)
     d = np.linalg.norm(aligned - fp, axis=1)
     out.update(footprint_error_mean_m=float(d.mean()), footprint_error_rms_m=float(np.sqrt(np.mean(d**2))),

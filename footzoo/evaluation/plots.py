@@ -24,7 +24,7 @@ from ..core.atomic import OutputError, atomic_path
 from ..core.conventions import quat_to_euler
 from ..core.data import Recording
 from ..core.errors import ConfigError, RecordingError
-from .metrics import estimated_footprints, match_strides, rigid_align_2d, rotate_about_vertical, yaw_alignment
+from .metrics import footprint_pairs, match_strides, rigid_align_2d, rotate_about_vertical, yaw_alignment
 from .result import Result
 
 P = ParamSpec("P")
@@ -36,6 +36,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Colour of the reference (truth) in every figure.
 REFERENCE_STYLE: dict[str, Any] = {"color": "k", "ls": "--", "lw": 1.0}
+#: How measured footprints (Köroğlu's ground control points) are drawn: black crosses.
+FOOTPRINT_STYLE: dict[str, Any] = {"marker": "x", "ls": "none", "color": REFERENCE_STYLE["color"], "ms": 6, "mew": 1.2}
 #: Shade of stance periods.
 STANCE_COLOR = "0.88"
 #: Smallest span of the FPA axis (deg).
@@ -168,15 +170,16 @@ def aligned_footprints(result: Result, recording: Recording | None) -> np.ndarra
     Measured footprints (Köroğlu's ground control points) are in the dataset's own axes: they are aligned
     onto the estimated footprints (:func:`~footzoo.evaluation.metrics.estimated_footprints`) by the 2-D
     rigid alignment that the footprint metric uses the other way round (reflection allowed). None also when
-    the counts differ: the metric compares nothing then either (its ``footprints_est`` says how many).
+    :func:`~footzoo.evaluation.metrics.footprint_pairs` does not pair them: the metric compares nothing then
+    either (its ``footprints_est`` says how many).
     """
     check_pair(result, recording)
     if recording is None or recording.truth is None or recording.truth.footprints is None:
         return None
-    fp = np.asarray(recording.truth.footprints, dtype=float)
-    est = estimated_footprints(result.steps)
-    if len(est) != len(fp) or len(fp) < 2:
+    pairs = footprint_pairs(result.steps, recording.truth.footprints)
+    if pairs is None:
         return None
+    est, fp = pairs
     return rigid_align_2d(fp, est)[0]
 
 
@@ -358,8 +361,7 @@ def trajectory_figure(result: Result, recording: Recording | None = None) -> Fig
     top.plot(pos[::s, 1], pos[::s, 0], color="C0", lw=1.3, label="estimate")
     footprints = aligned_footprints(result, recording)
     if footprints is not None:
-        top.plot(footprints[:, 1], footprints[:, 0], "x", color=REFERENCE_STYLE["color"], ms=6, mew=1.2,
-                 label="measured footprints (aligned)")
+        top.plot(footprints[:, 1], footprints[:, 0], **FOOTPRINT_STYLE, label="measured footprints (aligned)")
     ends = _stride_ends(result)
     if ends is not None:
         number, _, p = ends

@@ -21,7 +21,7 @@ import pandas as pd
 
 from ..core.errors import FootzooWarning, user_stacklevel
 from ..evaluation.metrics import rotate_about_vertical, yaw_alignment
-from ..evaluation.plots import REFERENCE_STYLE, png_bytes, pyplot, save, styled
+from ..evaluation.plots import FOOTPRINT_STYLE, REFERENCE_STYLE, png_bytes, pyplot, save, styled
 from .cache import HEAVY, with_heavy
 
 
@@ -532,8 +532,6 @@ MAX_OVERLAID = 8
 
 #: The run-record fields a trajectories figure reads back from the cache.
 TRAJECTORY_FIELDS = ("trajectory", "reference", "footprints", "trajectory_on_footprints")
-#: How measured footprints are drawn (Köroğlu's ground control points): the single-run figure's crosses.
-FOOTPRINT_STYLE = {"marker": "x", "ls": "none", "color": REFERENCE_STYLE["color"], "ms": 6, "mew": 1.2}
 
 
 def _curves(runs: list[dict[str, Any]], labels: dict[str, str]

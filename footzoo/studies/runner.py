@@ -43,7 +43,7 @@ from ..core.errors import ConfigError, FootzooWarning, OutputError, user_stackle
 from ..core.files import sha256
 from ..core.usage import used_from
 from ..core.warninglog import LOG, WarningLog, log_text
-from ..evaluation.metrics import estimated_footprints, reference_steps, rigid_transform_2d, run_metrics
+from ..evaluation.metrics import footprint_pairs, reference_steps, rigid_transform_2d, run_metrics
 from ..evaluation.validity import MetricWarning, checked_metrics, estimate_problems, missing_reason, reference_problems
 from ..plugins.contract import checked, no_statistic_note
 from ..plugins.extensions import load_plugins
@@ -218,10 +218,10 @@ def _on_footprints(rec, res, pos: np.ndarray, step: int) -> dict[str, np.ndarray
     if fp is None:
         return {}
     fp = np.asarray(fp, float)[:, :2]
-    est = estimated_footprints(res.steps)
-    if len(est) != len(fp) or len(fp) < 2 or not (np.isfinite(fp).all() and np.isfinite(est).all()):
+    pairs = footprint_pairs(res.steps, fp)
+    if pairs is None:
         return {"footprints": fp}
-    on = rigid_transform_2d(est, fp).apply(pos)
+    on = rigid_transform_2d(*pairs).apply(pos)
     return {"footprints": fp, "trajectory_on_footprints": np.column_stack([rec.t, on, pos[:, 2]])[::step].round(4)}
 
 

@@ -513,3 +513,8 @@ def test_measured_footprints_are_drawn_aligned_onto_the_estimated_ones(walk):
     fewer = dataclasses.replace(rec, truth=dataclasses.replace(rec.truth, footprints=measured[:-1]))
     assert aligned_footprints(res, fewer) is None
     assert aligned_footprints(res, rec) is None  # no measured footprints
+    holed = measured.copy()
+    holed[2] = np.nan  # a footprint not measured: no alignment (it failed in the SVD before), the figure still drawn
+    holey = dataclasses.replace(rec, truth=dataclasses.replace(rec.truth, footprints=holed))
+    assert aligned_footprints(res, holey) is None
+    close(trajectory_figure(res, holey))
