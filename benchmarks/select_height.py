@@ -45,10 +45,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from accuracy import DEFAULT_DATA, motion_class, recordings, run_cached, run_dataset  # noqa: E402
+from accuracy import DEFAULT_DATA, motion_class, run_cached  # noqa: E402
 from height_drift import sim_case  # noqa: E402
 from nested_cv import held_out_of, improves, nested_choice, stratified_folds  # noqa: E402
-from select_nested import CHECKS, FOLDS, SEED, other_references  # noqa: E402
+from select_nested import CHECKS, FOLDS, SEED, XIO_3D, other_references  # noqa: E402
 from select_recommended import score  # noqa: E402
 
 from footzoo.studies import Study  # noqa: E402
@@ -106,27 +106,6 @@ def pyshoe(cands: list[dict[str, Any]], data: Path, results: Path, jobs: int) ->
                  for m in ("pyshoe_error_m", "armse_3d_m"))
 
 
-def closures(cands: list[dict[str, Any]], data: Path, results: Path, jobs: int) -> pd.DataFrame:
-    """x-io's closed walk: horizontal and 3-D end-to-start distance (m) per candidate."""
-    recs = recordings(data, quick=False, sim={})
-    if "xio" not in recs:
-        return pd.DataFrame(index=[c["name"] for c in cands])
-    folder = results / "configs"
-    folder.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for c in cands:
-        p = folder / f"{c['name'].replace(' ', '_')}.yaml"
-        p.write_text(yaml.safe_dump(c, sort_keys=False))
-        paths.append(p)
-    t = run_dataset("xio", recs["xio"], paths, results / "xio", jobs, False)
-    by = {p.stem: c["name"] for p, c in zip(paths, cands, strict=True)}
-    t = t[t["metric"].isin(["loop_closure_xy_m", "loop_closure_3d_m"])]
-    out = t.pivot_table(index="config", columns="metric", values="value", aggfunc="first")
-    out.index = [by[i] for i in out.index]
-    return out.rename(columns={"loop_closure_xy_m": "x-io horizontal closure (m)",
-                               "loop_closure_3d_m": "x-io 3-D closure (m)"}).reindex([c["name"] for c in cands])
-
-
 def simulated(cands: list[dict[str, Any]], data: Path, jobs: int) -> pd.DataFrame:
     """The simulated track (one 437.5 m lap) and stairs at each rate of :data:`SIM_RATES`, per candidate."""
     from joblib import Parallel, delayed
@@ -157,7 +136,6 @@ def run(args: argparse.Namespace) -> list[str]:
         chosen, held3 = nested_choice(err3, classes, folds, pick)
         runs[who] = (chosen, held_out_of(chosen, folds, err2), held3, pick(err3, classes))
     other = other_references(cands, args.data, args.results, args.jobs)
-    other = other.join(closures(cands, args.data, args.results, args.jobs))
     sim = simulated(cands, args.data, args.jobs)
     return report(err2, err3, classes, folds, runs, other, sim, names)
 
@@ -188,7 +166,7 @@ def _fold_rows(err2: pd.DataFrame, err3: pd.DataFrame, folds: pd.Series,
 
 def references(other: pd.DataFrame, sim: pd.DataFrame, name: str) -> pd.DataFrame:
     """Every other reference: ``name``'s value, the baseline's and whether it is no worse (:func:`no_worse`)."""
-    checks = {**CHECKS, "x-io 3-D closure (m)": "min"}
+    checks = {**CHECKS, XIO_3D: "min"}
     rows = []
     for col, direction in checks.items():
         if col not in other.columns:

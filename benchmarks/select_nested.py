@@ -131,6 +131,13 @@ CHECKS = {
 }
 
 
+#: x-io's 3-D end-to-start distance (m): reported with the other references, not one of :data:`CHECKS` here (a height
+#: update's selection, ``benchmarks/select_height.py``, checks it).
+XIO_3D = "x-io 3-D closure (m)"
+#: What a cached row of :func:`other_references` holds (part of its cache key: a row of fewer columns is not reused).
+OTHER_COLUMNS = "checks + x-io 3-D"
+
+
 def name_of(th: float, vs: float, roll: float) -> str:
     """A zero-velocity candidate's name."""
     return f"th {th:g} vs {vs:g} roll {roll:g}"
@@ -186,7 +193,7 @@ def other_references(cands: list[dict[str, Any]], data: Path, folder: Path, jobs
     for c in cands:
         path = cfg_dir / f"{slug(c['name'])}.yaml"
         path.write_text(yaml.safe_dump(json.loads(json.dumps(c)), sort_keys=False))
-        key = hashlib.sha256((json.dumps(c, sort_keys=True) + code).encode()).hexdigest()[:24]
+        key = hashlib.sha256((json.dumps(c, sort_keys=True) + code + OTHER_COLUMNS).encode()).hexdigest()[:24]
         entry = cache / f"{key}.json"
         if entry.exists():
             rows[c["name"]] = json.loads(entry.read_text())
@@ -212,8 +219,9 @@ def _other_rows(paths: dict[str, Path], data: Path, folder: Path, jobs: int) -> 
     out: dict[str, dict[str, Any]] = {n: {} for n in paths}
     if "xio" in recs:
         t = run_dataset("xio", recs["xio"], configs, folder / "xio", jobs, False)
-        for _, r in t[t["metric"] == "loop_closure_xy_m"].iterrows():
-            out[by_stem[r["config"]]]["x-io loop closure (m)"] = float(r["value"])
+        for metric, column in (("loop_closure_xy_m", "x-io loop closure (m)"), ("loop_closure_3d_m", XIO_3D)):
+            for _, r in t[t["metric"] == metric].iterrows():
+                out[by_stem[r["config"]]][column] = float(r["value"])
     strides = run_stride_references({k: v for k, v in recs.items() if k.startswith(("gaitmap", "koroglu"))},
                                     configs, jobs)
     for n in paths:
