@@ -180,9 +180,15 @@ def mounting_report(quat: np.ndarray, gyr: np.ndarray, pos: np.ndarray, stances:
     return out
 
 
-def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | None = None) -> None:
+def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | None = None,
+                  axis_fault: str | None = None) -> None:
     """A :class:`SensorWarning` when the report finds the foot walking backwards, across the sensor's x axis, or
     its pitch reversed.
+
+    ``axis_fault``: the gyroscope axis fault the gyroscope–accelerometer scan named
+    (:class:`footzoo.filters.consistency.ConsistencyScan`, e.g. ``"gyr_y has the wrong sign"``), if any. Such an
+    axis turns the attitude the mounting is measured from, so no axis map is named then: the report
+    records why under ``withheld`` and the scan's own warning gives the fix.
 
     ``axes`` is the axis map the recording was read with (``Recording.meta["axes"]``): the fix is the
     map to read the file with instead, spelled as the ``axes`` option every reader takes
@@ -200,6 +206,10 @@ def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | N
         symptoms.append(f"the sensor's y axis points left (y · right = {report['y_right']:+.2f}): gyr_y is negative "
                         "when the toe lifts, so heel strike and toe-off swap places for a method reading gyr_y")
     if not symptoms:
+        return
+    if axis_fault:
+        report["withheld"] = (f"{'; '.join(symptoms)}: not warned, because {axis_fault} (see "
+                              "diagnostics['sensor']['consistency']), which turns the attitude this is measured from")
         return
     where = f"recording {name!r}: " if name else ""
     suggested = report.get("suggested_axes")

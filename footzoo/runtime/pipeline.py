@@ -351,14 +351,15 @@ class Pipeline:
         axes.push_recording(rec.t, rec.acc, rec.gyr)
         scan.use_evidence(axes)  # the gait's plausibility weighs the gyroscope-accelerometer evidence of the rate
         sensor = {**rec.meta.get("sanity", {}), **scan.finish()}
-        if axes.finish():
-            sensor["consistency"] = axes.report
+        fault = axes.finish()  # a gyroscope axis of the wrong sign turns the attitude the mounting is measured from
+        if fault:
+            sensor["consistency"] = fault
         calibration = reports.pop("calibration", None)
         diagnostics = {**reports, "sensor": sensor}  # a missing detector statistic is NaN, with a note
         if calibration is not None:
             diagnostics["calibration"] = calibration
         diagnostics["mounting"] = mounting_report(quat, rec.gyr, pos, stances, sagittal)
-        warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"))
+        warn_mounting(diagnostics["mounting"], rec.name, rec.meta.get("axes"), fault.get("cause"))
         config = self.to_dict()
         config["engine"] = engine
         samples = samples_frame(rec.t, quat, pos, out["vel"], out["acc_nav"], stance)
