@@ -203,6 +203,10 @@ def read(path: Path, sidecar: str | Path | None = None, axes: Any = None, acc_un
         of a file whose description declares another one.
     """
     side = Path(sidecar) if sidecar is not None else sidecar_of(path)
+    if sidecar is not None and not side.is_file():
+        what = "is a folder" if side.is_dir() else "does not exist"
+        raise FormatError(f"{path}: its description sidecar={side} {what}; pass the path of a description file "
+                          f"({FORMAT_DOCS})")
     if not side.exists():
         raise FormatError(f"{path}: no description {side.name} next to it; write one ({FORMAT_DOCS}"
                           f"{_first_line_hint(path)}) or pass sidecar= (the path of a description shared by several "

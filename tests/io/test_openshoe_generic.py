@@ -291,3 +291,8 @@ def test_a_file_without_its_description_is_told_what_to_describe(walk, tmp_path)
     with pytest.raises(FormatError, match=r"no description walk.csv.footzoo.yaml next to it.*the file begins "
                                           r"'ax_g,ay_g,az_g,gx,gy,gz': name its columns under time"):
         load(p, format="generic")
+    # a description passed by path that is not there is named as such, not as one missing next to the file
+    for side, what in ((tmp_path / "nowhere" / "lab.yaml", "does not exist"), (tmp_path, "is a folder")):
+        with pytest.raises(FormatError, match=rf"walk.csv: its description sidecar=.*{what}; pass the path of a "
+                                              "description file"):
+            load(p, sidecar=side)
