@@ -667,7 +667,7 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     """Run a study: every config × recording cell, in parallel, cached, with tables and plots."""
     # deferred: pandas, scipy and the study runner: the command line starts without them
     from ..studies import run_study
-    from ..studies.report import compared, readable, summarise, to_markdown
+    from ..studies.report import compared, crossed, readable, summarise, to_markdown
 
     out = Path(args.out or f"ablation_{Path(args.study).stem}")  # printed as 'results in study/', not 'study//'
     prune = {"max_age_days": 0.0 if args.prune_cache else args.cache_max_age,
@@ -694,11 +694,16 @@ def cmd_ablate(args: argparse.Namespace) -> int:
         return _failed_exit_code(a["causes"])
     factors = [c for c in table.columns
                if c not in ("run", "base", "recording", "metric", "value", "error", "note")]
-    for f in compared(table, factors)[:3]:
+    shown = compared(table, factors)
+    for f in shown[:3]:
         s = readable(summarise(table, f), f)
         keep = s[s["metric"].isin(args.show)] if args.show else s
         print(f"\n{f}:")
         print(to_markdown(keep), end="")
+    if len(shown) == 2:  # two factors: the median of each pair of levels too (summary.md has every pair)
+        s = crossed(table, *shown)
+        print(f"\n{shown[0]} × {shown[1]} (median):")
+        print(to_markdown(s[s["metric"].isin(args.show)] if args.show else s), end="")
     return 0
 
 

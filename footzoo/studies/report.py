@@ -101,6 +101,24 @@ def readable(summary: pd.DataFrame, factor: str) -> pd.DataFrame:
     return out
 
 
+def crossed(table: pd.DataFrame, rows: str, columns: str) -> pd.DataFrame:
+    """The median of every metric over the runs of each pair of levels of two factors: one row per metric and level
+    of ``rows``, one column per level of ``columns``.
+
+    The median over the recordings and seeds of a cell, as :func:`summarise`'s; a cell whose runs all lack a
+    value (refused, or failed) is NaN. Levels are labelled as :func:`readable` labels them.
+    """
+    ok = table[table["metric"].notna()]
+    wide = ok.pivot_table(index=["metric", rows], columns=columns, values="value", aggfunc="median", dropna=False)
+    wide = wide.reindex(columns=list(dict.fromkeys(ok[columns].tolist())))
+    names = {f: level_labels(f, list(dict.fromkeys(ok[f].tolist()))) for f in (rows, columns)}
+    leaf = {f: f.split(".")[-1] + "=" for f in (rows, columns)}
+    wide.columns = [names[columns][str(c)].removeprefix(leaf[columns]) for c in wide.columns]
+    out = wide.reset_index()
+    out[rows] = [names[rows][str(v)].removeprefix(leaf[rows]) for v in out[rows]]
+    return out.rename(columns={rows: f"{rows} \\ {columns}"})
+
+
 def to_markdown(df: pd.DataFrame, digits: int = 4) -> str:
     """A GitHub-style Markdown table."""
     cols = [str(c) for c in df.columns]
@@ -306,6 +324,10 @@ def _write_tables(table: pd.DataFrame, runs: list[dict[str, Any]], factors: list
         s = readable(summarise(table, f), f)
         md.append(f"## {f}\n\n" + to_markdown(s))
         tex.append(f"% {f}\n" + to_latex(s))
+    for a, b in itertools.combinations(compared(table, factors), 2):  # two factors: the median of each pair of levels
+        s = crossed(table, a, b)
+        md.append(f"## {a} × {b} (median)\n\n" + to_markdown(s))
+        tex.append(f"% {a} x {b} (median)\n" + to_latex(s))
     errors = table[table["error"].notna()][["run", "recording", "error"]].drop_duplicates()
     if len(errors):
         md.append("## failed runs\n\n" + to_markdown(errors))

@@ -110,6 +110,16 @@ def test_dictionary_levels_are_labelled_readably_in_the_summary(tmp_path):
     assert '{"' not in section  # no raw JSON for a reader
 
 
+def test_a_study_of_two_factors_summarises_each_pair_of_their_levels(tmp_path):
+    spec = {**STUDY, "factors": {**STUDY["factors"], "detector.type": ["angular_rate_fsm", "shoe"]},
+            "metrics": ["armse_3d_m"]}
+    table = run_study(Study.from_dict(spec), out=tmp_path)
+    section = (tmp_path / "summary.md").read_text().split("## orientation.static_gain × detector.type (median)")[1]
+    row = next(x for x in section.splitlines() if x.startswith("| armse_3d_m | 0.5 |"))
+    cell = table[(table["orientation.static_gain"] == 0.5) & (table["detector.type"] == "shoe")]["value"].median()
+    assert row.split("|")[4].strip() == f"{cell:.4g}"  # the shoe column's median, as to_markdown writes it
+
+
 def test_a_metric_no_run_could_compute_is_kept_in_the_table_but_not_drawn(tmp_path):
     """A simulated walk without a reference has no stance mask: ``stance_f1`` is NaN with its reason, no empty plot."""
     import numpy as np

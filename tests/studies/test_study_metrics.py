@@ -256,6 +256,24 @@ def test_the_summary_says_why_a_metric_has_no_value():
     assert unexplained.loc[("b", "armse_3d_m"), "reason"] == "no reason recorded"
 
 
+def test_two_factors_are_crossed_as_the_median_of_each_pair_of_levels():
+    """``crossed``: one row per metric and level of the first factor, one column per level of the second, the
+    median over the cell's recordings; a cell without a value is NaN; plug-in specs labelled as in the summaries."""
+    from footzoo.studies.report import crossed
+
+    shoe, fsm = '{"type": "shoe"}', '{"type": "angular_rate_fsm", "threshold": 0.6}'
+    table = pd.DataFrame({
+        "run": range(8), "recording": ["x", "y"] * 4, "metric": "armse_3d_m", "error": None, "note": None,
+        "orientation.static_gain": [0.5, 0.5, 0.5, 0.5, 1.05, 1.05, 1.05, 1.05],
+        "detector": [shoe, shoe, fsm, fsm] * 2, "value": [1.0, 3.0, 5.0, 6.0, 2.0, 2.0, np.nan, np.nan]})
+    c = crossed(table, "orientation.static_gain", "detector")
+    assert list(c.columns) == ["metric", "orientation.static_gain \\ detector", "shoe",
+                               "angular_rate_fsm (threshold=0.6)"]
+    assert c["shoe"].tolist() == [2.0, 2.0] and c["angular_rate_fsm (threshold=0.6)"].iloc[0] == 5.5
+    assert np.isnan(c["angular_rate_fsm (threshold=0.6)"].iloc[1])  # both runs refused: no value, not a zero
+    assert c["orientation.static_gain \\ detector"].tolist() == ["0.5", "1.05"]
+
+
 def test_reasons_alike_but_for_their_numbers_are_given_once_with_their_count():
     """Nine PyShoe trials' fragmented stance references: one reason and how many more, not nine sentences."""
     from footzoo.studies.report import summarise
