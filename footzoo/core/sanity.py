@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -342,6 +343,9 @@ STILL_MAX_DRIFT = 0.25
 #: Share of a drifting still period's samples taken for stance above which the drift is the correction's, not the
 #: detector's.
 STILL_STANCE_SHARE = 0.9
+#: Below this distance (m) a run without any stance did not move: a velocity correction held it (a dedrift of a
+#: swing that never ended), rather than drifting.
+NO_STANCE_STILL_M = 0.05
 #: Shortest motion after the still start (s) for which "no stance at all" is reported.
 NO_STANCE_MIN_DURATION = 5.0
 #: Share of the samples after the still start taken for stance from which, with the accelerometer showing
@@ -613,8 +617,13 @@ class EstimateScan:
     fix) as soon as they are known, and kept in :attr:`report`.
     """
 
-    def __init__(self, t_start: float, gravity: float = GRAVITY, name: str = "recording", detector: str = "detector"):
+    def __init__(self, t_start: float, gravity: float = GRAVITY, name: str = "recording", detector: str = "detector",
+                 corrections: Sequence[tuple[str, float | None]] | None = None):
+        """``corrections``: the pipeline's corrections as ``(name, hold_after)``, ``hold_after`` the stillness hold's
+        duration (s) where the correction has one (:mod:`footzoo.corrections.stillness`), else None; they word the
+        fix of a drift while still that the detector did mark. None: not known."""
         self.t_start, self.gravity, self.name, self.detector = t_start, gravity, name, detector
+        self.corrections = None if corrections is None else list(corrections)
         self.report: dict[str, Any] = {}
         self._stance = 0
         self._after = 0  # samples after the still start
@@ -744,9 +753,7 @@ class EstimateScan:
                    "duration_s": duration, "drift_m": run["drift"], "stance_share": share}
         self.report.setdefault("still_drift", []).append(finding)
         if share >= STILL_STANCE_SHARE:
-            why = (f"the detector {self.detector!r} takes {share:.0%} of these samples for stance, yet the velocity "
-                   "correction does not hold the standing foot. With zupt or ekf_zupt keep hold_after > 0 (the "
-                   "stillness hold, footzoo.corrections.stillness)")
+            why = f"the detector {self.detector!r} takes {share:.0%} of these samples for stance, yet " + self._held()
         else:
             why = (f"the detector {self.detector!r} misses this stillness ({share:.0%} of these samples are stance), "
                    "so the velocity drifts. Raise its threshold, choose another detector, or keep the stance guard "
@@ -773,6 +780,24 @@ class EstimateScan:
         if self.gait.report:
             self.report["plausibility"] = self.gait.report
 
+    def _held(self) -> str:
+        """Why a foot the detector marked as standing still moved, and the fix, from the corrections."""
+        hold = "the stillness hold (hold_after > 0 s, footzoo.corrections.stillness)"
+        if self.corrections == []:
+            return ("no velocity correction uses the stances, so nothing stops the velocity's drift: add one "
+                    f"(corrections: e.g. zupt, which also has {hold})")
+        if self.corrections is None:
+            return f"the velocity correction does not hold the standing foot: use a correction with {hold}"
+        off = [n for n, h in self.corrections if h is not None and h <= 0]
+        names = ", ".join(n for n, _ in self.corrections)
+        if off:
+            return f"{names} does not hold the standing foot: its stillness hold is off; set hold_after > 0 on {off[0]}"
+        on = [(n, h) for n, h in self.corrections if h is not None]
+        if on:
+            return (f"{names} does not hold the standing foot, though its stillness hold is on (hold_after = "
+                    f"{on[0][1]:g} s on {on[0][0]}): compare hold_std with this drift (footzoo.corrections.stillness)")
+        return f"{names} does not hold the standing foot: add or use a correction with {hold}"
+
     def finish(self) -> dict[str, Any]:
         """End of the data: the still run open at the end, no stance at all, the gait's plausibility; the findings."""
         if self._run is not None:
@@ -786,11 +811,14 @@ class EstimateScan:
             if duration > NO_STANCE_MIN_DURATION:
                 moved = float(np.linalg.norm(self._last[1] - self._first[1]))
                 self.report["no_stance"] = {"t0": self._first[0], "t1": self._last[0], "distance_m": moved}
+                track = (f"so the track ({moved:.1f} m from there to the end) is pure drift"
+                         if moved >= NO_STANCE_STILL_M else
+                         f"so the track stays where it was ({moved:.2f} m from there to the end): the velocity "
+                         "correction had no stance to end a swing with, and the foot's motion is lost")
                 warnings.warn(
                     f"{self.name}: no stance from t = {self._first[0]:.2f} s to the end ({duration:.1f} s): the "
                     f"detector {self.detector!r} never fired after the still start and the velocity was never "
-                    f"reset, so the track ({moved:.1f} m from there to the end) is pure drift (or, with a dedrift, "
-                    "never corrected). Choose a detector made "
+                    f"reset, {track}. Choose a detector made "
                     "for this motion or tune its threshold, and keep the stance guard on (guards.max_swing). Details "
                     "in diagnostics['sensor']",
                     SensorWarning, stacklevel=user_stacklevel(),

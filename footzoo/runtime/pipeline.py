@@ -344,7 +344,8 @@ class Pipeline:
         sagittal = sagittal_rate(quat, rec.gyr, pos, stances) if len(stances) >= 2 else None
         steps = self.analyse(rec, stance, quat, pos, stances, sagittal)
         reports["guards"].update(check_speed(rec.t, out["vel"], self.guards.max_speed, rec.name))
-        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, self.detector.name)
+        scan = EstimateScan(ctx.t0 + self.init["duration"], self.gravity, rec.name, self.detector.name,
+                            self.correction_holds())
         scan.dropouts(rec.meta.get("sanity", {}).get("frozen", []))  # a frozen channel explains what follows it
         scan.push(out["k"], rec.t, rec.acc, rec.gyr, stance, pos)
         axes = ConsistencyScan(ctx.rate, self.gravity, rec.name)
@@ -368,6 +369,11 @@ class Pipeline:
                 samples[f"pos_std_{axis}"] = diagnostics["pos_std"][:, j]
         return Result(samples=samples, steps=steps, config=config, versions=versions(),
                       recording=dict(rec.meta), diagnostics=diagnostics, reference=rec.truth)
+
+    def correction_holds(self) -> list[tuple[str, float | None]]:
+        """Each correction's name and its stillness hold's ``hold_after`` (s; None: it has none), for the checks
+        that word why a standing foot moved (:class:`footzoo.core.sanity.EstimateScan`)."""
+        return [(c.name, float(c.hold_after) if "hold_after" in c.param_names() else None) for c in self.corrections]
 
     def context(self, rec: Recording) -> RunContext:
         """The run context of a batch run over ``rec``: its median rate, this pipeline's gravity, its start."""

@@ -437,7 +437,8 @@ class Stream:
                           "uses the whole recording's median rate): pass rate= the sensor's nominal rate",
                           FootzooWarning, stacklevel=user_stacklevel())
         self.ctx = RunContext(rate=rate, gravity=pipe.gravity, t0=float(t[0]), name="stream")
-        self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name)
+        self._estimates = EstimateScan(self.ctx.t0 + duration, pipe.gravity, "stream", pipe.detector.name,
+                                       pipe.correction_holds())
         self._axes = ConsistencyScan(rate, pipe.gravity, "stream")
         self._estimates.use_evidence(self._axes)  # the gait's plausibility weighs the evidence of the rate
 

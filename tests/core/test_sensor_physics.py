@@ -206,6 +206,16 @@ def test_a_detector_that_never_fires_with_the_guard_off_is_reported(walk):
     assert "no_stance" in res.diagnostics["sensor"]
     assert res.diagnostics["sensor"]["no_stance"]["distance_m"] > 1.0  # the drift it warns about
     assert any("no stance from t =" in m and "'test_stance_until' never fired" in m for m in found)
+    assert any("is pure drift" in m for m in found)
+
+
+def test_a_detector_that_never_fires_under_a_dedrift_says_the_track_stood_still(walk):
+    """A dedrift whose swing never ends holds the track where the still start left it: not 'pure drift' of 0.0 m."""
+    config = {**BASE, "detector": {"type": "test_stance_until", "until": 0.0}, "guards": {"max_swing": 0}}
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(config).run(walk))
+    assert res.diagnostics["sensor"]["no_stance"]["distance_m"] < 0.05
+    message = next(m for m in found if "no stance from t =" in m)
+    assert "the track stays where it was" in message and "pure drift" not in message
 
 
 def test_a_detector_that_takes_every_sample_for_stance_is_reported_batch_and_live(walk):
@@ -310,7 +320,13 @@ def test_drift_of_a_foot_the_detector_takes_for_stance_is_blamed_on_the_correcti
     res, found = _sensor_warnings(lambda: Pipeline.from_dict(unheld).run(rec))
     (drift,) = res.diagnostics["sensor"]["still_drift"]
     assert drift["stance_share"] == 1.0 and drift["drift_m"] > 0.5
-    assert any("takes 100% of these samples for stance" in m and "hold_after" in m for m in found)
+    assert any("takes 100% of these samples for stance" in m and "its stillness hold is off; set hold_after > 0 on "
+               "zupt" in m for m in found)
+    bare, found = _sensor_warnings(lambda: Pipeline.from_dict({**config, "corrections": []}).run(rec))
+    assert bare.diagnostics["sensor"]["still_drift"][0]["stance_share"] == 1.0
+    # nothing to tune on a correction that is not there: the warning says to add one
+    assert any("no velocity correction uses the stances" in m and "add one" in m for m in found)
+    assert not any("hold_after > 0 on" in m for m in found)
     held, found = _sensor_warnings(lambda: Pipeline.from_dict({**config, "corrections": [{"type": "zupt"}]}).run(rec))
     assert "still_drift" not in held.diagnostics.get("sensor", {}) and not found
     assert np.abs(held.pos).max() < 0.01
