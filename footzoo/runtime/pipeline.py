@@ -270,8 +270,8 @@ class Pipeline:
                 continue
             elif not block.incremental():
                 reasons.append(f"{block.kind} {block.name!r} does not implement the incremental protocol "
-                               "(begin/step/finish): it runs on whole recordings only (see the plug-in guide, "
-                               "'Running live')")
+                               "(begin/step/finish): it runs on whole recordings only (to run it live, write them: "
+                               "docs/plugins.md, 'Example 3: a detector that runs live')")
         if fits is not None and len(fits) != len(self.calibration):
             reasons.append(f"fits: {len(fits)} calibration fit(s) for {len(self.calibration)} calibration(s)")
         if self.smoother == "rts":
