@@ -323,7 +323,7 @@ class Study:
         if "base" not in d or "recordings" not in d:
             raise ConfigError("a study needs 'base' (config path(s)) and 'recordings'")
         plugins = resolve_specs(d.get("plugins"), root, "plugins")
-        bases = []
+        bases, unnamed = [], []
         for b in d["base"] if isinstance(d["base"], list) else [d["base"]]:
             if isinstance(b, str):
                 path = _resolve(root, b)
@@ -332,12 +332,15 @@ class Study:
             elif isinstance(b, dict):
                 cfg, folder = copy.deepcopy(b), root
                 name = str(b.get("name", f"base{len(bases)}"))
+                if "name" not in b:
+                    unnamed.append(len(bases))
             else:
                 raise ConfigError(f"base entries must be config paths or mappings, got {b!r}")
             if cfg.get("plugins"):  # the base's own plug-ins, made absolute so any worker finds them
                 cfg["plugins"] = resolve_specs(cfg["plugins"], folder, f"base {name}: plugins")
                 plugins += [p for p in cfg["plugins"] if p not in plugins]
             bases.append((name, cfg))
+        bases = _named_by_difference(bases, unnamed)
         load_plugins(plugins)  # here too: errors surface before any run, and factors may name the plug-ins
         factors = d.get("factors") or {}
         if not isinstance(factors, dict):
@@ -499,6 +502,24 @@ def _reader_problem(rec: RecordingSpec) -> str | None:
     except FootzooError as err:
         return str(err)
     return None
+
+
+def _named_by_difference(bases: list[tuple[str, dict[str, Any]]], unnamed: list[int]) -> list[tuple[str, dict]]:
+    """Inline base configs without a ``name`` named by what differs between the bases (``detector: shoe``), as the
+    summaries label a factor's levels; ``base<i>`` stays where that gives no name or two bases the same one."""
+    if len(bases) < 2 or not unnamed:
+        return bases
+    from .report import level_labels
+
+    texts = [json.dumps({k: v for k, v in cfg.items() if k != "name"}, sort_keys=True, default=str) for _, cfg in bases]
+    labels = level_labels("base", texts)
+    out = list(bases)
+    for i in unnamed:
+        label = labels[texts[i]]
+        taken = [n for j, (n, _) in enumerate(out) if j != i]
+        if label and label not in taken and texts.count(texts[i]) == 1:
+            out[i] = (label, bases[i][1])
+    return out
 
 
 def _resolve(root: Path, path: str) -> str:

@@ -99,6 +99,17 @@ def test_a_comparison_of_base_configs_is_drawn_and_summarised_as_a_factor(tmp_pa
     assert "| fsm | armse_3d_m |" in summary and "| shoe | armse_3d_m |" in summary
 
 
+def test_inline_base_configs_without_a_name_are_named_by_what_differs():
+    fsm = STUDY["base"]
+    shoe = {**fsm, "detector": {"type": "shoe"}}
+    names = [n for n, _ in Study.from_dict({**STUDY, "base": [fsm, shoe]}).bases]
+    assert names == ["detector: angular_rate_fsm", "detector: shoe"]
+    named = [n for n, _ in Study.from_dict({**STUDY, "base": [fsm, {**shoe, "name": "mine"}]}).bases]
+    assert named == ["detector: angular_rate_fsm", "mine"]
+    twins = [n for n, _ in Study.from_dict({**STUDY, "base": [fsm, fsm]}).bases]
+    assert twins == ["base0", "base1"]  # nothing differs: numbered
+
+
 def test_dictionary_levels_are_labelled_readably_in_the_summary(tmp_path):
     spec = {**STUDY, "factors": {"detector": [{"type": "shoe"}, {"type": "angular_rate_fsm", "threshold": 0.6}]},
             "metrics": ["armse_3d_m"]}
