@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import _version
-from ..config.library import is_name, resolve
+from ..config.library import BUILTIN, is_name, resolve
 from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, FootzooError, RecordingError, did_you_mean, prefixed
@@ -612,7 +612,13 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
             raise ConfigError(f"recordings[{i}].format must be a format name, got {r['format']!r}")
         matches = sorted(glob.glob(pattern)) or sorted(glob.glob(str(root / pattern)))
         if not matches:
-            raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}")
+            where = ("" if Path(pattern).is_absolute() else
+                     f", neither from the working folder ({Path.cwd()}) nor from the study file's ({root})")
+            fix = "fix the path or the working folder"
+            if Path(root).resolve() == BUILTIN.resolve():  # a shipped study: its data paths are the repository's
+                fix = ("a shipped study finds its data from the repository's root; copy it next to your data "
+                       "(footzoo configs --copy <its name> --to my_study.yaml) and edit the path")
+            raise ConfigError(f"recordings[{i}]: no file matches {pattern!r}{where}: {fix}")
         matches = _without_sidecars(matches)
         label = r.get("label")
         if label is not None and not isinstance(label, (str, int)):

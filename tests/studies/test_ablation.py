@@ -37,6 +37,19 @@ def test_study_errors_name_the_problem(tmp_path):
         Study.from_dict({**SMALL, "factor": {}})
     with pytest.raises(ConfigError, match="no file matches"):
         Study.from_dict({**SMALL, "recordings": [{"path": str(tmp_path / "*.mat")}]})
+    with pytest.raises(ConfigError, match=r"no file matches 'lab/\*\.mat', neither from the working folder .* nor "
+                                          r"from the study file's .*: fix the path"):
+        Study.from_dict({**SMALL, "recordings": [{"path": "lab/*.mat"}]}, root=tmp_path)
+
+
+def test_a_shipped_study_run_away_from_its_data_says_how_to_copy_it(tmp_path, monkeypatch):
+    from footzoo.config.library import BUILTIN
+
+    monkeypatch.chdir(tmp_path)  # not the repository's root: ../shared/data is not beside it
+    spec = {**SMALL, "recordings": [{"path": "../shared/data/pyshoe_vicon/*.mat", "format": "pyshoe"}]}
+    with pytest.raises(ConfigError, match=r"a shipped study finds its data from the repository's root; copy it next "
+                                          r"to your data \(footzoo configs --copy"):
+        Study.from_dict(spec, root=BUILTIN)
     assert len(Study.from_dict(SMALL).cells()) == 2 * 2 * 2
 
 
