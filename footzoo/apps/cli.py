@@ -48,6 +48,7 @@ from ..core.errors import (
     FormatError,
     OutputError,
     PluginError,
+    ReaderOptionError,
     RecordingError,
     did_you_mean,
     user_stacklevel,
@@ -266,6 +267,10 @@ def _load_recording(args: argparse.Namespace):
     from ..io import builtin_sample, load
 
     if args.data is None:
+        given = [o for o in ("option", "format") if getattr(args, o, None)]
+        if given:  # they describe --data; the built-in walk is read as it is
+            raise ConfigError(f"--{given[0]} describes the file given with --data; without --data footzoo runs its "
+                              f"built-in walk, which takes no reader options: add --data FILE or drop --{given[0]}")
         rec = builtin_sample()
         if getattr(args, "foot", None) in ("left", "right"):
             rec.meta["foot"] = args.foot  # the sample does not say which foot it is from
@@ -1050,6 +1055,8 @@ def _classify(err: Exception) -> tuple[int, str]:
     """Exit code and message for an exception leaving a command."""
     if isinstance(err, PluginError):
         return EXIT_PLUGIN, f"plug-in error: {err}"
+    if isinstance(err, ReaderOptionError):  # an argument's problem, though a reader raised it
+        return EXIT_USAGE, f"error: {err}"
     if isinstance(err, (RecordingError, FormatError, OutputError)):
         return EXIT_DATA, f"error: {err}"
     if isinstance(err, (ConfigError, FootzooError)):

@@ -26,6 +26,13 @@ class FormatError(FootzooError, ValueError):
     """A file cannot be read in the requested (or detected) format."""
 
 
+class ReaderOptionError(FormatError, ConfigError):
+    """A reader option is unknown, missing or given a value it cannot take (``axes=[x, y, w]``, ``foot=middle``).
+
+    An argument's problem, not the file's (the command line's exit code 2), and a :class:`FormatError` for code
+    that catches what a reader raises."""
+
+
 class NotARecordingError(RecordingError, TypeError):
     """An argument that must be a footzoo :class:`~footzoo.Recording` is something else (a path, an array, None).
 

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..core.conventions import ACC_UNITS, DIST_UNITS, GYR_UNITS, quat_from_matrix, quat_mul
 from ..core.data import DEFAULT_NAME, Recording, Truth
-from ..core.errors import FootzooError, FormatError, PluginError, RecordingError, did_you_mean
+from ..core.errors import FootzooError, FormatError, PluginError, ReaderOptionError, RecordingError, did_you_mean
 from ..core.files import not_utf8, nul_in_path, why_missing
 from . import xio
 from .axes import apply_axes, describe_axes, parse_axes
@@ -133,27 +133,34 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
     out: dict[str, Any] = {}
     foot = axes = None
     for key, value in options.items():
-        if key in declared:
+        if key == "axes":
+            try:
+                parsed = parse_axes(value, "axes")  # refused before the file is read
+            except FormatError as e:
+                raise ReaderOptionError(str(e)) from None
+            if key in declared:
+                out[key] = value
+            else:
+                axes = parsed
+        elif key in declared:
             out[key] = value
-        elif key == "axes":
-            axes = parse_axes(value, "axes")  # refused before the file is read
         elif key in fixed:
             if not _same_unit(key, value, fixed[key]):
-                raise FormatError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
+                raise ReaderOptionError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
                                   f"{key}={value!r} cannot apply (drop the option)")
         elif key == "foot":
             foot = value
         else:
             valid = sorted({*declared, "foot", "axes"})
 
-            raise FormatError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
+            raise ReaderOptionError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
                               f"{valid} (see footzoo.io.READERS[{fmt!r}].options)")
     missing = [k for k, o in declared.items() if o.default is REQUIRED and k not in out]
     if missing:
-        raise FormatError(f"{path}: the {fmt} reader needs the option(s) {missing}: "
+        raise ReaderOptionError(f"{path}: the {fmt} reader needs the option(s) {missing}: "
                           + "; ".join(f"{k}: {declared[k].doc}" for k in missing))
     if foot is not None and foot not in ("left", "right"):
-        raise FormatError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
+        raise ReaderOptionError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
     return out, foot, axes
 
 

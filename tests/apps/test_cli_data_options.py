@@ -76,3 +76,18 @@ def test_foot_both_on_a_described_file_names_the_two_description_route(tmp_path,
     assert main(["run", YUN, "--data", str(path), "--foot", "both"]) == 3
     err = capsys.readouterr().err
     assert "one description per foot" in err and "footzoo.Session" in err and "Both feet in one file" in err
+
+
+def test_a_reader_option_that_cannot_apply_is_an_argument_error(tmp_path, capsys):
+    """An unknown option, an axis map that is not one, a foot that is not one: exit code 2 (the arguments), the
+    message naming the option and the fix; options without --data are refused, not ignored on the built-in walk."""
+    rec = simulate(n_strides=2, rate=50.0)
+    path = tmp_path / "walk.csv"
+    rec.to_dataframe().to_csv(path, index=False)
+    cases = {"foo=1": "unknown option 'foo'", "axes=[x, y, w]": "'w' is not a sensor axis",
+             "axes=[x, y, -z]": "is left-handed", "foot=middle": "'middle' is not a foot"}
+    for option, says in cases.items():
+        assert main(["run", YUN, "--data", str(path), "--option", option]) == 2, option
+        assert says in capsys.readouterr().err
+    assert main(["run", YUN, "--option", "axes=[x, -y, -z]"]) == 2
+    assert "without --data footzoo runs its built-in walk, which takes no reader options" in capsys.readouterr().err
