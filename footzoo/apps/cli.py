@@ -30,7 +30,9 @@ import argparse
 import contextlib
 import json
 import os
+import re
 import sys
+import textwrap
 import traceback
 import warnings
 from pathlib import Path
@@ -385,8 +387,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     pipeline = Pipeline.from_yaml(args.config)
     out = _writable_dir(args.out) if args.out is not None else None
     if args.plot and out is None:
-        print("--plot needs --out DIR (where the figures are written)", file=sys.stderr)
-        return 2
+        raise ConfigError("--plot needs --out DIR (the folder the figures are written to): add --out DIR")
     if out is None:
         return _run(args, pipeline, None)
     data = Path(args.data).name if args.data else "the built-in sample"
@@ -795,20 +796,33 @@ def cmd_configs(args: argparse.Namespace) -> int:
 
     for kind in ("pipeline", "study"):
         print(f"{kind} configs ({'footzoo ablate NAME' if kind == 'study' else 'footzoo run NAME'}):")
+        indent = " " * 27
         for name in library.names(kind):
-            print(f"  {name:<24} {_first_comment(library.path(name))}")
+            print(textwrap.fill(_first_sentence(library.path(name)), width=110, initial_indent=f"  {name:<24} ",
+                                subsequent_indent=indent))
             if kind == "pipeline":
-                print(f"  {'':<24} {live_summary(Pipeline.from_yaml(name))}")
+                print(textwrap.fill(live_summary(Pipeline.from_yaml(name)), width=110, initial_indent=indent,
+                                    subsequent_indent=indent))
     print("copy one to edit it: footzoo configs --copy NAME [--to FOLDER]")
     return EXIT_OK
 
 
-def _first_comment(path: Path) -> str:
-    """The first comment line of a YAML file, without the ``#``."""
+#: The end of a sentence: a full stop before a capital or a number, not the one of an abbreviation ("et al.", "Fig.",
+#: "eq.", "K.F.").
+_SENTENCE_END = re.compile(r"(?<!\bal)(?<!\bFig)(?<!\b[Ee]q)(?<!\b[Ee]qs)(?<!\bSec)(?<!\bvs)(?<!\b[A-Z])"
+                           r"\.\s+(?=[A-Z0-9(])")
+
+
+def _first_sentence(path: Path) -> str:
+    """The first sentence of a YAML file's leading comment block, without the ``#`` (its lines joined)."""
+    lines = []
     for line in path.read_text().splitlines():
-        if line.startswith("#"):
-            return line.lstrip("# ").strip()
-    return ""
+        if not line.startswith("#"):
+            break
+        lines.append(line.lstrip("#").strip())
+    text = " ".join(x for x in lines if x)
+    end = _SENTENCE_END.search(text)
+    return text[: end.start() + 1] if end else text
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -821,8 +835,9 @@ def build_parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                         help="show the Python traceback of an error")
-    common.add_argument("--quiet", action="store_true", help="no warnings and no progress bar on the terminal; the "
-                        f"warnings are kept in the result and in OUT/{LOG} (a study's: OUT/{LOG})")
+    common.add_argument("--quiet", action="store_true", help="no warnings and no progress bar on the terminal: a "
+                        f"command writing a folder (--out) keeps them in its {LOG} (run --out also in the saved "
+                        "result); the others say how many they did not show")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_subparser(common))
 
     run = sub.add_parser("run", help="run a pipeline config on a recording (default: the built-in walk)")
@@ -987,8 +1002,10 @@ def _swap_hint(args: argparse.Namespace, extras: list[str]) -> str:
     # deferred: yaml, read only for a usage error
     from ..core.yamlsafe import RECORDING_SUFFIXES
 
-    yaml_extra = next((e for e in extras if Path(e).suffix.lower() in YAML_SUFFIXES), None)
     given = getattr(args, "config", None) or getattr(args, "study", None)
+    yaml_extra = next((e for e in extras if Path(e).suffix.lower() in YAML_SUFFIXES), None)
+    if yaml_extra is None and args.command == "run" and given and Path(given).suffix.lower() in RECORDING_SUFFIXES:
+        yaml_extra = next((e for e in extras if not e.startswith("-") and not Path(e).suffix), None)  # a shipped name
     if args.command == "run" and yaml_extra and given and Path(given).suffix.lower() in RECORDING_SUFFIXES:
         return (f"; the config comes first and the recording after --data (swapped?): footzoo run {yaml_extra} "
                 f"--data {given}")

@@ -124,6 +124,8 @@ CASES = [
     # arguments in the wrong place
     ("run-swapped", lambda d, w: ["run", str(w), str(YUN)], EXIT_USAGE,
      f"the config comes first and the recording after --data (swapped?): footzoo run {YUN} --data "),
+    ("run-swapped-shipped-name", lambda d, w: ["run", str(w), "yun2012"], EXIT_USAGE,
+     "the config comes first and the recording after --data (swapped?): footzoo run yun2012 --data "),
     ("run-swapped-with-data", lambda d, w: ["run", str(w), "--data", str(YUN)], EXIT_USAGE,
      f"a config file: the config comes first and the recording after --data (swapped?): footzoo run {YUN} --data "),
     ("run-recording-as-extra", lambda d, w: ["run", "yun2012", str(w)], EXIT_USAGE,

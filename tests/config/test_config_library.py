@@ -46,6 +46,18 @@ def test_the_configs_command_lists_and_copies(tmp_path, capsys):
     assert main(["configs", "--copy", "recommended", "--to", str(tmp_path), "--force"]) == 0
 
 
+def test_the_configs_command_gives_each_description_s_first_whole_sentence(tmp_path, capsys):
+    from footzoo.apps.cli import _first_sentence
+
+    f = tmp_path / "c.yaml"
+    f.write_text("# Smith et al. 2020 (Fig. 3, eqs. 1-4): the \"K.F.\" method,\n# on two lines. A second sentence.\n"
+                 "# More.\nname: c\n# not the description\n")
+    assert _first_sentence(f) == 'Smith et al. 2020 (Fig. 3, eqs. 1-4): the "K.F." method, on two lines.'
+    assert main(["configs"]) == 0
+    out = " ".join(capsys.readouterr().out.split())  # the lines as wrapped, joined
+    assert "the 9-state filter without distance sensors." in out and "(eqs. 15-16)." in out
+
+
 def test_a_study_names_its_base_config_by_name(tmp_path):
     from footzoo.studies import Study
 
