@@ -561,7 +561,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
     pipeline = Pipeline.from_yaml(path)
     print(f"{args.config}: valid")
     print(live_summary(pipeline))
-    print(json.dumps(pipeline.to_dict(), indent=2))
+    if args.resolved:
+        import yaml
+
+        print("# the config with every default filled in (what footzoo run runs):")
+        print(yaml.safe_dump(json.loads(json.dumps(pipeline.to_dict())), sort_keys=False), end="")
     return EXIT_OK
 
 
@@ -970,6 +974,8 @@ def build_parser() -> argparse.ArgumentParser:
     val = sub.add_parser("validate", help="check a pipeline config (or a study or tune file: every config of its "
                                           "grid) without running it")
     val.add_argument("config", type=_input_yaml, help="pipeline YAML, or a study or tune file")
+    val.add_argument("--resolved", action="store_true", help="also print the config with every default filled in "
+                     "(YAML, as footzoo run runs it)")
     val.set_defaults(func=cmd_validate)
     return parser
 

@@ -210,3 +210,14 @@ def test_settings_blocks_refuse_unknown_keys_and_non_mappings_alike(key, value, 
     with pytest.raises(ConfigError) as err:
         Pipeline.from_dict(cfg)
     assert message in str(err.value)
+
+
+def test_validate_prints_the_resolved_config_on_request_and_it_runs_as_the_original(capsys):
+    import yaml
+
+    assert main(["validate", "recommended"]) == 0
+    assert "every default filled in" not in capsys.readouterr().out  # short by default
+    assert main(["validate", "recommended", "--resolved"]) == 0
+    text = capsys.readouterr().out.split("# the config with every default filled in (what footzoo run runs):\n")[1]
+    resolved = Pipeline.from_dict(yaml.safe_load(text))
+    assert resolved.to_dict() == Pipeline.from_yaml("recommended").to_dict()
