@@ -114,7 +114,7 @@ class CheckReport:
 
     def __str__(self) -> str:
         notes = f"; {len(self.notes)} note(s): " + " ".join(self.notes) if self.notes else ""
-        return f"check_plugin: {self.plugin} passed {len(self.checks)} checks ({', '.join(self.checks)}){notes}"
+        return f"check_plugin: {self.plugin} passed {len(self.checks)} checks ({'; '.join(self.checks)}){notes}"
 
     def details(self) -> str:
         """One line per check and note."""
