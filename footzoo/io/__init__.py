@@ -153,8 +153,10 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
         else:
             valid = sorted({*declared, "foot", "axes"})
 
-            raise ReaderOptionError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}; its options are "
-                              f"{valid} (see footzoo.io.READERS[{fmt!r}].options)")
+            elsewhere = (" (sidecar= is the generic reader's option: it reads a delimited file as a description "
+                         "says; drop the format, or give format=generic)" if key == "sidecar" else "")
+            raise ReaderOptionError(f"{fmt} reader: unknown option {key!r}{did_you_mean(key, valid)}{elsewhere}; its "
+                                    f"options are {valid} (see footzoo.io.READERS[{fmt!r}].options)")
     missing = [k for k, o in declared.items() if o.default is REQUIRED and k not in out]
     if missing:
         raise ReaderOptionError(f"{path}: the {fmt} reader needs the option(s) {missing}: "

@@ -91,3 +91,7 @@ def test_a_reader_option_that_cannot_apply_is_an_argument_error(tmp_path, capsys
         assert says in capsys.readouterr().err
     assert main(["run", YUN, "--option", "axes=[x, -y, -z]"]) == 2
     assert "without --data footzoo runs its built-in walk, which takes no reader options" in capsys.readouterr().err
+    side = tmp_path / "lab.yaml"
+    side.write_text("time: {rate: 50}\n")
+    assert main(["run", YUN, "--data", str(path), "--format", "canonical", "--option", f"sidecar={side}"]) == 2
+    assert "sidecar= is the generic reader's option" in capsys.readouterr().err
