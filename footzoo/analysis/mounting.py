@@ -220,8 +220,11 @@ def warn_mounting(report: dict[str, Any], name: str | None = None, axes: str | N
             suggested, how = axis_map_text(rows), f": {axes_fix(rows)}"
         except FormatError:
             suggested = f"{suggested} on top of the axis map it was read with ({axes})"
-    fix = (f"if the sensor is not mounted so on purpose (e.g. upside down), the axis map is wrong: read it with "
-           f"the axis map {suggested} (x toward the toe, y right, z down, in sensor axes){how}"
+    motion = (" and the foot did not really move so (walking backwards or sideways, measured on "
+              f"{report.get('strides_used', 0)} of {report.get('strides', 0)} strides)"
+              if report.get("walks_backwards") or report.get("x_across") else "")
+    fix = (f"if the sensor is not mounted so on purpose (e.g. upside down){motion}, the axis map is wrong: read it "
+           f"with the axis map {suggested} (x toward the toe, y right, z down, in sensor axes){how}"
            if suggested else "check the axis map (x toward the toe, y right, z down) and read the file with the "
                              "right one: --option 'axes=[...]' on the command line, footzoo.load(path, axes=...)")
     warnings.warn(f"{where}{'; '.join(symptoms)}. footzoo's strides and gait events do not depend on the "
