@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from ..core import errors
+from ..core.archive import MANIFEST as RESULT_MANIFEST
 from ..core.atomic import begin_folder, check_complete, end_folder, folder_lock, previous_marker, write_bytes
 from ..core.errors import ConfigError, FootzooWarning, OutputError, user_stacklevel
 from ..core.files import sha256
@@ -563,6 +564,10 @@ def _check_report_folder(out: Path, study: Study) -> None:
     except (OSError, ValueError, KeyError, TypeError):
         manifest, earlier = None, set()
     foreign = [n for n in REPORT_TABLES if (out / n).exists() and n not in earlier]
+    if (out / LOG).exists() and LOG not in earlier and (out / RESULT_MANIFEST).exists():
+        raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} holds a saved result (its "
+                          f"{RESULT_MANIFEST}, e.g. of footzoo run --out) whose {LOG} the study's log would replace: "
+                          "choose another --out for the study")
     if foreign:
         raise OutputError(f"study {study.name!r}: the output folder {str(out)!r} already holds {', '.join(foreign)}, "
                           f"which no earlier study there wrote (its {MANIFEST} does not list them); the study's report "

@@ -288,3 +288,15 @@ def test_a_study_does_not_replace_report_tables_it_did_not_write(name, tmp_path)
     with pytest.raises(OutputError, match=rf"already holds {name}, which no earlier study there wrote"):
         run_study(_study(tmp_path, "next", "angular_rate_fsm"), out=out, quiet=True, max_runs=0)  # before any run
     assert _digest(out) == before
+
+
+def test_a_study_does_not_replace_the_log_of_a_saved_run(tmp_path, walk_file):
+    """A run's folder lists its footzoo.log in its manifest.json: a study's log over it would be lost work."""
+    out = tmp_path / "out"
+    assert main(["run", "yun2012", "--data", str(walk_file), "--out", str(out), "--quiet"]) == EXIT_OK
+    before = _digest(out)
+    with pytest.raises(OutputError, match=r"holds a saved result \(its manifest.json, e.g. of footzoo run --out\) "
+                                          r"whose footzoo.log the study's log would replace"):
+        run_study(_study(tmp_path, "next", "angular_rate_fsm"), out=out, quiet=True, max_runs=0)
+    assert _digest(out) == before
+    Result.load(out)
