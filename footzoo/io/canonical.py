@@ -226,6 +226,19 @@ def written_by_footzoo(path: Path) -> bool:
     return found is not None and found.group(1) == sha256(path)
 
 
+def _footzoo_sidecar(path: Path, side: Path) -> bool:
+    """Whether ``side``, a sidecar of ``path`` whose data file is gone, is one :func:`write` left: a metadata sidecar
+    that names its data's SHA-256, or the steps it lists by theirs (a recording deleted by hand leaves these)."""
+    try:
+        meta = meta_path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    if side == meta_path(path):
+        return re.search(r"^data_sha256:\s*[0-9a-f]{64}\s*$", meta, re.M) is not None
+    listed = re.search(r"^steps_sha256:\s*([0-9a-f]{64})\s*$", meta, re.M)
+    return listed is not None and listed.group(1) == sha256(side)
+
+
 def check_output(path: str | Path) -> Path:
     """``path`` when :func:`write` writes its extension (``.csv``, ``.parquet``, ``.pq``) and may replace what is there
     (nothing, or a recording it wrote: never a user's file), else an OutputError."""
@@ -246,6 +259,9 @@ def check_output(path: str | Path) -> Path:
         if side.is_dir():
             raise OutputError(f"{str(p)!r}: its sidecar {side.name} ({holds}, written next to it) cannot be written: "
                               f"{side.name} is a folder; move it away, or choose another name")
+        if side.is_file() and not p.exists() and not _footzoo_sidecar(p, side):  # a user's file under that name
+            raise OutputError(f"{str(p)!r}: its sidecar {side.name} ({holds}, written next to it) already exists "
+                              f"without {p.name}, and footzoo did not write it: move it away, or choose another name")
     return p
 
 

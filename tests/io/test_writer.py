@@ -67,3 +67,12 @@ def test_the_writer_replaces_its_own_recording_but_never_a_users_file(tmp_path):
     own = write(rec, tmp_path / "walk.csv")
     assert write(simulate(n_strides=4, rate=100.0), own) == own  # footzoo's own recording is replaced, as before
     assert load(own).n > rec.n
+    # a user's file under a sidecar's name, with no recording beside it, is not footzoo's either
+    for side in ("lone.csv.meta.yaml", "lone.csv.steps.csv"):
+        (tmp_path / side).write_text("mine\n")
+        with pytest.raises(OutputError, match=rf"its sidecar {side} .* already exists without lone.csv, and footzoo "
+                                              "did not write it: move it away, or choose another name"):
+            write(rec, tmp_path / "lone.csv")
+        assert main(["simulate", "straight", "--strides", "3", "--out", str(tmp_path / "lone.csv")]) == EXIT_DATA
+        assert (tmp_path / side).read_text() == "mine\n" and not (tmp_path / "lone.csv").exists()
+        (tmp_path / side).unlink()
