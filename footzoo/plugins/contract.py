@@ -205,8 +205,8 @@ def read_only(value: Any) -> Any:
     if isinstance(value, pd.DataFrame):
         return value.copy()
     if isinstance(value, np.ndarray):
-        if not value.flags.writeable:
-            return value
+        # a view even of a frozen array: a frozen array that owns its data can be made writable again
+        # (gyr.setflags(write=True)), a view of it cannot
         view = value.view()
         view.flags.writeable = False
         return view
@@ -236,9 +236,9 @@ def fault(plugin: Any, method: str, err: BaseException) -> PluginError:
     class for ``__init__``)."""
     text = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
     hint = "fix the plug-in"
-    if isinstance(err, ValueError) and "read-only" in str(err):
-        hint = ("it writes into an input array, which footzoo passes read-only (the caller's recording must not "
-                "change): copy it first, e.g. acc = np.array(acc)")
+    if isinstance(err, ValueError) and ("read-only" in str(err) or "WRITEABLE" in str(err)):
+        hint = ("it writes into an input array (or makes it writable), which footzoo passes read-only (the caller's "
+                "recording must not change): copy it first, e.g. acc = np.array(acc)")
     elif isinstance(err, SystemExit):
         hint = "a plug-in must raise an exception, never exit the process"
     return PluginError(f"{who(plugin)} ({_where(plugin)}) failed in {method}(): {text}; {hint}",

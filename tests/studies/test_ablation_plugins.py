@@ -14,7 +14,7 @@ from footzoo.plugins.registry import available
 from footzoo.sim import NoiseModel, simulate
 from footzoo.studies import Study, run_study
 
-from ..conftest import ON_PROCESS_CLUSTER, STANCES_GUARDED
+from ..conftest import HARD_IRON_NOT_FITTED, ON_PROCESS_CLUSTER, STANCES_GUARDED
 
 # A detector defined outside the package: Yun's angular-rate FSM under a new name, so its results must
 # equal the built-in's exactly; THRESHOLD is what the "edit" tests change.
@@ -293,6 +293,31 @@ def test_a_plugin_that_writes_into_its_input_fails_its_cells_not_the_others(tmp_
     expected = f"PluginError: detector '{name}'.*writes into an input array.*copy it first"
     assert mine["error"].str.contains(expected).all()
     clean = run_study(Study.from_dict({**d, "factors": {"detector.type": ["angular_rate_fsm"]}}, root=tmp_path))
+    builtin = table[table["detector.type"] == "angular_rate_fsm"]
+    np.testing.assert_array_equal(builtin["value"].to_numpy(), clean["value"].to_numpy())
+
+
+@pytest.mark.filterwarnings(HARD_IRON_NOT_FITTED)  # yun2012's calibration on a straight walk (expected)
+def test_a_plugin_that_makes_its_input_writable_again_fails_its_cells_not_the_others(tmp_path):
+    """The usual fix for "assignment destination is read-only" (setflags(write=True)) must not reach the shared
+    recording: the frozen array is passed as a view, which cannot be made writable again."""
+    name = det_name(tmp_path)
+    (tmp_path / "unfreezer.py").write_text(PLUGIN.format(threshold=0.6, name=name) + '''
+    def detect(self, t, acc, gyr):
+        gyr.setflags(write=True)
+        gyr[:, 2] += 0.05  # a bug: changes the caller's recording
+        return super().detect(t, acc, gyr)
+''')
+    from footzoo.io.canonical import write
+
+    write(simulate(path="straight", n_strides=4, rate=50), tmp_path / "walk.csv")  # a file's arrays own their data
+    d = {**study_dict("unfreezer.py", name), "recordings": [str(tmp_path / "walk.csv")], "base": "yun2012"}
+    d["factors"] = {"detector.type": [name, "angular_rate_fsm"]}
+    # first the built-in alone (a process keeps the recordings it read: the clean values come first)
+    clean = run_study(Study.from_dict({**d, "factors": {"detector.type": ["angular_rate_fsm"]}}, root=tmp_path))
+    table = run_study(Study.from_dict(d, root=tmp_path))
+    mine = table[table["detector.type"] == name]
+    assert mine["error"].str.contains(f"PluginError: detector '{name}'.*makes it writable.*copy it first").all()
     builtin = table[table["detector.type"] == "angular_rate_fsm"]
     np.testing.assert_array_equal(builtin["value"].to_numpy(), clean["value"].to_numpy())
 
