@@ -371,6 +371,7 @@ class Study:
         if not recordings:
             raise ConfigError("the study has no recordings (check the globs)")
         _name_feet(recordings)
+        _refuse_identical_simulations(recordings)
         seen: dict[str, RecordingSpec] = {}
         for rec in recordings:
             other = seen.setdefault(rec.label, rec)
@@ -650,6 +651,22 @@ def _expand_recording(r: Any, root: Path, i: int) -> list[RecordingSpec]:
             "seed (seeds: [0])")
     label = str(r.get("label", f"sim_{sim.get('path', 'straight')}"))
     return [RecordingSpec(f"{label}_s{s}", simulate=sim, seed=int(s), group=group) for s in seeds]
+
+
+def _refuse_identical_simulations(recordings: list[RecordingSpec]) -> None:
+    """Two simulated recordings of one scenario without a random part (no noise) are one recording whatever their
+    seeds: across entries too, a study would average identical runs as if they were independent."""
+    first: dict[str, RecordingSpec] = {}
+    for rec in recordings:
+        if rec.simulate is None or seed_matters(rec.simulate):
+            continue
+        other = first.setdefault(json.dumps(rec.simulate, sort_keys=True, default=str), rec)
+        if other is not rec:
+            raise ConfigError(
+                f"recordings {other.label!r} and {rec.label!r} are identical: the same simulation (seeds {other.seed} "
+                f"and {rec.seed}) without a random part (no noise, or noise: {{scale: 0}}), so the study would "
+                "average identical runs as if they were independent; add the sensor noise (noise: {scale: 1}) or "
+                "keep one of them")
 
 
 def _name_feet(recordings: list[RecordingSpec]) -> None:

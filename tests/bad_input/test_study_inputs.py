@@ -35,6 +35,11 @@ CASES = [
     ("seeds-with-zero-noise", _study([{"simulate": {**SIM, "noise": {"scale": 0}}, "seeds": [0, 1]}]),
      "give 2 identical recordings"),
     ("repeats-without-noise", _study([{"simulate": SIM, "repeats": 3}]), "its 3 seeds give 3 identical"),
+    ("seeds-without-noise-in-two-entries", _study([{"simulate": {**SIM, "noise": {"scale": 0}}, "seeds": [0]},
+                                                   {"simulate": {**SIM, "noise": {"scale": 0}}, "seeds": [1],
+                                                    "label": "again"}]),
+     "recordings 'sim_straight_s0' and 'again_s1' are identical: the same simulation (seeds 0 and 1) without a random "
+     "part"),
     ("seed-negative", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seeds": [-1]}]),
      "recordings[0].seeds must be a list of whole numbers >= 0, got [-1]"),
     ("seed-key-singular", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seed": 7}]),
