@@ -169,6 +169,10 @@ TURN_FRACTION = 0.01
 SHORT_MOTION_TIME = 0.3
 SHORT_TURN_RATE = 20.0 * math.pi / 180.0
 DEG = math.pi / 180.0
+#: A gyroscope that reads too little is named as rad/s declared as deg/s only when its peak read as rad/s would be a
+#: foot's (at least UNIT_PEAK_MIN rad/s; the slowest walks of the data folder peak at 3 rad/s): a dead or
+#: disconnected gyroscope (zeros, noise) reads too little in any unit.
+UNIT_PEAK_MIN = 2.0
 
 #: How the message names swings anchored at a running foot's quietest instants (the foot is never still).
 _RUNNING = " (anchored at its quietest instants by a running foot's bounds: it is never quite still)"
@@ -465,16 +469,23 @@ class GaitScan:
         """Keep the finding of a gyroscope in rad/s declared as deg/s and warn with its fix."""
         m = self._motion
         count, turning = m.samples, m.turning
+        unit = peak / DEG >= UNIT_PEAK_MIN
         self.report["gyro_unit"] = {"sample": sample, "moving_s": m.seconds,
                                     "moving_samples": count, "turning_samples": turning, "peak_rate_rad_s": peak,
-                                    "peak_if_rad_s": peak / DEG}
+                                    "peak_if_rad_s": peak / DEG, "unit_explains": unit}
+        if unit:
+            cause = (f"The gyroscope's values look like rad/s declared as deg/s (read as rad/s they peak at "
+                     f"{peak / DEG:.3g} rad/s): declare gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the "
+                     "command line --option gyr_unit=rad/s, a sidecar's gyr: {..., unit: rad/s}), or check that the "
+                     "gyroscope works")
+        else:
+            cause = (f"No unit explains it (even read as rad/s instead of deg/s they would peak at {peak / DEG:.3g} "
+                     "rad/s): the gyroscope does not measure the foot's rotation. Check that it works and that the "
+                     "columns read as the gyroscope are its own")
         warnings.warn(
             f"{self.name}: the accelerometer shows {m.seconds:.1f} s of motion (|‖f‖ − g| above "
             f"{MOTION_ACC:g} m/s², {count} samples) but the gyroscope turns faster than {TURN_RATE:g} rad/s in "
-            f"only {turning} of them, at most {peak:.3g} rad/s{short}: a moving foot turns at 5–20 rad/s. The "
-            f"gyroscope's values look like rad/s declared as deg/s (read as rad/s they peak at {peak / DEG:.3g} "
-            "rad/s): declare gyr_unit: rad/s (footzoo.load(path, gyr_unit='rad/s'), on the command line "
-            "--option gyr_unit=rad/s, a sidecar's gyr: {..., unit: rad/s}), or check that the gyroscope works. "
+            f"only {turning} of them, at most {peak:.3g} rad/s{short}: a moving foot turns at 5–20 rad/s. {cause}. "
             "Details in diagnostics['sensor']['plausibility']",
             SensorWarning, stacklevel=user_stacklevel(),
         )

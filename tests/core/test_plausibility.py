@@ -204,6 +204,17 @@ def test_a_gyroscope_in_rad_s_declared_as_deg_s_is_named_batch_and_live(walk):
     assert len(live) == 1
 
 
+def test_a_gyroscope_that_measures_no_rotation_is_not_named_a_unit(walk):
+    """Noise alone (a dead or disconnected gyroscope) reads too little in any unit: not "declare gyr_unit: rad/s"."""
+    noise = np.random.default_rng(0).normal(0.0, 0.003, walk.gyr.shape)  # rad/s
+    rec = Recording(t=walk.t, acc=walk.acc, gyr=noise, meta={"name": "dead"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["gyro_unit"]
+    assert not finding["unit_explains"] and finding["peak_if_rad_s"] < 2.0
+    named = [m for m in found if "turns faster than" in m]
+    assert len(named) == 1 and "No unit explains it" in named[0] and "gyr_unit: rad/s" not in named[0]
+
+
 def _frozen_acc(rec: Recording, lo: int, hi: int, name: str) -> Recording:
     """``rec`` with its accelerometer repeating sample ``lo``'s reading up to ``hi`` (a dropout; it is warned)."""
     acc = rec.acc.copy()
