@@ -197,6 +197,21 @@ def first_line(path: str | Path) -> str:
     return ""
 
 
+def next_line(path: str | Path, after: str) -> str:
+    """The first non-blank line after the first non-blank line ``after`` (:func:`first_line`), or ``""``."""
+    with _open_text(Path(path)) as fh:
+        found = False
+        for _ in range(2 * MAX_BLANK_LINES):
+            line = fh.readline(HEADER_MAX_CHARS)
+            if not line:
+                return ""
+            if line.strip():
+                if found:
+                    return line.rstrip("\r\n")
+                found = line.rstrip("\r\n") == after
+    return ""
+
+
 def _open_text(path: Path) -> Any:
     """The text of a file for sniffing its header: decompressed for ``.gz``, ``.bz2`` and ``.xz`` (as pandas reads
     them), as it is otherwise (a ``.zip`` or ``.zst`` shows its binary start, which no reader claims)."""

@@ -34,7 +34,7 @@ from typing import Any
 
 from ..core.errors import FootzooWarning, FormatError, did_you_mean, user_stacklevel
 from ..core.files import SNIFF_BYTES, foreign_encoding
-from .base import MAT_ROUTE, first_line
+from .base import MAT_ROUTE, first_line, next_line
 
 #: The entry-point group readers register under.
 GROUP = "footzoo.readers"
@@ -192,7 +192,11 @@ class Readers(Mapping[str, Any]):
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
         sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"), (" ", "spaces"))
                     if head and ch in head and "," not in head), "")
-        if sep:
+        second = next_line(p, head) if head and "," not in head and p.suffix.lower() in (".csv", "") else ""
+        if second.count(",") >= 2:  # a title line above a comma-separated header
+            seen += (f"; a line without commas comes before what looks like its header ({second[:60]!r}): remove that "
+                     f"line, or describe the file (skip_rows: 1, or comment: '#') in a sidecar {p.name}.footzoo.yaml")
+        elif sep:
             seen += (f"; its values are separated by {sep}, not commas: save it as comma-separated CSV, or "
                      f"describe it (delimiter, decimal) in a sidecar {p.name}.footzoo.yaml")
         if p.suffix.lower() == ".mat":

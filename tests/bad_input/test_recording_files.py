@@ -225,6 +225,8 @@ CASES = [
          FormatError, "r.csv: not UTF-8 text (byte 0xe9 at offset 99999, line"),
     Case("space-separated", lambda d, w, x: (lambda: load(_file(d, "r.csv", _table(x).to_csv(
         index=False, sep=" ").encode()))), FormatError, "its values are separated by spaces, not commas"),
+    Case("title-line-above-the-header", lambda d, w, x: (lambda: load(_file(d, "r.csv", b"# left foot sensor\n" + x))),
+         FormatError, "a line without commas comes before what looks like its header ('t,acc_x,"),
     # a sidecar that cannot be written
     Case("sidecar-is-a-folder", lambda d, w, x: (lambda: write(w, _folder_sidecar(d))), OutputError,
          "its sidecar s.csv.meta.yaml (its metadata, written next to it) cannot be written: s.csv.meta.yaml is a "
