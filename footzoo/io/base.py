@@ -197,6 +197,18 @@ def first_line(path: str | Path) -> str:
     return ""
 
 
+def load_mat(path: str | Path, what: str = "a MATLAB .mat file", fix: str = "copy it again from its source") -> dict:
+    """``scipy.io.loadmat(path)``; a file it cannot read is a :class:`FormatError` naming the file, scipy's reason and
+    the fix (a truncated copy, an interrupted download, a file of another kind under a ``.mat`` name)."""
+    import scipy.io as sio  # deferred: loading footzoo's readers does not load scipy
+
+    try:
+        return sio.loadmat(path)
+    except Exception as err:  # noqa: BLE001 - scipy raises several types for a damaged file
+        raise FormatError(f"{path}: cannot read {what} ({type(err).__name__}: {err}): the file is damaged or "
+                          f"truncated, or not a MATLAB file; {fix}") from None
+
+
 def next_line(path: str | Path, after: str) -> str:
     """The first non-blank line after the first non-blank line ``after`` (:func:`first_line`), or ``""``."""
     with _open_text(Path(path)) as fh:

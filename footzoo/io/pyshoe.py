@@ -26,7 +26,7 @@ import pandas as pd
 from ..core.data import Recording, Truth
 from ..core.errors import FormatError
 from .axes import describe_axes, parse_axes, rotate_columns
-from .base import MAT_ROUTE, RECORDING_OPTIONS, Reader, frame_options, text_source
+from .base import MAT_ROUTE, RECORDING_OPTIONS, Reader, frame_options, load_mat, text_source
 
 #: Columns of ``trial_error``: PyShoe's ARMSE (m) with each detector at its best threshold.
 TRIAL_ERROR_DETECTORS = ("shoe", "ared", "amvd", "mbgtd", "vicon")
@@ -40,12 +40,7 @@ def read(path: Path, axes: Any = AXES, acc_unit: str = ACC_UNIT, gyr_unit: str =
          **options: Any) -> Recording:
     """Read a PyShoe ``.mat`` trial with its VICON reference as truth (``axes``: :mod:`footzoo.io.axes`)."""
     rows = parse_axes(AXES if axes is None else axes, "axes")
-    import scipy.io as sio  # here: loading footzoo's readers does not load scipy
-
-    try:
-        d = sio.loadmat(path)
-    except Exception as err:  # scipy raises several types for bad files
-        raise FormatError(f"{path}: cannot read as a MATLAB .mat file: {err}") from None
+    d = load_mat(path, "it as a MATLAB .mat file")
     missing = [k for k in ("imu", "ts") if k not in d]
     if missing:
         have = sorted(k for k in d if not k.startswith("__"))

@@ -34,6 +34,7 @@ from .base import (
     data_suffix,
     first_line,
     frame_options,
+    load_mat,
     text_source,
 )
 
@@ -106,13 +107,8 @@ def footprint_reference(path: Path) -> Truth | None:
     """Köroğlu's ground control points (``GCP_meters``, ``numberOfStrides``) from a ``.mat`` file, if present."""
     if not path.exists():
         return None
-    # deferred: scipy, only for .mat files
-    import scipy.io as sio
-
-    try:
-        d = sio.loadmat(path)
-    except Exception as err:  # scipy raises several types for bad files
-        raise FormatError(f"{path}: cannot read the ground-control-point file: {err}") from None
+    d = load_mat(path, "the ground-control-point file", "copy it again from its source, or move it away (the "
+                 "recording is then read without its footprints)")
     if "GCP_meters" not in d:
         return None
     fix = f"fix {path.name} (GCP_meters K x 2 in m, numberOfStrides, GCP_exist_and_correct) or move it away"

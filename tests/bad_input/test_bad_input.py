@@ -97,6 +97,12 @@ def _pyshoe(tmp: Path, walk: Recording, gt_rows: int | None = None, imu_cols: in
     return p
 
 
+def _truncated(p: Path) -> Path:
+    """``p`` cut to its first half (an interrupted copy)."""
+    p.write_bytes(p.read_bytes()[: p.stat().st_size // 2])
+    return p
+
+
 _TEXT_COLUMN = "t,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n" + "".join(
     f'{k / 100},"0,1",0,-9.8,0,0,0\n' for k in range(300))
 
@@ -218,7 +224,9 @@ CASES = [
          "pyshoe reader: unknown option 'foo' (did you mean 'foot'?); its options are ['acc_unit', 'axes', "
          "'duplicates', 'foot', 'gyr_unit', 'max_gap', 'nan_policy']"),
     Case("csv-read-as-pyshoe", lambda d, w: (lambda: load(_csv(d, w), format="pyshoe")), FormatError,
-         "cannot read as a MATLAB .mat file"),
+         "cannot read it as a MATLAB .mat file"),
+    Case("pyshoe-truncated", lambda d, w: (lambda: load(_truncated(_pyshoe(d, w)), format="pyshoe")), FormatError,
+         "): the file is damaged or truncated, or not a MATLAB file; copy it again from its source"),
     Case("canonical-unknown-option", lambda d, w: (lambda: load(_csv(d, w), acc_units="g")), FormatError,
          "canonical reader: unknown option 'acc_units' (did you mean 'acc_unit'?)"),
     Case("invalid-meta-yaml", lambda d, w: _with_meta(d, w, "meta: {name: [unclosed\n"), FormatError,
