@@ -696,8 +696,8 @@ def cmd_ablate(args: argparse.Namespace) -> int:
     tell_unshown(args, logged_texts(out / LOG), out / LOG)
     total = a["computed"] + a["cached"]
     if a["causes"]:
-        print(f"{'every' if a['failed'] == total else a['failed']} run{'' if a['failed'] == 1 else 's'} failed; "
-              "the distinct causes:", file=sys.stderr)
+        failed = "every run" if a["failed"] == total else f"{a['failed']} run{'' if a['failed'] == 1 else 's'}"
+        print(f"{failed} failed; the distinct causes:", file=sys.stderr)
         for cause, n in list(a["causes"].items())[:5]:
             print(f"  - {cause} ({n} run{'' if n == 1 else 's'})", file=sys.stderr)
     if total and a["failed"] == total:

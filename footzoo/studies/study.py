@@ -24,6 +24,7 @@ from ..config.library import BUILTIN, is_name, resolve
 from ..config.library import path as library_path
 from ..config.schema import load_yaml
 from ..core.errors import ConfigError, FootzooError, RecordingError, did_you_mean, prefixed
+from ..core.files import why_missing
 from ..core.yamlsafe import load_file
 from ..evaluation.metrics import FIGURE_METRICS, METRICS
 from ..io import _options_for, companion_files, detect_format
@@ -199,6 +200,8 @@ class RecordingSpec:
                 return f"{self.path!r} is a dangling link (its target {os.readlink(p)!r} does not exist)"
             return f"{self.path!r} does not exist (any more)"
         except OSError as err:
+            if p.is_symlink():  # a loop of links (ELOOP): named as footzoo run names it, with the fix
+                return f"{self.path!r} {why_missing(p)}"
             return f"{self.path!r} cannot be accessed: {err.strerror or err}"
         if stat.S_ISDIR(st.st_mode):
             return (f"{self.path!r} is a directory, not a recording file; give its recordings with a glob such as "

@@ -98,6 +98,20 @@ def folder_of_recordings(tmp_path):
     return data
 
 
+def test_a_link_in_a_loop_is_named_with_its_fix():
+    import os
+    import tempfile
+
+    from footzoo.studies.study import RecordingSpec
+
+    with tempfile.TemporaryDirectory() as d:
+        os.symlink("b.csv", os.path.join(d, "a.csv"))
+        os.symlink("a.csv", os.path.join(d, "b.csv"))
+        problem = RecordingSpec("a", path=os.path.join(d, "a.csv")).problem()
+    assert "is a symbolic link in a loop" in problem and "a.csv -> b.csv -> a.csv" in problem
+    assert "point it at a real file" in problem
+
+
 @pytest.mark.slow
 def test_a_dangling_link_or_a_directory_fails_its_cells_not_the_study(tmp_path, folder_of_recordings):
     d = {**SMALL, "recordings": [{"path": str(folder_of_recordings / "*.parquet")}]}
