@@ -300,3 +300,20 @@ def test_a_study_does_not_replace_the_log_of_a_saved_run(tmp_path, walk_file):
         run_study(_study(tmp_path, "next", "angular_rate_fsm"), out=out, quiet=True, max_runs=0)
     assert _digest(out) == before
     Result.load(out)
+
+
+def test_ctrl_c_while_the_command_line_starts_ends_with_one_line_and_code_130(monkeypatch, capsys):
+    """The console script (and python -m footzoo) wraps even the command line's imports: no traceback."""
+    import configparser
+
+    from footzoo.apps import cli, entry
+
+    def interrupted(argv=None):
+        raise KeyboardInterrupt  # as a Ctrl-C while pandas is imported
+
+    monkeypatch.setattr(cli, "main", interrupted)
+    assert entry.main(["run", "yun2012"]) == EXIT_INTERRUPTED
+    assert capsys.readouterr().err == "footzoo: interrupted\n"
+    setup = configparser.ConfigParser()
+    setup.read(Path(__file__).resolve().parents[2] / "setup.cfg")
+    assert "footzoo = footzoo.apps.entry:main" in setup["options.entry_points"]["console_scripts"]
