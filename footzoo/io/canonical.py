@@ -336,7 +336,8 @@ def _warn_unwritten(rec: Recording, path: Path, meta: list[str] = ()) -> None:
     if meta:
         warnings.warn(FootzooWarning(
             f"{path.name}: metadata {', '.join(meta[:8])} not written to {path.name}.meta.yaml (not plain text, "
-            "numbers, lists or mappings); convert it (e.g. to text) before writing, or keep it apart"),
+            "numbers, lists or mappings of them, or nested more than 32 deep: a mapping that holds itself); convert "
+            "it (e.g. to text) before writing, or keep it apart"),
             stacklevel=user_stacklevel())
     tr = rec.truth
     lost = [name for name in ("footprints", "stride_positions") if tr is not None and getattr(tr, name) is not None]

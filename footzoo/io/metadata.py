@@ -174,7 +174,13 @@ def plain_meta(meta: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     return kept, dropped
 
 
-def _plain(value: Any) -> tuple[bool, Any]:
+#: Deepest nesting of metadata a sidecar holds: deeper (or a mapping that holds itself) is named as not written.
+MAX_META_DEPTH = 32
+
+
+def _plain(value: Any, depth: int = 0) -> tuple[bool, Any]:
+    if depth > MAX_META_DEPTH:
+        return False, None
     if value is None or isinstance(value, (str, bool)):
         return True, value
     if isinstance(value, (int, np.integer)) and not isinstance(value, np.bool_):
@@ -194,13 +200,13 @@ def _plain(value: Any) -> tuple[bool, Any]:
     if isinstance(value, dict):
         out = {}
         for k, v in value.items():
-            ok, plain = _plain(v)
+            ok, plain = _plain(v, depth + 1)
             if not ok or not isinstance(k, (str, int)):
                 return False, None
             out[k] = plain
         return True, out
     if isinstance(value, (list, tuple)):
-        items = [_plain(v) for v in value]
+        items = [_plain(v, depth + 1) for v in value]
         return (True, [v for _, v in items]) if all(ok for ok, _ in items) else (False, None)
     return False, None
 

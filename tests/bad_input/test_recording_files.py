@@ -321,6 +321,11 @@ def test_non_scalar_metadata_is_written_and_what_cannot_be_is_named(tmp_path, wa
     assert back.meta["subject"] == {"age": 30, "height_m": 1.8} and back.meta["tags"] == ["a", "b"]
     assert back.meta["arr"] == [0.0, 1.0, 2.0] and back.meta["when"] == "2024-01-02"
     assert back.meta["pair"] == [1, 2] and back.meta["f32"] == 1.5 and "obj" not in back.meta
+    loop: dict = {"depth": 1}
+    loop["me"] = loop  # a mapping that holds itself: named, not a RecursionError
+    rec.meta = {"name": "m", "loop": loop}
+    with pytest.warns(FootzooWarning, match=r"metadata loop \(dict\) not written .* a mapping that holds itself"):
+        assert "loop" not in load(write(rec, tmp_path / "m.csv")).meta
 
 
 def test_a_results_metrics_json_keeps_nested_metadata():
