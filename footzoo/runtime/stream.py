@@ -429,7 +429,7 @@ class Stream:
             raise RecordingError(
                 f"Stream: the time stamps of the first {t[n_init - 1] - t[0]:.2f} s come at {measured:.4g} Hz, but "
                 f"the stream was made with rate={rate:g} Hz: every window and duration would be off by "
-                f"{measured / rate:.2f}×. Pass the sensor's real rate (rate={measured:.4g}), or fix the time stamps "
+                f"{measured / rate:.3g}×. Pass the sensor's real rate (rate={measured:.4g}), or fix the time stamps "
                 "(seconds, of each sample)")
         if rate is None:
             rate = measured
