@@ -58,8 +58,25 @@ TMP_INFIX = ".footzoo-tmp-"
 PathLike = str | os.PathLike
 
 
+#: Age (s) from which a temporary file is a leftover of a killed writer: no single file takes an hour to write.
+STALE_TEMPORARY = 3600.0
+
+
 def _temporary_name(target: Path) -> Path:
     return target.with_name(f".{target.name}{TMP_INFIX}{secrets.token_hex(4)}")
+
+
+def remove_stale_temporaries(folder: Path, name: str = "*") -> None:
+    """Remove the temporary files (``.<name>.footzoo-tmp-*``, ``name`` a glob) in ``folder`` that a writer killed
+    before it could rename or remove them left behind: those older than :data:`STALE_TEMPORARY` s (a running
+    writer's are younger). Called once per command: when an output folder is locked, and by the recording writer
+    for its files.
+    """
+    now = time.time()
+    for tmp in folder.glob(f".{name}{TMP_INFIX}*"):
+        with contextlib.suppress(OSError):  # gone meanwhile, or not ours to remove
+            if tmp.is_file() and not tmp.is_symlink() and now - tmp.stat().st_mtime > STALE_TEMPORARY:
+                tmp.unlink()
 
 
 def check_target(path: PathLike, what: str = "output") -> Path:
@@ -458,6 +475,7 @@ def folder_lock(folder: PathLike, what: str = "output folder", owner: str = "",
                 _HELD[key] -= 1
         return
     fh = _acquire(p, what, owner, identity)
+    remove_stale_temporaries(p)  # a killed writer's leftovers in the folder
     with _HELD_LOCK:
         _HELD[key] = 1
     try:
@@ -693,7 +711,7 @@ def check_complete(folder: PathLike, marker: str, what: str) -> Path:
     return f
 
 
-__all__ = ["INCOMPLETE", "LOCK_NAME", "TMP_INFIX", "FileGroup", "OutputError", "atomic_path", "atomic_write",
-           "begin_folder", "check_complete", "check_target", "dumps_json", "end_folder", "folder_lock", "incomplete",
-           "json_safe", "lock_holder", "previous_marker", "refuse_inputs", "same_file", "write_bytes", "write_json",
-           "write_text"]
+__all__ = ["INCOMPLETE", "LOCK_NAME", "STALE_TEMPORARY", "TMP_INFIX", "FileGroup", "OutputError", "atomic_path",
+           "atomic_write", "begin_folder", "check_complete", "check_target", "dumps_json", "end_folder", "folder_lock",
+           "incomplete", "json_safe", "lock_holder", "previous_marker", "refuse_inputs", "remove_stale_temporaries",
+           "same_file", "write_bytes", "write_json", "write_text"]

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.archive import parquet_available
-from ..core.atomic import FileGroup
+from ..core.atomic import FileGroup, remove_stale_temporaries
 from ..core.checks import check_bool
 from ..core.conventions import quat_from_matrix, quat_mul
 from ..core.data import ACC_COLS, GYR_COLS, MAG_COLS, TRUTH_POS_COLS, TRUTH_QUAT_COLS, TRUTH_VEL_COLS, Recording, Truth
@@ -290,6 +290,7 @@ def write(rec: Recording, path: str | Path, closed_loop: bool = False) -> Path:
         For another extension, an unwritable place, or a path that is one of the recording's inputs.
     """
     p = check_output(path)
+    remove_stale_temporaries(p.parent, f"{p.name}*")  # what a killed earlier write of these files left
     closed_loop = check_bool("closed_loop", closed_loop)
     suffix = p.suffix.lower()
     df = rec.to_dataframe()
