@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import copy
 import sys
-import time
 import warnings
 from pathlib import Path
 from typing import Any
@@ -33,9 +32,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from accuracy import CLASS_ORDER, DEFAULT_DATA, motion_class  # noqa: E402
+from accuracy import CLASS_ORDER, motion_class  # noqa: E402
 from height_drift import sim_case  # noqa: E402
-from select_height import no_worse, pyshoe  # noqa: E402
+from select_height import no_worse, pyshoe, report_main  # noqa: E402
 from select_nested import CHECKS, other_references  # noqa: E402
 
 from footzoo.studies.report import to_markdown  # noqa: E402
@@ -99,22 +98,7 @@ def run(args: argparse.Namespace) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
-    ap.add_argument("--results", type=Path, default=ROOT / "benchmarks" / "results" / "hdr_recommended")
-    ap.add_argument("--out", type=Path, default=DEFAULT_OUT)
-    ap.add_argument("--jobs", type=int, default=1)
-    args = ap.parse_args(argv)
-    if not (args.data / "pyshoe_vicon").is_dir():
-        print(f"no PyShoe trials in {args.data}: nothing to measure on", file=sys.stderr)
-        return 1
-    t0 = time.perf_counter()
-    lines = run(args)
-    lines.insert(2, f"Run time: {(time.perf_counter() - t0) / 60:.1f} min.")
-    lines.insert(3, "")
-    args.out.write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
-    return 0
+    return report_main(argv, __doc__, run, "hdr_recommended", DEFAULT_OUT, shown=60)
 
 
 if __name__ == "__main__":

@@ -267,23 +267,29 @@ def report(err2: pd.DataFrame, err3: pd.DataFrame, classes: pd.Series, folds: pd
     return lines
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def report_main(argv: list[str] | None, doc: str, make: Any, name: str, out: Path, shown: int = 40) -> int:
+    """A PyShoe report's command line: ``--data``, ``--results`` (``benchmarks/results/<name>``), ``--out``, ``--jobs``;
+    ``make(args)`` gives its Markdown lines, written to ``--out`` with the run time as the third line."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
-    ap.add_argument("--results", type=Path, default=ROOT / "benchmarks" / "results" / "select_height")
-    ap.add_argument("--out", type=Path, default=DEFAULT_OUT)
+    ap.add_argument("--results", type=Path, default=ROOT / "benchmarks" / "results" / name)
+    ap.add_argument("--out", type=Path, default=out)
     ap.add_argument("--jobs", type=int, default=1)
     args = ap.parse_args(argv)
     if not (args.data / "pyshoe_vicon").is_dir():
-        print(f"no PyShoe trials in {args.data}: nothing to select on", file=sys.stderr)
+        print(f"no PyShoe trials in {args.data}: nothing to measure on", file=sys.stderr)
         return 1
     t0 = time.perf_counter()
-    lines = run(args)
+    lines = make(args)
     lines.insert(2, f"Run time: {(time.perf_counter() - t0) / 60:.1f} min.")
     lines.insert(3, "")
     args.out.write_text("\n".join(lines) + "\n")
-    print("\n".join(lines[:40]))
+    print("\n".join(lines[:shown]))
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    return report_main(argv, __doc__, run, "select_height", DEFAULT_OUT)
 
 
 if __name__ == "__main__":
