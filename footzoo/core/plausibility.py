@@ -170,9 +170,10 @@ SHORT_MOTION_TIME = 0.3
 SHORT_TURN_RATE = 20.0 * math.pi / 180.0
 DEG = math.pi / 180.0
 #: A gyroscope that reads too little is named as rad/s declared as deg/s only when its peak read as rad/s would be a
-#: foot's (at least UNIT_PEAK_MIN rad/s; the slowest walks of the data folder peak at 3 rad/s): a dead or
-#: disconnected gyroscope (zeros, noise) reads too little in any unit.
-UNIT_PEAK_MIN = 2.0
+#: moving foot's (at least UNIT_PEAK_MIN rad/s: the data folder's crawl, its slowest-turning foot, peaks at 1.6 rad/s
+#: over its first 2 s of motion): a dead or disconnected gyroscope reads too little in any unit (zeros; a MEMS
+#: gyroscope's noise alone, about 0.1 °/s RMS at 100 Hz, peaks near 0.006 rad/s, 0.35 read as rad/s).
+UNIT_PEAK_MIN = 0.5
 
 #: How the message names swings anchored at a running foot's quietest instants (the foot is never still).
 _RUNNING = " (anchored at its quietest instants by a running foot's bounds: it is never quite still)"

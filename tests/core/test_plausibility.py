@@ -206,13 +206,31 @@ def test_a_gyroscope_in_rad_s_declared_as_deg_s_is_named_batch_and_live(walk):
 
 def test_a_gyroscope_that_measures_no_rotation_is_not_named_a_unit(walk):
     """Noise alone (a dead or disconnected gyroscope) reads too little in any unit: not "declare gyr_unit: rad/s"."""
-    noise = np.random.default_rng(0).normal(0.0, 0.003, walk.gyr.shape)  # rad/s
+    noise = np.random.default_rng(0).normal(0.0, 0.0017, walk.gyr.shape)  # rad/s: 0.1 °/s RMS, a MEMS gyroscope's
     rec = Recording(t=walk.t, acc=walk.acc, gyr=noise, meta={"name": "dead"})
     res, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
     finding = res.diagnostics["sensor"]["plausibility"]["gyro_unit"]
-    assert not finding["unit_explains"] and finding["peak_if_rad_s"] < 2.0
+    assert not finding["unit_explains"] and finding["peak_if_rad_s"] < 0.5
     named = [m for m in found if "turns faster than" in m]
     assert len(named) == 1 and "No unit explains it" in named[0] and "gyr_unit: rad/s" not in named[0]
+
+
+def test_a_slowly_turning_foot_in_rad_s_declared_as_deg_s_is_still_named_a_unit():
+    """PyShoe's crawl turns its foot slowly (1.6 rad/s at most in its first 2 s of motion): declared in deg/s, it
+    reads too little, and the unit explains it."""
+    from pathlib import Path
+
+    import footzoo
+
+    path = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "pyshoe_vicon" / "2018-02-09-11-18-04.mat"
+    if not path.exists():
+        pytest.skip("../shared/data absent")
+    crawl = footzoo.load(path)
+    rec = Recording(t=crawl.t, acc=crawl.acc, gyr=crawl.gyr * math.pi / 180.0, meta={"name": "crawl"})
+    res, found = _sensor_warnings(lambda: Pipeline.from_yaml("recommended").run(rec))
+    finding = res.diagnostics["sensor"]["plausibility"]["gyro_unit"]
+    assert finding["unit_explains"] and 0.5 < finding["peak_if_rad_s"] < 2.0
+    assert any("declare gyr_unit: rad/s" in m for m in found)
 
 
 def _frozen_acc(rec: Recording, lo: int, hi: int, name: str) -> Recording:
