@@ -150,6 +150,11 @@ class TuneSpec:
             v = values.to_numpy(dtype=float)
             if v.size == 0 or not np.all(np.isfinite(v)):
                 return math.inf  # a failed or refused run: never the best
+            if self.aggregate == "gmean" and np.any(v <= 0):
+                raise ConfigError(f"tune.aggregate gmean needs positive values of the objective, but "
+                                  f"{self.objective!r} is {float(v[v <= 0][0]):.4g} on a recording (a signed error, or "
+                                  "zero): use aggregate: mean or median, or an objective that is never negative (an "
+                                  "absolute or RMS error)")
             if self.weight == "recording":
                 return sign * agg(v)
             per_group = [agg(values[groups == g].to_numpy(dtype=float)) for g in pd.unique(groups)]

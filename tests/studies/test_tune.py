@@ -239,3 +239,18 @@ def test_a_recording_that_cannot_give_the_objective_is_named_as_left_out(tmp_pat
         result = tune(Study.from_dict(d), {"objective": "armse_3d_m"}, out=tmp_path / "out", quiet=True)
     assert "bare" not in result.values_.index and result.groups_.nunique() == 2
     assert "left out of the cross-validation" in (tmp_path / "out" / "footzoo.log").read_text()
+
+
+def test_a_geometric_mean_of_a_signed_objective_is_refused_not_scored_nan():
+    """gmean of a signed error (a negative stride-length bias) is NaN: the grid's first value would "win"."""
+    import pandas as pd
+
+    from footzoo.core.errors import ConfigError
+    from footzoo.studies.tune import TuneSpec
+
+    score = TuneSpec(objective="stride_length_mean_error_m", aggregate="gmean").score_function()
+    groups = pd.Series(["a", "b"])
+    assert score(pd.Series([0.02, 0.08]), groups) == pytest.approx(0.05)  # per group, then their mean
+    with pytest.raises(ConfigError, match=r"gmean needs positive values of the objective, but "
+                                          r"'stride_length_mean_error_m' is -0.03 on a recording.*aggregate: mean"):
+        score(pd.Series([0.02, -0.03]), groups)
