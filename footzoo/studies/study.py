@@ -344,6 +344,7 @@ class Study:
                 plugins += [p for p in cfg["plugins"] if p not in plugins]
             bases.append((name, cfg))
         bases = _named_by_difference(bases, unnamed)
+        _refuse_duplicate_bases(bases)
         load_plugins(plugins)  # here too: errors surface before any run, and factors may name the plug-ins
         factors = d.get("factors") or {}
         if not isinstance(factors, dict):
@@ -524,6 +525,21 @@ def _named_by_difference(bases: list[tuple[str, dict[str, Any]]], unnamed: list[
         if label and label not in taken and texts.count(texts[i]) == 1:
             out[i] = (label, bases[i][1])
     return out
+
+
+def _refuse_duplicate_bases(bases: list[tuple[str, dict[str, Any]]]) -> None:
+    """Two bases of one name, or of one config, would be counted twice in every summary (as a duplicate factor level
+    or seed would): refused, naming them."""
+    seen: dict[str, str] = {}
+    for name, cfg in bases:
+        text = json.dumps({k: v for k, v in cfg.items() if k != "name"}, sort_keys=True, default=str)
+        if name in seen.values():
+            raise ConfigError(f"base: {name!r} is given twice; its runs would be counted twice in every summary: give "
+                              "each base once (or name two variants apart: name: in an inline config)")
+        if text in seen:
+            raise ConfigError(f"base: {seen[text]!r} and {name!r} are the same config; their runs would be counted "
+                              "as two settings: keep one")
+        seen[text] = name
 
 
 def _resolve(root: Path, path: str) -> str:

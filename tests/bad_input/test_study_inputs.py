@@ -40,6 +40,13 @@ CASES = [
                                                     "label": "again"}]),
      "recordings 'sim_straight_s0' and 'again_s1' are identical: the same simulation (seeds 0 and 1) without a random "
      "part"),
+    ("base-twice", lambda: Study.from_dict({"name": "s", "base": ["yun2012", "yun2012"],
+                                            "recordings": [{"simulate": SIM}]}),
+     "base: 'yun2012' is given twice; its runs would be counted twice in every summary"),
+    ("base-same-config-two-names", lambda: Study.from_dict({"name": "s", "recordings": [{"simulate": SIM}], "base": [
+        {"name": "a", "orientation": {"type": "madgwick"}, "detector": {"type": "shoe"}},
+        {"name": "b", "orientation": {"type": "madgwick"}, "detector": {"type": "shoe"}}]}),
+     "base: 'a' and 'b' are the same config; their runs would be counted as two settings"),
     ("seed-negative", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seeds": [-1]}]),
      "recordings[0].seeds must be a list of whole numbers >= 0, got [-1]"),
     ("seed-key-singular", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seed": 7}]),

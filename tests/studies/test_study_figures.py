@@ -106,8 +106,8 @@ def test_inline_base_configs_without_a_name_are_named_by_what_differs():
     assert names == ["detector: angular_rate_fsm", "detector: shoe"]
     named = [n for n, _ in Study.from_dict({**STUDY, "base": [fsm, {**shoe, "name": "mine"}]}).bases]
     assert named == ["detector: angular_rate_fsm", "mine"]
-    twins = [n for n, _ in Study.from_dict({**STUDY, "base": [fsm, fsm]}).bases]
-    assert twins == ["base0", "base1"]  # nothing differs: numbered
+    with pytest.raises(ConfigError, match="'base0' and 'base1' are the same config"):  # nothing differs: one config
+        Study.from_dict({**STUDY, "base": [fsm, fsm]})
 
 
 def test_dictionary_levels_are_labelled_readably_in_the_summary(tmp_path):
