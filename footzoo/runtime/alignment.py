@@ -70,6 +70,39 @@ def initial_attitude(
     return q
 
 
+#: How long (s) the first samples are looked at to tell a recording that starts in motion.
+MOVING_START = 0.05
+
+
+def warn_moving_start(t: np.ndarray, gyr: np.ndarray, duration: float = 0.5, max_gyr: float = 0.6,
+                      name: str = "recording") -> bool:
+    """Warn (a :class:`~footzoo.core.errors.SensorWarning`) when the recording starts in motion; whether it does.
+
+    Every pipeline starts from rest: zero velocity at the first sample, its attitude carried back from the first
+    still period. A recording cut in the middle of a stride (its first :data:`MOVING_START` s turning faster than
+    ``max_gyr`` rad/s, in the median) breaks that: the swing it starts in is integrated from a velocity that is not
+    zero, and the whole track is shifted by that swing's error (a simulated walk cut mid-swing: 1.7 m). The 78
+    visible recordings (PyShoe, x-io, gaitmap, Köroğlu, IPOL) start at most at 0.11 rad/s. ``t`` (s), ``gyr``
+    (rad/s), ``duration`` (s) and ``max_gyr`` (rad/s) as in :func:`first_still_window`.
+    """
+    n = int(np.searchsorted(t, t[0] + MOVING_START, side="right"))
+    rate = float(np.median(np.linalg.norm(gyr[: max(n, 2)], axis=1)))
+    if rate <= max_gyr:
+        return False
+    try:
+        start, _ = first_still_window(t, gyr, duration, max_gyr)
+    except RecordingError:
+        return True  # no still period at all: the alignment's error names it
+    where = f"the first still period begins at t = {t[start]:.2f} s"
+    warnings.warn(
+        f"{name}: the recording starts in motion (the gyroscope turns at {rate:.2f} rad/s over its first "
+        f"{MOVING_START * 1e3:.0f} ms; {where}). Every estimate starts from rest, so the velocity of the swing it "
+        "starts in is unknown and the whole track is shifted by that swing's error (metres). Start the recording with "
+        "the foot at rest, or cut it where the foot stands (a stance)",
+        SensorWarning, stacklevel=user_stacklevel())
+    return True
+
+
 #: Largest relative difference between the still start's specific force and g that is left as it is. Calibrated
 #: sensors read well inside it (PyShoe's VICON trials, x-io and Köroğlu's recordings: at most 1.8 %, the IPOL set's
 #: right feet 0.4–1.6 %); the IPOL set's left-foot MTw reads 2.3–6.4 % above g.

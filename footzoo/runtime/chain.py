@@ -20,7 +20,7 @@ from ..core.context import RunContext
 from ..core.data import Recording
 from ..plugins.base import Calibration, Samples
 from ..plugins.incremental import Chunk, length
-from .alignment import accelerometer_gain, initial_attitude
+from .alignment import accelerometer_gain, initial_attitude, warn_moving_start
 from .stage import Stage
 from .stages import (
     BatchNavigationStage,
@@ -173,6 +173,7 @@ def input_stages(pipeline: Any, ctx: RunContext, start: Chunk, calibrations: lis
     """
     stages: list[Stage] = []
     out = start
+    warn_moving_start(start["t"], start["gyr"], name=ctx.name, **pipeline.init)
     gain = accelerometer_gain(start["t"], start["acc"], start["gyr"], pipeline.gravity, name=ctx.name, **pipeline.init)
     if gain != 1.0:
         stage = GainStage(gain, pipeline.gravity / gain, pipeline.gravity)

@@ -330,3 +330,16 @@ def test_drift_of_a_foot_the_detector_takes_for_stance_is_blamed_on_the_correcti
     held, found = _sensor_warnings(lambda: Pipeline.from_dict({**config, "corrections": [{"type": "zupt"}]}).run(rec))
     assert "still_drift" not in held.diagnostics.get("sensor", {}) and not found
     assert np.abs(held.pos).max() < 0.01
+
+
+def test_a_recording_cut_in_the_middle_of_a_swing_is_said_to_start_in_motion_batch_and_live():
+    """Every estimate starts from rest: a walk cut mid-swing is shifted by that swing's error, named at once."""
+    rec = simulate(n_strides=8, rate=100.0, noise=NoiseModel(seed=0))
+    k = int(np.flatnonzero(np.linalg.norm(rec.gyr, axis=1) > 3.0)[40])  # inside a swing
+    cut = Recording(t=rec.t[k:] - rec.t[k], acc=rec.acc[k:], gyr=rec.gyr[k:], meta={"name": "cut"})
+    _, found = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(cut))
+    assert sum("the recording starts in motion" in m for m in found) == 1
+    _, live = _sensor_warnings(lambda: Stream(Pipeline.from_dict(BASE), rate=cut.rate).run(cut, chunk=9))
+    assert sum("the recording starts in motion" in m for m in live) == 1
+    _, whole = _sensor_warnings(lambda: Pipeline.from_dict(BASE).run(rec))
+    assert not any("starts in motion" in m for m in whole)  # the same walk from its still start
