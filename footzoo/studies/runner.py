@@ -104,13 +104,19 @@ def _metrics(rec, res, pos: np.ndarray, metric_names: list[str] | None) -> tuple
     return {k: float(v) for k, v in m.items()}, notes
 
 
-def _roc(rec, detector_spec: dict[str, Any], points: int) -> list[list[float]]:
-    """Threshold sweep from the detector's statistic (stance where the statistic is below the threshold)."""
+def _roc(rec, detector_spec: dict[str, Any], points: int, label: str) -> list[list[float]]:
+    """Threshold sweep from the detector's statistic (stance where the statistic is below the threshold); ``label``
+    the recording's name in the study."""
 
     if rec.truth is None or rec.truth.stance is None:
+        warnings.warn(FootzooWarning(f"sweep: recording {label!r} has no reference stance, so no ROC curve is drawn "
+                                     "for it (a sweep needs one: a simulated recording, PyShoe's trials)"),
+                      stacklevel=user_stacklevel())
         return []
     det = build("detector", dict(detector_spec))
     if getattr(det, "needs_truth", False):
+        warnings.warn(FootzooWarning(f"sweep: detector {det.name!r} reads the reference stance itself, so it has no "
+                                     "threshold to sweep and no ROC curve"), stacklevel=user_stacklevel())
         return []
     checked(det.detect, rec.t, rec.acc, rec.gyr)
     stat, truth = np.asarray(getattr(det, "statistic_", None) if getattr(det, "statistic_", None) is not None
@@ -203,7 +209,7 @@ def _compute(cell: Cell, key: str, rec, metric_names: list[str] | None, sweep_po
         if sweep_points:
             with warnings.catch_warnings(record=True) as swept:
                 warnings.simplefilter("always")
-                out["roc"] = _roc(rec, cell.config["detector"], sweep_points)
+                out["roc"] = _roc(rec, cell.config["detector"], sweep_points, cell.recording.label)
             caught += swept
     except Exception as err:  # one failing run is reported, not fatal
         _fail(out, err)

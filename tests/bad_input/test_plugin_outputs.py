@@ -248,3 +248,27 @@ def test_property_annotate_is_accepted_exactly_when_it_keeps_the_strides_and_the
         assert broken
         return
     assert not broken
+
+
+def test_a_sweep_that_cannot_draw_a_curve_says_why(tmp_path):
+    """An oracle detector (it reads the reference) has no threshold; a recording without a stance reference has
+    nothing to score: each is said, never a silently empty roc.parquet."""
+    from footzoo.io.canonical import write
+    from footzoo.sim import simulate
+
+    walk = simulate(path="straight", n_strides=4, rate=50)
+    walk.truth = None
+    write(walk, tmp_path / "plain.csv")
+    study = Study.from_dict({
+        "name": "sweep", "base": {"orientation": {"type": "madgwick"}, "detector": {"type": "angular_rate_fsm"},
+                                  "corrections": [{"type": "zvu_dedrift"}]},
+        "factors": {"detector.type": ["oracle", "angular_rate_fsm"]},  # the oracle fails on plain.csv, said too
+        "recordings": [{"simulate": {"path": "straight", "n_strides": 4, "rate": 50}}, str(tmp_path / "plain.csv")],
+        "metrics": ["strides"], "sweep": {"points": 5}})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run_study(study, jobs=1)
+    said = [str(w.message) for w in caught]
+    assert any("detector 'oracle' reads the reference stance itself, so it has no threshold to sweep" in m
+               for m in said)
+    assert any("recording 'plain' has no reference stance, so no ROC curve is drawn" in m for m in said)
