@@ -665,6 +665,12 @@ def _check_units(rec: Recording) -> None:
     check_units(rec.acc, rec.gyr)
 
 
+#: A foot's specific force peaks at a few g (up to 16 g at a running heel strike): the 99th percentile of ‖f‖ over its
+#: reading at rest stays below this in any unit; above it, a unit error (which scales both alike) does not explain the
+#: reading at rest.
+REST_TO_PEAK_MAX = 50.0
+
+
 def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
     """Refuse an accelerometer or a gyroscope in another unit than the one declared (a RecordingError with the fix).
 
@@ -692,6 +698,15 @@ def check_units(acc: np.ndarray, gyr: np.ndarray) -> None:
             f"({unit_fix('acc_unit', 'mg')})"
         )
     if not 0.5 * GRAVITY < rest < 1.5 * GRAVITY:
+        peak = float(np.quantile(acc_norm, 0.99))
+        if rest > 0 and peak / rest > REST_TO_PEAK_MAX:  # motion in a sane unit, rest far below g: not a unit error
+            spans = ", ".join(f"acc_{a} {float(r):.3g}" for a, r in zip("xyz", np.ptp(acc, axis=0), strict=True))
+            raise RecordingError(
+                f"accelerometer magnitude at rest is {rest:.3g} m/s² as declared, far from g, but {peak:.3g} m/s² in "
+                f"motion (99th percentile): a unit error scales both alike, so no unit explains it. An axis may be "
+                f"dead or unconnected, or a column may not be the accelerometer's (ranges: {spans}); check the "
+                "sensor and which columns are read as acc_x, acc_y, acc_z"
+            )
         for true, declared in (("m/s^2", "g"), ("m/s^2", "mg"), ("g", "mg"), ("mg", "g")):
             read = GRAVITY * ACC_UNITS[declared] / ACC_UNITS[true]  # what g in `true` reads as `declared`, in m/s²
             if abs(np.log(rest / read)) < np.log(1.3):

@@ -238,3 +238,17 @@ def test_a_table_with_no_time_column_takes_its_rate():
         Recording.from_dataframe(df.assign(t=walk.t), rate=50.0)
     with pytest.raises(ConfigError, match="rate"):
         Recording.from_dataframe(df, rate=-5)
+
+
+def test_a_dead_accelerometer_axis_is_not_named_a_unit_whose_fix_changes_nothing():
+    """acc_z reads nothing (the gravity axis): at rest ‖f‖ is near 0, as g in m/s² declared as mg would read, but the
+    motion reads m/s²: no unit scales one and not the other. The error names the ranges instead of a unit."""
+    from footzoo.sim import NoiseModel, simulate
+
+    walk = simulate(n_strides=4, rate=100.0, noise=NoiseModel(seed=0))
+    acc = walk.acc.copy()
+    acc[:, 2] = np.random.default_rng(0).normal(0.0, 1e-4, len(acc))
+    with pytest.raises(RecordingError, match=r"a unit error scales both alike, so no unit explains it.*acc_z "
+                                             r"0.000\d+\)") as info:
+        Recording(t=walk.t, acc=acc, gyr=walk.gyr)
+    assert "declare acc_unit" not in str(info.value)
