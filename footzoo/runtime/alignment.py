@@ -18,7 +18,7 @@ import warnings
 
 import numpy as np
 
-from ..core.conventions import quat_conj, quat_from_rotvec, quat_mul
+from ..core.conventions import GRAVITY, quat_conj, quat_from_rotvec, quat_mul
 from ..core.errors import RecordingError, SensorWarning, user_stacklevel
 from ..orientation.fqa import fqa_sample
 
@@ -108,6 +108,10 @@ def warn_moving_start(t: np.ndarray, gyr: np.ndarray, duration: float = 0.5, max
 #: right feet 0.4–1.6 %); the IPOL set's left-foot MTw reads 2.3–6.4 % above g.
 ACC_GAIN_TOLERANCE = 0.03
 
+#: The gains (g over the still start's reading) a scale-factor error can need: a MEMS accelerometer's is a few per
+#: cent (the IPOL set's MTw: 6.4 %); a reading 20 % or more off g is a unit or a column, not a gain.
+ACC_GAIN_RANGE = (0.8, 1.25)
+
 #: Largest standard deviation of ‖f‖ over the still start, relative to g, for its mean to be taken as gravity: a
 #: sensor at rest scatters by its noise (0.1-0.5 % of g for the recordings above), a start whose gyroscope is quiet
 #: but whose foot accelerates (a slide, a tap) scatters more and says nothing about the gain.
@@ -129,6 +133,15 @@ def accelerometer_gain(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, gravity:
     start, stop = first_still_window(t, gyr, duration, max_gyr)
     still = float(np.linalg.norm(acc[start:stop].mean(axis=0)))
     if abs(still / gravity - 1.0) <= ACC_GAIN_TOLERANCE:
+        return 1.0
+    gain = gravity / still if still > 0 else float("inf")
+    if not ACC_GAIN_RANGE[0] <= gain <= ACC_GAIN_RANGE[1]:
+        warnings.warn(
+            f"{name}: the accelerometer reads {still:.3g} m/s² in the still start (t = {t[start]:.2f}-"
+            f"{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²: no "
+            "scale-factor error is that large, so the specific force is not rescaled. Check the accelerometer's unit "
+            "(acc_unit) and which columns are read as acc_* and gyr_*",
+            SensorWarning, stacklevel=user_stacklevel())
         return 1.0
     reading = (f"{name}: the accelerometer reads {still:.3f} m/s² in the still start (t = {t[start]:.2f}-"
                f"{t[stop - 1]:.2f} s), {100.0 * (still / gravity - 1.0):+.1f} % off g = {gravity:g} m/s²")
@@ -171,6 +184,13 @@ def first_still_window(t: np.ndarray, gyr: np.ndarray, duration: float, max_gyr:
         if m == n:
             break
         m = min(n, 4 * m)
+    level = float(np.median(np.linalg.norm(gyr, axis=1))) if n else 0.0
+    if abs(level / GRAVITY - 1.0) < 0.15:  # a "gyroscope" that reads g: the accelerometer's columns
+        raise RecordingError(
+            f"the recording has no still period: its gyroscope turns at {level:.2f} rad/s in the median, which is "
+            f"g = {GRAVITY} m/s² in number; the accelerometer's and the gyroscope's columns look swapped. Check which "
+            "columns are read as acc_* and gyr_* (a sidecar's columns, the file's header)"
+        )
     raise RecordingError(
         f"the recording has no still period of {duration} s (|ω| ≤ init.max_gyr = {max_gyr} rad/s) "
         "to align the initial attitude; record a moment of rest, shorten init.duration or raise init.max_gyr"

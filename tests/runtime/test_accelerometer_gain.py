@@ -156,3 +156,21 @@ def test_the_step_by_step_api_prepares_a_walk_read_5_percent_high_as_run_does(wa
     again = pipe.run(rec)  # run takes a prepared recording as it is too: not scaled twice, no second warning
     assert not [w for w in recwarn if issubclass(w.category, SensorWarning)]
     np.testing.assert_array_equal(again.pos, res.pos)
+
+
+def test_a_reading_far_from_g_is_not_rescaled_as_a_gain(walk):
+    """A gain is a few per cent: a still start at 0.3 g is a unit or a column, never multiplied up to g (a swapped
+    recording was once rescaled by 9674)."""
+    with pytest.warns(SensorWarning, match=r"-70.0 % off g .* no scale-factor error is that large, so the specific "
+                                           r"force is not rescaled"):
+        gain = alignment.accelerometer_gain(walk.t, walk.acc * 0.3, walk.gyr, 9.81, name="far")
+    assert gain == 1.0
+
+
+def test_no_still_period_because_the_columns_are_swapped_is_said_so(walk):
+    """With the accelerometer read as the gyroscope, |ω| reads g throughout: no still period, named as a swap."""
+    from footzoo import RecordingError
+
+    with pytest.raises(RecordingError, match=r"which is g = 9.81 m/s² in number; the accelerometer's and the "
+                                             r"gyroscope's columns look swapped"):
+        alignment.first_still_window(walk.t, walk.acc, 0.5, 0.6)
