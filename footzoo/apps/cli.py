@@ -653,6 +653,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     # deferred: pandas and the readers: the command line starts without them
     from ..analysis.foot_vector import calibrate_foot_vector, calibration_trial_problems
 
+    if Path(args.out).suffix.lower() not in YAML_SUFFIXES:  # huang_fpa reads its calibration as YAML
+        raise ConfigError(f"--out {args.out!r}: the foot-vector calibration is a YAML file, which huang_fpa's "
+                          f"calibration: reads; name it '{Path(args.out).stem}.yaml'")
     target = _writable_file(args.out)
     rec = _load_recording(args)
     refuse_inputs([target], _inputs(args, rec), "--out")

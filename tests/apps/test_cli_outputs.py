@@ -68,8 +68,8 @@ def test_run_out_through_a_symlink_or_dotdot_onto_the_input_is_refused(walk, tmp
 def test_calibrate_out_equal_to_data_is_refused(tmp_path, capsys):
     data = write(simulate_calibration(rate=100.0), tmp_path / "cal.csv")
     before = data.read_bytes()
-    assert main(["calibrate", "--data", str(data), "--out", str(data)]) == EXIT_DATA
-    assert "would overwrite the input" in capsys.readouterr().err and data.read_bytes() == before
+    assert main(["calibrate", "--data", str(data), "--out", str(data)]) == EXIT_USAGE  # refused before it is read
+    assert "the foot-vector calibration is a YAML file" in capsys.readouterr().err and data.read_bytes() == before
     assert main(["calibrate", "--data", str(data), "--out", str(tmp_path / "fv.yaml")]) == EXIT_OK
     assert (tmp_path / "fv.yaml").read_text().startswith("foot_vector:") and no_temporaries(tmp_path)
 

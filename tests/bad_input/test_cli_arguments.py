@@ -68,6 +68,8 @@ CASES = [
      "argument --cache-max-age: -1 days is out of range"),
     ("cache-size-nan", lambda d, w: ["ablate", str(QUICK), "--cache-max-size", "nan"], EXIT_USAGE,
      "argument --cache-max-size: nan MB is out of range"),
+    ("calibrate-out-not-yaml", lambda d, w: ["calibrate", "--data", str(w), "--out", str(d / "fv.csv")], EXIT_USAGE,
+     "the foot-vector calibration is a YAML file, which huang_fpa's calibration: reads; name it 'fv.yaml'"),
     ("still-text", lambda d, w: ["calibrate", "--data", str(w), "--still", "a", "b", "--out", str(d / "f.yaml")],
      EXIT_USAGE, "argument --still: 'a' is not a number"),
     ("ablate-out-empty", lambda d, w: ["ablate", str(QUICK), "--out", ""], EXIT_USAGE, "argument --out: an empty path"),
