@@ -192,10 +192,13 @@ class Readers(Mapping[str, Any]):
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
         sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"), (" ", "spaces"))
                     if head and ch in head and "," not in head), "")
-        second = next_line(p, head) if head and "," not in head and p.suffix.lower() in (".csv", "") else ""
-        if second.count(",") >= 2:  # a title line above a comma-separated header
-            seen += (f"; a line without commas comes before what looks like its header ({second[:60]!r}): remove that "
-                     f"line, or describe the file (skip_rows: 1, or comment: '#') in a sidecar {p.name}.footzoo.yaml")
+        second = next_line(p, head) if head and p.suffix.lower() in (".csv", ".txt", ".tsv", "") else ""
+        title = next(((ch, name) for ch, name in ((",", "commas"), ("\t", "tabs"), (";", "semicolons"))
+                      if second.count(ch) >= 2 and ch not in head), None)
+        if title:  # a title line above a delimited header
+            seen += (f"; a line without {title[1]} comes before what looks like its header ({second[:60]!r}, "
+                     f"separated by {title[1]}): remove that line, or describe the file (skip_rows: 1, or comment: "
+                     f"'#') in a sidecar {p.name}.footzoo.yaml")
         elif sep:
             seen += (f"; its values are separated by {sep}, not commas: save it as comma-separated CSV, or "
                      f"describe it (delimiter, decimal) in a sidecar {p.name}.footzoo.yaml")

@@ -227,6 +227,9 @@ CASES = [
         index=False, sep=" ").encode()))), FormatError, "its values are separated by spaces, not commas"),
     Case("title-line-above-the-header", lambda d, w, x: (lambda: load(_file(d, "r.csv", b"# left foot sensor\n" + x))),
          FormatError, "a line without commas comes before what looks like its header ('t,acc_x,"),
+    Case("title-line-above-a-tab-header", lambda d, w, x: (lambda: load(_file(d, "r.txt", b"Acquisition frequency: 100 "
+                                                                       b"Hz\n" + x.replace(b",", b"\t")))),
+         FormatError, "a line without tabs comes before what looks like its header ('t\\tacc_x"),
     # a sidecar that cannot be written
     Case("sidecar-is-a-folder", lambda d, w, x: (lambda: write(w, _folder_sidecar(d))), OutputError,
          "its sidecar s.csv.meta.yaml (its metadata, written next to it) cannot be written: s.csv.meta.yaml is a "
