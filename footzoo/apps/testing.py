@@ -142,6 +142,7 @@ def check_plugin(cls: type[Plugin], verbose: bool | None = None) -> CheckReport:
     """
     report = CheckReport(f"{getattr(cls, 'kind', '?')} {getattr(cls, 'name', '?')!r}")
     _check_declaration(cls)
+    _check_stored_as_given(cls)
     report.passed("registration and declaration")
     _check_declared_parameters(cls, report)
     instance = cls()
@@ -202,6 +203,18 @@ def _check_declaration(cls: type[Plugin]) -> None:
         f"found {registered!r})")
     assert (cls.__doc__ or "").strip(), f"{cls.__name__}: no docstring (cite the paper and its equations)"
     assert cls.paper, f"{cls.__name__}: class attribute 'paper' is empty (cite the source)"
+
+
+def _check_stored_as_given(cls: type[Plugin]) -> None:
+    """scikit-learn's rule, checked first (the later checks assume it): ``__init__`` stores each parameter as given,
+    as the attribute of its own name."""
+    instance = cls()
+    for name, default in cls.defaults().items():
+        rule = (f"{cls.__name__}.__init__ must store each parameter as given, under its own name (self.{name} = "
+                f"{name}); derived values belong in the action method")
+        assert hasattr(instance, name), f"{rule}: it has no attribute self.{name}"
+        assert _equal(getattr(instance, name), default), (f"{rule}: self.{name} is {getattr(instance, name)!r} where "
+                                                          f"{name}={default!r} was given")
 
 
 def _check_declared_parameters(cls: type[Plugin], report: CheckReport) -> None:

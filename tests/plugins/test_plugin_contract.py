@@ -67,6 +67,36 @@ def test_check_plugin_catches_a_numeric_parameter_without_a_unit():
         check_plugin(NoUnit)
 
 
+@pytest.mark.parametrize("stored, says", [
+    ("doubled", r"self.gyro_max is 1.2 where gyro_max=0.6 was given"),
+    ("renamed", r"it has no attribute self.gyro_max"),
+])
+def test_check_plugin_names_an_init_that_does_not_store_its_parameters_as_given(stored, says):
+    """scikit-learn's rule is checked first, so its breach is named as such (not as a set_params or action failure)."""
+    class Stores(Detector):
+        """Gyro-magnitude threshold whose __init__ breaks the rule."""
+
+        name = f"test_stores_{stored}"
+        paper = "none (test)"
+        parameters = {"gyro_max": Real("rad/s", "(0, 10]", "bound on |ω|", source="a test")}
+
+        def __init__(self, gyro_max: float = 0.6):
+            if stored == "doubled":
+                self.gyro_max = 2.0 * gyro_max
+            else:
+                self.gmax = gyro_max
+
+        def detect(self, t, acc, gyr):
+            self.statistic_ = np.linalg.norm(gyr, axis=1)
+            self.stance_ = self.statistic_ < 0.6
+            return self
+
+    footzoo.register(Stores)
+    with pytest.raises(AssertionError, match=r"Stores.__init__ must store each parameter as given, under its own "
+                                             rf"name \(self.gyro_max = gyro_max\).*{says}"):
+        check_plugin(Stores)
+
+
 def test_nan_input_to_any_action_method_footzoo_calls_is_a_clear_error():
     det = available("detector")["shoe"]()
     t = np.arange(100) / 100.0
