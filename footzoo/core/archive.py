@@ -530,6 +530,14 @@ def save_result(result: Any, path: str | os.PathLike, backend: str = "auto", inp
     """
     backend = _backend(backend)
     what = "Result.save"
+    if not isinstance(path, (str, os.PathLike)):
+        raise OutputError(f"{what}: the folder is a path (text or pathlib.Path), got {type(path).__name__} "
+                          f"{path!r:.60}")
+    for name, content in (files or {}).items():
+        if not isinstance(name, str) or not isinstance(content, (bytes, bytearray)):
+            raise OutputError(f"{what}: files= maps file names (text) to their content (bytes), got {name!r}: "
+                              f"{type(content).__name__}; a figure's bytes come from "
+                              "footzoo.evaluation.plots.png_bytes, text from str.encode()")
     suffix = Path(path).suffix.lower()
     if suffix in FILE_SUFFIXES and not Path(path).is_dir():
         raise OutputError(f"{what}: {str(path)!r} looks like a file name ({suffix}), but a result is saved as a folder "

@@ -366,6 +366,12 @@ def run_study(
     with WarningLog() as log:  # the study's warnings, for its footzoo.log; the caller gets them at the end
         if isinstance(study, Mapping):  # the study file's mapping, paths relative to the working folder
             study = Study.from_dict(study, max_cells=max_cells)
+        elif not isinstance(study, (str, os.PathLike)) and not isinstance(study, Study):
+            hint = (": a pipeline runs on a recording with pipeline.run(rec); a study of it names it as its base, "
+                    "e.g. run_study({'name': 's', 'base': 'yun2012', 'recordings': [...]})"
+                    if hasattr(study, "run") and hasattr(study, "detector") else "")
+            raise ConfigError(f"run_study takes a Study, a study file's path or name, or its mapping; got "
+                              f"{type(study).__name__}{hint}")
         elif not isinstance(study, Study):
             study = Study.from_yaml(study, max_cells=max_cells)
         if jobs is None:

@@ -591,6 +591,9 @@ def _seeds(r: dict[str, Any], i: int) -> list[int]:
     if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0
                                               for s in seeds):
         raise ConfigError(f"recordings[{i}].seeds must be a list of whole numbers >= 0, got {seeds!r:.120}")
+    if not seeds:
+        raise ConfigError(f"recordings[{i}].seeds is empty, so the entry gives no recording: list at least one seed "
+                          "(seeds: [0]), or remove the entry")
     repeats = r.get("repeats", 1)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ConfigError(f"recordings[{i}].repeats must be a whole number >= 1, got {repeats!r}")

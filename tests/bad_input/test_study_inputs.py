@@ -47,6 +47,11 @@ CASES = [
         {"name": "a", "orientation": {"type": "madgwick"}, "detector": {"type": "shoe"}},
         {"name": "b", "orientation": {"type": "madgwick"}, "detector": {"type": "shoe"}}]}),
      "base: 'a' and 'b' are the same config; their runs would be counted as two settings"),
+    ("seeds-empty", _study([{"simulate": SIM, "seeds": []}]),
+     "recordings[0].seeds is empty, so the entry gives no recording: list at least one seed"),
+    ("run-study-of-a-pipeline", lambda: __import__("footzoo").run_study(__import__("footzoo").Pipeline.from_yaml(
+        "yun2012")), "run_study takes a Study, a study file's path or name, or its mapping; got Pipeline: a pipeline "
+                     "runs on a recording with pipeline.run(rec)"),
     ("seed-negative", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seeds": [-1]}]),
      "recordings[0].seeds must be a list of whole numbers >= 0, got [-1]"),
     ("seed-key-singular", _study([{"simulate": {**SIM, "noise": {"scale": 1}}, "seed": 7}]),

@@ -348,3 +348,12 @@ def test_a_folder_name_the_file_system_refuses_is_an_output_error(result, tmp_pa
     monkeypatch.chdir(tmp_path)
     with pytest.raises(OutputError, match=r"cannot be used as a folder \(File name too long\); choose a shorter"):
         result.save(name)
+
+
+def test_save_names_an_argument_of_the_wrong_kind(result, tmp_path):
+    with pytest.raises(OutputError, match=r"Result.save: the folder is a path \(text or pathlib.Path\), got int 123"):
+        result.save(123)
+    with pytest.raises(OutputError, match=r"files= maps file names \(text\) to their content \(bytes\), got "
+                                          r"'fig.png': str"):
+        result.save(tmp_path / "r", files={"fig.png": "not bytes"})
+    assert not (tmp_path / "r").exists()  # refused before anything is written
