@@ -171,6 +171,10 @@ class Pipeline:
         self.guards = guards if isinstance(guards, StanceGuard) else StanceGuard.from_dict(guards)
         check_parameters([*self.calibration, orientation, detector, *self.corrections, *self.analysis])
         check_compatibility(orientation, detector, self.corrections)
+        fits = [c.name for c in self.calibration]
+        if len(set(fits)) < len(fits):  # the second fit would calibrate the signals the first already calibrated
+            raise ConfigError(f"calibration: {sorted({n for n in fits if fits.count(n) > 1})} listed more than once; "
+                              "keep one of each")
         if smoother not in self.SMOOTHERS:
             raise ConfigError(f"smoother must be one of {list(self.SMOOTHERS)}, got {smoother!r}")
         if smoother != "none" and not self.filter_corrections:

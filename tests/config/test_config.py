@@ -221,3 +221,24 @@ def test_validate_prints_the_resolved_config_on_request_and_it_runs_as_the_origi
     text = capsys.readouterr().out.split("# the config with every default filled in (what footzoo run runs):\n")[1]
     resolved = Pipeline.from_dict(yaml.safe_load(text))
     assert resolved.to_dict() == Pipeline.from_yaml("recommended").to_dict()
+
+
+def test_kalman_noises_on_a_pipeline_without_a_kalman_filter_are_refused_not_ignored():
+    import yaml
+
+    from footzoo.config.library import path as config_path
+
+    cfg = yaml.safe_load(config_path("yun2012").read_text())
+    with pytest.raises(ConfigError, match=r"navigation: velocity_noise set\(s\) the Kalman filter's noises, and this "
+                                          r"pipeline has none, so it would change nothing"):
+        Pipeline.from_dict({**cfg, "navigation": {"velocity_noise": 5.0}})
+
+
+def test_a_calibration_listed_twice_is_refused():
+    import yaml
+
+    from footzoo.config.library import path as config_path
+
+    cfg = yaml.safe_load(config_path("yun2012").read_text())
+    with pytest.raises(ConfigError, match=r"calibration: \['hard_iron'\] listed more than once; keep one of each"):
+        Pipeline.from_dict({**cfg, "calibration": [{"type": "hard_iron"}, {"type": "hard_iron"}]})

@@ -3,7 +3,6 @@ unchanged, closer to the truth, the backward recursions equal to filterpy's RTS 
 
 import numpy as np
 import pytest
-import yaml
 
 from footzoo import ConfigError, Pipeline
 from footzoo.sim import NoiseModel, simulate
@@ -51,14 +50,6 @@ def test_smoothing_needs_a_kalman_filter_and_a_known_name():
     with pytest.raises(ConfigError, match=r"smoother must be one of \['none', 'rts', 'stepwise'\]"):
         _pipeline("duong2015_zupt", "kalman")
 
-
-def test_kalman_noises_on_a_pipeline_without_a_kalman_filter_are_refused_not_ignored():
-    from footzoo.config.library import path as config_path
-
-    cfg = yaml.safe_load(config_path("yun2012").read_text())
-    with pytest.raises(ConfigError, match=r"navigation: velocity_noise set\(s\) the Kalman filter's noises, and this "
-                                          r"pipeline has none, so it would change nothing"):
-        Pipeline.from_dict({**cfg, "navigation": {"velocity_noise": 5.0}})
 
 
 def _linear_system(measured_every: int = 40):
