@@ -133,6 +133,10 @@ class TuneSpec:
             raise ConfigError(f"tune.space must map dotted paths to values or ranges, got {spec.space!r}")
         for path, dist in spec.space.items():
             _check_distribution(path, dist)
+        if spec.search == "grid" and spec.space:
+            raise ConfigError("tune.space is searched by search: random or optuna; with search: grid (the default) the "
+                              "candidates are the study's factors and the space would be ignored: set search: random "
+                              "(or optuna), or remove space")
         if spec.group_by is not None:
             try:
                 if re.compile(str(spec.group_by)).groups < 1:

@@ -254,3 +254,11 @@ def test_a_geometric_mean_of_a_signed_objective_is_refused_not_scored_nan():
     with pytest.raises(ConfigError, match=r"gmean needs positive values of the objective, but "
                                           r"'stride_length_mean_error_m' is -0.03 on a recording.*aggregate: mean"):
         score(pd.Series([0.02, -0.03]), groups)
+
+
+def test_a_space_with_a_grid_search_is_refused_not_ignored():
+    from footzoo.core.errors import ConfigError
+    from footzoo.studies.tune import TuneSpec
+
+    with pytest.raises(ConfigError, match=r"tune.space is searched by search: random or optuna; with search: grid"):
+        TuneSpec.from_dict({"objective": "armse_3d_m", "space": {"detector.threshold": [0.5, 0.6]}})
