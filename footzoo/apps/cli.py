@@ -878,8 +878,10 @@ def build_parser() -> argparse.ArgumentParser:
     comp.set_defaults(func=cmd_compile)
 
     sim = sub.add_parser("simulate", help="simulate a foot-mounted IMU recording with ground truth")
-    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "pendulum",
-                                          "calibration"])
+    sim.add_argument("scenario", choices=["straight", "rectangle", "track", "figure_eight", "mixed_speed", "run",
+                                          "stairs", "pendulum", "calibration"],
+                     help="the walk (run: a running gait; stairs: a flight up, from a level start), a pendulum or a "
+                          "foot-vector calibration trial")
     sim.add_argument("--out", required=True, type=_output,
                      help="output file (.csv or .parquet); truth in true_* columns, with its sidecars")
     sim.add_argument("--strides", type=_number(1, 100_000, integer=True), default=100,

@@ -210,3 +210,13 @@ def test_a_name_the_terminal_cannot_show_is_escaped_not_a_crash(tmp_path, monkey
     assert main(["validate", "gång.yaml"]) == EXIT_USAGE
     err.flush()
     assert "g\\xe5ng.yaml" in err.buffer.getvalue().decode("ascii")
+
+
+@pytest.mark.parametrize("scenario", ["run", "stairs"])
+def test_every_simulator_path_is_a_simulate_scenario(scenario, tmp_path):
+    """The command line offers what footzoo.sim.simulate offers (run and stairs were missing)."""
+    from footzoo.io import load
+
+    assert main(["simulate", scenario, "--strides", "4", "--rate", "50", "--out", str(tmp_path / "w.csv"),
+                 "--quiet"]) == 0
+    assert load(tmp_path / "w.csv").truth.pos is not None
