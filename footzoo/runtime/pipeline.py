@@ -142,7 +142,7 @@ class Pipeline:
     def __init__(
         self,
         orientation: Orientation,
-        detector: Detector,
+        detector: Detector | None = None,
         corrections: list[Plugin] | None = None,
         name: str = "pipeline",
         gravity: float = GRAVITY,
@@ -158,6 +158,12 @@ class Pipeline:
         for i, c in enumerate(self.calibration):
             if not isinstance(c, Calibration):
                 raise ConfigError(f"calibration[{i}] must be a footzoo.plugins.Calibration, got {type(c).__name__}")
+        if detector is None or isinstance(orientation, (str, os.PathLike, dict)):
+            how = ("Pipeline.from_dict(mapping)" if isinstance(orientation, dict) else
+                   f"Pipeline.from_yaml({str(orientation)!r})" if isinstance(orientation, (str, os.PathLike)) else
+                   "Pipeline.from_yaml(name) or Pipeline.from_dict(mapping)")
+            raise ConfigError(f"Pipeline(orientation, detector, ...) builds a pipeline from plug-in objects; a config "
+                              f"is read with {how}")
         self.orientation = orientation
         self.detector = detector
         self.corrections = list(corrections or [])
@@ -323,6 +329,9 @@ class Pipeline:
             in ``diagnostics['nis_rows']``) and their summary ``diagnostics['consistency']``
             (:func:`footzoo.evaluation.metrics.nis_summary`: 1 per row for a consistent filter).
         """
+        if not isinstance(self, Pipeline):  # Pipeline.run(rec, pipe): the class's method with the arguments swapped
+            raise NotAPipelineError(f"Pipeline.run was called on a {type(self).__name__}: call it on a pipeline, "
+                                    "pipeline.run(rec) (e.g. footzoo.Pipeline.from_yaml('yun2012').run(rec))")
         checked_engine("Pipeline.run", engine)
         covariance = checked_flag("Pipeline.run", "covariance", covariance)
         with inputs_checked_once(), _read_only(rec):  # each array is scanned for NaN once; none is written meanwhile

@@ -3,6 +3,8 @@ session run without a pipeline."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -74,11 +76,19 @@ def test_an_argument_of_the_wrong_kind_is_both_the_subjects_error_and_a_type_err
     for call, subject in [(lambda: pipe.run("walk.csv"), footzoo.RecordingError),
                           (lambda: footzoo.Session({"left": "walk.csv"}), footzoo.RecordingError),
                           (lambda: footzoo.Session({"left": sim_walk}).run("yun2012"), footzoo.ConfigError),
-                          (lambda: footzoo.Stream(None, rate=100.0), footzoo.ConfigError)]:
+                          (lambda: footzoo.Stream(None, rate=100.0), footzoo.ConfigError),
+                          (lambda: footzoo.Pipeline.run(sim_walk, pipe), footzoo.ConfigError)]:  # swapped
         with pytest.raises((NotARecordingError, NotAPipelineError)) as info:
             call()
         assert isinstance(info.value, subject) and isinstance(info.value, TypeError)
         assert "footzoo." in str(info.value) or "Pipeline.from_yaml" in str(info.value)
+
+
+def test_a_pipeline_built_from_a_config_name_says_how_to_read_one():
+    for given, how in (("yun2012", "Pipeline.from_yaml('yun2012')"), ({"orientation": {}}, "Pipeline.from_dict")):
+        with pytest.raises(footzoo.ConfigError, match=re.escape(f"builds a pipeline from plug-in objects; a config is "
+                                                                f"read with {how}")):
+            footzoo.Pipeline(given)
 
 
 # yun2012 fits a hard-iron calibration, which this straight simulated walk cannot give (expected warning)
