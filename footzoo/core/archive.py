@@ -632,7 +632,10 @@ def _read_manifest(path: str | os.PathLike, kind: str) -> dict[str, Any]:
             " (use Result.load for each foot's folder)" if found == FORMAT and kind == SESSION_FORMAT else ""
         raise FormatError(f"{manifest}: format {found!r}, expected {kind!r}{hint}")
     version = data.get("format_version")
-    if not isinstance(version, int) or version > FORMAT_VERSION:
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        raise FormatError(f"{manifest}: format version {version!r} is not one footzoo writes (whole numbers from 1); "
+                          "the manifest is damaged: save the result again or restore the folder from a copy")
+    if version > FORMAT_VERSION:
         raise FormatError(f"{manifest}: format version {version!r} is newer than this footzoo reads "
                           f"({FORMAT_VERSION}); upgrade footzoo (footzoo {data.get('footzoo_version')} wrote it)")
     files = data.get("files", {})

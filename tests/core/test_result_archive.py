@@ -357,3 +357,17 @@ def test_save_names_an_argument_of_the_wrong_kind(result, tmp_path):
                                           r"'fig.png': str"):
         result.save(tmp_path / "r", files={"fig.png": "not bytes"})
     assert not (tmp_path / "r").exists()  # refused before anything is written
+
+
+@pytest.mark.parametrize("version", [0, True, "1", None])
+def test_a_manifest_with_a_format_version_footzoo_never_wrote_is_refused(result, tmp_path, version):
+    import json
+    import re
+
+    folder = result.save(tmp_path / "r")
+    manifest = folder / "manifest.json"
+    data = json.loads(manifest.read_text())
+    data["format_version"] = version
+    manifest.write_text(json.dumps(data))
+    with pytest.raises(FormatError, match=rf"format version {re.escape(repr(version))} is not one footzoo writes"):
+        type(result).load(folder)
