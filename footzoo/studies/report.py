@@ -90,15 +90,20 @@ def readable(summary: pd.DataFrame, factor: str) -> pd.DataFrame:
     only what differs between the levels; a number keeps its value. The levels stay as they are
     when two would get one label.
     """
-    levels = list(dict.fromkeys(summary[factor].tolist()))
-    names = level_labels(factor, levels)
-    leaf = factor.split(".")[-1] + "="  # the column names the factor already
-    text = {k: v.removeprefix(leaf) for k, v in names.items()}
-    if len(set(text.values())) < len(levels):
-        return summary
+    text = _level_text(factor, summary[factor])
     out = summary.copy()
     out[factor] = [text[str(v)] for v in summary[factor]]
     return out
+
+
+def _level_text(factor: str, values: pd.Series) -> dict[str, str]:
+    """Each level of ``factor`` among ``values`` (by ``str(level)``) as a table cell under the factor's name: its
+    :func:`level_labels` label without the factor's own name (``static_gain=``), or the level as it is when two
+    would get one label."""
+    levels = list(dict.fromkeys(values.tolist()))
+    leaf = factor.split(".")[-1] + "="  # the column names the factor already
+    text = {k: v.removeprefix(leaf) for k, v in level_labels(factor, levels).items()}
+    return text if len(set(text.values())) == len(levels) else {str(v): str(v) for v in levels}
 
 
 def crossed(table: pd.DataFrame, rows: str, columns: str) -> pd.DataFrame:
@@ -111,11 +116,10 @@ def crossed(table: pd.DataFrame, rows: str, columns: str) -> pd.DataFrame:
     ok = table[table["metric"].notna()]
     wide = ok.pivot_table(index=["metric", rows], columns=columns, values="value", aggfunc="median", dropna=False)
     wide = wide.reindex(columns=list(dict.fromkeys(ok[columns].tolist())))
-    names = {f: level_labels(f, list(dict.fromkeys(ok[f].tolist()))) for f in (rows, columns)}
-    leaf = {f: f.split(".")[-1] + "=" for f in (rows, columns)}
-    wide.columns = [names[columns][str(c)].removeprefix(leaf[columns]) for c in wide.columns]
+    names = {f: _level_text(f, ok[f]) for f in (rows, columns)}
+    wide.columns = [names[columns][str(c)] for c in wide.columns]
     out = wide.reset_index()
-    out[rows] = [names[rows][str(v)].removeprefix(leaf[rows]) for v in out[rows]]
+    out[rows] = [names[rows][str(v)] for v in out[rows]]
     return out.rename(columns={rows: f"{rows} \\ {columns}"})
 
 
