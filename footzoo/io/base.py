@@ -209,8 +209,9 @@ def load_mat(path: str | Path, what: str = "a MATLAB .mat file", fix: str = "cop
                           f"truncated, or not a MATLAB file; {fix}") from None
 
 
-def next_line(path: str | Path, after: str) -> str:
-    """The first non-blank line after the first non-blank line ``after`` (:func:`first_line`), or ``""``."""
+def second_line(path: str | Path) -> str:
+    """The second non-blank line of a text file (without its line break), as :func:`first_line` reads the first;
+    ``""`` when there is none."""
     with _open_text(Path(path)) as fh:
         found = False
         for _ in range(2 * MAX_BLANK_LINES):
@@ -220,7 +221,7 @@ def next_line(path: str | Path, after: str) -> str:
             if line.strip():
                 if found:
                     return line.rstrip("\r\n")
-                found = line.rstrip("\r\n") == after
+                found = True
     return ""
 
 

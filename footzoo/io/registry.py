@@ -34,7 +34,7 @@ from typing import Any
 
 from ..core.errors import FootzooWarning, FormatError, did_you_mean, user_stacklevel
 from ..core.files import SNIFF_BYTES, foreign_encoding
-from .base import MAT_ROUTE, first_line, next_line
+from .base import MAT_ROUTE, first_line, second_line
 
 #: The entry-point group readers register under.
 GROUP = "footzoo.readers"
@@ -192,7 +192,7 @@ class Readers(Mapping[str, Any]):
         seen = f" from the header {head[:80]!r}" if head else f" (extension {p.suffix.lower()!r})"
         sep = next((name for ch, name in ((";", "semicolons"), ("\t", "tabs"), ("|", "'|'"), (" ", "spaces"))
                     if head and ch in head and "," not in head), "")
-        second = next_line(p, head) if head and p.suffix.lower() in (".csv", ".txt", ".tsv", "") else ""
+        second = second_line(p) if head and p.suffix.lower() in (".csv", ".txt", ".tsv", "") else ""
         title = next(((ch, name) for ch, name in ((",", "commas"), ("\t", "tabs"), (";", "semicolons"))
                       if second.count(ch) >= 2 and ch not in head), None)
         if title:  # a title line above a delimited header
