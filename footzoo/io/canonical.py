@@ -217,26 +217,28 @@ class CanonicalReader(Reader):
 def written_by_footzoo(path: Path) -> bool:
     """Whether the file ``path`` (a link: the file it names) is as :func:`write` left it: its metadata sidecar names
     its SHA-256."""
-    side = meta_path(path.resolve())
-    try:
-        found = re.search(r"^data_sha256:\s*([0-9a-f]{64})\s*$", side.read_text(encoding="utf-8", errors="replace"),
-                          re.M)
-    except OSError:
-        return False
-    return found is not None and found.group(1) == sha256(path)
+    vouched = _vouched(meta_path(path.resolve()), "data_sha256")
+    return vouched is not None and vouched == sha256(path)  # the data hashed only when a sidecar names a hash
 
 
 def _footzoo_sidecar(path: Path, side: Path) -> bool:
     """Whether ``side``, a sidecar of ``path`` whose data file is gone, is one :func:`write` left: a metadata sidecar
     that names its data's SHA-256, or the steps it lists by theirs (a recording deleted by hand leaves these)."""
-    try:
-        meta = meta_path(path).read_text(encoding="utf-8", errors="replace")
-    except OSError:
-        return False
     if side == meta_path(path):
-        return re.search(r"^data_sha256:\s*[0-9a-f]{64}\s*$", meta, re.M) is not None
-    listed = re.search(r"^steps_sha256:\s*([0-9a-f]{64})\s*$", meta, re.M)
-    return listed is not None and listed.group(1) == sha256(side)
+        return _vouched(side, "data_sha256") is not None
+    vouched = _vouched(meta_path(path), "steps_sha256")
+    return vouched is not None and vouched == sha256(side)
+
+
+def _vouched(meta: Path, key: str) -> str | None:
+    """The SHA-256 a metadata sidecar :func:`write` left names under ``key`` (``data_sha256``, ``steps_sha256``), or
+    None (no such line, or no readable sidecar)."""
+    try:
+        found = re.search(rf"^{key}:\s*([0-9a-f]{{64}})\s*$", meta.read_text(encoding="utf-8", errors="replace"),
+                          re.M)
+    except OSError:
+        return None
+    return None if found is None else found.group(1)
 
 
 def check_output(path: str | Path) -> Path:
