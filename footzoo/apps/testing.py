@@ -291,7 +291,6 @@ def _check_params(cls: type[Plugin], p: Plugin) -> None:
         numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
         assert not numeric or name in cls.units, (f"{cls.__name__}: numeric parameter {name!r} has no unit: declare "
                                                   f"it in parameters (or give its unit in 'units')")
-        assert hasattr(p, name), f"{cls.__name__}: parameter {name!r} is not stored as attribute self.{name}"
     stray = sorted(set(cls.units) - set(defaults))
     assert not stray, f"{cls.__name__}: 'units' names no parameter {stray}"
     params = p.get_params()
