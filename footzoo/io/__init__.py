@@ -147,7 +147,7 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
         elif key in fixed:
             if not _same_unit(key, value, fixed[key]):
                 raise ReaderOptionError(f"{path}: {fmt} files store {key.split('_')[0]} in {fixed[key]}; "
-                                  f"{key}={value!r} cannot apply (drop the option)")
+                                        f"{key}={value!r} cannot apply (drop the option)")
         elif key == "foot":
             foot = value
         else:
@@ -160,7 +160,7 @@ def _options_for(reader: Any, fmt: str, path: Path, options: dict[str, Any]) -> 
     missing = [k for k, o in declared.items() if o.default is REQUIRED and k not in out]
     if missing:
         raise ReaderOptionError(f"{path}: the {fmt} reader needs the option(s) {missing}: "
-                          + "; ".join(f"{k}: {declared[k].doc}" for k in missing))
+                                + "; ".join(f"{k}: {declared[k].doc}" for k in missing))
     if foot is not None and foot not in ("left", "right"):
         raise ReaderOptionError(f"foot={foot!r} is not a foot; use 'left' or 'right'")
     return out, foot, axes

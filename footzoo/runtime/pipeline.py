@@ -186,8 +186,9 @@ class Pipeline:
         if smoother != "none" and not self.filter_corrections:
             raise ConfigError(f"smoother: {smoother} smooths the Kalman filter, and this pipeline has none; "
                               "add a Kalman correction (e.g. zupt) or remove smoother")
-        if not self.filter_corrections and self.navigation != NavigationNoise():
-            changed = sorted(k for k, v in self.navigation.to_dict().items() if NavigationNoise().to_dict()[k] != v)
+        default = NavigationNoise().to_dict()
+        if not self.filter_corrections and self.navigation.to_dict() != default:
+            changed = sorted(k for k, v in self.navigation.to_dict().items() if default[k] != v)
             raise ConfigError(f"navigation: {', '.join(changed)} set(s) the Kalman filter's noises, and this pipeline "
                               "has none, so it would change nothing; add a Kalman correction (e.g. zupt) or remove "
                               "navigation")
